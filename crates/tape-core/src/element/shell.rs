@@ -1,0 +1,666 @@
+//! Geometrically nonlinear 4-node Mindlin-Reissner shell: total-Lagrangian director
+//! formulation with MITC4 assumed transverse shear and a Hughes-Brezzi drilling term.
+//!
+//! Kinematics. Node `a` carries a position `x_a` and an orthonormal triad `Q_a = [t1_a, t2_a, d_a]`
+//! whose third column is the director (the reference director is the averaged nodal normal).
+//! Bilinear interpolation `x(xi, eta) = N_a x_a`, `d(xi, eta) = N_a d_a`; derivatives with respect
+//! to a local orthonormal frame `(e1, e2)` of the reference mid-surface at each Gauss point are
+//! written `x_,i`. Strains (Naghdi / Simo-Fox, linear through the thickness):
+//!
+//! ```text
+//! membrane  eps_ij   = (x_,i . x_,j - X_,i . X_,j) / 2                 (Green-Lagrange)
+//! bending   kappa_ij = (x_,i . d_,j + x_,j . d_,i - (same)_ref) / 2
+//! shear     gamma_i  = x_,i . d - X_,i . D     (MITC4: covariant components tied at the
+//!                                               edge mid-points A, B, C, D, Dvorkin & Bathe 1984)
+//! drilling  psi_a    = c0 s - s0 c,  c = (t1.x_,1 + t2.x_,2)/2,  s = (t1.x_,2 - t2.x_,1)/2
+//! ```
+//!
+//! `psi_a` measures the drilling rotation of node `a`'s triad relative to the in-plane rotation of
+//! the membrane at the element centre (`c0, s0` are the reference values of `c, s`): it vanishes for
+//! any rigid motion and any pure stretch, so it does not lock curved shells. Energy per element:
+//!
+//! ```text
+//! Pi = sum_gp w [eps.C_m eps + kappa.C_b kappa]/2 + k_s G t gamma_t.S gamma_t / 2 + k_d (A/4) sum_a psi_a^2 / 2
+//! ```
+//!
+//! The internal force is the gradient of `Pi` with respect to `(u_a, theta_a)` where `theta_a` is the
+//! spatial rotation increment (`Q_a <- exp(theta_a^) Q_a`), and the tangent is its exact derivative:
+//! material part `B^T C B`, geometric part from the second derivatives of the strains, and for
+//! each node the non-symmetric term `-[g_a]x / 2` from the non-commutativity of rotations
+//! (`g_a` the rotational internal force).
+
+use nalgebra::{Matrix2, Matrix3, Matrix4, SMatrix, SVector, Vector3, Vector4};
+
+use super::quadrature::{bilinear, GAUSS_2X2};
+use crate::error::{Error, Result};
+use crate::material::SectionStiffness;
+use crate::rotation::{rotated_vector_hessian, skew};
+
+/// Degrees of freedom of one element (4 nodes x 6).
+pub const DOFS_PER_ELEMENT: usize = 24;
+/// Element vector.
+pub type ElementVector = SVector<f64, DOFS_PER_ELEMENT>;
+/// Element matrix.
+pub type ElementMatrix = SMatrix<f64, DOFS_PER_ELEMENT, DOFS_PER_ELEMENT>;
+
+/// Tying points of the MITC4 shear interpolation: `(xi, eta, direction)` with direction 0 for
+/// `gamma_xi` (points B, D) and 1 for `gamma_eta` (points A, C).
+const TYING: [(f64, f64, usize); 4] = [(0.0, -1.0, 0), (0.0, 1.0, 0), (-1.0, 0.0, 1), (1.0, 0.0, 1)];
+
+#[derive(Clone, Copy, Debug)]
+struct GaussPoint {
+    /// Cartesian derivatives of the shape functions `[dN_a/ds1, dN_a/ds2]` [1/m].
+    dn: [[f64; 2]; 4],
+    /// Integration weight (Jacobian determinant times Gauss weight) [m^2].
+    w: f64,
+    /// Reference membrane and bending strains (subtracted so the reference state is stress free).
+    eps0: [f64; 3],
+    kap0: [f64; 3],
+}
+
+/// Strains of an element at its Gauss points (for output and strain-rate damping).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShellStrains {
+    /// Membrane strains `[e11, e22, 2 e12]` at each Gauss point.
+    pub membrane: [[f64; 3]; 4],
+    /// Bending strains `[k11, k22, 2 k12]` [1/m] at each Gauss point.
+    pub bending: [[f64; 3]; 4],
+    /// Covariant transverse shear strains at the tying points B, D, A, C [m].
+    pub shear: [f64; 4],
+    /// Drilling strains at the nodes [rad].
+    pub drilling: [f64; 4],
+}
+
+/// A 4-node shell element with its reference geometry precomputed.
+#[derive(Clone, Debug)]
+pub struct ShellElement {
+    /// Global indices of the element's nodes.
+    pub nodes: [usize; 4],
+    gp: [GaussPoint; 4],
+    /// Shape-function coefficients of the tying points: `x_t = sum_a cg[t][a] x_a` (covariant base
+    /// vector) and `d_t = sum_a cd[t][a] d_a`.
+    cg: [[f64; 4]; 4],
+    cd: [[f64; 4]; 4],
+    gamma0: [f64; 4],
+    /// `S_tt' = sum_gp w sum_i beta_it beta_it'`, the shear energy metric on tying strains [m^2 / m^2].
+    shear_metric: Matrix4<f64>,
+    dn_centre: [[f64; 2]; 4],
+    drill_ref: [(f64, f64); 4],
+    psi0: [f64; 4],
+    area: f64,
+}
+
+#[inline]
+fn columns(q: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    (
+        q.column(0).into_owned(),
+        q.column(1).into_owned(),
+        q.column(2).into_owned(),
+    )
+}
+
+/// Local orthonormal frame of the reference surface at `(xi, eta)`, the Cartesian shape-function
+/// derivatives there, and the Jacobian determinant; `None` if the map is degenerate.
+fn cartesian(x: &[Vector3<f64>; 4], xi: f64, eta: f64) -> Option<([[f64; 2]; 4], f64, Matrix2<f64>)> {
+    let (_, dn) = bilinear(xi, eta);
+    let mut g = [Vector3::zeros(); 2];
+    for a in 0..4 {
+        g[0] += dn[a][0] * x[a];
+        g[1] += dn[a][1] * x[a];
+    }
+    let n = g[0].cross(&g[1]);
+    if n.norm() <= 1e-14 * g[0].norm_squared().max(g[1].norm_squared()) {
+        return None;
+    }
+    let e3 = n.normalize();
+    let e1 = g[0].normalize();
+    let e2 = e3.cross(&e1);
+    let jac = Matrix2::new(g[0].dot(&e1), g[0].dot(&e2), g[1].dot(&e1), g[1].dot(&e2));
+    let det = jac.determinant();
+    let inv = jac.try_inverse()?;
+    let mut dns = [[0.0; 2]; 4];
+    for a in 0..4 {
+        for i in 0..2 {
+            dns[a][i] = inv[(i, 0)] * dn[a][0] + inv[(i, 1)] * dn[a][1];
+        }
+    }
+    (det > 0.0).then_some((dns, det, inv))
+}
+
+impl ShellElement {
+    /// Precomputes the reference geometry from the nodal reference positions `x` [m] and the
+    /// reference nodal triads `q` (columns `t1, t2, D`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMesh`] if the element is degenerate or its normal opposes a nodal director.
+    pub fn try_new(nodes: [usize; 4], x: &[Vector3<f64>; 4], q: &[Matrix3<f64>; 4]) -> Result<Self> {
+        let degenerate = || Error::InvalidMesh(format!("element with nodes {nodes:?} is degenerate or inverted"));
+        let mut gp = [GaussPoint {
+            dn: [[0.0; 2]; 4],
+            w: 0.0,
+            eps0: [0.0; 3],
+            kap0: [0.0; 3],
+        }; 4];
+        let mut beta = [[[0.0; 4]; 2]; 4];
+        for (p, &(xi, eta)) in GAUSS_2X2.iter().enumerate() {
+            let (dn, det, inv) = cartesian(x, xi, eta).ok_or_else(degenerate)?;
+            gp[p].dn = dn;
+            gp[p].w = det;
+            // gamma_i = sum_alpha inv[i][alpha] gamma_alpha, gamma_xi = (1-eta)/2 g_B + (1+eta)/2 g_D, ...
+            let interp = [0.5 * (1.0 - eta), 0.5 * (1.0 + eta), 0.5 * (1.0 - xi), 0.5 * (1.0 + xi)];
+            for i in 0..2 {
+                for (t, &(_, _, dir)) in TYING.iter().enumerate() {
+                    beta[p][i][t] = inv[(i, dir)] * interp[t];
+                }
+            }
+        }
+        let (dn_centre, _, _) = cartesian(x, 0.0, 0.0).ok_or_else(degenerate)?;
+        let mut cg = [[0.0; 4]; 4];
+        let mut cd = [[0.0; 4]; 4];
+        for (t, &(xi, eta, dir)) in TYING.iter().enumerate() {
+            let (n, dn) = bilinear(xi, eta);
+            for a in 0..4 {
+                cg[t][a] = dn[a][dir];
+                cd[t][a] = n[a];
+            }
+        }
+        let mut shear_metric = Matrix4::zeros();
+        for p in 0..4 {
+            for i in 0..2 {
+                let b = Vector4::from(beta[p][i]);
+                shear_metric += b * b.transpose() * gp[p].w;
+            }
+        }
+        let area = gp.iter().map(|g| g.w).sum();
+        // Reference directors must agree with the element normal (consistent orientation).
+        let diagonal_normal = (x[2] - x[0]).cross(&(x[3] - x[1]));
+        let normal_ok = q.iter().all(|qa| qa.column(2).dot(&diagonal_normal) > 0.0);
+        if !normal_ok {
+            return Err(Error::InvalidMesh(format!(
+                "element with nodes {nodes:?} is oriented against its nodal normals (inconsistent orientation of neighbouring elements)"
+            )));
+        }
+        let mut drill_ref = [(0.0, 0.0); 4];
+        let xc = centre_gradient(&dn_centre, x);
+        for a in 0..4 {
+            let (t1, t2, _) = columns(&q[a]);
+            drill_ref[a] = (
+                0.5 * (t1.dot(&xc[0]) + t2.dot(&xc[1])),
+                0.5 * (t1.dot(&xc[1]) - t2.dot(&xc[0])),
+            );
+        }
+        let mut element = Self {
+            nodes,
+            gp,
+            cg,
+            cd,
+            gamma0: [0.0; 4],
+            shear_metric,
+            dn_centre,
+            drill_ref,
+            psi0: [0.0; 4],
+            area,
+        };
+        let s = element.strains(x, q);
+        for p in 0..4 {
+            element.gp[p].eps0 = s.membrane[p];
+            element.gp[p].kap0 = s.bending[p];
+        }
+        element.gamma0 = s.shear;
+        element.psi0 = s.drilling;
+        Ok(element)
+    }
+
+    /// Reference area of the element [m^2].
+    #[must_use]
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// Strains in the configuration `(x, q)` (zero in the reference configuration).
+    #[must_use]
+    pub fn strains(&self, x: &[Vector3<f64>; 4], q: &[Matrix3<f64>; 4]) -> ShellStrains {
+        let d = q.map(|qa| qa.column(2).into_owned());
+        let mut s = ShellStrains::default();
+        for (p, g) in self.gp.iter().enumerate() {
+            let (xs, ds) = gradients(&g.dn, x, &d);
+            s.membrane[p] = [
+                0.5 * xs[0].norm_squared() - g.eps0[0],
+                0.5 * xs[1].norm_squared() - g.eps0[1],
+                xs[0].dot(&xs[1]) - g.eps0[2],
+            ];
+            s.bending[p] = [
+                xs[0].dot(&ds[0]) - g.kap0[0],
+                xs[1].dot(&ds[1]) - g.kap0[1],
+                xs[0].dot(&ds[1]) + xs[1].dot(&ds[0]) - g.kap0[2],
+            ];
+        }
+        for t in 0..4 {
+            let (gt, dt) = self.tying_vectors(t, x, &d);
+            s.shear[t] = gt.dot(&dt) - self.gamma0[t];
+        }
+        let xc = centre_gradient(&self.dn_centre, x);
+        for a in 0..4 {
+            let (t1, t2, _) = columns(&q[a]);
+            let (u, v) = self.drill_vectors(a, &xc);
+            s.drilling[a] = 0.5 * (t1.dot(&u) - t2.dot(&v)) - self.psi0[a];
+        }
+        s
+    }
+
+    #[inline]
+    fn tying_vectors(&self, t: usize, x: &[Vector3<f64>; 4], d: &[Vector3<f64>; 4]) -> (Vector3<f64>, Vector3<f64>) {
+        let mut gt = Vector3::zeros();
+        let mut dt = Vector3::zeros();
+        for a in 0..4 {
+            gt += self.cg[t][a] * x[a];
+            dt += self.cd[t][a] * d[a];
+        }
+        (gt, dt)
+    }
+
+    #[inline]
+    fn drill_vectors(&self, a: usize, xc: &[Vector3<f64>; 2]) -> (Vector3<f64>, Vector3<f64>) {
+        let (c0, s0) = self.drill_ref[a];
+        (c0 * xc[1] - s0 * xc[0], c0 * xc[0] + s0 * xc[1])
+    }
+
+    /// Strain energy [J] in the configuration `(x, q)`.
+    #[must_use]
+    pub fn energy(&self, x: &[Vector3<f64>; 4], q: &[Matrix3<f64>; 4], sec: &SectionStiffness) -> f64 {
+        let s = self.strains(x, q);
+        let mut e = 0.0;
+        for (p, g) in self.gp.iter().enumerate() {
+            let eps = Vector3::from(s.membrane[p]);
+            let kap = Vector3::from(s.bending[p]);
+            e += 0.5 * g.w * (eps.dot(&(sec.membrane * eps)) + kap.dot(&(sec.bending * kap)));
+        }
+        let gam = Vector4::from(s.shear);
+        e += 0.5 * sec.shear * gam.dot(&(self.shear_metric * gam));
+        let kd = sec.drilling * self.area * 0.25;
+        e + 0.5 * kd * s.drilling.iter().map(|p| p * p).sum::<f64>()
+    }
+
+    /// Internal force `f` (gradient of the strain energy) and, if `k` is given, the consistent
+    /// tangent, in the configuration `(x, q)`; returns the strain energy [J].
+    ///
+    /// Layout of `f` and `k`: node-major, `[u_x, u_y, u_z, theta_x, theta_y, theta_z]` per node.
+    #[allow(clippy::too_many_lines)]
+    pub fn compute_into(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        f: &mut ElementVector,
+        mut k: Option<&mut ElementMatrix>,
+    ) -> f64 {
+        let (mut t1, mut t2, mut d) = ([Vector3::zeros(); 4], [Vector3::zeros(); 4], [Vector3::zeros(); 4]);
+        for a in 0..4 {
+            (t1[a], t2[a], d[a]) = columns(&q[a]);
+        }
+        // Energy gradients with respect to x_a and to the rotated vectors d_a, t1_a, t2_a.
+        let mut f_x = [Vector3::zeros(); 4];
+        let mut f_d = [Vector3::zeros(); 4];
+        let mut f_t1 = [Vector3::zeros(); 4];
+        let mut f_t2 = [Vector3::zeros(); 4];
+        // Second-derivative coefficients: x_a.x_b, x_a.d_b, x_a.t1_b, x_a.t2_b.
+        let mut sxx = [[0.0; 4]; 4];
+        let mut sxd = [[0.0; 4]; 4];
+        let mut sxt1 = [[0.0; 4]; 4];
+        let mut sxt2 = [[0.0; 4]; 4];
+        if let Some(k) = k.as_deref_mut() {
+            k.fill(0.0);
+        }
+        let mut energy = 0.0;
+
+        // Membrane and bending at the 2x2 Gauss points.
+        for g in &self.gp {
+            let (xs, ds) = gradients(&g.dn, x, &d);
+            let eps = Vector3::new(
+                0.5 * xs[0].norm_squared() - g.eps0[0],
+                0.5 * xs[1].norm_squared() - g.eps0[1],
+                xs[0].dot(&xs[1]) - g.eps0[2],
+            );
+            let kap = Vector3::new(
+                xs[0].dot(&ds[0]) - g.kap0[0],
+                xs[1].dot(&ds[1]) - g.kap0[1],
+                xs[0].dot(&ds[1]) + xs[1].dot(&ds[0]) - g.kap0[2],
+            );
+            let n = sec.membrane * eps * g.w;
+            let m = sec.bending * kap * g.w;
+            energy += 0.5 * (n.dot(&eps) + m.dot(&kap));
+            for a in 0..4 {
+                let [p, r] = g.dn[a];
+                f_x[a] += n[0] * p * xs[0]
+                    + n[1] * r * xs[1]
+                    + n[2] * (p * xs[1] + r * xs[0])
+                    + m[0] * p * ds[0]
+                    + m[1] * r * ds[1]
+                    + m[2] * (p * ds[1] + r * ds[0]);
+                f_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
+            }
+            if let Some(k) = k.as_deref_mut() {
+                let mut b = SMatrix::<f64, 6, DOFS_PER_ELEMENT>::zeros();
+                for a in 0..4 {
+                    let [p, r] = g.dn[a];
+                    let c = 6 * a;
+                    let rows_x = [
+                        p * xs[0],
+                        r * xs[1],
+                        p * xs[1] + r * xs[0],
+                        p * ds[0],
+                        r * ds[1],
+                        p * ds[1] + r * ds[0],
+                    ];
+                    for (i, v) in rows_x.iter().enumerate() {
+                        b.fixed_view_mut::<1, 3>(i, c).copy_from(&v.transpose());
+                    }
+                    let rows_t = [
+                        d[a].cross(&(p * xs[0])),
+                        d[a].cross(&(r * xs[1])),
+                        d[a].cross(&(p * xs[1] + r * xs[0])),
+                    ];
+                    for (i, v) in rows_t.iter().enumerate() {
+                        b.fixed_view_mut::<1, 3>(3 + i, c + 3)
+                            .copy_from(&v.transpose());
+                    }
+                }
+                let mut cb = SMatrix::<f64, 6, DOFS_PER_ELEMENT>::zeros();
+                cb.fixed_rows_mut::<3>(0)
+                    .copy_from(&(sec.membrane * g.w * b.fixed_rows::<3>(0)));
+                cb.fixed_rows_mut::<3>(3)
+                    .copy_from(&(sec.bending * g.w * b.fixed_rows::<3>(3)));
+                k.gemm_tr(1.0, &b, &cb, 1.0);
+                for a in 0..4 {
+                    let [pa, ra] = g.dn[a];
+                    for bb in 0..4 {
+                        let [pb, rb] = g.dn[bb];
+                        let cross = pa * rb + ra * pb;
+                        sxx[a][bb] += n[0] * pa * pb + n[1] * ra * rb + n[2] * cross;
+                        sxd[a][bb] += m[0] * pa * pb + m[1] * ra * rb + m[2] * cross;
+                    }
+                }
+            }
+        }
+
+        // Transverse shear (MITC4 tying strains).
+        let mut gt = [Vector3::zeros(); 4];
+        let mut dt = [Vector3::zeros(); 4];
+        let mut gam = Vector4::zeros();
+        for t in 0..4 {
+            (gt[t], dt[t]) = self.tying_vectors(t, x, &d);
+            gam[t] = gt[t].dot(&dt[t]) - self.gamma0[t];
+        }
+        let qv = self.shear_metric * gam * sec.shear;
+        energy += 0.5 * gam.dot(&qv);
+        for t in 0..4 {
+            for a in 0..4 {
+                f_x[a] += qv[t] * self.cg[t][a] * dt[t];
+                f_d[a] += qv[t] * self.cd[t][a] * gt[t];
+            }
+        }
+        if let Some(k) = k.as_deref_mut() {
+            let mut bs = SMatrix::<f64, 4, DOFS_PER_ELEMENT>::zeros();
+            for t in 0..4 {
+                for a in 0..4 {
+                    let c = 6 * a;
+                    bs.fixed_view_mut::<1, 3>(t, c)
+                        .copy_from(&(self.cg[t][a] * dt[t]).transpose());
+                    bs.fixed_view_mut::<1, 3>(t, c + 3)
+                        .copy_from(&d[a].cross(&(self.cd[t][a] * gt[t])).transpose());
+                    for bb in 0..4 {
+                        sxd[a][bb] += qv[t] * self.cg[t][a] * self.cd[t][bb];
+                    }
+                }
+            }
+            let sbs = self.shear_metric * sec.shear * bs;
+            k.gemm_tr(1.0, &bs, &sbs, 1.0);
+        }
+
+        // Drilling.
+        let xc = centre_gradient(&self.dn_centre, x);
+        let kd = sec.drilling * self.area * 0.25;
+        for a in 0..4 {
+            let (c0, s0) = self.drill_ref[a];
+            let (u, v) = self.drill_vectors(a, &xc);
+            let psi = 0.5 * (t1[a].dot(&u) - t2[a].dot(&v)) - self.psi0[a];
+            let big_psi = kd * psi;
+            energy += 0.5 * kd * psi * psi;
+            f_t1[a] += 0.5 * big_psi * u;
+            f_t2[a] -= 0.5 * big_psi * v;
+            let mut row = ElementVector::zeros();
+            for bb in 0..4 {
+                let [p, r] = self.dn_centre[bb];
+                let (al, be) = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
+                let gx = al * t1[a] + be * t2[a];
+                f_x[bb] += big_psi * gx;
+                row.fixed_rows_mut::<3>(6 * bb).copy_from(&gx);
+                sxt1[bb][a] += big_psi * al;
+                sxt2[bb][a] += big_psi * be;
+            }
+            if let Some(k) = k.as_deref_mut() {
+                row.fixed_rows_mut::<3>(6 * a + 3)
+                    .copy_from(&(0.5 * (t1[a].cross(&u) - t2[a].cross(&v))));
+                k.ger(kd, &row, &row, 1.0);
+            }
+        }
+
+        // Internal force.
+        let mut g_rot = [Vector3::zeros(); 4];
+        for a in 0..4 {
+            g_rot[a] = d[a].cross(&f_d[a]) + t1[a].cross(&f_t1[a]) + t2[a].cross(&f_t2[a]);
+            f.fixed_rows_mut::<3>(6 * a).copy_from(&f_x[a]);
+            f.fixed_rows_mut::<3>(6 * a + 3).copy_from(&g_rot[a]);
+        }
+
+        // Geometric stiffness and the rotational terms.
+        if let Some(k) = k {
+            for a in 0..4 {
+                for bb in 0..4 {
+                    let (ra, cb) = (6 * a, 6 * bb);
+                    for i in 0..3 {
+                        k[(ra + i, cb + i)] += sxx[a][bb];
+                    }
+                    let kut = -(skew(&d[bb]) * sxd[a][bb] + skew(&t1[bb]) * sxt1[a][bb] + skew(&t2[bb]) * sxt2[a][bb]);
+                    let mut blk = k.fixed_view_mut::<3, 3>(ra, cb + 3);
+                    blk += kut;
+                    let mut blk_t = k.fixed_view_mut::<3, 3>(cb + 3, ra);
+                    blk_t += kut.transpose();
+                }
+                let h = rotated_vector_hessian(&f_d[a], &d[a])
+                    + rotated_vector_hessian(&f_t1[a], &t1[a])
+                    + rotated_vector_hessian(&f_t2[a], &t2[a])
+                    - skew(&g_rot[a]) * 0.5;
+                let mut blk = k.fixed_view_mut::<3, 3>(6 * a + 3, 6 * a + 3);
+                blk += h;
+            }
+        }
+        energy
+    }
+}
+
+#[inline]
+fn gradients(
+    dn: &[[f64; 2]; 4],
+    x: &[Vector3<f64>; 4],
+    d: &[Vector3<f64>; 4],
+) -> ([Vector3<f64>; 2], [Vector3<f64>; 2]) {
+    let mut xs = [Vector3::zeros(); 2];
+    let mut ds = [Vector3::zeros(); 2];
+    for a in 0..4 {
+        for i in 0..2 {
+            xs[i] += dn[a][i] * x[a];
+            ds[i] += dn[a][i] * d[a];
+        }
+    }
+    (xs, ds)
+}
+
+#[inline]
+fn centre_gradient(dn: &[[f64; 2]; 4], x: &[Vector3<f64>; 4]) -> [Vector3<f64>; 2] {
+    let mut xs = [Vector3::zeros(); 2];
+    for a in 0..4 {
+        xs[0] += dn[a][0] * x[a];
+        xs[1] += dn[a][1] * x[a];
+    }
+    xs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::ShellSection;
+    use crate::rotation::rotate;
+    use nalgebra::UnitQuaternion;
+
+    /// A warped, curved quadrilateral with nodal triads from its corner normals.
+    fn sample() -> ([Vector3<f64>; 4], [UnitQuaternion<f64>; 4], ShellElement) {
+        let x = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(2.1e-3, 0.1e-3, 0.2e-3),
+            Vector3::new(2.3e-3, 1.9e-3, 0.5e-3),
+            Vector3::new(-0.2e-3, 2.0e-3, 0.1e-3),
+        ];
+        let q = std::array::from_fn(|a| {
+            let n = (x[(a + 1) % 4] - x[a])
+                .cross(&(x[(a + 3) % 4] - x[a]))
+                .normalize();
+            let t1 = (Vector3::x() - n * n.x).normalize();
+            let t2 = n.cross(&t1);
+            UnitQuaternion::from_matrix(&Matrix3::from_columns(&[t1, t2, n]))
+        });
+        let m = q.map(|qa: UnitQuaternion<f64>| qa.to_rotation_matrix().into_inner());
+        let e = ShellElement::try_new([0, 1, 2, 3], &x, &m).unwrap();
+        (x, q, e)
+    }
+
+    fn section() -> SectionStiffness {
+        ShellSection {
+            thickness: 0.138e-3,
+            drilling_factor: 0.1,
+            ..ShellSection::default()
+        }
+        .stiffness()
+    }
+
+    fn deformed(
+        x0: &[Vector3<f64>; 4],
+        q0: &[UnitQuaternion<f64>; 4],
+    ) -> ([Vector3<f64>; 4], [UnitQuaternion<f64>; 4]) {
+        let du = [
+            Vector3::new(1e-5, -2e-5, 3e-4),
+            Vector3::new(-2e-5, 1e-5, -1e-4),
+            Vector3::new(3e-5, 2e-5, 2e-4),
+            Vector3::new(0.0, -1e-5, -3e-4),
+        ];
+        let th = [
+            Vector3::new(0.3, -0.2, 0.1),
+            Vector3::new(-0.1, 0.4, 0.05),
+            Vector3::new(0.2, 0.1, -0.3),
+            Vector3::new(0.0, -0.3, 0.2),
+        ];
+        (
+            std::array::from_fn(|a| x0[a] + du[a]),
+            std::array::from_fn(|a| rotate(&q0[a], &th[a])),
+        )
+    }
+
+    fn mats(q: &[UnitQuaternion<f64>; 4]) -> [Matrix3<f64>; 4] {
+        q.map(|qa| qa.to_rotation_matrix().into_inner())
+    }
+
+    fn perturb(
+        x: &[Vector3<f64>; 4],
+        q: &[UnitQuaternion<f64>; 4],
+        j: usize,
+        h: f64,
+    ) -> ([Vector3<f64>; 4], [UnitQuaternion<f64>; 4]) {
+        let (mut x, mut q) = (*x, *q);
+        let (a, c) = (j / 6, j % 6);
+        if c < 3 {
+            x[a][c] += h;
+        } else {
+            q[a] = rotate(&q[a], &Vector3::ith(c - 3, h));
+        }
+        (x, q)
+    }
+
+    #[test]
+    fn reference_state_is_stress_free() {
+        let (x, q, e) = sample();
+        let mut f = ElementVector::zeros();
+        let energy = e.compute_into(&x, &mats(&q), &section(), &mut f, None);
+        assert!(
+            energy.abs() < 1e-20 && f.norm() < 1e-12,
+            "energy {energy}, |f| {}",
+            f.norm()
+        );
+    }
+
+    #[test]
+    fn internal_force_is_gradient_of_energy() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let mut f = ElementVector::zeros();
+        e.compute_into(&x, &mats(&q), &sec, &mut f, None);
+        for j in 0..24 {
+            let h = if j % 6 < 3 { 1e-8 } else { 1e-6 };
+            let (xp, qp) = perturb(&x, &q, j, h);
+            let (xm, qm) = perturb(&x, &q, j, -h);
+            let fd = (e.energy(&xp, &mats(&qp), &sec) - e.energy(&xm, &mats(&qm), &sec)) / (2.0 * h);
+            assert!(
+                (fd - f[j]).abs() <= 1e-6 * f.amax() + 1e-12,
+                "dof {j}: f = {}, fd = {fd}",
+                f[j]
+            );
+        }
+    }
+
+    #[test]
+    fn stiffness_is_derivative_of_internal_force() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let mut f = ElementVector::zeros();
+        let mut k = ElementMatrix::zeros();
+        e.compute_into(&x, &mats(&q), &sec, &mut f, Some(&mut k));
+        let mut worst: f64 = 0.0;
+        for j in 0..24 {
+            let h = if j % 6 < 3 { 1e-9 } else { 1e-7 };
+            let (xp, qp) = perturb(&x, &q, j, h);
+            let (xm, qm) = perturb(&x, &q, j, -h);
+            let (mut fp, mut fm) = (ElementVector::zeros(), ElementVector::zeros());
+            e.compute_into(&xp, &mats(&qp), &sec, &mut fp, None);
+            e.compute_into(&xm, &mats(&qm), &sec, &mut fm, None);
+            let col = (fp - fm) / (2.0 * h);
+            for i in 0..24 {
+                // Scale each entry by its row/column units so that translations and rotations compare.
+                let scale = (k[(i, i)].abs() * k[(j, j)].abs()).sqrt();
+                worst = worst.max((col[i] - k[(i, j)]).abs() / scale);
+            }
+        }
+        assert!(worst < 1e-6, "max relative tangent error {worst:e}");
+    }
+
+    #[test]
+    fn rigid_body_motion_gives_zero_internal_force() {
+        let (x0, q0, e) = sample();
+        let rot = UnitQuaternion::from_scaled_axis(Vector3::new(0.7, -1.9, 2.4));
+        let shift = Vector3::new(0.3, -0.1, 0.2);
+        let x: [Vector3<f64>; 4] = std::array::from_fn(|a| rot * x0[a] + shift);
+        let q: [UnitQuaternion<f64>; 4] = std::array::from_fn(|a| rot * q0[a]);
+        let mut f = ElementVector::zeros();
+        let energy = e.compute_into(&x, &mats(&q), &section(), &mut f, None);
+        let (mut f_scale, mut k) = (ElementVector::zeros(), ElementMatrix::zeros());
+        let (xd, qd) = deformed(&x0, &q0);
+        e.compute_into(&xd, &mats(&qd), &section(), &mut f_scale, Some(&mut k));
+        assert!(energy.abs() < 1e-18, "energy {energy}");
+        assert!(
+            f.amax() < 1e-9 * f_scale.amax(),
+            "|f| = {} vs deformed {}",
+            f.amax(),
+            f_scale.amax()
+        );
+    }
+}

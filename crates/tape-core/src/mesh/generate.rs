@@ -1,0 +1,191 @@
+//! Structured mesh generators: flat plate, cylindrical panel and tape spring.
+
+use nalgebra::Vector3;
+
+use super::Mesh;
+use crate::error::{check_positive, Error, Result};
+
+/// Structured grid of `nx * ny` quadrilaterals over a parametric rectangle, mapped by `place(s, r)`
+/// with `s, r` in `[0, 1]`. Node `(i, j)` has index `j * (nx + 1) + i`.
+fn grid(nx: usize, ny: usize, place: impl Fn(f64, f64) -> Vector3<f64>) -> Result<Mesh> {
+    if nx == 0 || ny == 0 {
+        return Err(Error::InvalidParameter(format!(
+            "element counts must be >= 1 (got {nx} x {ny})"
+        )));
+    }
+    let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            nodes.push(place(i as f64 / nx as f64, j as f64 / ny as f64));
+        }
+    }
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let mut quads = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            quads.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let mut mesh = Mesh::try_new(nodes, quads)?;
+    mesh.add_node_set("s0", (0..=ny).map(|j| id(0, j)).collect())?;
+    mesh.add_node_set("s1", (0..=ny).map(|j| id(nx, j)).collect())?;
+    mesh.add_node_set("r0", (0..=nx).map(|i| id(i, 0)).collect())?;
+    mesh.add_node_set("r1", (0..=nx).map(|i| id(i, ny)).collect())?;
+    mesh.add_node_set("all", (0..mesh.n_nodes()).collect())?;
+    Ok(mesh)
+}
+
+/// Flat rectangular plate `[0, lx] x [0, ly]` in the x-y plane (normal +z), `nx * ny` elements.
+///
+/// Node sets: `x0`, `x1` (edges x = 0 and x = lx), `y0`, `y1`, `all`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for non-positive sizes or zero element counts.
+pub fn flat_plate(lx: f64, ly: f64, nx: usize, ny: usize) -> Result<Mesh> {
+    check_positive("plate length lx [m]", lx)?;
+    check_positive("plate width ly [m]", ly)?;
+    let mut mesh = grid(nx, ny, |s, r| Vector3::new(s * lx, r * ly, 0.0))?;
+    rename(&mut mesh, &[("s0", "x0"), ("s1", "x1"), ("r0", "y0"), ("r1", "y1")]);
+    Ok(mesh)
+}
+
+/// Cylindrical panel of radius `radius` about the x axis: points `(x, R sin(phi), R cos(phi))`
+/// for `x` in `[0, length]` and `phi` in `[phi0, phi1]` [rad]; normals point away from the axis.
+///
+/// Node sets: `x0`, `x1` (curved edges), `phi0`, `phi1` (straight edges), `all`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for non-positive sizes, `phi1 <= phi0` or zero element counts.
+pub fn cylindrical_panel(radius: f64, length: f64, phi0: f64, phi1: f64, n_axial: usize, n_arc: usize) -> Result<Mesh> {
+    check_positive("radius [m]", radius)?;
+    check_positive("length [m]", length)?;
+    check_positive("angular span phi1 - phi0 [rad]", phi1 - phi0)?;
+    let mut mesh = grid(n_axial, n_arc, |s, r| {
+        let phi = phi0 + r * (phi1 - phi0);
+        Vector3::new(s * length, radius * phi.sin(), radius * phi.cos())
+    })?;
+    rename(&mut mesh, &[("s0", "x0"), ("s1", "x1"), ("r0", "phi0"), ("r1", "phi1")]);
+    Ok(mesh)
+}
+
+/// Geometry of a tape spring: a straight strip of length `length` along x whose cross-section is a
+/// circular arc of radius `radius` subtending `alpha` [rad] in the y-z plane, symmetric about z,
+/// with its centre of curvature on the +z side (at `z = radius`); the arc's middle lies on the x axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TapeGeometry {
+    /// Length L [m].
+    pub length: f64,
+    /// Transverse radius of curvature R [m].
+    pub radius: f64,
+    /// Subtended angle alpha [rad].
+    pub alpha: f64,
+}
+
+impl TapeGeometry {
+    /// Checks that every dimension is positive and `alpha < 2 pi`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the bad value.
+    pub fn validate(&self) -> Result<()> {
+        check_positive("tape length L [m]", self.length)?;
+        check_positive("tape radius R [m]", self.radius)?;
+        check_positive("subtended angle alpha [rad]", self.alpha)?;
+        if self.alpha >= 2.0 * std::f64::consts::PI {
+            return Err(Error::InvalidParameter(format!(
+                "subtended angle alpha must be < 2 pi (got {})",
+                self.alpha
+            )));
+        }
+        Ok(())
+    }
+
+    /// Point of the mid-surface at abscissa `x` and arc angle `phi` (0 on the symmetry plane).
+    #[must_use]
+    pub fn point(&self, x: f64, phi: f64) -> Vector3<f64> {
+        Vector3::new(x, self.radius * phi.sin(), self.radius * (1.0 - phi.cos()))
+    }
+
+    /// Centroid of the cross-section arc, relative to the arc's middle point: `(0, 0, z_c)` with
+    /// `z_c = R (1 - sin(alpha/2) / (alpha/2))` [m].
+    #[must_use]
+    pub fn section_centroid_z(&self) -> f64 {
+        let h = 0.5 * self.alpha;
+        self.radius * (1.0 - h.sin() / h)
+    }
+}
+
+/// Tape-spring mesh with elements of size about `h` [m] (the arc count is rounded up to an even
+/// number so that a line of nodes lies on the symmetry plane).
+///
+/// Node sets: `end0` (x = 0), `end1` (x = L), `side0`, `side1` (the free edges), `midline`
+/// (symmetry line y = 0), `all`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad geometry or element size.
+pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
+    geometry.validate()?;
+    check_positive("element size h [m]", h)?;
+    let nx = (geometry.length / h).round().max(1.0) as usize;
+    let arc = geometry.radius * geometry.alpha;
+    let mut na = (arc / h).round().max(2.0) as usize;
+    na += na % 2;
+    if nx * na > 20_000_000 {
+        return Err(Error::InvalidParameter(format!(
+            "element size h = {h} m gives {} elements: too many",
+            nx * na
+        )));
+    }
+    let g = *geometry;
+    let mut mesh = grid(nx, na, |s, r| g.point(s * g.length, (r - 0.5) * g.alpha))?;
+    rename(
+        &mut mesh,
+        &[("s0", "end0"), ("s1", "end1"), ("r0", "side0"), ("r1", "side1")],
+    );
+    let mid = na / 2;
+    mesh.add_node_set("midline", (0..=nx).map(|i| mid * (nx + 1) + i).collect())?;
+    Ok(mesh)
+}
+
+/// Twists the sections of a tape spring about the x axis by `amplitude * sin(pi x / L)` [rad], a
+/// geometric imperfection that selects one branch at the equal-sense bifurcation.
+pub fn apply_twist_imperfection(mesh: &mut Mesh, length: f64, amplitude: f64) {
+    for x in &mut mesh.nodes {
+        let angle = amplitude * (std::f64::consts::PI * x.x / length).sin();
+        let (s, c) = angle.sin_cos();
+        let (y, z) = (x.y, x.z);
+        x.y = c * y - s * z;
+        x.z = s * y + c * z;
+    }
+}
+
+fn rename(mesh: &mut Mesh, pairs: &[(&str, &str)]) {
+    for (from, to) in pairs {
+        if let Some(set) = mesh.node_sets.remove(*from) {
+            mesh.node_sets.insert((*to).to_owned(), set);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tape_spring_section_is_the_requested_arc() {
+        let g = TapeGeometry {
+            length: 0.1,
+            radius: 15.55e-3,
+            alpha: 69.85_f64.to_radians(),
+        };
+        let mesh = tape_spring(&g, 2e-3).unwrap();
+        assert_eq!(mesh.quads.len(), 50 * 10);
+        let centre = Vector3::new(0.0, 0.0, g.radius);
+        for &n in mesh.node_set("end1").unwrap() {
+            let x = mesh.nodes[n];
+            assert!((x.x - 0.1).abs() < 1e-15);
+            assert!(((x - Vector3::new(x.x, 0.0, 0.0) - centre).norm() - g.radius).abs() < 1e-12);
+        }
+        let side = mesh.nodes[mesh.node_set("side1").unwrap()[0]];
+        assert!((side.y.atan2(g.radius - side.z) - g.alpha / 2.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,1 @@
+"""tapespring: nonlinear shell simulation and experimental analysis of tape springs."""
