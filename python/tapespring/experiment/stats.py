@@ -1,0 +1,70 @@
+"""Statistics across trials: mean, standard deviation, maximum difference, CV.
+
+For the values x_1..x_k of one quantity across k trials (NaN ignored):
+
+- mean = sum(x) / k;
+- std = sample standard deviation (ddof = 1; NaN if k < 2);
+- max_diff = max(x) - min(x) (paper Tables 2 and 7, "Max. diff.");
+- cv = std / |mean|, the variation coefficient or relative standard deviation
+  (paper Fig. 15, Tables 2 and 7); it is positive also for negative means
+  (minima of the bending angle).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Summary", "summarize"]
+
+
+@dataclass(frozen=True)
+class Summary:
+    """Statistics of one quantity across trials (floats, or arrays for many quantities).
+
+    Attributes
+    ----------
+    mean, std, max_diff, cv : float or ndarray
+        Mean, sample standard deviation, max - min, and std / |mean|
+        (units of the quantity, except cv which is dimensionless).
+    count : int or ndarray
+        Number of finite values used.
+    """
+
+    mean: float | np.ndarray
+    std: float | np.ndarray
+    max_diff: float | np.ndarray
+    cv: float | np.ndarray
+    count: int | np.ndarray
+
+
+def summarize(values: np.ndarray, axis: int | None = None) -> Summary:
+    """Summarise values across trials.
+
+    Parameters
+    ----------
+    values : array_like
+        The values; NaN entries are ignored.
+    axis : int, optional
+        Axis along which the trials run (None: all values are one quantity).
+
+    Returns
+    -------
+    Summary
+        Floats if ``axis`` is None or ``values`` is 1-D, else arrays.
+    """
+    x = np.asarray(values, dtype=float)
+    if x.ndim == 1:
+        axis = None
+    count = np.sum(np.isfinite(x), axis=axis)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns give NaN, on purpose
+        mean = np.nanmean(x, axis=axis)
+        std = np.where(count >= 2, np.nanstd(x, axis=axis, ddof=1), np.nan)
+        max_diff = np.nanmax(x, axis=axis) - np.nanmin(x, axis=axis)
+        cv = std / np.abs(mean)
+    if np.ndim(mean) == 0:
+        return Summary(float(mean), float(std), float(max_diff), float(cv), int(count))
+    return Summary(mean, std, max_diff, cv, count)
