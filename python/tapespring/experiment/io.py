@@ -42,6 +42,7 @@ written ``nan``; empty fields are read as missing too.
 from __future__ import annotations
 
 import re
+import struct
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -123,10 +124,10 @@ def read_c3d(
         raise TrialError(path, f"not a readable C3D file ({exc})") from exc
     header = c3d["header"]["points"]
     points = c3d["data"]["points"]
-    n_expected = header["last_frame"] - header["first_frame"] + 1
     n = points.shape[2]
-    if n != n_expected:
-        raise TrialError(path, f"truncated C3D data: {n} of {n_expected} frames")
+    n_declared = _declared_frames(path)
+    if n_declared is not None and n != n_declared:
+        raise TrialError(path, f"truncated C3D data: {n} of {n_declared} frames")
     if n < 2:
         raise TrialError(path, f"the file holds {n} marker frame(s), at least 2 are needed")
     params = c3d["parameters"]
@@ -171,6 +172,32 @@ def read_c3d(
     trial = Trial(time=time, markers=markers, force_plates=tuple(plates), metadata=metadata)
     _check_durations(trial)
     return trial
+
+
+def _declared_frames(path: Path) -> int | None:
+    """Number of frames declared in the raw C3D header (None if it cannot say).
+
+    ezc3d silently reads a truncated file and rewrites its header to the frames
+    it found, so the declared count is read from the file itself: words 4 and 5
+    of the header block are the first and last frame (1-based, 16-bit, in the
+    byte order of the processor type stored in the parameter block: 84 Intel,
+    85 DEC little-endian, 86 MIPS big-endian). Files of 65535 frames or more
+    cannot state their length there.
+    """
+    with path.open("rb") as fh:
+        head = fh.read(512)
+        param_block = head[0] if head else 0
+        if param_block < 1:
+            return None
+        fh.seek(512 * (param_block - 1))
+        param_head = fh.read(4)
+    if len(head) < 10 or len(param_head) < 4:
+        return None
+    order = ">" if param_head[3] == 86 else "<"
+    first, last = struct.unpack(order + "HH", head[6:10])
+    if last >= 65535 or last < first:
+        return None
+    return last - first + 1
 
 
 def _force_platforms(c3d: ezc3d.c3d, path: Path) -> list[dict]:
