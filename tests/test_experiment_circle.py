@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import fit_circle, max_lateral_displacement
 
 SIGMA = 0.05e-3  # m, marker precision

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import fit_damping, select_window_peaks
 from tapespring.experiment.samples import vibration_displacement
 

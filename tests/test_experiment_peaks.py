@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import compare_peaks, extract_peaks, peak_statistics
 from tapespring.experiment.samples import deployment_angle
 
@@ -91,16 +90,17 @@ def test_extract_peaks_rejects_nan():
 def test_peak_statistics_per_peak_mean_std_maxdiff_cv():
     t = np.arange(0, 3, 1 / RATE)
     amplitudes = np.array([1.0, 1.1, 0.9, 1.2])
-    peaks = [extract_peaks(t, a * np.sin(2 * np.pi * t), n=2) for a in amplitudes]
+    # Peaks fall on samples (t = 0.25 s + k): unrefined values are exact.
+    peaks = [extract_peaks(t, a * np.sin(2 * np.pi * t), n=2, refine=False) for a in amplitudes]
     stats = peak_statistics(peaks)
     amp = stats.max_amplitude
-    np.testing.assert_allclose(amp.mean, [1.05, 1.05], rtol=1e-9)
-    np.testing.assert_allclose(amp.std, [np.std(amplitudes, ddof=1)] * 2, rtol=1e-9)
-    np.testing.assert_allclose(amp.max_diff, [0.3, 0.3], rtol=1e-9)
-    np.testing.assert_allclose(amp.cv, amp.std / 1.05, rtol=1e-9)
+    np.testing.assert_allclose(amp.mean, [1.05, 1.05], rtol=1e-14)
+    np.testing.assert_allclose(amp.std, [np.std(amplitudes, ddof=1)] * 2, rtol=1e-14)
+    np.testing.assert_allclose(amp.max_diff, [0.3, 0.3], rtol=1e-14)
+    np.testing.assert_allclose(amp.cv, amp.std / 1.05, rtol=1e-14)
     # Minima are negative: the CV uses |mean| and stays positive.
-    np.testing.assert_allclose(stats.min_amplitude.cv, amp.cv, rtol=1e-9)
-    np.testing.assert_allclose(stats.max_separation.mean, [0.25, 1.0], atol=1e-6)
+    np.testing.assert_allclose(stats.min_amplitude.cv, amp.cv, rtol=1e-14)
+    np.testing.assert_allclose(stats.max_separation.mean, [0.25, 1.0], atol=1e-12)
     assert stats.n_trials == 4
 
 

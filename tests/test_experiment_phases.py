@@ -2,9 +2,13 @@
 
 import numpy as np
 import pytest
-
-from tapespring.experiment import bending_angle, detect_phases, equilibrium_value, extract_peaks
-from tapespring.experiment import release_index
+from tapespring.experiment import (
+    bending_angle,
+    detect_phases,
+    equilibrium_value,
+    extract_peaks,
+    release_index,
+)
 from tapespring.experiment.samples import make_deployment_trial
 
 

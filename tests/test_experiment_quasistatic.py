@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import analyze_pull_test
 
 RATE = 4000.0  # Hz: span 101 = 25 ms, as in the paper

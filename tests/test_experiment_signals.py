@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import bending_angle, equilibrium_value, noise_std, release_index, smooth
 
 

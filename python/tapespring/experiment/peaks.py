@@ -9,10 +9,11 @@ signal's range (noise-free simulated signals). At the paper's marker precision
 1 and 2), a noise-only local extremum with a prominence of 8 sigma has a
 probability below 1e-14 per sample.
 
-Each peak is then refined by a least-squares parabola through the contiguous
-samples around it that lie within ``4 sigma`` of the highest sample (at least
-two samples on each side), which averages the noise and removes the sampling
-quantisation. The refinement is kept only if the parabola has the right
+Each peak is then refined by a least-squares parabola through the samples
+around it that lie within ``4 sigma`` of the top (at least two samples on each
+side; the window is found on a 5-sample moving average, then re-centred on the
+first vertex and the parabola refitted), which averages the noise and removes
+the sampling quantisation. A fit is kept only if the parabola has the right
 curvature and its vertex lies inside the fitted samples.
 
 Time separation: for the maxima (resp. minima), ``separation[0]`` is the time
@@ -28,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
-from .signals import noise_std
+from .signals import noise_std, smooth
 from .stats import Summary, summarize
 
 __all__ = [
@@ -109,31 +110,53 @@ class Peaks:
         return time[order], value[order], kind[order]
 
 
-def _refine(t: np.ndarray, y: np.ndarray, i: int, depth: float) -> tuple[float, float]:
-    """Vertex of a least-squares parabola through the top of the maximum at sample i."""
-    n = y.size
-    top = y[i]
-    lo = i
-    while lo > 0 and y[lo - 1] >= top - depth:
-        lo -= 1
-    hi = i
-    while hi < n - 1 and y[hi + 1] >= top - depth:
-        hi += 1
-    lo = max(0, min(lo, i - 2))
-    hi = min(n - 1, max(hi, i + 2))
-    if hi - lo < 4:
-        return float(t[i]), float(top)
-    ts = t[lo : hi + 1] - t[i]
-    ys = y[lo : hi + 1]
-    if not np.all(np.isfinite(ys)):
-        return float(t[i]), float(top)
-    c2, c1, c0 = np.polyfit(ts, ys, 2)
+def _fit_vertex(t: np.ndarray, y: np.ndarray, lo: int, hi: int, t0: float):
+    """Least-squares parabola through samples lo..hi; (c2, time, value) of its vertex."""
+    ts = t[lo : hi + 1] - t0
+    c2, c1, c0 = np.polyfit(ts, y[lo : hi + 1], 2)
     if c2 >= 0:
-        return float(t[i]), float(top)
+        return None
     tv = -c1 / (2.0 * c2)
     if not ts[0] <= tv <= ts[-1]:
-        return float(t[i]), float(top)
-    return float(t[i] + tv), float(c0 - c1 * c1 / (4.0 * c2))
+        return None
+    return c2, t0 + tv, c0 - c1 * c1 / (4.0 * c2)
+
+
+def _refine(
+    t: np.ndarray, y: np.ndarray, y_smooth: np.ndarray, i: int, depth: float
+) -> tuple[float, float]:
+    """Vertex of a least-squares parabola through the top of the maximum at sample i.
+
+    The first window is the run of samples around i where a 5-sample moving
+    average stays within ``depth`` of its top (the average keeps single noisy
+    samples from cutting the run). The window is then re-centred on the vertex
+    with the half-width where the parabola has dropped by ``depth``, and the
+    parabola refitted once.
+    """
+    n = y.size
+    top = np.max(y_smooth[max(0, i - 2) : i + 3])
+    lo = i
+    while lo > 0 and y_smooth[lo - 1] >= top - depth:
+        lo -= 1
+    hi = i
+    while hi < n - 1 and y_smooth[hi + 1] >= top - depth:
+        hi += 1
+    lo, hi = max(0, min(lo, i - 2)), min(n - 1, max(hi, i + 2))
+    fallback = (float(t[i]), float(y[i]))
+    if hi - lo < 4:
+        return fallback
+    first = _fit_vertex(t, y, lo, hi, t[i])
+    if first is None:
+        return fallback
+    c2, tv, _ = first
+    dt = (t[-1] - t[0]) / (n - 1)
+    half = max(2, round(np.sqrt(2.0 * depth / -c2) / dt))
+    centre = round((tv - t[0]) / dt)
+    lo, hi = max(0, centre - half), min(n - 1, centre + half)
+    second = _fit_vertex(t, y, lo, hi, t[centre]) if hi - lo >= 4 else None
+    if second is None:
+        return float(tv), float(first[2])
+    return float(second[1]), float(second[2])
 
 
 def _extrema(
@@ -147,14 +170,16 @@ def _extrema(
     t_ref: float,
     sign: float,
 ) -> Extrema:
-    idx, _ = find_peaks(sign * y, prominence=prominence, distance=distance)
+    signed = sign * y
+    idx, _ = find_peaks(signed, prominence=prominence, distance=distance)
     if n is not None:
         idx = idx[:n]
+    signed_smooth = smooth(signed, 5) if refine else signed
     times = np.empty(idx.size)
     values = np.empty(idx.size)
     for k, i in enumerate(idx):
         if refine:
-            tk, vk = _refine(t, sign * y, int(i), depth)
+            tk, vk = _refine(t, signed, signed_smooth, int(i), depth)
         else:
             tk, vk = float(t[i]), float(sign * y[i])
         times[k] = tk
