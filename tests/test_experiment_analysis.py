@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from tapespring.experiment import (
     Trial,
     TrialError,

@@ -3,7 +3,6 @@
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
-
 from tapespring.experiment import (
     analyze_deployment,
     analyze_pull_trial,
