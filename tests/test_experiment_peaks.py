@@ -122,3 +122,15 @@ def test_compare_peaks_gives_peak_by_peak_differences():
     np.testing.assert_allclose(diff.min_amplitude, [-0.1, -0.1], atol=1e-6)
     np.testing.assert_allclose(diff.max_separation, [0.01, 0.0], atol=1e-6)
     assert diff.n == 2
+
+
+def test_head_equals_extracting_fewer_peaks():
+    t = np.arange(0, 6, 1 / RATE)
+    y = np.exp(-0.2 * t) * np.sin(2 * np.pi * t) + np.random.default_rng(0).normal(0, 1e-3, t.size)
+    all_peaks = extract_peaks(t, y, None)
+    first = extract_peaks(t, y, 3, prominence=all_peaks.prominence)
+    head = all_peaks.head(3)
+    for a, b in ((head.maxima, first.maxima), (head.minima, first.minima)):
+        np.testing.assert_array_equal(a.time, b.time)
+        np.testing.assert_array_equal(a.value, b.value)
+        np.testing.assert_array_equal(a.separation, b.separation)

@@ -157,7 +157,7 @@ def analyze_deployment(
     all_peaks = extract_peaks(tt, yy, None, prominence=prominence, t_ref=t_rel)
     if len(all_peaks.maxima) == 0 and len(all_peaks.minima) == 0:
         raise TrialError(trial.metadata.label, "no peak found in the bending angle")
-    peaks = extract_peaks(tt, yy, n_peaks, prominence=all_peaks.prominence, t_ref=t_rel)
+    peaks = all_peaks.head(n_peaks)
     phases = detect_phases(all_peaks)
 
     tip_eq = np.array([equilibrium_value(t, m3[:, k], tail=tail) for k in range(3)])

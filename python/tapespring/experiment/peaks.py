@@ -91,6 +91,14 @@ class Peaks:
     noise: float
     t_ref: float
 
+    def head(self, n: int) -> Peaks:
+        """The first ``n`` maxima and the first ``n`` minima (separations unchanged)."""
+
+        def cut(e: Extrema) -> Extrema:
+            return Extrema(e.time[:n], e.value[:n], e.separation[:n], e.index[:n])
+
+        return Peaks(cut(self.maxima), cut(self.minima), self.prominence, self.noise, self.t_ref)
+
     def sequence(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """All peaks merged in time order.
 
