@@ -20,3 +20,13 @@ pub mod mesh;
 pub mod rotation;
 
 pub use error::{Error, Result};
+pub mod assembly;
+pub mod dof;
+pub mod linalg;
+pub mod model;
+pub mod solver;
+pub mod state;
+
+pub use assembly::System;
+pub use model::{Dof, Model};
+pub use state::State;

@@ -1,0 +1,576 @@
+//! Static equilibrium paths: `r(q, lambda) = f_int(q) - lambda f_ext = 0` at the free DOFs, with
+//! the constrained DOFs at `lambda * value`.
+//!
+//! Every increment is a bordered Newton iteration: with `K = dr/dq` and
+//! `b = -dr/dlambda = f_ext - K_fc * values`, each iteration solves `K dq_r = -r` and `K dq_b = b`
+//! (one factorisation, two solves) and sets `dq = dq_r + dlambda dq_b`, where `dlambda` comes from
+//! the control equation: zero (load control), the controlled DOF fixed (displacement control, Batoz
+//! & Dhatt 1979), or the arc-length constraint
+//! `|Dq|_W^2 + Dlambda^2 c = Ds^2` (Crisfield 1981), whose root is chosen at the smallest angle with
+//! the current increment. The predictor direction follows the previous increment (Feng et al.
+//! 1996), so limit points, snap-through and snap-back are passed. Norms weigh rotations by the
+//! characteristic length `L_c` of the model.
+//!
+//! An increment that fails (no convergence, singular tangent, no arc-length root, non-finite
+//! values) is restarted from the last converged state with half the increment, up to
+//! `max_cutbacks` times; then the analysis stops with [`Error::NotConverged`] and the path so far.
+
+use std::time::Instant;
+
+use super::{Control, StaticParams, StaticPath, StaticStep, Stats};
+use crate::assembly::{Assembled, System};
+use crate::dof::Slot;
+use crate::error::{Error, Result};
+use crate::linalg::LinearSolver;
+use crate::state::State;
+
+/// What one increment does.
+#[derive(Clone, Copy, Debug)]
+enum Increment {
+    Load(f64),
+    Displacement { eq: usize, delta: f64 },
+    Arc { ds: f64, sign: f64 },
+}
+
+struct Outcome {
+    iterations: usize,
+    residual: f64,
+    dq: Vec<f64>,
+    dlambda: f64,
+}
+
+struct Solver<'a> {
+    system: &'a mut System,
+    linear: LinearSolver,
+    asm: Assembled,
+    /// `asm` holds residual and tangent of the current state.
+    fresh: bool,
+    weights: Vec<f64>,
+    values: Vec<f64>,
+    c_lambda: f64,
+    params: &'a StaticParams,
+    stats: Stats,
+    force_floor: f64,
+}
+
+impl Solver<'_> {
+    fn assemble(&mut self, state: &State) {
+        let t = Instant::now();
+        self.system.assemble(state, true, &mut self.asm);
+        self.stats.assembly_s += t.elapsed().as_secs_f64();
+        self.fresh = true;
+    }
+
+    fn dot_w(&self, a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .zip(&self.weights)
+            .map(|((x, y), w)| w * x * y)
+            .sum()
+    }
+
+    fn force_norm(&self, f: &[f64]) -> f64 {
+        f.iter()
+            .zip(&self.weights)
+            .map(|(v, w)| v * v / w)
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    fn reaction_norm(&self) -> f64 {
+        let lc2 = self.system.char_length.powi(2);
+        self.system
+            .dofs
+            .constrained
+            .iter()
+            .zip(&self.asm.reactions)
+            .map(|(c, r)| if c.dof.is_rotation() { r * r / lc2 } else { r * r })
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    fn reference_force(&self, lambda: f64) -> f64 {
+        (lambda.abs() * self.force_norm(&self.asm.f_ext))
+            .max(self.reaction_norm())
+            .max(self.force_floor)
+    }
+
+    /// `b = f_ext - K_fc values`.
+    fn load_vector(&self) -> Vec<f64> {
+        let mut b = self.asm.f_ext.clone();
+        let mut kv = vec![0.0; b.len()];
+        self.system
+            .pattern_fc
+            .mul_add(&self.asm.k_fc, &self.values, &mut kv);
+        for (bi, k) in b.iter_mut().zip(kv) {
+            *bi -= k;
+        }
+        b
+    }
+
+    /// Factorises the current tangent and returns `(dq_r, dq_b)`.
+    fn solve_pair(&mut self) -> Result<(Vec<f64>, Vec<f64>)> {
+        let t = Instant::now();
+        self.linear.factorize(&self.asm.k_ff)?;
+        self.stats.factorisations += 1;
+        let mut dq_r: Vec<f64> = self.asm.residual.iter().map(|r| -r).collect();
+        self.linear.solve_in_place(&mut dq_r)?;
+        let mut dq_b = self.load_vector();
+        self.linear.solve_in_place(&mut dq_b)?;
+        self.stats.solve_s += t.elapsed().as_secs_f64();
+        Ok((dq_r, dq_b))
+    }
+
+    fn converged(&self, lambda: f64, energy: Option<(f64, f64)>) -> (bool, f64) {
+        let res = self.force_norm(&self.asm.residual);
+        let ok_force = res <= self.params.newton.tol_force * self.reference_force(lambda);
+        let ok_energy = energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first);
+        (ok_force && ok_energy && res.is_finite(), res)
+    }
+
+    /// One increment from the converged `state`; on error the state is left modified.
+    #[allow(clippy::too_many_lines)]
+    fn increment(&mut self, state: &mut State, inc: Increment) -> Result<Outcome> {
+        if !self.fresh {
+            self.assemble(state);
+        }
+        let (dq_r, dq_b) = self.solve_pair()?;
+        let (dlambda0, mut dq) = match inc {
+            Increment::Load(dl) => (dl, dq_r.clone()),
+            Increment::Displacement { eq, delta } => {
+                if dq_b[eq].abs() < 1e-300 {
+                    return Err(Error::Factorisation(
+                        "the controlled DOF does not respond to the load".into(),
+                    ));
+                }
+                ((delta - dq_r[eq]) / dq_b[eq], dq_r.clone())
+            }
+            Increment::Arc { ds, sign } => {
+                let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
+                (sign * ds / norm, vec![0.0; dq_b.len()])
+            }
+        };
+        for (d, b) in dq.iter_mut().zip(&dq_b) {
+            *d += dlambda0 * b;
+        }
+        self.system.update(state, &dq, dlambda0);
+        let mut acc = dq;
+        let mut acc_lambda = dlambda0;
+        let mut energy_first = None;
+        let max_it = self.params.newton.max_iterations;
+        let mut res = f64::INFINITY;
+        let mut no_root = 0;
+        for it in 1..=max_it {
+            self.stats.iterations += 1;
+            self.assemble(state);
+            let (ok, r) = self.converged(state.lambda, energy_first);
+            res = r;
+            if !res.is_finite() {
+                return Err(Error::Factorisation("non-finite residual".into()));
+            }
+            if ok {
+                return Ok(Outcome {
+                    iterations: it,
+                    residual: res,
+                    dq: acc,
+                    dlambda: acc_lambda,
+                });
+            }
+            if it == max_it {
+                break;
+            }
+            let (dq_r, dq_b) = self.solve_pair()?;
+            let dl = match inc {
+                Increment::Load(_) => 0.0,
+                Increment::Displacement { eq, .. } => -dq_r[eq] / dq_b[eq],
+                Increment::Arc { ds, .. } => {
+                    let u: Vec<f64> = acc.iter().zip(&dq_r).map(|(a, r)| a + r).collect();
+                    let a = self.dot_w(&dq_b, &dq_b) + self.c_lambda;
+                    let b = 2.0 * (self.dot_w(&dq_b, &u) + acc_lambda * self.c_lambda);
+                    let c = self.dot_w(&u, &u) + acc_lambda * acc_lambda * self.c_lambda - ds * ds;
+                    let disc = b * b - 4.0 * a * c;
+                    if disc < 0.0 {
+                        no_root += 1;
+                        if no_root > 2 {
+                            return Err(Error::Factorisation(
+                                "the arc-length constraint has no real root".into(),
+                            ));
+                        }
+                        -b / (2.0 * a)
+                    } else {
+                        let sq = disc.sqrt();
+                        let roots = [(-b + sq) / (2.0 * a), (-b - sq) / (2.0 * a)];
+                        let score = |l: f64| {
+                            let new: Vec<f64> = u.iter().zip(&dq_b).map(|(x, y)| x + l * y).collect();
+                            self.dot_w(&new, &acc) + (acc_lambda + l) * acc_lambda * self.c_lambda
+                        };
+                        if score(roots[0]) >= score(roots[1]) {
+                            roots[0]
+                        } else {
+                            roots[1]
+                        }
+                    }
+                }
+            };
+            let step: Vec<f64> = dq_r.iter().zip(&dq_b).map(|(r, b)| r + dl * b).collect();
+            let e = self
+                .asm
+                .residual
+                .iter()
+                .zip(&step)
+                .map(|(r, s)| r * s)
+                .sum::<f64>()
+                .abs();
+            let energy = match energy_first {
+                None => {
+                    energy_first = Some((e.max(1e-300), e));
+                    energy_first
+                }
+                Some((first, _)) => Some((first, e)),
+            };
+            energy_first = energy;
+            let mut alpha = 1.0;
+            let saved =
+                (!matches!(inc, Increment::Arc { .. }) && self.params.newton.line_search).then(|| state.clone());
+            loop {
+                let scaled: Vec<f64> = step.iter().map(|s| alpha * s).collect();
+                self.system.update(state, &scaled, alpha * dl);
+                let Some(saved) = &saved else { break };
+                if alpha < 0.1 {
+                    break;
+                }
+                let t = Instant::now();
+                self.system.assemble(state, false, &mut self.asm);
+                self.stats.assembly_s += t.elapsed().as_secs_f64();
+                self.fresh = false;
+                let new_res = self.force_norm(&self.asm.residual);
+                if new_res.is_finite() && new_res <= res {
+                    break;
+                }
+                *state = saved.clone();
+                alpha *= 0.5;
+            }
+            for (a, s) in acc.iter_mut().zip(&step) {
+                *a += alpha * s;
+            }
+            acc_lambda += alpha * dl;
+        }
+        Err(Error::NotConverged {
+            lambda: state.lambda,
+            iterations: max_it,
+            residual: res,
+            detail: "Newton iterations exhausted".into(),
+        })
+    }
+
+    fn record(&mut self, state: &State, out: &Outcome) -> Result<StaticStep> {
+        let negative_eigenvalues = if self.params.stability {
+            let t = Instant::now();
+            let n = self.linear.negative_eigenvalues(&self.asm.k_ff)?;
+            self.stats.solve_s += t.elapsed().as_secs_f64();
+            Some(n)
+        } else {
+            None
+        };
+        let reference = &self.system.reference;
+        let (displacements, rotations) = if self.params.record_fields {
+            (
+                (0..state.x.len())
+                    .map(|i| state.displacement(reference, i).into())
+                    .collect(),
+                (0..state.x.len())
+                    .map(|i| state.rotation(reference, i).into())
+                    .collect(),
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Ok(StaticStep {
+            lambda: state.lambda,
+            iterations: out.iterations,
+            residual: out.residual,
+            energy: self.asm.energy,
+            reactions: self.asm.reactions.clone(),
+            negative_eigenvalues,
+            displacements,
+            rotations,
+        })
+    }
+}
+
+/// Follows the static equilibrium path of `system` from `state` as `params` says, calling
+/// `progress` after each converged step (return `false` to stop). `state` ends at the last
+/// converged configuration.
+///
+/// # Errors
+/// Invalid parameters or a model with nothing to solve are returned at once; failures during the
+/// analysis are reported in [`StaticPath::error`] with the converged steps kept.
+pub fn solve_static(
+    system: &mut System,
+    state: &mut State,
+    params: &StaticParams,
+    progress: &mut dyn FnMut(&StaticStep, &Stats) -> bool,
+) -> Result<StaticPath> {
+    params.validate()?;
+    let start = Instant::now();
+    let values: Vec<f64> = system.dofs.constrained.iter().map(|c| c.value).collect();
+    let has_motion = values.iter().any(|v| *v != 0.0);
+    let has_load = system.loads.iter().any(|l| l.value != 0.0);
+    if !has_load && !has_motion {
+        return Err(Error::InvalidModel(
+            "the analysis has no load and no prescribed motion".into(),
+        ));
+    }
+    if system.dofs.constrained.is_empty() {
+        return Err(Error::InvalidModel(
+            "the model has no constraint against rigid-body motion".into(),
+        ));
+    }
+    let linear = LinearSolver::try_new(&system.pattern_ff)?;
+    let lc2 = system.char_length.powi(2);
+    let c_lambda: f64 = system
+        .dofs
+        .constrained
+        .iter()
+        .map(|c| {
+            if c.dof.is_rotation() {
+                lc2 * c.value * c.value
+            } else {
+                c.value * c.value
+            }
+        })
+        .sum();
+    let weights = system.free_weights();
+    let force_floor = 1e-13 * system.section.membrane[(0, 0)] * system.char_length;
+    let mut s = Solver {
+        system,
+        linear,
+        asm: Assembled::default(),
+        fresh: false,
+        weights,
+        values,
+        c_lambda,
+        params,
+        stats: Stats::default(),
+        force_floor,
+    };
+    let mut path = StaticPath::default();
+
+    // Each control is a sequence of increments; `next` proposes one from the last accepted one.
+    let mut prev: Option<Outcome> = None;
+    let mut size;
+    let mut steps_left;
+    let mut done_target = None;
+    match &params.control {
+        Control::Load { lambda_end, increments } => {
+            size = (lambda_end - state.lambda) / *increments as f64;
+            steps_left = usize::MAX;
+            done_target = Some(*lambda_end);
+        }
+        Control::Displacement {
+            node,
+            dof,
+            delta,
+            increments,
+        } => {
+            let node = *node;
+            if node >= s.system.dofs.slots.len() {
+                return Err(Error::InvalidModel(format!("controlled node {node} does not exist")));
+            }
+            let Slot::Free(_) = s.system.dofs.slots[s.system.dofs.owner(node)][dof.index()] else {
+                return Err(Error::InvalidModel(format!(
+                    "controlled DOF {dof:?} of node {node} is not free"
+                )));
+            };
+            if s.system.dofs.master[node].is_some() {
+                return Err(Error::InvalidModel(format!(
+                    "controlled node {node} is rigidly tied; control its reference node"
+                )));
+            }
+            size = delta / *increments as f64;
+            steps_left = *increments;
+        }
+        Control::ArcLength {
+            initial_increment,
+            direction,
+            max_steps,
+            ..
+        } => {
+            size = initial_increment * direction;
+            steps_left = *max_steps;
+        }
+    }
+    let initial_size = size.abs();
+    let mut travelled = 0.0;
+    let mut arc_ds: Option<f64> = None;
+    let mut cutbacks = 0;
+    'steps: while steps_left > 0 {
+        if let Some(end) = done_target {
+            let remaining = end - state.lambda;
+            if remaining.abs() <= 1e-12 * end.abs().max(1.0) {
+                break;
+            }
+            if size.abs() > remaining.abs() {
+                size = remaining;
+            }
+        }
+        if let Control::Displacement { delta, .. } = &params.control {
+            let remaining = delta - travelled;
+            if remaining.abs() <= 1e-12 * delta.abs() {
+                break;
+            }
+            if size.abs() > remaining.abs() {
+                size = remaining;
+            }
+        }
+        let inc = match &params.control {
+            Control::Load { .. } => Increment::Load(size),
+            Control::Displacement { node, dof, .. } => {
+                let Slot::Free(eq) = s.system.dofs.slots[*node][dof.index()] else {
+                    unreachable!()
+                };
+                Increment::Displacement { eq, delta: size }
+            }
+            Control::ArcLength {
+                direction,
+                initial_increment,
+                ..
+            } => {
+                if arc_ds.is_none() {
+                    // First step: the arc length that gives the requested load-factor increment.
+                    if !s.fresh {
+                        s.assemble(state);
+                    }
+                    let (_, dq_b) = match s.solve_pair() {
+                        Ok(v) => v,
+                        Err(e) => {
+                            path.error = Some(e);
+                            break 'steps;
+                        }
+                    };
+                    arc_ds = Some(initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt());
+                    size = arc_ds.expect("set");
+                }
+                let sign = match &prev {
+                    None => *direction,
+                    Some(p) => {
+                        // Feng's predictor: keep going the way the last increment went.
+                        if !s.fresh {
+                            s.assemble(state);
+                        }
+                        let (_, dq_b) = match s.solve_pair() {
+                            Ok(v) => v,
+                            Err(e) => {
+                                path.error = Some(e);
+                                break 'steps;
+                            }
+                        };
+                        let d = s.dot_w(&p.dq, &dq_b) + p.dlambda * s.c_lambda;
+                        if d >= 0.0 {
+                            1.0
+                        } else {
+                            -1.0
+                        }
+                    }
+                };
+                Increment::Arc { ds: size.abs(), sign }
+            }
+        };
+        let saved = state.clone();
+        match s.increment(state, inc) {
+            Ok(out) => {
+                // Arc-length: do not overshoot the final load factor; finish with a load step.
+                if let Control::ArcLength { lambda_end, .. } = &params.control {
+                    let start_l = saved.lambda;
+                    let crossed = (start_l - lambda_end) * (state.lambda - lambda_end) < 0.0 && prev.is_some();
+                    if crossed {
+                        let mut trial = saved.clone();
+                        s.fresh = false;
+                        if let Ok(o2) = s.increment(&mut trial, Increment::Load(lambda_end - start_l)) {
+                            *state = trial;
+                            let step = match s.record(state, &o2) {
+                                Ok(st) => st,
+                                Err(e) => {
+                                    path.error = Some(e);
+                                    break;
+                                }
+                            };
+                            s.stats.steps += 1;
+                            path.steps.push(step);
+                            let _ = progress(path.steps.last().expect("pushed"), &s.stats);
+                            break;
+                        }
+                        s.fresh = false;
+                        s.assemble(state);
+                    }
+                }
+                cutbacks = 0;
+                let step = match s.record(state, &out) {
+                    Ok(st) => st,
+                    Err(e) => {
+                        path.error = Some(e);
+                        break;
+                    }
+                };
+                s.stats.steps += 1;
+                let keep_going = progress(&step, &s.stats);
+                path.steps.push(step);
+                if let Control::Displacement { .. } = &params.control {
+                    travelled += size;
+                }
+                // Adapt the increment to the Newton effort.
+                let ratio = (params.target_iterations as f64 / out.iterations.max(1) as f64)
+                    .sqrt()
+                    .clamp(0.5, 2.0);
+                match &params.control {
+                    Control::ArcLength {
+                        max_increment_factor,
+                        lambda_end,
+                        ..
+                    } => {
+                        let ds0 = arc_ds.expect("set on the first step");
+                        size = (size.abs() * ratio).min(ds0 * max_increment_factor);
+                        let reached = (state.lambda - lambda_end) * (saved.lambda - lambda_end) <= 0.0;
+                        if reached && prev.is_some() {
+                            break;
+                        }
+                    }
+                    _ => size = size.signum() * (size.abs() * ratio).min(initial_size),
+                }
+                prev = Some(out);
+                if !keep_going {
+                    path.cancelled = true;
+                    break;
+                }
+                steps_left = steps_left.saturating_sub(1);
+            }
+            Err(err) => {
+                *state = saved;
+                s.fresh = false;
+                cutbacks += 1;
+                s.stats.cutbacks += 1;
+                if cutbacks > params.max_cutbacks {
+                    let detail = format!("increment cut back {} times; last failure: {err}", params.max_cutbacks);
+                    let (iterations, residual) = match err {
+                        Error::NotConverged {
+                            iterations, residual, ..
+                        } => (iterations, residual),
+                        _ => (0, f64::NAN),
+                    };
+                    path.error = Some(Error::NotConverged {
+                        lambda: state.lambda,
+                        iterations,
+                        residual,
+                        detail,
+                    });
+                    break;
+                }
+                size *= 0.5;
+                log::debug!("increment failed at lambda = {}: {err}; cutting back", state.lambda);
+            }
+        }
+    }
+    s.stats.wall_s = start.elapsed().as_secs_f64();
+    path.stats = s.stats;
+    Ok(path)
+}
