@@ -18,6 +18,7 @@ pub mod error;
 pub mod material;
 pub mod mesh;
 pub mod rotation;
+pub mod samples;
 
 pub use error::{Error, Result};
 pub mod assembly;

@@ -71,7 +71,7 @@ pub fn cylindrical_panel(radius: f64, length: f64, phi0: f64, phi1: f64, n_axial
 /// Geometry of a tape spring: a straight strip of length `length` along x whose cross-section is a
 /// circular arc of radius `radius` subtending `alpha` [rad] in the y-z plane, symmetric about z,
 /// with its centre of curvature on the +z side (at `z = radius`); the arc's middle lies on the x axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TapeGeometry {
     /// Length L [m].
     pub length: f64,

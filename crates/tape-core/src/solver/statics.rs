@@ -29,7 +29,7 @@ use crate::state::State;
 enum Increment {
     Load(f64),
     Displacement { eq: usize, delta: f64 },
-    Arc { ds: f64, sign: f64 },
+    Arc { ds: f64, direction: f64 },
 }
 
 struct Outcome {
@@ -45,6 +45,12 @@ struct Solver<'a> {
     asm: Assembled,
     /// `asm` holds residual and tangent of the current state.
     fresh: bool,
+    /// `linear` holds the factorisation of `asm`'s tangent.
+    factorised: bool,
+    /// Largest reference force met on the path so far [N] (the force scale near zero load).
+    path_force: f64,
+    /// Increment of the last converged step, for the arc-length predictor direction.
+    previous: Option<(Vec<f64>, f64)>,
     weights: Vec<f64>,
     values: Vec<f64>,
     c_lambda: f64,
@@ -59,6 +65,7 @@ impl Solver<'_> {
         self.system.assemble(state, true, &mut self.asm);
         self.stats.assembly_s += t.elapsed().as_secs_f64();
         self.fresh = true;
+        self.factorised = false;
     }
 
     fn dot_w(&self, a: &[f64], b: &[f64]) -> f64 {
@@ -111,8 +118,11 @@ impl Solver<'_> {
     /// Factorises the current tangent and returns `(dq_r, dq_b)`.
     fn solve_pair(&mut self) -> Result<(Vec<f64>, Vec<f64>)> {
         let t = Instant::now();
-        self.linear.factorize(&self.asm.k_ff)?;
-        self.stats.factorisations += 1;
+        if !self.factorised {
+            self.linear.factorize(&self.asm.k_ff)?;
+            self.stats.factorisations += 1;
+            self.factorised = true;
+        }
         let mut dq_r: Vec<f64> = self.asm.residual.iter().map(|r| -r).collect();
         self.linear.solve_in_place(&mut dq_r)?;
         let mut dq_b = self.load_vector();
@@ -123,8 +133,12 @@ impl Solver<'_> {
 
     fn converged(&self, lambda: f64, energy: Option<(f64, f64)>) -> (bool, f64) {
         let res = self.force_norm(&self.asm.residual);
-        let ok_force = res <= self.params.newton.tol_force * self.reference_force(lambda);
-        let ok_energy = energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first);
+        let tol = self.params.newton.tol_force * self.reference_force(lambda);
+        let ok_force = res <= tol;
+        // The energy ratio cannot go below round-off on tiny increments: a residual a hundred times
+        // below the force tolerance is converged whatever the energy ratio says.
+        let ok_energy =
+            energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first) || res <= 0.01 * tol;
         (ok_force && ok_energy && res.is_finite(), res)
     }
 
@@ -145,7 +159,18 @@ impl Solver<'_> {
                 }
                 ((delta - dq_r[eq]) / dq_b[eq], dq_r.clone())
             }
-            Increment::Arc { ds, sign } => {
+            Increment::Arc { ds, direction } => {
+                // Feng's predictor: keep going the way the last increment went.
+                let sign = match &self.previous {
+                    None => direction,
+                    Some((dq, dl)) => {
+                        if self.dot_w(dq, &dq_b) + dl * self.c_lambda >= 0.0 {
+                            1.0
+                        } else {
+                            -1.0
+                        }
+                    }
+                };
                 let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
                 (sign * ds / norm, vec![0.0; dq_b.len()])
             }
@@ -266,7 +291,13 @@ impl Solver<'_> {
     fn record(&mut self, state: &State, out: &Outcome) -> Result<StaticStep> {
         let negative_eigenvalues = if self.params.stability {
             let t = Instant::now();
-            let n = self.linear.negative_eigenvalues(&self.asm.k_ff)?;
+            // The LDL^T of the converged tangent is the one factorised for the convergence check.
+            if !self.factorised {
+                self.linear.factorize(&self.asm.k_ff)?;
+                self.stats.factorisations += 1;
+                self.factorised = true;
+            }
+            let n = self.linear.negative_eigenvalues()?;
             self.stats.solve_s += t.elapsed().as_secs_f64();
             Some(n)
         } else {
@@ -347,6 +378,9 @@ pub fn solve_static(
         linear,
         asm: Assembled::default(),
         fresh: false,
+        factorised: false,
+        path_force: 0.0,
+        previous: None,
         weights,
         values,
         c_lambda,
@@ -451,29 +485,10 @@ pub fn solve_static(
                     arc_ds = Some(initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt());
                     size = arc_ds.expect("set");
                 }
-                let sign = match &prev {
-                    None => *direction,
-                    Some(p) => {
-                        // Feng's predictor: keep going the way the last increment went.
-                        if !s.fresh {
-                            s.assemble(state);
-                        }
-                        let (_, dq_b) = match s.solve_pair() {
-                            Ok(v) => v,
-                            Err(e) => {
-                                path.error = Some(e);
-                                break 'steps;
-                            }
-                        };
-                        let d = s.dot_w(&p.dq, &dq_b) + p.dlambda * s.c_lambda;
-                        if d >= 0.0 {
-                            1.0
-                        } else {
-                            -1.0
-                        }
-                    }
-                };
-                Increment::Arc { ds: size.abs(), sign }
+                Increment::Arc {
+                    ds: size.abs(),
+                    direction: *direction,
+                }
             }
         };
         let saved = state.clone();
@@ -486,6 +501,7 @@ pub fn solve_static(
                     if crossed {
                         let mut trial = saved.clone();
                         s.fresh = false;
+                        s.factorised = false;
                         if let Ok(o2) = s.increment(&mut trial, Increment::Load(lambda_end - start_l)) {
                             *state = trial;
                             let step = match s.record(state, &o2) {
@@ -500,11 +516,13 @@ pub fn solve_static(
                             let _ = progress(path.steps.last().expect("pushed"), &s.stats);
                             break;
                         }
-                        s.fresh = false;
                         s.assemble(state);
                     }
                 }
                 cutbacks = 0;
+                s.path_force = s
+                    .path_force
+                    .max((state.lambda.abs() * s.force_norm(&s.asm.f_ext)).max(s.reaction_norm()));
                 let step = match s.record(state, &out) {
                     Ok(st) => st,
                     Err(e) => {
@@ -537,6 +555,7 @@ pub fn solve_static(
                     }
                     _ => size = size.signum() * (size.abs() * ratio).min(initial_size),
                 }
+                s.previous = Some((out.dq.clone(), out.dlambda));
                 prev = Some(out);
                 if !keep_going {
                     path.cancelled = true;
@@ -547,6 +566,7 @@ pub fn solve_static(
             Err(err) => {
                 *state = saved;
                 s.fresh = false;
+                s.factorised = false;
                 cutbacks += 1;
                 s.stats.cutbacks += 1;
                 if cutbacks > params.max_cutbacks {

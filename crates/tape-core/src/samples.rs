@@ -1,0 +1,231 @@
+//! Canonical problems shared by tests, benchmarks and the Python front end.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::material::ShellSection;
+use crate::mesh::generate::{apply_twist_imperfection, tape_spring, TapeGeometry};
+use crate::model::{Dof, Model};
+use crate::solver::{solve_static, Control, StaticParams, StaticPath, StaticStep, Stats};
+use crate::{State, System};
+
+/// Pure bending of one tape spring (paper Sec. 2, Fig. 4).
+///
+/// Each end section is rigidly tied to a reference node at the centroid of the end cross-section.
+/// The reference node at x = 0 is clamped; the one at x = L is free to translate in x and z, held
+/// in y and about x and z, and its rotation about y is driven from 0 to `theta_max` (positive:
+/// opposite-sense bending, negative: equal sense). The bending moment is the reaction moment
+/// about y at the driven node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TapeBending {
+    /// Cross-section and length of the tape.
+    pub geometry: TapeGeometry,
+    /// Shell section (thickness, material).
+    pub section: ShellSection,
+    /// Element size [m].
+    pub mesh_size: f64,
+    /// Final bending angle [rad], non-zero.
+    pub theta_max: f64,
+    /// Also unload back to zero.
+    pub unload: bool,
+    /// Twist imperfection amplitude [rad] (sections rotated about x by `a sin(pi x / L)`).
+    pub imperfection: f64,
+    /// Load-factor increment of the first arc-length step, in (0, 1).
+    pub initial_increment: f64,
+    /// Maximum arc-length steps per branch (loading, unloading).
+    pub max_steps: usize,
+}
+
+impl Default for TapeBending {
+    /// The paper's tape (Table 1 geometry, Table 5 identified t and E), 2 mm mesh, 0 to 90 degrees.
+    fn default() -> Self {
+        Self {
+            geometry: TapeGeometry {
+                length: 0.1,
+                radius: 15.55e-3,
+                alpha: 69.85_f64.to_radians(),
+            },
+            section: ShellSection::default(),
+            mesh_size: 2e-3,
+            theta_max: std::f64::consts::FRAC_PI_2,
+            unload: false,
+            imperfection: 0.0,
+            initial_increment: 0.01,
+            max_steps: 1000,
+        }
+    }
+}
+
+/// The bending model and the handles needed to read its results.
+pub struct BendingModel {
+    /// The model.
+    pub model: Model,
+    /// Clamped reference node (x = 0).
+    pub clamped_node: usize,
+    /// Driven reference node (x = L).
+    pub driven_node: usize,
+    /// Index of the driven rotation among the constrained DOFs (its reaction is the moment).
+    pub moment_index: usize,
+}
+
+/// One point of a bending curve.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BendingPoint {
+    /// Bending angle [rad].
+    pub theta: f64,
+    /// Bending moment [N m].
+    pub moment: f64,
+    /// Negative eigenvalues of the tangent (0: stable under rotation control).
+    pub negative_eigenvalues: usize,
+    /// Branch: 0 loading, 1 unloading.
+    pub branch: u8,
+}
+
+/// A bending curve with the statistics of the run.
+#[derive(Debug, Default)]
+pub struct BendingCurve {
+    /// Points in path order (loading, then unloading).
+    pub points: Vec<BendingPoint>,
+    /// Number of free DOFs.
+    pub ndof: usize,
+    /// Solver statistics (summed over branches).
+    pub stats: Stats,
+    /// Why the run stopped early, if it did (the points so far are kept).
+    pub error: Option<Error>,
+}
+
+impl TapeBending {
+    /// Checks the set-up.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the bad value.
+    pub fn validate(&self) -> Result<()> {
+        self.geometry.validate()?;
+        self.section.validate()?;
+        if !(self.theta_max.is_finite() && self.theta_max != 0.0 && self.theta_max.abs() < 2.0 * std::f64::consts::PI) {
+            return Err(Error::InvalidParameter(format!(
+                "theta_max must be non-zero and within (-2 pi, 2 pi) (got {})",
+                self.theta_max
+            )));
+        }
+        if !(self.initial_increment > 0.0 && self.initial_increment < 1.0) {
+            return Err(Error::InvalidParameter(format!(
+                "initial_increment must lie in (0, 1) (got {})",
+                self.initial_increment
+            )));
+        }
+        if !self.imperfection.is_finite() {
+            return Err(Error::InvalidParameter("imperfection must be finite".into()));
+        }
+        Ok(())
+    }
+
+    /// Builds the model.
+    ///
+    /// # Errors
+    /// Invalid parameters.
+    pub fn build(&self) -> Result<BendingModel> {
+        self.validate()?;
+        let mut mesh = tape_spring(&self.geometry, self.mesh_size)?;
+        if self.imperfection != 0.0 {
+            apply_twist_imperfection(&mut mesh, self.geometry.length, self.imperfection);
+        }
+        let end0 = mesh.node_set("end0")?.to_vec();
+        let end1 = mesh.node_set("end1")?.to_vec();
+        let mut model = Model::try_new(mesh, self.section)?;
+        let zc = self.geometry.section_centroid_z();
+        let clamped_node = model.add_node(Vector3::new(0.0, 0.0, zc))?;
+        let driven_node = model.add_node(Vector3::new(self.geometry.length, 0.0, zc))?;
+        model.tie(&end0, clamped_node)?;
+        model.tie(&end1, driven_node)?;
+        model.fix(&[clamped_node], &Dof::ALL)?;
+        model.fix(&[driven_node], &[Dof::Uy, Dof::Rx, Dof::Rz])?;
+        model.prescribe(driven_node, Dof::Ry, self.theta_max)?;
+        let moment_index = model
+            .constraints
+            .iter()
+            .position(|c| c.node == driven_node && c.dof == Dof::Ry)
+            .expect("prescribed above");
+        Ok(BendingModel {
+            model,
+            clamped_node,
+            driven_node,
+            moment_index,
+        })
+    }
+
+    /// Arc-length settings of one branch.
+    #[must_use]
+    pub fn params(&self, lambda_end: f64, direction: f64) -> StaticParams {
+        StaticParams {
+            control: Control::ArcLength {
+                lambda_end,
+                initial_increment: self.initial_increment,
+                max_increment_factor: 50.0,
+                max_steps: self.max_steps,
+                direction,
+            },
+            stability: true,
+            record_fields: false,
+            target_iterations: 6,
+            ..StaticParams::default()
+        }
+    }
+
+    /// Traces the bending curve (and the unloading branch if asked), calling `progress` with the
+    /// current angle [rad] after each converged step (return `false` to stop).
+    ///
+    /// # Errors
+    /// Invalid parameters; failures during the analysis are reported in [`BendingCurve::error`].
+    pub fn run(&self, progress: &mut dyn FnMut(f64) -> bool) -> Result<BendingCurve> {
+        let bm = self.build()?;
+        let mut system = System::try_new(&bm.model)?;
+        let mut state = system.initial_state();
+        let mut curve = BendingCurve {
+            ndof: system.n_free(),
+            ..BendingCurve::default()
+        };
+        let branches: &[(f64, f64)] = if self.unload {
+            &[(1.0, 1.0), (0.0, -1.0)]
+        } else {
+            &[(1.0, 1.0)]
+        };
+        for (branch, &(lambda_end, direction)) in branches.iter().enumerate() {
+            let params = self.params(lambda_end, direction);
+            let theta_max = self.theta_max;
+            let mut cb = |s: &StaticStep, _: &Stats| progress(s.lambda * theta_max);
+            let path = solve_static(&mut system, &mut state, &params, &mut cb)?;
+            self.collect(&bm, &path, u8::try_from(branch).unwrap_or(u8::MAX), &mut curve);
+            curve.stats.steps += path.stats.steps;
+            curve.stats.iterations += path.stats.iterations;
+            curve.stats.cutbacks += path.stats.cutbacks;
+            curve.stats.factorisations += path.stats.factorisations;
+            curve.stats.assembly_s += path.stats.assembly_s;
+            curve.stats.solve_s += path.stats.solve_s;
+            curve.stats.wall_s += path.stats.wall_s;
+            if path.error.is_some() || path.cancelled {
+                curve.error = path.error;
+                break;
+            }
+        }
+        Ok(curve)
+    }
+
+    fn collect(&self, bm: &BendingModel, path: &StaticPath, branch: u8, curve: &mut BendingCurve) {
+        for s in &path.steps {
+            curve.points.push(BendingPoint {
+                theta: s.lambda * self.theta_max,
+                moment: s.reactions[bm.moment_index],
+                negative_eigenvalues: s.negative_eigenvalues.unwrap_or(0),
+                branch,
+            });
+        }
+    }
+}
+
+/// The reference state of a model (helper for callers that only need positions).
+#[must_use]
+pub fn reference_state(system: &System) -> State {
+    system.initial_state()
+}
