@@ -1,0 +1,171 @@
+//! Shared builders for the validation tests: sections, reference data, consistent nodal loads, an
+//! exact linear solve and interpolation along recorded equilibrium paths.
+
+#![allow(dead_code)]
+
+use nalgebra::Vector3;
+use serde_json::Value;
+
+use tape_core::assembly::Assembled;
+use tape_core::linalg::LinearSolver;
+use tape_core::material::ShellSection;
+use tape_core::mesh::Mesh;
+use tape_core::{Model, Result, System};
+
+/// Homogeneous isotropic section; the other fields (drilling factor, shear factor) keep their defaults.
+pub fn section(thickness: f64, youngs_modulus: f64, poisson: f64) -> ShellSection {
+    ShellSection {
+        thickness,
+        youngs_modulus,
+        poisson,
+        ..ShellSection::default()
+    }
+}
+
+/// Reads `tests/reference_values/<file>`.
+///
+/// # Panics
+/// If the file is missing or is not JSON.
+pub fn reference(file: &str) -> Value {
+    let path = format!("{}/tests/reference_values/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// A JSON number.
+///
+/// # Panics
+/// If `v` is not a number.
+pub fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// A JSON array of numbers.
+///
+/// # Panics
+/// If `v` is not an array of numbers.
+pub fn nums(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap_or_else(|| panic!("not an array: {v}"))
+        .iter()
+        .map(num)
+        .collect()
+}
+
+/// Consistent nodal areas `int N_a dA` of a bilinear mesh (2 x 2 Gauss rule): a uniform surface
+/// load `q` per unit area gives the nodal forces `q * area[a]`.
+pub fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
+    let g = 1.0 / 3.0_f64.sqrt();
+    let (xa, ea) = ([-1.0, 1.0, 1.0, -1.0], [-1.0, -1.0, 1.0, 1.0]);
+    let mut area = vec![0.0; mesh.n_nodes()];
+    for quad in &mesh.quads {
+        let x = quad.map(|n| mesh.nodes[n]);
+        for (xi, eta) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+            let mut g1 = Vector3::zeros();
+            let mut g2 = Vector3::zeros();
+            let mut n = [0.0; 4];
+            for a in 0..4 {
+                n[a] = 0.25 * (1.0 + xa[a] * xi) * (1.0 + ea[a] * eta);
+                g1 += 0.25 * xa[a] * (1.0 + ea[a] * eta) * x[a];
+                g2 += 0.25 * ea[a] * (1.0 + xa[a] * xi) * x[a];
+            }
+            let det = g1.cross(&g2).norm();
+            for a in 0..4 {
+                area[quad[a]] += n[a] * det;
+            }
+        }
+    }
+    area
+}
+
+/// Index of the node nearest to `p`.
+pub fn nearest_node(mesh: &Mesh, p: Vector3<f64>) -> usize {
+    (0..mesh.n_nodes())
+        .min_by(|&a, &b| {
+            (mesh.nodes[a] - p)
+                .norm()
+                .total_cmp(&(mesh.nodes[b] - p).norm())
+        })
+        .expect("the mesh has nodes")
+}
+
+/// Linear (small-displacement) nodal displacements of `model` under its loads at load factor 1:
+/// the tangent at the stress-free reference configuration is the linear stiffness, so
+/// `K u = f_ext` is solved once. This avoids the cancellation that evaluating the nonlinear
+/// residual at a tiny load factor would suffer (strains of order 1e-12 computed as differences of
+/// metrics of order 1).
+///
+/// # Errors
+/// Invalid model or singular stiffness.
+pub fn linear_displacements(model: &Model) -> Result<Vec<[f64; 3]>> {
+    let mut system = System::try_new(model)?;
+    let state = system.initial_state();
+    let mut asm = Assembled::default();
+    system.assemble(&state, true, &mut asm);
+    let mut solver = LinearSolver::try_new(&system.pattern_ff)?;
+    solver.factorize(&asm.k_ff)?;
+    let mut u = asm.f_ext.clone();
+    solver.solve_in_place(&mut u)?;
+    let mut disp = vec![[0.0; 3]; model.mesh.n_nodes()];
+    for (eq, (node, dof)) in system.dofs.free_dofs.iter().enumerate() {
+        if dof.index() < 3 {
+            disp[*node][dof.index()] = u[eq];
+        }
+    }
+    Ok(disp)
+}
+
+/// Piecewise-linear interpolation of `ys(xs)` at `x`; `xs` must be increasing and bracket `x`.
+///
+/// # Panics
+/// If `x` lies outside `[xs[0], xs[last]]`.
+pub fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+    assert!(
+        x >= xs[0] && x <= xs[xs.len() - 1],
+        "{x} outside [{}, {}]",
+        xs[0],
+        xs[xs.len() - 1]
+    );
+    let i = xs.partition_point(|&v| v < x).clamp(1, xs.len() - 1);
+    let t = (x - xs[i - 1]) / (xs[i] - xs[i - 1]);
+    ys[i - 1] + t * (ys[i] - ys[i - 1])
+}
+
+/// Observed order of convergence `log(e1 / e2) / log(h1 / h2)`.
+pub fn rate(e1: f64, e2: f64, h1: f64, h2: f64) -> f64 {
+    (e1 / e2).ln() / (h1 / h2).ln()
+}
+
+/// Quarter of a hemisphere of radius `radius` centred at the origin, pole on +z, with a polar hole
+/// of half-angle `hole` [rad]: polar angle in `[hole, pi/2]` (`n_polar` elements, from the hole to
+/// the equator) and azimuth in `[0, pi/2]` (`n_azimuth` elements, from the x-z plane to the y-z
+/// plane). Normals point outward.
+///
+/// Node sets: `y0` (azimuth 0, plane y = 0), `x0` (azimuth 90 deg, plane x = 0), `equator`, `hole`.
+///
+/// # Errors
+/// Invalid mesh (never for sensible arguments).
+pub fn quarter_hemisphere(radius: f64, hole: f64, n_polar: usize, n_azimuth: usize) -> Result<Mesh> {
+    let id = |i: usize, j: usize| j * (n_polar + 1) + i;
+    let mut nodes = Vec::new();
+    for j in 0..=n_azimuth {
+        let phi = std::f64::consts::FRAC_PI_2 * j as f64 / n_azimuth as f64;
+        for i in 0..=n_polar {
+            let theta = hole + (std::f64::consts::FRAC_PI_2 - hole) * i as f64 / n_polar as f64;
+            nodes.push(radius * Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()));
+        }
+    }
+    let mut quads = Vec::new();
+    for j in 0..n_azimuth {
+        for i in 0..n_polar {
+            // (d/dtheta) x (d/dphi) points outward.
+            quads.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let mut mesh = Mesh::try_new(nodes, quads)?;
+    mesh.add_node_set("y0", (0..=n_polar).map(|i| id(i, 0)).collect())?;
+    mesh.add_node_set("x0", (0..=n_polar).map(|i| id(i, n_azimuth)).collect())?;
+    mesh.add_node_set("hole", (0..=n_azimuth).map(|j| id(0, j)).collect())?;
+    mesh.add_node_set("equator", (0..=n_azimuth).map(|j| id(n_polar, j)).collect())?;
+    Ok(mesh)
+}
