@@ -128,7 +128,9 @@ impl StaticOptions {
                 )))
             }
         };
-        if !self.control.eq_ignore_ascii_case("displacement") && (self.node.is_some() || self.dof.is_some() || self.delta.is_some()) {
+        if !self.control.eq_ignore_ascii_case("displacement")
+            && (self.node.is_some() || self.dof.is_some() || self.delta.is_some())
+        {
             return Err(PyValueError::new_err(format!(
                 "node, dof and delta only apply to control='displacement' (control is '{}')",
                 self.control
