@@ -3,9 +3,10 @@
 //! `K` is structurally symmetric, and numerically symmetric up to the small skew terms of finite
 //! rotations (`-[g]x / 2` at nodes carrying a rotational force, lever arms of rigid ties). It is
 //! solved by factorising its symmetric part `S = (K + K^T)/2` with a supernodal LDL^T (AMD
-//! ordering, symbolic analysis done once) and iterative refinement `x <- x + S^{-1}(b - K x)`,
-//! which converges to the exact solution of `K x = b` when the skew part is small; if it does
-//! not, an LU factorisation of `K` (COLAMD, also analysed once) is used instead. The pivots of the
+//! ordering, symbolic analysis done once) and, when `K` is not symmetric, GMRES preconditioned by
+//! `S^{-1}` to the exact solution of `K x = b` (a few iterations: `S^{-1} K` is the identity plus a
+//! small perturbation); if GMRES does not converge, an LU factorisation of `K` (COLAMD, also
+//! analysed once) is used instead. The pivots of the
 //! LDL^T factorisation give the inertia of `S` (Sylvester's law): the number of negative
 //! eigenvalues that tells whether an equilibrium is stable.
 
@@ -23,9 +24,9 @@ use faer::{Conj, MatMut, Par, Side};
 use crate::assembly::Pattern;
 use crate::error::{Error, Result};
 
-/// Relative residual at which iterative refinement stops.
+/// Backward error at which GMRES stops (a few hundred ulps).
 const REFINE_TOL: f64 = 1e-13;
-/// Refinement sweeps before falling back to LU.
+/// GMRES iterations before falling back to LU (restarts of 30).
 const REFINE_MAX: usize = 30;
 
 /// Solver for matrices with a fixed, structurally symmetric pattern.
@@ -39,6 +40,8 @@ pub struct LinearSolver {
     values: Vec<f64>,
     sym: Vec<f64>,
     skew_free: bool,
+    /// Largest column sum of |K| (the 1-norm).
+    k_norm: f64,
     negative: usize,
     lu_symbolic: Option<SymbolicLu<usize>>,
     lu: Option<Lu<usize, f64>>,
@@ -47,6 +50,8 @@ pub struct LinearSolver {
     pub factorisations: usize,
     /// Number of solves that needed the LU fallback.
     pub lu_fallbacks: usize,
+    /// Refinement sweeps done (each one a sparse product and an LDL^T solve).
+    pub refinement_sweeps: usize,
 }
 
 impl LinearSolver {
@@ -89,12 +94,14 @@ impl LinearSolver {
             values: Vec::new(),
             sym: Vec::new(),
             skew_free: true,
+            k_norm: 0.0,
             negative: 0,
             lu_symbolic: None,
             lu: None,
             factorised: false,
             factorisations: 0,
             lu_fallbacks: 0,
+            refinement_sweeps: 0,
         })
     }
 
@@ -120,6 +127,15 @@ impl LinearSolver {
                 .map(|(v, &t)| 0.5 * (v + values[t])),
         );
         let max = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let cp = self.symbolic.col_ptr();
+        self.k_norm = (0..self.symbolic.ncols())
+            .map(|j| {
+                values[cp[j]..cp[j + 1]]
+                    .iter()
+                    .map(|v| v.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
         self.skew_free = values
             .iter()
             .zip(&self.sym)
@@ -206,6 +222,107 @@ impl LinearSolver {
         Ok(self.negative)
     }
 
+    /// `y = K x`.
+    fn mul(&self, x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        let (cp, ri) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        for (j, xj) in x.iter().enumerate() {
+            for p in cp[j]..cp[j + 1] {
+                y[ri[p]] += self.values[p] * xj;
+            }
+        }
+    }
+
+    /// Flexible GMRES(m) on `K x = b`, right-preconditioned by the LDL^T of the symmetric part,
+    /// starting from `x` (= S^{-1} b). Returns whether `|b - K x| <= REFINE_TOL |b|` was reached.
+    fn gmres(&mut self, b: &[f64], b_norm: f64, x: &mut [f64]) -> bool {
+        const M: usize = 30;
+        let n = b.len();
+        // Backward-error criterion, as a direct solver would achieve: |b - K x| <= tol (|b| + |K| |x|).
+        let x_norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let tol = REFINE_TOL * (b_norm + self.k_norm * x_norm);
+        let mut r = vec![0.0; n];
+        let mut w = vec![0.0; n];
+        for _restart in 0..REFINE_MAX / 10 {
+            self.mul(x, &mut w);
+            for i in 0..n {
+                r[i] = b[i] - w[i];
+            }
+            let beta = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !beta.is_finite() {
+                return false;
+            }
+            if beta <= tol {
+                return true;
+            }
+            let mut v: Vec<Vec<f64>> = vec![r.iter().map(|ri| ri / beta).collect()];
+            let mut z: Vec<Vec<f64>> = Vec::with_capacity(M);
+            let mut h = vec![[0.0; M + 1]; M];
+            let (mut cs, mut sn) = ([0.0; M], [0.0; M]);
+            let mut g = [0.0; M + 1];
+            g[0] = beta;
+            let mut k_done = 0;
+            for j in 0..M {
+                let mut zj = v[j].clone();
+                self.solve_sym(&mut zj);
+                self.refinement_sweeps += 1;
+                self.mul(&zj, &mut w);
+                z.push(zj);
+                for (i, vi) in v.iter().enumerate() {
+                    let hij = w.iter().zip(vi).map(|(a, c)| a * c).sum::<f64>();
+                    h[j][i] = hij;
+                    for (wk, vk) in w.iter_mut().zip(vi) {
+                        *wk -= hij * vk;
+                    }
+                }
+                let hn = w.iter().map(|a| a * a).sum::<f64>().sqrt();
+                h[j][j + 1] = hn;
+                for i in 0..j {
+                    let t = cs[i] * h[j][i] + sn[i] * h[j][i + 1];
+                    h[j][i + 1] = -sn[i] * h[j][i] + cs[i] * h[j][i + 1];
+                    h[j][i] = t;
+                }
+                let den = h[j][j].hypot(h[j][j + 1]);
+                if den == 0.0 || !den.is_finite() {
+                    return false;
+                }
+                cs[j] = h[j][j] / den;
+                sn[j] = h[j][j + 1] / den;
+                h[j][j] = den;
+                h[j][j + 1] = 0.0;
+                g[j + 1] = -sn[j] * g[j];
+                g[j] *= cs[j];
+                k_done = j + 1;
+                if g[j + 1].abs() <= tol || hn == 0.0 {
+                    break;
+                }
+                v.push(w.iter().map(|a| a / hn).collect());
+            }
+            // Back substitution for the Krylov coefficients, then x += Z y.
+            let mut y = [0.0; M];
+            for i in (0..k_done).rev() {
+                let mut acc = g[i];
+                for l in (i + 1)..k_done {
+                    acc -= h[l][i] * y[l];
+                }
+                y[i] = acc / h[i][i];
+            }
+            for (zi, yi) in z.iter().zip(&y[..k_done]) {
+                for (xk, zk) in x.iter_mut().zip(zi) {
+                    *xk += yi * zk;
+                }
+            }
+        }
+        self.mul(x, &mut w);
+        let res = b
+            .iter()
+            .zip(&w)
+            .map(|(bi, wi)| (bi - wi) * (bi - wi))
+            .sum::<f64>()
+            .sqrt();
+        res <= tol
+    }
+
     fn solve_sym(&mut self, x: &mut [f64]) {
         let n = x.len();
         LdltRef::new(&self.ldlt, &self.l_values).solve_in_place_with_conj(
@@ -241,31 +358,10 @@ impl LinearSolver {
                     Err(singular())
                 };
             }
-            let n = rhs.len();
-            let mut r = vec![0.0; n];
-            for _ in 0..REFINE_MAX {
-                // r = b - K x
-                r.copy_from_slice(&b);
-                let (cp, ri) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
-                for j in 0..n {
-                    let xj = rhs[j];
-                    for p in cp[j]..cp[j + 1] {
-                        r[ri[p]] -= self.values[p] * xj;
-                    }
-                }
-                let r_norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                if !r_norm.is_finite() {
-                    break;
-                }
-                if r_norm <= REFINE_TOL * b_norm {
-                    return Ok(());
-                }
-                self.solve_sym(&mut r);
-                for (x, d) in rhs.iter_mut().zip(&r) {
-                    *x += d;
-                }
+            if self.gmres(&b, b_norm, rhs) {
+                return Ok(());
             }
-            // Refinement did not converge: the skew part is too large; use LU from now on.
+            // GMRES did not converge: the skew part is too large; use LU for this matrix.
             self.lu_fallbacks += 1;
             self.factorize_lu()?;
             rhs.copy_from_slice(&b);

@@ -64,6 +64,10 @@ pub struct SectionStiffness {
     pub shear: f64,
     /// Drilling stiffness [N/m] (per unit area, times the squared drilling strain).
     pub drilling: f64,
+    /// `L^T` with `C_m = L L^T` (Cholesky), so that `B^T C_m B = (L^T B)^T (L^T B)`.
+    pub membrane_factor: Matrix3<f64>,
+    /// `L^T` with `C_b = L L^T`.
+    pub bending_factor: Matrix3<f64>,
 }
 
 impl ShellSection {
@@ -110,9 +114,17 @@ impl ShellSection {
         let c = e * t / (1.0 - nu * nu);
         let membrane = Matrix3::new(c, c * nu, 0.0, c * nu, c, 0.0, 0.0, 0.0, c * (1.0 - nu) / 2.0);
         let g = e / (2.0 * (1.0 + nu));
+        let bending = membrane * (t * t / 12.0);
+        // Positive definite for E, t > 0 and -1 < nu < 0.5 (checked by `validate`).
+        let factor = |c: Matrix3<f64>| {
+            c.cholesky()
+                .map_or_else(Matrix3::zeros, |l| l.l().transpose())
+        };
         SectionStiffness {
             membrane,
-            bending: membrane * (t * t / 12.0),
+            bending,
+            membrane_factor: factor(membrane),
+            bending_factor: factor(bending),
             shear: self.shear_factor * g * t,
             drilling: self.drilling_factor * g * t,
         }

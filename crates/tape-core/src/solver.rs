@@ -165,6 +165,10 @@ pub struct Stats {
     pub cutbacks: usize,
     /// Numeric factorisations.
     pub factorisations: usize,
+    /// Iterative-refinement sweeps of the linear solves (see [`crate::linalg`]).
+    pub refinement_sweeps: usize,
+    /// Linear solves that fell back to LU.
+    pub lu_fallbacks: usize,
     /// Time in assembly [s].
     pub assembly_s: f64,
     /// Time in factorisation and solves [s].

@@ -10,7 +10,7 @@ fn print_curve() -> Result<()> {
         ..TapeBending::default()
     };
     let curve = tb.run(&mut |_| true)?;
-    for p in curve.points.iter().step_by(1000) {
+    for p in curve.points.iter().step_by(1) {
         eprintln!(
             "{:8.3} {:10.5} {} {}",
             p.theta.to_degrees(),

@@ -38,6 +38,8 @@ use crate::rotation::{rotated_vector_hessian, skew};
 
 /// Degrees of freedom of one element (4 nodes x 6).
 pub const DOFS_PER_ELEMENT: usize = 24;
+/// Material strain rows: 6 per Gauss point, 4 MITC4 tying strains, 4 drilling strains.
+const N_ROWS: usize = 32;
 /// Element vector.
 pub type ElementVector = SVector<f64, DOFS_PER_ELEMENT>;
 /// Element matrix.
@@ -84,6 +86,8 @@ pub struct ShellElement {
     gamma0: [f64; 4],
     /// `S_tt' = sum_gp w sum_i beta_it beta_it'`, the shear energy metric on tying strains [m^2 / m^2].
     shear_metric: Matrix4<f64>,
+    /// `L^T` with `shear_metric = L L^T`.
+    shear_factor: Matrix4<f64>,
     dn_centre: [[f64; 2]; 4],
     drill_ref: [(f64, f64); 4],
     psi0: [f64; 4],
@@ -196,6 +200,11 @@ impl ShellElement {
             cd,
             gamma0: [0.0; 4],
             shear_metric,
+            shear_factor: shear_metric
+                .cholesky()
+                .ok_or_else(degenerate)?
+                .l()
+                .transpose(),
             dn_centre,
             drill_ref,
             psi0: [0.0; 4],
@@ -292,7 +301,7 @@ impl ShellElement {
         q: &[Matrix3<f64>; 4],
         sec: &SectionStiffness,
         f: &mut ElementVector,
-        mut k: Option<&mut ElementMatrix>,
+        k: Option<&mut ElementMatrix>,
     ) -> f64 {
         let (mut t1, mut t2, mut d) = ([Vector3::zeros(); 4], [Vector3::zeros(); 4], [Vector3::zeros(); 4]);
         for a in 0..4 {
@@ -308,9 +317,10 @@ impl ShellElement {
         let mut sxd = [[0.0; 4]; 4];
         let mut sxt1 = [[0.0; 4]; 4];
         let mut sxt2 = [[0.0; 4]; 4];
-        if let Some(k) = k.as_deref_mut() {
-            k.fill(0.0);
-        }
+        let tangent = k.is_some();
+        // Material rows of all integration points, column-major by DOF: sqrt(w) L^T B.
+        let mut btil = [0.0; DOFS_PER_ELEMENT * N_ROWS];
+        let mut n_rows = 0;
         let mut energy = 0.0;
 
         // Membrane and bending at the 2x2 Gauss points.
@@ -339,12 +349,13 @@ impl ShellElement {
                     + m[2] * (p * ds[1] + r * ds[0]);
                 f_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
             }
-            if let Some(k) = k.as_deref_mut() {
-                let mut b = SMatrix::<f64, 6, DOFS_PER_ELEMENT>::zeros();
+            if tangent {
+                // Rows of B (6 x 24) at this point, premultiplied by sqrt(w) L^T.
+                let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
                 for a in 0..4 {
                     let [p, r] = g.dn[a];
                     let c = 6 * a;
-                    let rows_x = [
+                    let bx = [
                         p * xs[0],
                         r * xs[1],
                         p * xs[1] + r * xs[0],
@@ -352,25 +363,30 @@ impl ShellElement {
                         r * ds[1],
                         p * ds[1] + r * ds[0],
                     ];
-                    for (i, v) in rows_x.iter().enumerate() {
-                        b.fixed_view_mut::<1, 3>(i, c).copy_from(&v.transpose());
-                    }
-                    let rows_t = [
+                    let bt = [
                         d[a].cross(&(p * xs[0])),
                         d[a].cross(&(r * xs[1])),
                         d[a].cross(&(p * xs[1] + r * xs[0])),
                     ];
-                    for (i, v) in rows_t.iter().enumerate() {
-                        b.fixed_view_mut::<1, 3>(3 + i, c + 3)
-                            .copy_from(&v.transpose());
+                    for i in 0..3 {
+                        rows[i][c..c + 3].copy_from_slice(bx[i].as_slice());
+                        rows[3 + i][c..c + 3].copy_from_slice(bx[3 + i].as_slice());
+                        rows[3 + i][c + 3..c + 6].copy_from_slice(bt[i].as_slice());
                     }
                 }
-                let mut cb = SMatrix::<f64, 6, DOFS_PER_ELEMENT>::zeros();
-                cb.fixed_rows_mut::<3>(0)
-                    .copy_from(&(sec.membrane * g.w * b.fixed_rows::<3>(0)));
-                cb.fixed_rows_mut::<3>(3)
-                    .copy_from(&(sec.bending * g.w * b.fixed_rows::<3>(3)));
-                k.gemm_tr(1.0, &b, &cb, 1.0);
+                let sw = g.w.sqrt();
+                for (block, factor) in [(0, &sec.membrane_factor), (3, &sec.bending_factor)] {
+                    for i in 0..3 {
+                        for j in 0..DOFS_PER_ELEMENT {
+                            let mut v = 0.0;
+                            for kk in i..3 {
+                                v += factor[(i, kk)] * rows[block + kk][j];
+                            }
+                            btil[j * N_ROWS + n_rows + block + i] = sw * v;
+                        }
+                    }
+                }
+                n_rows += 6;
                 for a in 0..4 {
                     let [pa, ra] = g.dn[a];
                     for bb in 0..4 {
@@ -399,22 +415,29 @@ impl ShellElement {
                 f_d[a] += qv[t] * self.cd[t][a] * gt[t];
             }
         }
-        if let Some(k) = k.as_deref_mut() {
-            let mut bs = SMatrix::<f64, 4, DOFS_PER_ELEMENT>::zeros();
+        if tangent {
+            let mut rows = [[0.0; DOFS_PER_ELEMENT]; 4];
             for t in 0..4 {
                 for a in 0..4 {
                     let c = 6 * a;
-                    bs.fixed_view_mut::<1, 3>(t, c)
-                        .copy_from(&(self.cg[t][a] * dt[t]).transpose());
-                    bs.fixed_view_mut::<1, 3>(t, c + 3)
-                        .copy_from(&d[a].cross(&(self.cd[t][a] * gt[t])).transpose());
+                    rows[t][c..c + 3].copy_from_slice((self.cg[t][a] * dt[t]).as_slice());
+                    rows[t][c + 3..c + 6].copy_from_slice(d[a].cross(&(self.cd[t][a] * gt[t])).as_slice());
                     for bb in 0..4 {
                         sxd[a][bb] += qv[t] * self.cg[t][a] * self.cd[t][bb];
                     }
                 }
             }
-            let sbs = self.shear_metric * sec.shear * bs;
-            k.gemm_tr(1.0, &bs, &sbs, 1.0);
+            let sk = sec.shear.sqrt();
+            for t in 0..4 {
+                for j in 0..DOFS_PER_ELEMENT {
+                    let mut v = 0.0;
+                    for tt in t..4 {
+                        v += self.shear_factor[(t, tt)] * rows[tt][j];
+                    }
+                    btil[j * N_ROWS + n_rows + t] = sk * v;
+                }
+            }
+            n_rows += 4;
         }
 
         // Drilling.
@@ -428,20 +451,23 @@ impl ShellElement {
             energy += 0.5 * kd * psi * psi;
             f_t1[a] += 0.5 * big_psi * u;
             f_t2[a] -= 0.5 * big_psi * v;
-            let mut row = ElementVector::zeros();
+            let mut row = [0.0; DOFS_PER_ELEMENT];
             for bb in 0..4 {
                 let [p, r] = self.dn_centre[bb];
                 let (al, be) = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
                 let gx = al * t1[a] + be * t2[a];
                 f_x[bb] += big_psi * gx;
-                row.fixed_rows_mut::<3>(6 * bb).copy_from(&gx);
+                row[6 * bb..6 * bb + 3].copy_from_slice(gx.as_slice());
                 sxt1[bb][a] += big_psi * al;
                 sxt2[bb][a] += big_psi * be;
             }
-            if let Some(k) = k.as_deref_mut() {
-                row.fixed_rows_mut::<3>(6 * a + 3)
-                    .copy_from(&(0.5 * (t1[a].cross(&u) - t2[a].cross(&v))));
-                k.ger(kd, &row, &row, 1.0);
+            if tangent {
+                row[6 * a + 3..6 * a + 6].copy_from_slice((0.5 * (t1[a].cross(&u) - t2[a].cross(&v))).as_slice());
+                let sk = kd.sqrt();
+                for j in 0..DOFS_PER_ELEMENT {
+                    btil[j * N_ROWS + n_rows] = sk * row[j];
+                }
+                n_rows += 1;
             }
         }
 
@@ -455,6 +481,24 @@ impl ShellElement {
 
         // Geometric stiffness and the rotational terms.
         if let Some(k) = k {
+            // Material part: K = Bt^T Bt, upper triangle by contiguous dot products, then mirrored.
+            debug_assert_eq!(n_rows, N_ROWS);
+            for j in 0..DOFS_PER_ELEMENT {
+                let bj = &btil[j * N_ROWS..(j + 1) * N_ROWS];
+                for i in 0..=j {
+                    let bi = &btil[i * N_ROWS..(i + 1) * N_ROWS];
+                    // Independent lanes so that the reduction vectorises without reassociation.
+                    let mut acc = [0.0; 8];
+                    for (ci, cj) in bi.chunks_exact(8).zip(bj.chunks_exact(8)) {
+                        for l in 0..8 {
+                            acc[l] += ci[l] * cj[l];
+                        }
+                    }
+                    let v = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+                    k[(i, j)] = v;
+                    k[(j, i)] = v;
+                }
+            }
             for a in 0..4 {
                 for bb in 0..4 {
                     let (ra, cb) = (6 * a, 6 * bb);

@@ -7,8 +7,10 @@
 //! the control equation: zero (load control), the controlled DOF fixed (displacement control, Batoz
 //! & Dhatt 1979), or the arc-length constraint
 //! `|Dq|_W^2 + Dlambda^2 c = Ds^2` (Crisfield 1981), whose root is chosen at the smallest angle with
-//! the current increment. The predictor direction follows the previous increment (Feng et al.
-//! 1996), so limit points, snap-through and snap-back are passed. Norms weigh rotations by the
+//! the predictor. The first predictor follows the tangent in the requested direction; later ones
+//! extrapolate the previous converged increment (secant predictor), and a converged increment that
+//! turns back on the path (negative inner product with the previous one) is rejected and cut back,
+//! so limit points, snap-through and snap-back are passed without reversing. Norms weigh rotations by the
 //! characteristic length `L_c` of the model.
 //!
 //! An increment that fails (no convergence, singular tangent, no arc-length root, non-finite
@@ -47,9 +49,11 @@ struct Solver<'a> {
     fresh: bool,
     /// `linear` holds the factorisation of `asm`'s tangent.
     factorised: bool,
+    /// Residual norm reachable in floating point [N]: a few ulps of the element forces.
+    round_off: f64,
     /// Largest reference force met on the path so far [N] (the force scale near zero load).
     path_force: f64,
-    /// Increment of the last converged step, for the arc-length predictor direction.
+    /// Increment of the last converged step, for the arc-length secant predictor.
     previous: Option<(Vec<f64>, f64)>,
     weights: Vec<f64>,
     values: Vec<f64>,
@@ -134,7 +138,7 @@ impl Solver<'_> {
     fn converged(&self, lambda: f64, energy: Option<(f64, f64)>) -> (bool, f64) {
         let res = self.force_norm(&self.asm.residual);
         let tol = self.params.newton.tol_force * self.reference_force(lambda);
-        let ok_force = res <= tol;
+        let ok_force = res <= tol.max(self.round_off);
         // The energy ratio cannot go below round-off on tiny increments: a residual a hundred times
         // below the force tolerance is converged whatever the energy ratio says.
         let ok_energy =
@@ -148,36 +152,36 @@ impl Solver<'_> {
         if !self.fresh {
             self.assemble(state);
         }
-        let (dq_r, dq_b) = self.solve_pair()?;
-        let (dlambda0, mut dq) = match inc {
-            Increment::Load(dl) => (dl, dq_r.clone()),
-            Increment::Displacement { eq, delta } => {
-                if dq_b[eq].abs() < 1e-300 {
-                    return Err(Error::Factorisation(
-                        "the controlled DOF does not respond to the load".into(),
-                    ));
-                }
-                ((delta - dq_r[eq]) / dq_b[eq], dq_r.clone())
+        let (dlambda0, dq) = match (inc, &self.previous) {
+            (Increment::Arc { ds, .. }, Some((prev_dq, prev_dl))) => {
+                // Secant predictor: extrapolate the last converged increment to the new arc length.
+                let norm = (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda).sqrt();
+                let scale = ds / norm;
+                (scale * prev_dl, prev_dq.iter().map(|v| scale * v).collect())
             }
-            Increment::Arc { ds, direction } => {
-                // Feng's predictor: keep going the way the last increment went.
-                let sign = match &self.previous {
-                    None => direction,
-                    Some((dq, dl)) => {
-                        if self.dot_w(dq, &dq_b) + dl * self.c_lambda >= 0.0 {
-                            1.0
-                        } else {
-                            -1.0
+            _ => {
+                let (dq_r, dq_b) = self.solve_pair()?;
+                let (dlambda0, mut dq) = match inc {
+                    Increment::Load(dl) => (dl, dq_r),
+                    Increment::Displacement { eq, delta } => {
+                        if dq_b[eq].abs() < 1e-300 {
+                            return Err(Error::Factorisation(
+                                "the controlled DOF does not respond to the load".into(),
+                            ));
                         }
+                        ((delta - dq_r[eq]) / dq_b[eq], dq_r)
+                    }
+                    Increment::Arc { ds, direction } => {
+                        let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
+                        (direction * ds / norm, vec![0.0; dq_b.len()])
                     }
                 };
-                let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
-                (sign * ds / norm, vec![0.0; dq_b.len()])
+                for (d, b) in dq.iter_mut().zip(&dq_b) {
+                    *d += dlambda0 * b;
+                }
+                (dlambda0, dq)
             }
         };
-        for (d, b) in dq.iter_mut().zip(&dq_b) {
-            *d += dlambda0 * b;
-        }
         self.system.update(state, &dq, dlambda0);
         let mut acc = dq;
         let mut acc_lambda = dlambda0;
@@ -194,6 +198,16 @@ impl Solver<'_> {
                 return Err(Error::Factorisation("non-finite residual".into()));
             }
             if ok {
+                if let (Increment::Arc { .. }, Some((prev_dq, prev_dl))) = (inc, &self.previous) {
+                    // A converged increment that turns back on the path means the step jumped
+                    // across a sharp turn: reject it so that the step is cut back.
+                    let cos = self.dot_w(&acc, prev_dq) + acc_lambda * prev_dl * self.c_lambda;
+                    if cos <= 0.0 {
+                        return Err(Error::Factorisation(
+                            "the arc-length step turned back on the path".into(),
+                        ));
+                    }
+                }
                 return Ok(Outcome {
                     iterations: it,
                     residual: res,
@@ -373,12 +387,26 @@ pub fn solve_static(
         .sum();
     let weights = system.free_weights();
     let force_floor = 1e-13 * system.section.membrane[(0, 0)] * system.char_length;
+    // Element forces are sums of terms of size E t |x| that cancel: the residual cannot go below a
+    // few ulps of them (measured: about eps E t |x| per node).
+    let x_max = system
+        .reference
+        .x
+        .iter()
+        .map(|x| x.norm())
+        .fold(0.0, f64::max);
+    let round_off = 100.0
+        * f64::EPSILON
+        * system.section.membrane[(0, 0)]
+        * (x_max + system.char_length)
+        * (system.reference.x.len() as f64).sqrt();
     let mut s = Solver {
         system,
         linear,
         asm: Assembled::default(),
         fresh: false,
         factorised: false,
+        round_off,
         path_force: 0.0,
         previous: None,
         weights,
@@ -590,6 +618,8 @@ pub fn solve_static(
             }
         }
     }
+    s.stats.refinement_sweeps = s.linear.refinement_sweeps;
+    s.stats.lu_fallbacks = s.linear.lu_fallbacks;
     s.stats.wall_s = start.elapsed().as_secs_f64();
     path.stats = s.stats;
     Ok(path)
