@@ -104,7 +104,7 @@ def bend_tape(
     theta_max: float = ...,
     unload: bool = False,
     imperfection: float = 0.0,
-    initial_increment: float = 0.01,
+    initial_increment: float = 0.02,
     max_steps: int = 1000,
     progress: Callable[[float], bool | None] | None = None,
 ) -> dict[str, Any]:

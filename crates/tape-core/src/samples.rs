@@ -51,7 +51,7 @@ impl Default for TapeBending {
             theta_max: std::f64::consts::FRAC_PI_2,
             unload: false,
             imperfection: 0.0,
-            initial_increment: 0.01,
+            initial_increment: 0.02,
             max_steps: 1000,
         }
     }
@@ -93,6 +93,8 @@ pub struct BendingCurve {
     pub stats: Stats,
     /// Why the run stopped early, if it did (the points so far are kept).
     pub error: Option<Error>,
+    /// True if the progress callback asked to stop.
+    pub cancelled: bool,
 }
 
 impl TapeBending {
@@ -214,6 +216,7 @@ impl TapeBending {
             curve.stats.wall_s += path.stats.wall_s;
             if path.error.is_some() || path.cancelled {
                 curve.error = path.error;
+                curve.cancelled = path.cancelled;
                 break;
             }
         }

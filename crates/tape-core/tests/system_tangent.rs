@@ -13,7 +13,10 @@ use tape_core::{Result, System};
 
 #[test]
 fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
-    let tb = TapeBending { mesh_size: 4e-3, ..TapeBending::default() };
+    let tb = TapeBending {
+        mesh_size: 4e-3,
+        ..TapeBending::default()
+    };
     let bm = tb.build()?;
     let mut system = System::try_new(&bm.model)?;
     let mut state = system.initial_state();
@@ -34,7 +37,9 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
     system.assemble(&state, true, &mut a);
     let k = a.k_ff.clone();
     // Columns to check: the driven reference node's free DOFs and a spread of shell DOFs.
-    let driven: Vec<usize> = (0..n).filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node).collect();
+    let driven: Vec<usize> = (0..n)
+        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
+        .collect();
     let mut cols = driven.clone();
     cols.extend((0..n).step_by(97));
     let mut worst: f64 = 0.0;
@@ -51,15 +56,30 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
         let (mut ap, mut am) = (Assembled::default(), Assembled::default());
         system.assemble(&plus, false, &mut ap);
         system.assemble(&minus, false, &mut am);
-        let fd: Vec<f64> = ap.residual.iter().zip(&am.residual).map(|(p, m)| (p - m) / (2.0 * h)).collect();
+        let fd: Vec<f64> = ap
+            .residual
+            .iter()
+            .zip(&am.residual)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
         let mut col = vec![0.0; n];
         let pat = &system.pattern_ff;
         for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
             col[pat.row_idx[p]] = k[p];
         }
         let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let err = fd.iter().zip(&col).map(|(f, c)| (f - c) * (f - c)).sum::<f64>().sqrt() / norm;
-        assert!(err < 1e-5, "column {j} ({:?}): relative error {err:e}", system.dofs.free_dofs[j]);
+        let err = fd
+            .iter()
+            .zip(&col)
+            .map(|(f, c)| (f - c) * (f - c))
+            .sum::<f64>()
+            .sqrt()
+            / norm;
+        assert!(
+            err < 1e-5,
+            "column {j} ({:?}): relative error {err:e}",
+            system.dofs.free_dofs[j]
+        );
         worst = worst.max(err);
     }
     assert!(driven.len() == 2, "the driven node has free ux and uz");
@@ -70,7 +90,10 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
 /// `dr/dlambda = K_fc values - f_ext` (the bordering vector of displacement-driven continuation).
 #[test]
 fn coupling_to_prescribed_dofs_is_derivative_of_residual() -> Result<()> {
-    let tb = TapeBending { mesh_size: 4e-3, ..TapeBending::default() };
+    let tb = TapeBending {
+        mesh_size: 4e-3,
+        ..TapeBending::default()
+    };
     let bm = tb.build()?;
     let mut system = System::try_new(&bm.model)?;
     let mut state = system.initial_state();
@@ -93,9 +116,20 @@ fn coupling_to_prescribed_dofs_is_derivative_of_residual() -> Result<()> {
     let (mut ap, mut am) = (Assembled::default(), Assembled::default());
     system.assemble(&plus, false, &mut ap);
     system.assemble(&minus, false, &mut am);
-    let fd: Vec<f64> = ap.residual.iter().zip(&am.residual).map(|(p, m)| (p - m) / (2.0 * h)).collect();
+    let fd: Vec<f64> = ap
+        .residual
+        .iter()
+        .zip(&am.residual)
+        .map(|(p, m)| (p - m) / (2.0 * h))
+        .collect();
     let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let err = fd.iter().zip(&pred).map(|(f, c)| (f - c) * (f - c)).sum::<f64>().sqrt() / norm;
+    let err = fd
+        .iter()
+        .zip(&pred)
+        .map(|(f, c)| (f - c) * (f - c))
+        .sum::<f64>()
+        .sqrt()
+        / norm;
     assert!(err < 1e-5, "relative error of dr/dlambda {err:e}");
     Ok(())
 }
@@ -105,7 +139,10 @@ fn coupling_to_prescribed_dofs_is_derivative_of_residual() -> Result<()> {
 #[test]
 fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
     use tape_core::Dof;
-    let tb = TapeBending { mesh_size: 4e-3, ..TapeBending::default() };
+    let tb = TapeBending {
+        mesh_size: 4e-3,
+        ..TapeBending::default()
+    };
     let mut bm = tb.build()?;
     bm.model.constraints.retain(|c| c.node != bm.driven_node);
     bm.model.add_load(bm.driven_node, Dof::Ry, 0.05)?;
@@ -127,10 +164,16 @@ fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
     system.update(&mut state, &dq, 0.5);
     let mut a = Assembled::default();
     system.assemble(&state, true, &mut a);
-    let cols: Vec<usize> = (0..n).filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node).collect();
+    let cols: Vec<usize> = (0..n)
+        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
+        .collect();
     assert_eq!(cols.len(), 6);
     for &j in &cols {
-        let h = if system.dofs.free_dofs[j].1.is_rotation() { 1e-6 } else { 1e-7 };
+        let h = if system.dofs.free_dofs[j].1.is_rotation() {
+            1e-6
+        } else {
+            1e-7
+        };
         let mut e = vec![0.0; n];
         let (mut plus, mut minus) = (state.clone(), state.clone());
         e[j] = h;
@@ -145,10 +188,25 @@ fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
         for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
             col[pat.row_idx[p]] = a.k_ff[p];
         }
-        let fd: Vec<f64> = ap.residual.iter().zip(&am.residual).map(|(p, m)| (p - m) / (2.0 * h)).collect();
+        let fd: Vec<f64> = ap
+            .residual
+            .iter()
+            .zip(&am.residual)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
         let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let err = fd.iter().zip(&col).map(|(f, c)| (f - c) * (f - c)).sum::<f64>().sqrt() / norm;
-        assert!(err < 1e-5, "column {j} ({:?}): relative error {err:e}", system.dofs.free_dofs[j]);
+        let err = fd
+            .iter()
+            .zip(&col)
+            .map(|(f, c)| (f - c) * (f - c))
+            .sum::<f64>()
+            .sqrt()
+            / norm;
+        assert!(
+            err < 1e-5,
+            "column {j} ({:?}): relative error {err:e}",
+            system.dofs.free_dofs[j]
+        );
     }
     Ok(())
 }

@@ -261,6 +261,8 @@ pub fn stats_to_dict<'py>(py: Python<'py>, s: &Stats) -> PyResult<Bound<'py, PyD
     d.set_item("iterations", s.iterations)?;
     d.set_item("cutbacks", s.cutbacks)?;
     d.set_item("factorisations", s.factorisations)?;
+    d.set_item("refinement_sweeps", s.refinement_sweeps)?;
+    d.set_item("lu_fallbacks", s.lu_fallbacks)?;
     d.set_item("assembly_s", s.assembly_s)?;
     d.set_item("solve_s", s.solve_s)?;
     d.set_item("wall_s", s.wall_s)?;

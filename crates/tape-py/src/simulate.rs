@@ -270,7 +270,7 @@ pub fn solve_static<'py>(
 #[pyo3(signature = (
     *, length = 0.1, radius = 15.55e-3, alpha = 1.21911, thickness = 0.138e-3, youngs_modulus = 151.76e9,
     poisson = 0.3, mesh_size = 2e-3, theta_max = std::f64::consts::FRAC_PI_2, unload = false, imperfection = 0.0,
-    initial_increment = 0.01, max_steps = 1000, progress = None
+    initial_increment = 0.02, max_steps = 1000, progress = None
 ))]
 #[allow(clippy::too_many_arguments, clippy::needless_pass_by_value)]
 pub fn bend_tape<'py>(
@@ -334,6 +334,7 @@ pub fn bend_tape<'py>(
     d.set_item("ndof", curve.ndof)?;
     d.set_item("stats", convert::stats_to_dict(py, &curve.stats)?)?;
     d.set_item("error", curve.error.as_ref().map(ToString::to_string))?;
+    d.set_item("cancelled", curve.cancelled)?;
     let s = PyDict::new(py);
     s.set_item("length", length)?;
     s.set_item("radius", radius)?;
@@ -348,6 +349,7 @@ pub fn bend_tape<'py>(
     let arc = bending.params(1.0, 1.0);
     s.set_item("target_iterations", arc.target_iterations)?;
     s.set_item("tol_force", arc.newton.tol_force)?;
+    s.set_item("tol_energy", arc.newton.tol_energy)?;
     s.set_item("max_iterations", arc.newton.max_iterations)?;
     s.set_item("max_cutbacks", arc.max_cutbacks)?;
     if let Control::ArcLength {
