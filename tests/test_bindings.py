@@ -322,6 +322,8 @@ def test_result_dict_has_every_key_with_consistent_shapes():
         "iterations",
         "cutbacks",
         "factorisations",
+        "refinement_sweeps",
+        "lu_fallbacks",
         "assembly_s",
         "solve_s",
         "wall_s",
@@ -383,9 +385,9 @@ def test_exception_in_progress_callback_propagates():
 
 
 def test_gil_is_released_during_a_solve():
-    # A single load step of a 16 x 16 plate: Newton iterations with no callback in between, so the
+    # A single load step of a 48 x 48 plate: Newton iterations with no callback in between, so the
     # other thread can only run while the solver has released the GIL.
-    model = cantilever(nx=16, ny=16, load=200.0)
+    model = cantilever(nx=48, ny=48, load=200.0)
     ticks = []
     done = threading.Event()
 
