@@ -82,6 +82,7 @@ def solve_static(
     direction: int = 1,
     stability: bool = False,
     record_fields: bool = True,
+    jump: bool = False,
     tol_force: float = 1e-8,
     max_iterations: int = 20,
     max_cutbacks: int = 10,
@@ -106,6 +107,7 @@ def bend_tape(
     imperfection: float = 0.0,
     initial_increment: float = 0.02,
     max_steps: int = 1000,
+    jump: bool = False,
     progress: Callable[[float], bool | None] | None = None,
 ) -> dict[str, Any]:
     """Pure bending of a tape spring; keys: theta, moment, negative_eigenvalues, branch, ndof,

@@ -72,6 +72,10 @@ class BendingSetup:
         Also unload back to zero (hysteresis).
     imperfection_deg : float
         Twist imperfection amplitude [deg]: sections rotated about x by ``a sin(pi x / L)``.
+    jump : bool
+        Follow the path of a slow rotation-controlled test: where the angle reaches a limit, jump
+        to the stable equilibrium beyond it instead of tracing the unstable branch back. Off: the
+        whole equilibrium path (stable and unstable) is traced.
     """
 
     length: float = 0.100
@@ -84,6 +88,7 @@ class BendingSetup:
     theta_max_deg: float = 90.0
     unload: bool = False
     imperfection_deg: float = 0.0
+    jump: bool = False
 
     @property
     def flexural_rigidity(self) -> float:
@@ -122,6 +127,8 @@ class BendingResult:
         Whether each equilibrium is stable under rotation control.
     branch : ndarray of int
         0 on loading, 1 on unloading.
+    jump : ndarray of bool
+        True where the point was reached by a jump (snap at fixed angle) from the previous one.
     ndof : int
         Number of free degrees of freedom.
     wall_s : float
@@ -139,6 +146,7 @@ class BendingResult:
     moment: NDArray[np.float64]
     stable: NDArray[np.bool_]
     branch: NDArray[np.int64]
+    jump: NDArray[np.bool_]
     ndof: int
     wall_s: float
     stats: dict[str, Any] = field(default_factory=dict)
@@ -239,6 +247,7 @@ def bend(
             theta_max=theta_max,
             unload=setup.unload,
             imperfection=math.radians(setup.imperfection_deg),
+            jump=setup.jump,
             progress=callback,
         )
     finally:
@@ -250,6 +259,7 @@ def bend(
         moment=np.asarray(out["moment"], dtype=float),
         stable=np.asarray(out["negative_eigenvalues"]) == 0,
         branch=np.asarray(out["branch"], dtype=np.int64),
+        jump=np.asarray(out["jump"], dtype=bool),
         ndof=int(out["ndof"]),
         wall_s=float(out["stats"]["wall_s"]),
         stats=dict(out["stats"]),
@@ -271,8 +281,8 @@ def summarize(result: BendingResult) -> BendingSummary:
     The peak is the largest moment in the sense of bending on the loading branch; the residual
     moment ``M*`` is the moment at the last point of the loading branch. The snap angle is where
     the loading path first turns back in ``theta`` (under rotation control the tape jumps to the
-    folded branch there); the heel angle is where the unloading path first turns back (the fold
-    disappears).
+    folded branch there), or where it first jumps when jumps are on; the heel angle is the same on
+    the unloading branch (the fold disappears).
 
     Parameters
     ----------
@@ -289,11 +299,13 @@ def summarize(result: BendingResult) -> BendingSummary:
     if th.size == 0:
         raise ValueError("the curve has no point on its loading branch")
     i_max = int(np.argmax(m * sense))
-    snap = _first_turn(th, sense)
+    jumps = np.nonzero(result.jump[load])[0]
+    snap = int(jumps[0]) if jumps.size else _first_turn(th, sense)
     heel = None
     if np.any(~load):
         th_u = result.theta_deg[~load]
-        j = _first_turn(th_u, -sense)
+        jumps_u = np.nonzero(result.jump[~load])[0]
+        j = int(jumps_u[0]) if jumps_u.size else _first_turn(th_u, -sense)
         heel = float(th_u[j]) if j is not None else None
     return BendingSummary(
         m_max=float(m[i_max]),
@@ -356,7 +368,11 @@ def plot_bending(result: BendingResult, *, ax: Any = None, summary: bool = True)
             continue
         th, m, st = result.theta_deg[sel], result.moment[sel], result.stable[sel]
         # Draw segment by segment so that stability can change along the path.
+        jp = result.jump[sel]
         for i in range(len(sel) - 1):
+            if jp[i + 1]:
+                ax.plot(th[i : i + 2], m[i : i + 2], color=colours[b], linestyle=":", linewidth=1.0)
+                continue
             ok = st[i] and st[i + 1]
             ax.plot(
                 th[i : i + 2],

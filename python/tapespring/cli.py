@@ -80,6 +80,16 @@ def _add_bend(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="twist imperfection amplitude [deg] (default 0.1 in equal sense, else 0)",
     )
+    p.add_argument(
+        "--path",
+        choices=("full", "jump"),
+        default=None,
+        help=(
+            "full: trace the whole equilibrium path, stable and unstable (default in opposite "
+            "sense); jump: follow a slow rotation-controlled test, jumping at snaps to the stable "
+            "equilibrium beyond (default in equal sense, whose path branches)"
+        ),
+    )
     p.add_argument("--csv", help="write theta_deg, moment_Nm, stable to this CSV file")
     p.add_argument("--plot", help="write the curve as a PNG (paper Fig. 4)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
@@ -108,6 +118,7 @@ def _run_bend(args: argparse.Namespace) -> int:
         theta_max_deg=args.theta_max,
         unload=args.unload,
         imperfection_deg=imperfection,
+        jump=(args.path or ("jump" if args.theta_max < 0 else "full")) == "jump",
     )
     try:
         result = bend(setup, progress=not (args.no_progress or args.json))

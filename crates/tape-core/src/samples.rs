@@ -35,6 +35,9 @@ pub struct TapeBending {
     pub initial_increment: f64,
     /// Maximum arc-length steps per branch (loading, unloading).
     pub max_steps: usize,
+    /// Follow the path a slow rotation-controlled test follows: at a limit point of the angle,
+    /// jump to the stable equilibrium beyond it (instead of tracing the unstable branch).
+    pub jump: bool,
 }
 
 impl Default for TapeBending {
@@ -53,6 +56,7 @@ impl Default for TapeBending {
             imperfection: 0.0,
             initial_increment: 0.02,
             max_steps: 1000,
+            jump: false,
         }
     }
 }
@@ -80,6 +84,8 @@ pub struct BendingPoint {
     pub negative_eigenvalues: usize,
     /// Branch: 0 loading, 1 unloading.
     pub branch: u8,
+    /// Reached by a jump (snap at fixed angle) from the previous point.
+    pub jump: bool,
 }
 
 /// A bending curve with the statistics of the run.
@@ -170,6 +176,7 @@ impl TapeBending {
             },
             stability: true,
             record_fields: false,
+            jump_at_limit_points: self.jump,
             target_iterations: 8,
             // Moments to 1e-6 relative; the energy norm is quadratic in the residual.
             newton: NewtonParams {
@@ -230,6 +237,7 @@ impl TapeBending {
                 moment: s.reactions[bm.moment_index],
                 negative_eigenvalues: s.negative_eigenvalues.unwrap_or(0),
                 branch,
+                jump: s.jump,
             });
         }
     }

@@ -89,6 +89,10 @@ pub struct StaticParams {
     pub stability: bool,
     /// Record nodal displacements and rotations at each converged state.
     pub record_fields: bool,
+    /// Arc-length only: where the load factor reaches a limit and the path turns back, jump to the
+    /// stable equilibrium beyond the limit instead of following the unstable branch, as a test
+    /// driven slowly by the same loads or prescribed motions does (see [`statics`]).
+    pub jump_at_limit_points: bool,
 }
 
 impl Default for StaticParams {
@@ -103,6 +107,7 @@ impl Default for StaticParams {
             target_iterations: 5,
             stability: false,
             record_fields: true,
+            jump_at_limit_points: false,
         }
     }
 }
@@ -196,6 +201,8 @@ pub struct StaticStep {
     pub displacements: Vec<[f64; 3]>,
     /// Nodal rotation vectors [rad] (empty unless fields are recorded).
     pub rotations: Vec<[f64; 3]>,
+    /// True if this state was reached by a jump from the previous one (a snap at fixed load factor).
+    pub jump: bool,
 }
 
 /// The equilibrium path followed by a static analysis.

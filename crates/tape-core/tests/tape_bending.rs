@@ -6,19 +6,22 @@ use tape_core::Result;
 fn print_curve() -> Result<()> {
     let t = std::time::Instant::now();
     let tb = TapeBending {
+        theta_max: -std::f64::consts::FRAC_PI_2,
+        imperfection: 0.1_f64.to_radians(),
+        jump: true,
         unload: true,
         ..TapeBending::default()
     };
     let curve = tb.run(&mut |_| true)?;
-    for p in curve.points.iter().step_by(1) {
+    for p in &curve.points {
         eprintln!(
-            "{:8.3} {:10.5} {} {}",
+            "{:8.3} {:10.5} {} {} {}",
             p.theta.to_degrees(),
             p.moment,
             p.negative_eigenvalues,
-            p.branch
+            p.branch,
+            p.jump
         );
-        let _ = p;
     }
     eprintln!(
         "{:?} {:?} ndof {} wall {:?}",

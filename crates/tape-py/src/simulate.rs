@@ -80,6 +80,7 @@ struct StaticOptions {
     direction: i64,
     stability: bool,
     record_fields: bool,
+    jump: bool,
     tol_force: f64,
     max_iterations: i64,
     max_cutbacks: i64,
@@ -147,6 +148,7 @@ impl StaticOptions {
             target_iterations: count("target_iterations", self.target_iterations, 1)?,
             stability: self.stability,
             record_fields: self.record_fields,
+            jump_at_limit_points: self.jump,
         };
         to_py(params.validate())?;
         Ok(params)
@@ -166,6 +168,7 @@ impl StaticOptions {
         d.set_item("direction", self.direction)?;
         d.set_item("stability", self.stability)?;
         d.set_item("record_fields", self.record_fields)?;
+        d.set_item("jump", self.jump)?;
         d.set_item("tol_force", params.newton.tol_force)?;
         d.set_item("tol_energy", params.newton.tol_energy)?;
         d.set_item("line_search", params.newton.line_search)?;
@@ -181,7 +184,7 @@ impl StaticOptions {
 #[pyo3(signature = (
     model, /, *, control = "load", lambda_end = 1.0, increments = 10, node = None, dof = None, delta = None,
     initial_increment = 0.01, max_increment_factor = 10.0, max_steps = 500, direction = 1, stability = false,
-    record_fields = true, tol_force = 1e-8, max_iterations = 20, max_cutbacks = 10, target_iterations = 5,
+    record_fields = true, jump = false, tol_force = 1e-8, max_iterations = 20, max_cutbacks = 10, target_iterations = 5,
     progress = None
 ))]
 #[allow(clippy::too_many_arguments, clippy::needless_pass_by_value)]
@@ -200,6 +203,7 @@ pub fn solve_static<'py>(
     direction: i64,
     stability: bool,
     record_fields: bool,
+    jump: bool,
     tol_force: f64,
     max_iterations: i64,
     max_cutbacks: i64,
@@ -219,6 +223,7 @@ pub fn solve_static<'py>(
         direction,
         stability,
         record_fields,
+        jump,
         tol_force,
         max_iterations,
         max_cutbacks,
@@ -270,7 +275,7 @@ pub fn solve_static<'py>(
 #[pyo3(signature = (
     *, length = 0.1, radius = 15.55e-3, alpha = 1.21911, thickness = 0.138e-3, youngs_modulus = 151.76e9,
     poisson = 0.3, mesh_size = 2e-3, theta_max = std::f64::consts::FRAC_PI_2, unload = false, imperfection = 0.0,
-    initial_increment = 0.02, max_steps = 1000, progress = None
+    initial_increment = 0.02, max_steps = 1000, jump = false, progress = None
 ))]
 #[allow(clippy::too_many_arguments, clippy::needless_pass_by_value)]
 pub fn bend_tape<'py>(
@@ -287,6 +292,7 @@ pub fn bend_tape<'py>(
     imperfection: f64,
     initial_increment: f64,
     max_steps: i64,
+    jump: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let bending = TapeBending {
@@ -303,6 +309,7 @@ pub fn bend_tape<'py>(
         imperfection,
         initial_increment,
         max_steps: count("max_steps", max_steps, 1)?,
+        jump,
     };
     to_py(bending.validate())?;
     let progress = callable(progress, py)?;
@@ -331,6 +338,10 @@ pub fn bend_tape<'py>(
         ),
     )?;
     d.set_item("branch", numpy_i64(py, pts.iter().map(|p| i64::from(p.branch))))?;
+    d.set_item(
+        "jump",
+        numpy::PyArray1::from_iter(py, pts.iter().map(|p| p.jump)).into_any(),
+    )?;
     d.set_item("ndof", curve.ndof)?;
     d.set_item("stats", convert::stats_to_dict(py, &curve.stats)?)?;
     d.set_item("error", curve.error.as_ref().map(ToString::to_string))?;
@@ -346,6 +357,7 @@ pub fn bend_tape<'py>(
     s.set_item("imperfection", imperfection)?;
     s.set_item("initial_increment", initial_increment)?;
     s.set_item("max_steps", max_steps)?;
+    s.set_item("jump", jump)?;
     let arc = bending.params(1.0, 1.0);
     s.set_item("target_iterations", arc.target_iterations)?;
     s.set_item("tol_force", arc.newton.tol_force)?;

@@ -339,6 +339,114 @@ impl Solver<'_> {
             negative_eigenvalues,
             displacements,
             rotations,
+            jump: false,
+        })
+    }
+
+    /// Weighted distance between two configurations (translations [m], rotations times `L_c`).
+    fn distance(&self, a: &State, b: &State) -> f64 {
+        let lc2 = self.system.char_length.powi(2);
+        a.x.iter()
+            .zip(&b.x)
+            .zip(a.q.iter().zip(&b.q))
+            .map(|((xa, xb), (qa, qb))| {
+                (xa - xb).norm_squared() + lc2 * (qa * qb.inverse()).scaled_axis().norm_squared()
+            })
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    /// Moves the load factor to `lambda` and relaxes `state` to a stable equilibrium there by
+    /// pseudo-transient continuation: each pseudo-time step solves
+    /// `r(q) + C (q - q_k) = 0` with `C = beta diag|K|`, `beta` large enough that `K + C` is positive
+    /// definite, so every step descends the potential (an implicit gradient flow); `beta` shrinks as
+    /// steps succeed, ending in plain Newton at a stable equilibrium. Returns the pseudo-steps used.
+    fn relax(&mut self, state: &mut State, lambda: f64) -> Result<usize> {
+        const MAX_STEPS: usize = 400;
+        let n = self.system.n_free();
+        let zero = vec![0.0; n];
+        self.system.update(state, &zero, lambda - state.lambda);
+        self.fresh = false;
+        self.factorised = false;
+        let diag: Vec<usize> = (0..n)
+            .map(|i| {
+                self.system
+                    .pattern_ff
+                    .find(i, i)
+                    .expect("diagonal entries are in the pattern")
+            })
+            .collect();
+        let mut beta: f64 = 1e-2;
+        for step in 0..MAX_STEPS {
+            self.assemble(state);
+            let (ok, _) = self.converged(state.lambda, None);
+            if ok && beta <= 1e-6 {
+                self.linear.factorize(&self.asm.k_ff)?;
+                self.stats.factorisations += 1;
+                self.factorised = true;
+                if self.linear.negative_eigenvalues()? == 0 {
+                    return Ok(step);
+                }
+                beta = beta.max(1e-3);
+            }
+            let anchor = state.clone();
+            let mut acc = vec![0.0; n];
+            let mut success = false;
+            let mut iterations = 0;
+            for it in 0..15 {
+                iterations = it + 1;
+                if it > 0 {
+                    self.assemble(state);
+                }
+                let mut k = self.asm.k_ff.clone();
+                let mut r = self.asm.residual.clone();
+                for (i, &p) in diag.iter().enumerate() {
+                    let c = beta * self.asm.k_ff[p].abs().max(1e-12);
+                    k[p] += c;
+                    r[i] += c * acc[i];
+                }
+                let res = self.force_norm(&r);
+                if it > 0
+                    && res <= self.params.newton.tol_force * self.reference_force(state.lambda).max(self.round_off)
+                {
+                    success = true;
+                    break;
+                }
+                let t = std::time::Instant::now();
+                self.linear.factorize(&k)?;
+                self.stats.factorisations += 1;
+                self.factorised = false;
+                if self.linear.negative_eigenvalues().unwrap_or(1) > 0 {
+                    // K + C must be positive definite for a descent step.
+                    break;
+                }
+                let mut dq: Vec<f64> = r.iter().map(|v| -v).collect();
+                self.linear.solve_in_place(&mut dq)?;
+                self.stats.solve_s += t.elapsed().as_secs_f64();
+                self.stats.iterations += 1;
+                self.system.update(state, &dq, 0.0);
+                for (a, d) in acc.iter_mut().zip(&dq) {
+                    *a += d;
+                }
+            }
+            if success {
+                beta = (beta / if iterations <= 3 { 4.0 } else { 1.5 }).max(1e-12);
+                if beta <= 1e-6 {
+                    beta = 0.0;
+                }
+            } else {
+                *state = anchor;
+                beta = (beta * 4.0).max(1e-4);
+                if beta > 1e4 {
+                    break;
+                }
+            }
+        }
+        Err(Error::NotConverged {
+            lambda: state.lambda,
+            iterations: MAX_STEPS,
+            residual: self.force_norm(&self.asm.residual),
+            detail: "relaxation past a limit point found no stable equilibrium".into(),
         })
     }
 }
@@ -496,6 +604,7 @@ pub fn solve_static(
             Control::ArcLength {
                 direction,
                 initial_increment,
+                lambda_end,
                 ..
             } => {
                 if arc_ds.is_none() {
@@ -513,15 +622,84 @@ pub fn solve_static(
                     arc_ds = Some(initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt());
                     size = arc_ds.expect("set");
                 }
+                // Without a previous increment (first step, or after a jump) head for lambda_end.
+                let towards = (lambda_end - state.lambda).signum();
                 Increment::Arc {
                     ds: size.abs(),
-                    direction: *direction,
+                    direction: if towards == 0.0 { *direction } else { towards },
                 }
             }
         };
         let saved = state.clone();
         match s.increment(state, inc) {
             Ok(out) => {
+                // A limit point of the load factor: jump to the stable equilibrium beyond it.
+                if let (true, Control::ArcLength { lambda_end, .. }) = (params.jump_at_limit_points, &params.control) {
+                    let travel = (lambda_end - saved.lambda).signum();
+                    if (state.lambda - saved.lambda) * travel < 0.0 && prev.is_some() {
+                        let mut offset = prev
+                            .as_ref()
+                            .map_or(1e-3, |p| 0.25 * p.dlambda.abs())
+                            .max(1e-6);
+                        let mut jumped = false;
+                        for _ in 0..8 {
+                            *state = saved.clone();
+                            match s.relax(state, saved.lambda + travel * offset) {
+                                Ok(_) => {
+                                    if s.distance(state, &saved) > 0.5 * size.abs() {
+                                        jumped = true;
+                                        break;
+                                    }
+                                    // Still on the same branch: the limit lies further on.
+                                    offset *= 2.0;
+                                }
+                                Err(e) => {
+                                    *state = saved.clone();
+                                    path.error = Some(e);
+                                    break 'steps;
+                                }
+                            }
+                        }
+                        if !jumped {
+                            *state = saved.clone();
+                            path.error = Some(Error::NotConverged {
+                                lambda: state.lambda,
+                                iterations: 0,
+                                residual: f64::NAN,
+                                detail: "no stable equilibrium found beyond the limit point".into(),
+                            });
+                            break 'steps;
+                        }
+                        s.fresh = false;
+                        s.factorised = false;
+                        s.assemble(state);
+                        let relaxed = Outcome {
+                            iterations: 0,
+                            residual: 0.0,
+                            dq: Vec::new(),
+                            dlambda: 0.0,
+                        };
+                        match s.record(state, &relaxed) {
+                            Ok(mut st) => {
+                                st.jump = true;
+                                s.stats.steps += 1;
+                                let keep_going = progress(&st, &s.stats);
+                                path.steps.push(st);
+                                if !keep_going {
+                                    path.cancelled = true;
+                                    break 'steps;
+                                }
+                            }
+                            Err(e) => {
+                                path.error = Some(e);
+                                break 'steps;
+                            }
+                        }
+                        s.previous = None;
+                        cutbacks = 0;
+                        continue 'steps;
+                    }
+                }
                 // Arc-length: do not overshoot the final load factor; finish with a load step.
                 if let Control::ArcLength { lambda_end, .. } = &params.control {
                     let start_l = saved.lambda;
