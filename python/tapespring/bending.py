@@ -380,8 +380,12 @@ def plot_bending(result: BendingResult, *, ax: Any = None, summary: bool = True)
                 color=colours[b],
                 linestyle="-" if ok else "--",
                 linewidth=1.8 if ok else 1.0,
-                label=labels[b] if i == 0 else None,
             )
+        ax.plot([], [], color=colours[b], linewidth=1.8, label=f"{labels[b]} (stable)")
+    if not result.stable.all():
+        ax.plot([], [], color="0.3", linestyle="--", linewidth=1.0, label="unstable")
+    if result.jump.any():
+        ax.plot([], [], color="0.3", linestyle=":", linewidth=1.0, label="snap (jump)")
     if summary and result.theta_deg.size:
         s = summarize(result)
         ax.axhline(
