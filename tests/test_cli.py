@@ -1,0 +1,113 @@
+"""Command line `tapespring bend` (and the registration of `tapespring trials`), in-process.
+
+Runs use a 4 mm mesh to 30 deg (about 1 s each): through the peak, the snap and onto the folded
+branch, so every summary line has a value.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from tapespring.cli import main
+
+QUICK = ["bend", "--mesh-size", "0.004", "--theta-max", "30", "--no-progress"]
+
+
+def test_json_prints_exactly_one_object_with_the_summary(capsys):
+    code = main([*QUICK, "--json"])
+    out = capsys.readouterr().out
+    assert code == 0
+    # One object on one line, nothing else on stdout (the progress bar is off with --json).
+    assert out.endswith("\n") and out.count("\n") == 1
+    data = json.loads(out)
+    assert isinstance(data, dict)
+    required = {
+        "theta_deg",
+        "moment_Nm",
+        "m_max",
+        "theta_at_m_max_deg",
+        "m_star",
+        "theta_heel_deg",
+        "ndof",
+        "wall_s",
+    }
+    assert required <= data.keys()
+    assert len(data["theta_deg"]) == len(data["moment_Nm"]) > 0
+    assert data["m_max"] == max(data["moment_Nm"])
+    assert data["m_star"] > 0.0 and data["m_max"] > data["m_star"]
+    assert data["theta_heel_deg"] is None  # no unloading asked
+    assert data["ndof"] == 1010  # 4 mm mesh
+    assert data["wall_s"] > 0.0
+
+
+def test_json_without_progress_flag_keeps_stdout_clean(capsys):
+    # --json alone (no --no-progress) must not draw the progress bar anywhere.
+    code = main(["bend", "--mesh-size", "0.004", "--theta-max", "10", "--json"])
+    captured = capsys.readouterr()
+    assert code == 0
+    json.loads(captured.out)
+    assert captured.err == ""
+
+
+def test_csv_plot_and_text_summary(tmp_path, capsys):
+    csv_path, png_path = tmp_path / "bend.csv", tmp_path / "bend.png"
+    code = main([*QUICK, "--csv", str(csv_path), "--plot", str(png_path)])
+    out = capsys.readouterr().out
+    assert code == 0
+    lines = csv_path.read_text().splitlines()
+    assert lines[0].startswith("# tapespring bend: {")
+    assert lines[2] == "theta_deg,moment_Nm,stable,branch"
+    assert len(lines) > 10
+    assert png_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "M_max" in out
+    assert "M*" in out
+    assert "analytical (1+nu) D alpha = +0.0579 N m" in out
+    assert "1010 DOFs" in out
+    assert str(csv_path) in out and str(png_path) in out
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--thickness", "-1", "thickness must be finite and > 0"),
+        ("--youngs-modulus", "0", "Young's modulus must be finite and > 0"),
+        ("--mesh-size", "0", "mesh size must be finite and > 0"),
+        ("--length", "abc", "length must be a number"),
+    ],
+)
+def test_bad_value_is_rejected_by_the_parser(option, value, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["bend", option, value])
+    assert exc.value.code != 0
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--theta-max", "0", "--theta-max must be a non-zero angle"),
+        ("--poisson", "0.5", "Poisson's ratio nu must lie in (-1, 0.5)"),
+    ],
+)
+def test_bad_value_exits_non_zero_with_a_message(option, value, message, capsys):
+    code = main(["bend", "--no-progress", option, value])
+    captured = capsys.readouterr()
+    assert code != 0
+    assert message in captured.err
+    assert captured.out == ""
+
+
+def test_trials_command_is_registered(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["trials", "--help"])
+    assert exc.value.code == 0
+    assert "analyze" in capsys.readouterr().out
+
+
+def test_top_level_help_lists_both_commands(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert "bend" in out and "trials" in out
