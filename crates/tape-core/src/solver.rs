@@ -123,7 +123,8 @@ impl StaticParams {
         if n.max_iterations == 0 {
             return bad("max_iterations must be >= 1");
         }
-        if !(n.tol_force > 0.0 && n.tol_force < 1.0) || !(n.tol_energy > 0.0 && n.tol_energy < 1.0) {
+        let in_unit = |v: f64| v > 0.0 && v < 1.0;
+        if !(in_unit(n.tol_force) && in_unit(n.tol_energy)) {
             return bad("Newton tolerances must lie in (0, 1)");
         }
         if self.target_iterations == 0 {
@@ -147,10 +148,12 @@ impl StaticParams {
                 max_steps,
                 direction,
             } => {
-                if !lambda_end.is_finite() || !(*initial_increment > 0.0) || !initial_increment.is_finite() {
+                let increment_ok = initial_increment.is_finite() && *initial_increment > 0.0;
+                if !lambda_end.is_finite() || !increment_ok {
                     return bad("arc-length needs a finite lambda_end and initial_increment > 0");
                 }
-                if !(*max_increment_factor >= 1.0) || *max_steps == 0 || direction.abs() != 1.0 {
+                let factor_ok = *max_increment_factor >= 1.0;
+                if !factor_ok || *max_steps == 0 || direction.abs() != 1.0 {
                     return bad("arc-length needs max_increment_factor >= 1, max_steps >= 1 and direction +1 or -1");
                 }
             }

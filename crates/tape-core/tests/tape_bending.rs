@@ -37,33 +37,58 @@ fn equal_sense_residual_moment_matches_analytical_and_peak_is_below_opposite_sen
     let curve = equal.run(&mut |_| true)?;
     assert!(curve.error.is_none(), "{:?}", curve.error);
     let last = loading(&curve).last().expect("points");
-    assert!((last.theta + std::f64::consts::FRAC_PI_2).abs() < 1e-9, "reached {}", last.theta);
+    assert!(
+        (last.theta + std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+        "reached {}",
+        last.theta
+    );
     let m_star = -(1.0 - equal.section.poisson) * d_alpha(&equal);
     let rel = (last.moment - m_star) / m_star.abs();
-    assert!(rel.abs() < 0.10, "M-* = {} vs analytical {m_star} ({rel:+.3})", last.moment);
+    assert!(
+        rel.abs() < 0.10,
+        "M-* = {} vs analytical {m_star} ({rel:+.3})",
+        last.moment
+    );
     // Torsional folds form progressively: the path snaps (jumps) at least once on the way.
     assert!(loading(&curve).any(|p| p.jump), "no snap in equal sense");
     let m_minus_max = loading(&curve).map(|p| -p.moment).fold(0.0, f64::max);
 
-    let opposite = TapeBending { theta_max: 20_f64.to_radians(), ..TapeBending::default() };
+    let opposite = TapeBending {
+        theta_max: 20_f64.to_radians(),
+        ..TapeBending::default()
+    };
     let op = opposite.run(&mut |_| true)?;
     let m_plus_max = loading(&op).map(|p| p.moment).fold(0.0, f64::max);
     // Paper Sec. 2: |M-max| < M+max (measured 0.156 vs 0.296 N m).
-    assert!(m_minus_max < m_plus_max, "|M-max| = {m_minus_max}, M+max = {m_plus_max}");
+    assert!(
+        m_minus_max < m_plus_max,
+        "|M-max| = {m_minus_max}, M+max = {m_plus_max}"
+    );
     Ok(())
 }
 
 #[test]
 fn opposite_sense_full_path_passes_unstable_equilibria_between_stable_branches() -> Result<()> {
-    let tb = TapeBending { theta_max: 30_f64.to_radians(), ..TapeBending::default() };
+    let tb = TapeBending {
+        theta_max: 30_f64.to_radians(),
+        ..TapeBending::default()
+    };
     let curve = tb.run(&mut |_| true)?;
     assert!(curve.error.is_none(), "{:?}", curve.error);
     let pts: Vec<_> = loading(&curve).collect();
-    let i_max = (0..pts.len()).max_by(|&a, &b| pts[a].moment.total_cmp(&pts[b].moment)).expect("points");
+    let i_max = (0..pts.len())
+        .max_by(|&a, &b| pts[a].moment.total_cmp(&pts[b].moment))
+        .expect("points");
     // Stable up to the peak, unstable on the way back (snap-back in theta), stable on the fold.
     assert!(pts[..i_max].iter().all(|p| p.negative_eigenvalues == 0));
-    assert!(pts[i_max..].iter().any(|p| p.negative_eigenvalues > 0), "no unstable equilibrium after the peak");
+    assert!(
+        pts[i_max..].iter().any(|p| p.negative_eigenvalues > 0),
+        "no unstable equilibrium after the peak"
+    );
     assert_eq!(pts.last().expect("points").negative_eigenvalues, 0);
-    assert!(pts[i_max + 1..].iter().any(|p| p.theta < pts[i_max].theta), "the path does not turn back");
+    assert!(
+        pts[i_max + 1..].iter().any(|p| p.theta < pts[i_max].theta),
+        "the path does not turn back"
+    );
     Ok(())
 }
