@@ -292,9 +292,10 @@ def test_equal_sense_peak_is_lower_than_opposite_sense(to_30_deg):
     # Paper Section 2: |M-max| < M+max. M-max is the peak before the snap (BendingSummary). The
     # trace is stopped 5 steps after the path first turns back in theta (the snap, at -3.2 deg,
     # M = -0.1455 N m): with this build the equal-sense path beyond it wanders between -4 and
-    # -24 deg for the full 1000 arc-length steps (~70 s) without reaching -30 deg (reported with
-    # error None). The residual moment M-* = -(1 - nu) D alpha (paper eq. 3) at -90 deg is left
-    # to the lead: another engineer is making equal-sense runs reach -90 deg.
+    # -24 deg for the full 1000 arc-length steps (~65 s) without reaching -30 deg (reported with
+    # error None); with BendingSetup(jump=True) the run reaches -30 deg in ~7 s with the same
+    # M-max. The residual moment M-* = -(1 - nu) D alpha (paper eq. 3) at -90 deg is left to the
+    # lead: another engineer is making equal-sense runs reach -90 deg.
     seen: list[float] = []
 
     def stop_after_snap(theta: float) -> bool:
