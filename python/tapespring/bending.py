@@ -139,6 +139,8 @@ class BendingResult:
         Every solver setting used.
     error : str or None
         Why the run stopped early, if it did (the points so far are kept).
+    cancelled : bool
+        True if the progress callback stopped the run.
     """
 
     setup: BendingSetup
@@ -152,6 +154,7 @@ class BendingResult:
     stats: dict[str, Any] = field(default_factory=dict)
     settings: dict[str, Any] = field(default_factory=dict)
     error: str | None = None
+    cancelled: bool = False
 
 
 @dataclass(frozen=True)
@@ -161,7 +164,8 @@ class BendingSummary:
     Attributes
     ----------
     m_max : float
-        Peak moment before the snap on loading, signed [N m].
+        Peak moment on loading before the snap (over the whole loading branch if it never
+        snaps), signed [N m].
     theta_at_m_max_deg : float
         Angle at the peak [deg].
     m_star : float
@@ -219,6 +223,13 @@ def bend(
     from tapespring import _core
 
     setup = setup or BendingSetup()
+    if not (math.isfinite(setup.theta_max_deg) and 0.0 < abs(setup.theta_max_deg) < 360.0):
+        raise ValueError(
+            f"theta_max_deg must be non-zero and within (-360, 360) degrees "
+            f"(got {setup.theta_max_deg})"
+        )
+    if not (math.isfinite(setup.mesh_size) and setup.mesh_size > 0.0):
+        raise ValueError(f"mesh_size [m] must be finite and > 0 (got {setup.mesh_size})")
     theta_max = math.radians(setup.theta_max_deg)
     callback: Callable[[float], bool | None] | None
     bar = None
@@ -265,6 +276,7 @@ def bend(
         stats=dict(out["stats"]),
         settings=dict(out["settings"]),
         error=out["error"],
+        cancelled=bool(out.get("cancelled", False)),
     )
 
 
@@ -298,15 +310,18 @@ def summarize(result: BendingResult) -> BendingSummary:
     th, m = result.theta_deg[load], result.moment[load]
     if th.size == 0:
         raise ValueError("the curve has no point on its loading branch")
-    i_max = int(np.argmax(m * sense))
+    # A jump leaves from the last point before it (the limit point).
     jumps = np.nonzero(result.jump[load])[0]
-    snap = int(jumps[0]) if jumps.size else _first_turn(th, sense)
+    snap = int(jumps[0]) - 1 if jumps.size else _first_turn(th, sense)
+    # The peak before the snap (the whole branch if it never snaps).
+    upto = th.size if snap is None else snap + 1
+    i_max = int(np.argmax(m[:upto] * sense))
     heel = None
     if np.any(~load):
         th_u = result.theta_deg[~load]
         jumps_u = np.nonzero(result.jump[~load])[0]
-        j = int(jumps_u[0]) if jumps_u.size else _first_turn(th_u, -sense)
-        heel = float(th_u[j]) if j is not None else None
+        j = int(jumps_u[0]) - 1 if jumps_u.size else _first_turn(th_u, -sense)
+        heel = float(th_u[j]) if j is not None and j >= 0 else None
     return BendingSummary(
         m_max=float(m[i_max]),
         theta_at_m_max_deg=float(th[i_max]),
@@ -320,7 +335,7 @@ def summarize(result: BendingResult) -> BendingSummary:
 
 
 def write_csv(result: BendingResult, path: str | Path) -> None:
-    """Write the curve as CSV with columns ``theta_deg, moment_Nm, stable, branch``.
+    """Write the curve as CSV with columns ``theta_deg, moment_Nm, stable, branch, jump``.
 
     The first lines are ``#`` comments holding the set-up and solver settings as JSON, so the file
     carries what produced it.
@@ -330,11 +345,12 @@ def write_csv(result: BendingResult, path: str | Path) -> None:
         fh.write("# tapespring bend: " + json.dumps(asdict(result.setup)) + "\n")
         fh.write("# settings: " + json.dumps(result.settings, default=str) + "\n")
         writer = csv.writer(fh)
-        writer.writerow(["theta_deg", "moment_Nm", "stable", "branch"])
-        for t, m, s, b in zip(
-            result.theta_deg, result.moment, result.stable, result.branch, strict=True
-        ):
-            writer.writerow([f"{t:.6f}", f"{m:.9e}", int(bool(s)), int(b)])
+        writer.writerow(["theta_deg", "moment_Nm", "stable", "branch", "jump"])
+        rows = zip(
+            result.theta_deg, result.moment, result.stable, result.branch, result.jump, strict=True
+        )
+        for t, m, s, b, j in rows:
+            writer.writerow([f"{t:.6f}", f"{m:.9e}", int(bool(s)), int(b), int(bool(j))])
 
 
 def plot_bending(result: BendingResult, *, ax: Any = None, summary: bool = True) -> Any:

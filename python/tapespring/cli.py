@@ -177,6 +177,9 @@ def _run_bend(args: argparse.Namespace) -> int:
         if args.plot:
             lines.append(f"  plot written to {args.plot}")
         print("\n".join(lines))
+    if result.cancelled:
+        print("warning: the run was stopped before the final angle", file=sys.stderr)
+        return 1
     if result.error:
         print(f"warning: the path stopped early: {result.error}", file=sys.stderr)
         return 1

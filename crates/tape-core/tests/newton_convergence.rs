@@ -23,7 +23,12 @@ use tape_core::{Dof, Model, Result, System};
 #[test]
 fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> {
     let (l, b, t, e) = (12.0, 1.0, 0.1, 1.2e6);
-    let section = ShellSection { thickness: t, youngs_modulus: e, poisson: 0.0, ..ShellSection::default() };
+    let section = ShellSection {
+        thickness: t,
+        youngs_modulus: e,
+        poisson: 0.0,
+        ..ShellSection::default()
+    };
     let mut model = Model::try_new(flat_plate(l, b, 16, 1)?, section)?;
     let root = model.mesh.node_set("x0")?.to_vec();
     let tip = model.mesh.node_set("x1")?.to_vec();
@@ -34,7 +39,13 @@ fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> 
     }
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
-    let params = StaticParams { control: Control::Load { lambda_end: 0.38, increments: 8 }, ..StaticParams::default() };
+    let params = StaticParams {
+        control: Control::Load {
+            lambda_end: 0.38,
+            increments: 8,
+        },
+        ..StaticParams::default()
+    };
     let path = solve_static(&mut system, &mut state, &params, &mut |_, _| true)?;
     assert!(path.error.is_none(), "{:?}", path.error);
 
@@ -64,13 +75,24 @@ fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> 
         solver.factorize(&a.k_ff)?;
         let mut dq: Vec<f64> = a.residual.iter().map(|r| -r).collect();
         solver.solve_in_place(&mut dq)?;
-        corr.push(dq.iter().zip(&weights).map(|(d, w)| w * d * d).sum::<f64>().sqrt());
+        corr.push(
+            dq.iter()
+                .zip(&weights)
+                .map(|(d, w)| w * d * d)
+                .sum::<f64>()
+                .sqrt(),
+        );
         system.update(&mut state, &dq, 0.0);
     }
-    assert!(nonsymmetric > 1e-3 * m_max, "the tangent should be non-symmetric here: {nonsymmetric}");
+    assert!(
+        nonsymmetric > 1e-3 * m_max,
+        "the tangent should be non-symmetric here: {nonsymmetric}"
+    );
     // Asymptotic range of the weighted correction norms (translations, rotations times L_c): the
     // strictly decreasing run of corrections that ends at the smallest one (round-off after it).
-    let i_min = (0..corr.len()).min_by(|&a, &b| corr[a].total_cmp(&corr[b])).expect("corrections");
+    let i_min = (0..corr.len())
+        .min_by(|&a, &b| corr[a].total_cmp(&corr[b]))
+        .expect("corrections");
     let mut i0 = i_min;
     while i0 > 0 && corr[i0 - 1] > corr[i0] {
         i0 -= 1;
@@ -85,6 +107,9 @@ fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> 
     assert!(growth < 10.0, "C_k = {ck:?}: corrections {corr:?}");
     let order = (asym[n_a - 1] / asym[n_a - 2]).ln() / (asym[n_a - 2] / asym[n_a - 3]).ln();
     assert!(order > 1.7, "convergence order {order}: corrections {corr:?}");
-    assert!(*res.last().expect("residuals") < 1e-9 * res[0], "residual did not converge: {res:?}");
+    assert!(
+        *res.last().expect("residuals") < 1e-9 * res[0],
+        "residual did not converge: {res:?}"
+    );
     Ok(())
 }

@@ -124,7 +124,7 @@ impl TapeGeometry {
 /// [`Error::InvalidParameter`] for a bad geometry or element size.
 pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
     geometry.validate()?;
-    check_positive("element size h [m]", h)?;
+    check_positive("mesh size h [m]", h)?;
     let nx = (geometry.length / h).round().max(1.0) as usize;
     let arc = geometry.radius * geometry.alpha;
     let mut na = (arc / h).round().max(2.0) as usize;

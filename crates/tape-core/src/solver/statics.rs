@@ -53,6 +53,8 @@ struct Solver<'a> {
     round_off: f64,
     /// Largest reference force met on the path so far [N] (the force scale near zero load).
     path_force: f64,
+    /// Reject arc-length steps that bend sharply (cleared after repeated cut-backs).
+    strict_turns: bool,
     /// Increment of the last converged step, for the arc-length secant predictor.
     previous: Option<(Vec<f64>, f64)>,
     weights: Vec<f64>,
@@ -201,10 +203,20 @@ impl Solver<'_> {
                 if let (Increment::Arc { .. }, Some((prev_dq, prev_dl))) = (inc, &self.previous) {
                     // A converged increment that turns back on the path means the step jumped
                     // across a sharp turn: reject it so that the step is cut back.
-                    let cos = self.dot_w(&acc, prev_dq) + acc_lambda * prev_dl * self.c_lambda;
-                    if cos <= 0.0 {
+                    let dot = self.dot_w(&acc, prev_dq) + acc_lambda * prev_dl * self.c_lambda;
+                    let norms = ((self.dot_w(&acc, &acc) + acc_lambda * acc_lambda * self.c_lambda)
+                        * (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda))
+                        .sqrt();
+                    if dot <= 0.0 {
                         return Err(Error::Factorisation(
                             "the arc-length step turned back on the path".into(),
+                        ));
+                    }
+                    // A bend of more than 60 degrees in one step may have jumped to another branch:
+                    // refine (the driver accepts it once half of the cut-backs are spent).
+                    if dot < 0.5 * norms && self.strict_turns {
+                        return Err(Error::Factorisation(
+                            "the arc-length step bent by more than 60 degrees".into(),
                         ));
                     }
                 }
@@ -516,6 +528,7 @@ pub fn solve_static(
         factorised: false,
         round_off,
         path_force: 0.0,
+        strict_turns: true,
         previous: None,
         weights,
         values,
@@ -722,10 +735,27 @@ pub fn solve_static(
                             let _ = progress(path.steps.last().expect("pushed"), &s.stats);
                             break;
                         }
-                        s.assemble(state);
+                        // The final load step failed: retry the crossing with a shorter arc.
+                        *state = saved;
+                        s.fresh = false;
+                        s.factorised = false;
+                        cutbacks += 1;
+                        s.stats.cutbacks += 1;
+                        if cutbacks > params.max_cutbacks {
+                            path.error = Some(Error::NotConverged {
+                                lambda: state.lambda,
+                                iterations: 0,
+                                residual: f64::NAN,
+                                detail: format!("could not land on the final load factor {lambda_end}"),
+                            });
+                            break;
+                        }
+                        size *= 0.5;
+                        continue 'steps;
                     }
                 }
                 cutbacks = 0;
+                s.strict_turns = true;
                 s.path_force = s
                     .path_force
                     .max((state.lambda.abs() * s.force_norm(&s.asm.f_ext)).max(s.reaction_norm()));
@@ -792,8 +822,23 @@ pub fn solve_static(
                     break;
                 }
                 size *= 0.5;
+                s.strict_turns = cutbacks < params.max_cutbacks / 2;
                 log::debug!("increment failed at lambda = {}: {err}; cutting back", state.lambda);
             }
+        }
+    }
+    if let Control::ArcLength {
+        lambda_end, max_steps, ..
+    } = &params.control
+    {
+        let short = (state.lambda - lambda_end).abs() > 1e-9 * lambda_end.abs().max(1.0);
+        if path.error.is_none() && !path.cancelled && short {
+            path.error = Some(Error::NotConverged {
+                lambda: state.lambda,
+                iterations: 0,
+                residual: f64::NAN,
+                detail: format!("{max_steps} arc-length steps used before the load factor reached {lambda_end}"),
+            });
         }
     }
     s.stats.refinement_sweeps = s.linear.refinement_sweeps;
