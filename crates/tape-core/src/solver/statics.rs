@@ -212,7 +212,8 @@ impl Solver<'_> {
                             "the arc-length step turned back on the path".into(),
                         ));
                     }
-                    // A bend of more than 60 degrees in one step may have jumped to another branch:
+                    // A bend of more than 60 degrees in one step may have jumped to another branch (seen on a
+                    // 4 mm tape unloading past the heel):
                     // refine (the driver accepts it once half of the cut-backs are spent).
                     if dot < 0.5 * norms && self.strict_turns {
                         return Err(Error::Factorisation(
