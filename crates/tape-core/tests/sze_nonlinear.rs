@@ -1,7 +1,7 @@
 //! Geometrically nonlinear shell benchmarks of Sze, Liu & Lo (2004): cantilever under end shear,
-//! pull-out of an open cylinder and the hinged cylindrical roof (snap-through). The slit annular
-//! plate (10 x 80 needed, 74 s) and the hemisphere (24 x 24 needed, 45 s) meet 2 % but exceed the
-//! time budget with the current linear solver; they are not in this file yet.
+//! slit annular plate under a lifting line force, hemisphere with an 18 degree hole under
+//! alternating radial forces, pull-out of an open cylinder and the hinged cylindrical roof
+//! (snap-through).
 //!
 //! Source: K.Y. Sze, X.H. Liu, S.H. Lo, "Popular benchmark problems for geometric nonlinear
 //! analysis of shells", FEAD 40 (2004) 1551-1569; tables as transcribed in
@@ -19,7 +19,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::Vector3;
 use tape_core::mesh::generate::{cylindrical_panel, flat_plate};
-use tape_core::solver::{solve_static, Control, StaticParams};
+use tape_core::solver::{solve_static, Control, NewtonParams, StaticParams};
 use tape_core::{Dof, Model, Result, System};
 
 /// Sze 3.1, cantilever under end shear.
@@ -70,6 +70,153 @@ fn cantilever_end_shear_follows_sze_within_2_percent() -> Result<()> {
         levels[iw + 1]
     );
     assert!(eu < 0.02 && ew < 0.02, "-u: {ours_u:?}\nw: {ours_w:?}");
+    Ok(())
+}
+
+/// Sze 3.3, slit annular plate under a lifting line force.
+///
+/// ```text
+///            y                      flat annulus Ri = 6 <= r <= Ro = 10, slit along theta = 0:
+///         .-~~~-.                   side theta = 0 (A at Ri, B at Ro) carries the line force
+///       /  .-~-.  \                 p = (P/Pmax) * 0.8 per unit length along +z (dead);
+///      |  |     |  |                side theta = 2 pi clamped (all six DOFs);
+///      |  |  +  A==B---> x          inner and outer circles free
+///       \  '-.-'  /
+///         '-.._.-'
+/// ```
+/// E = 21e6, nu = 0, h = 0.03, Pmax = 0.8 (parameters and BCs of the MBDyn model that carries the
+/// table, `sze33.awk`). The line force is lumped as the consistent edge forces of the bilinear
+/// elements: p (Ro - Ri) / n on interior edge nodes, half on the two ends. Full model (no
+/// symmetry). Measured: w at A (inner) and B (outer radius of the loaded side).
+///
+/// Mesh 6 (radial) x 80 (circumferential). The error is governed by the circumferential count:
+/// at the full load 6 x 30: 5.2 %, 8 x 40: 3.1 %, 6 x 60: 2.1 %, 6 x 70: 1.8 %, 6 x 80: 1.6 %,
+/// 8 x 80: 1.35 %, 10 x 80 (the mesh the table is attributed to): 1.2 % (w_A; w_B a little
+/// less). Our deflections approach the table from below, and the deviation grows with the load, so
+/// the worst point is always P = Pmax. Load control through each tabulated level (one increment
+/// per level, cut back automatically; default Newton tolerances, which converge since Newton
+/// carries a round-off floor). Tolerance: 2 % plus half a unit of the table's last digit (5e-4)
+/// at every level. Observed: worst 1.6 % (w_A) and 1.3 % (w_B), both at Pmax; about 8 s in
+/// release on 2 cores (measured while other benchmarks ran).
+#[test]
+fn slit_annular_plate_follows_sze_within_2_percent() -> Result<()> {
+    let start = std::time::Instant::now();
+    let data = common::reference("sze2004.json");
+    let p = &data["problems"]["slit_annular_plate"];
+    let (ri, ro) = (common::num(&p["geometry"]["Ri"]), common::num(&p["geometry"]["Ro"]));
+    let section = common::section(
+        common::num(&p["thickness"]),
+        common::num(&p["material"]["E"]),
+        common::num(&p["material"]["nu"]),
+    );
+    let p_max = common::num(&p["load"]["Pmax"]);
+    let table = &p["tabulated"];
+    let levels = common::nums(&table["P"]);
+    let (w_a, w_b) = (common::nums(&table["w_A"]), common::nums(&table["w_B"]));
+
+    let (n_radial, n_arc) = (6, 80);
+    let mut model = Model::try_new(common::slit_annulus(ri, ro, n_radial, n_arc)?, section)?;
+    let loaded = model.mesh.node_set("slit0")?.to_vec();
+    let clamped = model.mesh.node_set("slit1")?.to_vec();
+    model.fix(&clamped, &Dof::ALL)?;
+    let edge_force = p_max * (ro - ri) / n_radial as f64;
+    for (k, &n) in loaded.iter().enumerate() {
+        let share = if k == 0 || k == n_radial { 0.5 } else { 1.0 };
+        model.add_load(n, Dof::Uz, share * edge_force)?;
+    }
+    let (a, b) = (loaded[0], loaded[n_radial]);
+    let mut system = System::try_new(&model)?;
+    let mut state = system.initial_state();
+    // The first row is the origin.
+    let steps = common::follow_load_levels(&mut system, &mut state, &levels[1..], 1, NewtonParams::default())?;
+    let ours_a: Vec<f64> = steps.iter().map(|s| s.displacements[a][2]).collect();
+    let ours_b: Vec<f64> = steps.iter().map(|s| s.displacements[b][2]).collect();
+    let (ea, ia) = common::worst_relative_error(&ours_a, &w_a[1..], 5e-4, 0.0);
+    let (eb, ib) = common::worst_relative_error(&ours_b, &w_b[1..], 5e-4, 0.0);
+    eprintln!(
+        "slit plate {n_radial}x{n_arc} at Pmax: w_A = {:.3} (Sze 13.891), w_B = {:.3} (17.528); worst errors {ea:.4} (P = {}), {eb:.4} (P = {}); {:.1} s",
+        ours_a[ours_a.len() - 1],
+        ours_b[ours_b.len() - 1],
+        levels[ia + 1],
+        levels[ib + 1],
+        start.elapsed().as_secs_f64()
+    );
+    assert!(ea < 0.02 && eb < 0.02, "w_A: {ours_a:?}\nw_B: {ours_b:?}");
+    Ok(())
+}
+
+/// Sze 3.4, hemisphere with an 18 degree hole under alternating radial forces.
+///
+/// ```text
+///            z   hole edge (polar angle 18 deg), free
+///            |  .-~~-.
+///            | /      \
+///   P/2 <-B  |/        \       quarter: azimuth 0..90 deg; equator free
+///    (0,R,0) +----------A-> P/2 (R,0,0), outward
+/// ```
+/// R = 10, h = 0.04, E = 6.825e7, nu = 0.3, Pmax = 400 at each of the four equator points (the
+/// Elmer model that carries the table, `runhemisphere.m` / `pointload.sif`). Quarter model, as in
+/// `pinched_hemisphere.rs`: plane x = 0: u_x = theta_y = theta_z = 0; plane y = 0:
+/// u_y = theta_x = theta_z = 0; u_z = 0 at one hole node (the loads are horizontal, so its
+/// reaction vanishes); the load points lie on the symmetry planes, so each carries P/2 (+x at A,
+/// -y at B). Measured: u_x at A (outward) and -u_y at B (inward).
+///
+/// Mesh 24 x 24 on the quarter. Worst errors 16 x 16: 2.8 % / 5.1 %, 20 x 20: 1.2 % / 2.6 %,
+/// 22 x 22: 0.8 % / 1.99 % (too close to the limit), 24 x 24: 0.65 % / 1.75 % (A / B). Our
+/// displacements approach the table from below. Load control through each tabulated level (one
+/// increment per level, cut back automatically; default Newton tolerances). Tolerance: 2 % plus
+/// 5e-4 (half a unit of the table's last digit) at every level. Observed: worst 0.65 % (A, at
+/// P/Pmax = 0.4) and 1.75 % (B, at 0.3); 2 to 4 s in release on 2 cores (measured while other
+/// benchmarks ran).
+#[test]
+fn hemisphere_alternating_forces_follows_sze_within_2_percent() -> Result<()> {
+    let start = std::time::Instant::now();
+    let data = common::reference("sze2004.json");
+    let p = &data["problems"]["hemisphere_alternating_forces"];
+    let r = common::num(&p["geometry"]["R"]);
+    let hole = common::num(&p["geometry"]["hole_half_angle_deg"]).to_radians();
+    let section = common::section(
+        common::num(&p["thickness"]),
+        common::num(&p["material"]["E"]),
+        common::num(&p["material"]["nu"]),
+    );
+    let p_max = common::num(&p["load"]["Pmax"]);
+    let table = &p["tabulated"];
+    // This table has no origin row.
+    let levels = common::nums(&table["P"]);
+    let (ref_a, ref_b) = (
+        common::nums(&table["radial_disp_outward_point"]),
+        common::nums(&table["radial_disp_inward_point"]),
+    );
+
+    let n = 24;
+    let mut model = Model::try_new(common::quarter_hemisphere(r, hole, n, n)?, section)?;
+    let plane_x0 = model.mesh.node_set("x0")?.to_vec();
+    let plane_y0 = model.mesh.node_set("y0")?.to_vec();
+    model.fix(&plane_x0, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
+    model.fix(&plane_y0, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
+    let hole_node = model.mesh.node_set("hole")?[0];
+    model.fix(&[hole_node], &[Dof::Uz])?;
+    let a = common::nearest_node(&model.mesh, Vector3::new(r, 0.0, 0.0));
+    let b = common::nearest_node(&model.mesh, Vector3::new(0.0, r, 0.0));
+    model.add_load(a, Dof::Ux, p_max / 2.0)?;
+    model.add_load(b, Dof::Uy, -p_max / 2.0)?;
+    let mut system = System::try_new(&model)?;
+    let mut state = system.initial_state();
+    let steps = common::follow_load_levels(&mut system, &mut state, &levels, 1, NewtonParams::default())?;
+    let ours_a: Vec<f64> = steps.iter().map(|s| s.displacements[a][0]).collect();
+    let ours_b: Vec<f64> = steps.iter().map(|s| -s.displacements[b][1]).collect();
+    let (ea, ia) = common::worst_relative_error(&ours_a, &ref_a, 5e-4, 0.0);
+    let (eb, ib) = common::worst_relative_error(&ours_b, &ref_b, 5e-4, 0.0);
+    eprintln!(
+        "hemisphere {n}x{n} at Pmax: u_A = {:.3} (Sze 4.067), -u_B = {:.3} (8.178); worst errors {ea:.4} (P = {}), {eb:.4} (P = {}); {:.1} s",
+        ours_a[ours_a.len() - 1],
+        ours_b[ours_b.len() - 1],
+        levels[ia],
+        levels[ib],
+        start.elapsed().as_secs_f64()
+    );
+    assert!(ea < 0.02 && eb < 0.02, "u_A: {ours_a:?}\n-u_B: {ours_b:?}");
     Ok(())
 }
 

@@ -170,6 +170,38 @@ pub fn quarter_hemisphere(radius: f64, hole: f64, n_polar: usize, n_azimuth: usi
     Ok(mesh)
 }
 
+/// Flat annular plate in the x-y plane, radii `inner` to `outer`, slit along the radial line at
+/// angle 0: the two sides of the slit (angle 0 and angle 2 pi) carry distinct nodes. `n_radial`
+/// elements across the width, `n_arc` around the circumference; normals along +z.
+///
+/// Node sets: `slit0` (angle 0, from the inner to the outer radius) and `slit1` (angle 2 pi, same
+/// order).
+///
+/// # Errors
+/// Invalid mesh (never for sensible arguments).
+pub fn slit_annulus(inner: f64, outer: f64, n_radial: usize, n_arc: usize) -> Result<Mesh> {
+    let id = |i: usize, j: usize| j * (n_radial + 1) + i;
+    let mut nodes = Vec::new();
+    for j in 0..=n_arc {
+        let theta = std::f64::consts::TAU * j as f64 / n_arc as f64;
+        for i in 0..=n_radial {
+            let r = inner + (outer - inner) * i as f64 / n_radial as f64;
+            nodes.push(Vector3::new(r * theta.cos(), r * theta.sin(), 0.0));
+        }
+    }
+    let mut quads = Vec::new();
+    for j in 0..n_arc {
+        for i in 0..n_radial {
+            // (d/dr) x (d/dtheta) points along +z.
+            quads.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let mut mesh = Mesh::try_new(nodes, quads)?;
+    mesh.add_node_set("slit0", (0..=n_radial).map(|i| id(i, 0)).collect())?;
+    mesh.add_node_set("slit1", (0..=n_radial).map(|i| id(i, n_arc)).collect())?;
+    Ok(mesh)
+}
+
 /// Follows the equilibrium path under load control through the load factors `levels` (increasing
 /// from the current one), with `increments` equal increments (cut back when needed) between
 /// consecutive levels; returns the converged step at each level, so that results are compared
