@@ -89,10 +89,15 @@ fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> 
         "the tangent should be non-symmetric here: {nonsymmetric}"
     );
     // Asymptotic range of the weighted correction norms (translations, rotations times L_c): the
-    // strictly decreasing run of corrections that ends at the smallest one (round-off after it).
-    let i_min = (0..corr.len())
+    // strictly decreasing run of corrections that ends at the first one at round-off level
+    // (1e-12 of the first correction; later ones are noise), or at the smallest one.
+    let smallest = (0..corr.len())
         .min_by(|&a, &b| corr[a].total_cmp(&corr[b]))
         .expect("corrections");
+    let i_min = corr
+        .iter()
+        .position(|&c| c <= 1e-12 * corr[0])
+        .unwrap_or(smallest);
     let mut i0 = i_min;
     while i0 > 0 && corr[i0 - 1] > corr[i0] {
         i0 -= 1;

@@ -142,9 +142,10 @@ impl Solver<'_> {
         let tol = self.params.newton.tol_force * self.reference_force(lambda);
         let ok_force = res <= tol.max(self.round_off);
         // The energy ratio cannot go below round-off on tiny increments: a residual a hundred times
-        // below the force tolerance is converged whatever the energy ratio says.
-        let ok_energy =
-            energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first) || res <= 0.01 * tol;
+        // below the force tolerance, or at the round-off floor, is converged whatever the energy
+        // ratio says.
+        let ok_energy = energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first)
+            || res <= (0.01 * tol).max(self.round_off);
         (ok_force && ok_energy && res.is_finite(), res)
     }
 
@@ -516,8 +517,8 @@ pub fn solve_static(
         .iter()
         .map(|x| x.norm())
         .fold(0.0, f64::max);
-    let round_off = 100.0
-        * f64::EPSILON
+    // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
+    let round_off = f64::EPSILON
         * system.section.membrane[(0, 0)]
         * (x_max + system.char_length)
         * (system.reference.x.len() as f64).sqrt();
