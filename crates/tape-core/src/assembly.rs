@@ -7,8 +7,9 @@
 //!
 //! The sparsity pattern (free x free, and free x constrained for the coupling used by
 //! displacement control) and each element's slots in it are computed once. Each assembly computes
-//! the element blocks in parallel (rayon) or serially into per-element buffers, then scatters them
-//! serially in element order, so both paths give bit-identical results.
+//! the element blocks in parallel (rayon) or serially into per-element buffers, then scatters the
+//! two halves of the element list into two buffers that are added in a fixed order, so both paths
+//! give bit-identical results.
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
@@ -119,6 +120,8 @@ pub struct System {
     f_buf: Vec<ElementVector>,
     k_buf: Vec<ElementMatrix>,
     e_buf: Vec<f64>,
+    k_scratch_ff: Vec<f64>,
+    k_scratch_fc: Vec<f64>,
     /// Use rayon for the element loop.
     pub parallel: bool,
 }
@@ -201,6 +204,8 @@ impl System {
             f_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
             e_buf: vec![0.0; n_el],
+            k_scratch_ff: Vec::new(),
+            k_scratch_fc: Vec::new(),
             parallel: true,
         })
     }
@@ -343,19 +348,50 @@ impl System {
             for i in 0..24 {
                 f_cond[own[i / 6]][i % 6] += f[i];
             }
-            if tangent {
-                let slots = &self.slots[e * 576..(e + 1) * 576];
-                for (s, v) in slots.iter().zip(k.as_slice()) {
-                    if *s == NONE {
-                        continue;
-                    }
-                    let s = *s as usize;
-                    if s < nnz_ff {
-                        out.k_ff[s] += v;
-                    } else {
-                        out.k_fc[s - nnz_ff] += v;
+        }
+        if tangent {
+            // Scatter the two halves of the element list into separate buffers (in parallel when
+            // asked) and add them in a fixed order: serial and parallel results are identical.
+            let n_el = self.elements.len();
+            let half = n_el / 2;
+            self.k_scratch_ff.clear();
+            self.k_scratch_ff.resize(nnz_ff, 0.0);
+            self.k_scratch_fc.clear();
+            self.k_scratch_fc.resize(self.pattern_fc.nnz(), 0.0);
+            let (slots, k_buf) = (&self.slots, &self.k_buf);
+            let scatter = |range: std::ops::Range<usize>, ff: &mut [f64], fc: &mut [f64]| {
+                for e in range {
+                    for (s, v) in slots[e * 576..(e + 1) * 576]
+                        .iter()
+                        .zip(k_buf[e].as_slice())
+                    {
+                        if *s == NONE {
+                            continue;
+                        }
+                        let s = *s as usize;
+                        if s < nnz_ff {
+                            ff[s] += v;
+                        } else {
+                            fc[s - nnz_ff] += v;
+                        }
                     }
                 }
+            };
+            let (sff, sfc) = (&mut self.k_scratch_ff, &mut self.k_scratch_fc);
+            if self.parallel {
+                rayon::join(
+                    || scatter(0..half, &mut out.k_ff, &mut out.k_fc),
+                    || scatter(half..n_el, sff, sfc),
+                );
+            } else {
+                scatter(0..half, &mut out.k_ff, &mut out.k_fc);
+                scatter(half..n_el, sff, sfc);
+            }
+            for (a, b) in out.k_ff.iter_mut().zip(sff.iter()) {
+                *a += b;
+            }
+            for (a, b) in out.k_fc.iter_mut().zip(sfc.iter()) {
+                *a += b;
             }
         }
 

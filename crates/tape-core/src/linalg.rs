@@ -118,34 +118,40 @@ impl LinearSolver {
     pub fn factorize(&mut self, values: &[f64]) -> Result<()> {
         self.factorised = false;
         self.lu = None;
-        if let Some(p) = values.iter().position(|v| !v.is_finite()) {
+        // One pass: copy, symmetric part, finiteness, largest entry and largest skew entry.
+        self.values.clear();
+        self.values.extend_from_slice(values);
+        self.sym.clear();
+        self.sym.reserve(values.len());
+        let (mut max, mut skew, mut finite) = (0.0_f64, 0.0_f64, true);
+        for (v, &t) in values.iter().zip(&self.transpose_of) {
+            let vt = values[t];
+            finite &= v.is_finite();
+            max = max.max(v.abs());
+            skew = skew.max((v - vt).abs());
+            self.sym.push(0.5 * (v + vt));
+        }
+        if !finite {
+            let p = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
             return Err(Error::Factorisation(format!(
                 "the tangent has a non-finite entry (position {p})"
             )));
         }
-        self.values.clear();
-        self.values.extend_from_slice(values);
-        self.sym.clear();
-        self.sym.extend(
-            values
-                .iter()
-                .zip(&self.transpose_of)
-                .map(|(v, &t)| 0.5 * (v + values[t])),
-        );
-        let max = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let cp = self.symbolic.col_ptr();
-        self.k_norm = (0..self.symbolic.ncols())
-            .map(|j| {
-                values[cp[j]..cp[j + 1]]
-                    .iter()
-                    .map(|v| v.abs())
-                    .sum::<f64>()
-            })
-            .fold(0.0, f64::max);
-        self.skew_free = values
-            .iter()
-            .zip(&self.sym)
-            .all(|(v, s)| (v - s).abs() <= 1e-15 * max);
+        self.skew_free = 0.5 * skew <= 1e-15 * max;
+        // The 1-norm is only needed by GMRES (non-symmetric matrices).
+        self.k_norm = if self.skew_free {
+            0.0
+        } else {
+            let cp = self.symbolic.col_ptr();
+            (0..self.symbolic.ncols())
+                .map(|j| {
+                    values[cp[j]..cp[j + 1]]
+                        .iter()
+                        .map(|v| v.abs())
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max)
+        };
         self.factorisations += 1;
         let mat = SparseColMatRef::new(self.symbolic.as_ref(), &self.sym);
         let ok = self

@@ -8,9 +8,12 @@
 //! & Dhatt 1979), or the arc-length constraint
 //! `|Dq|_W^2 + Dlambda^2 c = Ds^2` (Crisfield 1981), whose root is chosen at the smallest angle with
 //! the predictor. The first predictor follows the tangent in the requested direction; later ones
-//! extrapolate the previous converged increment (secant predictor), and a converged increment that
-//! turns back on the path (negative inner product with the previous one) is rejected and cut back,
-//! so limit points, snap-through and snap-back are passed without reversing. Norms weigh rotations by the
+//! follow the tangent at the converged state (when its factorisation is at hand from the
+//! stability count) oriented like the previous increment (Feng et al. 1996), or else, and always
+//! after a cut-back, extrapolate the previous converged increment (secant predictor). A converged
+//! increment that turns back on the path (negative inner product with the previous one) is
+//! rejected and cut back, and one that bends by more than 60 degrees is refined, so limit points,
+//! snap-through and snap-back are passed without reversing or jumping branches. Norms weigh rotations by the
 //! characteristic length `L_c` of the model.
 //!
 //! An increment that fails (no convergence, singular tangent, no arc-length root, non-finite
@@ -55,6 +58,9 @@ struct Solver<'a> {
     path_force: f64,
     /// Reject arc-length steps that bend sharply (cleared after repeated cut-backs).
     strict_turns: bool,
+    /// Use the tangent predictor when a factorisation of the converged state is at hand (off
+    /// after a cut-back: the secant predictor is safer at sharp turns).
+    tangent_predictor: bool,
     /// Increment of the last converged step, for the arc-length secant predictor.
     previous: Option<(Vec<f64>, f64)>,
     weights: Vec<f64>,
@@ -155,7 +161,22 @@ impl Solver<'_> {
         if !self.fresh {
             self.assemble(state);
         }
+        let tangent_predictor = self.factorised && self.tangent_predictor;
         let (dlambda0, dq) = match (inc, &self.previous) {
+            (Increment::Arc { ds, .. }, Some((prev_dq, prev_dl))) if tangent_predictor => {
+                // Tangent predictor from the factorisation already made for the stability count,
+                // oriented like the previous increment (Feng et al. 1996).
+                let mut dq_b = self.load_vector();
+                self.linear.solve_in_place(&mut dq_b)?;
+                let sign = if self.dot_w(prev_dq, &dq_b) + prev_dl * self.c_lambda >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
+                let dl = sign * ds / norm;
+                (dl, dq_b.iter().map(|v| dl * v).collect())
+            }
             (Increment::Arc { ds, .. }, Some((prev_dq, prev_dl))) => {
                 // Secant predictor: extrapolate the last converged increment to the new arc length.
                 let norm = (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda).sqrt();
@@ -531,6 +552,7 @@ pub fn solve_static(
         round_off,
         path_force: 0.0,
         strict_turns: true,
+        tangent_predictor: true,
         previous: None,
         weights,
         values,
@@ -758,6 +780,7 @@ pub fn solve_static(
                 }
                 cutbacks = 0;
                 s.strict_turns = true;
+                s.tangent_predictor = true;
                 s.path_force = s
                     .path_force
                     .max((state.lambda.abs() * s.force_norm(&s.asm.f_ext)).max(s.reaction_norm()));
@@ -825,6 +848,7 @@ pub fn solve_static(
                 }
                 size *= 0.5;
                 s.strict_turns = cutbacks < params.max_cutbacks / 2;
+                s.tangent_predictor = false;
                 log::debug!("increment failed at lambda = {}: {err}; cutting back", state.lambda);
             }
         }
