@@ -419,7 +419,7 @@ impl System {
                 let lever = state.x[s] - state.x[r];
                 let f_net = f_node[s] - state.lambda * f_ext_node[s];
                 let h = rotated_vector_hessian(&f_net, &lever) - skew(&lever.cross(&f_net)) * 0.5;
-                self.add_node_block(r, &h, out, nnz_ff);
+                self.add_node_block(r, &h, out);
             }
         }
 
@@ -441,8 +441,7 @@ impl System {
     }
 
     /// Adds a 3x3 block to the rotation-rotation block of independent node `r`.
-    fn add_node_block(&self, r: usize, h: &Matrix3<f64>, out: &mut Assembled, nnz_ff: usize) {
-        let _ = nnz_ff;
+    fn add_node_block(&self, r: usize, h: &Matrix3<f64>, out: &mut Assembled) {
         for i in 0..3 {
             let Slot::Free(row) = self.dofs.slots[r][3 + i] else {
                 continue;

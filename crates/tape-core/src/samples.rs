@@ -8,7 +8,7 @@ use crate::material::ShellSection;
 use crate::mesh::generate::{apply_twist_imperfection, tape_spring, TapeGeometry};
 use crate::model::{Dof, Model};
 use crate::solver::{solve_static, Control, NewtonParams, StaticParams, StaticPath, StaticStep, Stats};
-use crate::{State, System};
+use crate::System;
 
 /// Pure bending of one tape spring (paper Sec. 2, Fig. 4).
 ///
@@ -241,10 +241,4 @@ impl TapeBending {
             });
         }
     }
-}
-
-/// The reference state of a model (helper for callers that only need positions).
-#[must_use]
-pub fn reference_state(system: &System) -> State {
-    system.initial_state()
 }

@@ -11,6 +11,27 @@ use tape_core::assembly::Assembled;
 use tape_core::samples::TapeBending;
 use tape_core::{Result, State, System};
 
+/// `system`'s reference state moved by a smooth field of free increments (`rot` [rad] on
+/// rotations, `disp` [m] on translations, phase `phase`) and the load factor `lambda`.
+fn deformed(system: &System, rot: f64, disp: f64, phase: f64, lambda: f64) -> State {
+    let mut state = system.initial_state();
+    let dq: Vec<f64> = system
+        .dofs
+        .free_dofs
+        .iter()
+        .map(|&(node, dof)| {
+            let s = (node as f64 * 0.7 + dof.index() as f64 + phase).sin();
+            if dof.is_rotation() {
+                rot * s
+            } else {
+                disp * s
+            }
+        })
+        .collect();
+    system.update(&mut state, &dq, lambda);
+    state
+}
+
 /// Relative error of column `j` of the assembled tangent `k_ff` against central differences of
 /// the residual under the multiplicative update (steps 1e-7 m / 1e-6 rad).
 fn fd_column_error(system: &mut System, state: &State, k_ff: &[f64], j: usize) -> f64 {
@@ -57,20 +78,8 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
     };
     let bm = tb.build()?;
     let mut system = System::try_new(&bm.model)?;
-    let mut state = system.initial_state();
+    let state = deformed(&system, 0.05, 2e-4, 0.0, 0.05);
     let n = system.n_free();
-    let dq: Vec<f64> = (0..n)
-        .map(|i| {
-            let (node, dof) = system.dofs.free_dofs[i];
-            let s = (node as f64 * 0.7 + dof.index() as f64).sin();
-            if dof.is_rotation() {
-                0.05 * s
-            } else {
-                2e-4 * s
-            }
-        })
-        .collect();
-    system.update(&mut state, &dq, 0.05);
     let mut a = Assembled::default();
     system.assemble(&state, true, &mut a);
     let k = a.k_ff.clone();
@@ -80,7 +89,6 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
         .collect();
     let mut cols = driven.clone();
     cols.extend((0..n).step_by(97));
-    let mut worst: f64 = 0.0;
     for &j in &cols {
         let err = fd_column_error(&mut system, &state, &k, j);
         assert!(
@@ -88,10 +96,8 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
             "column {j} ({:?}): relative error {err:e}",
             system.dofs.free_dofs[j]
         );
-        worst = worst.max(err);
     }
     assert!(driven.len() == 2, "the driven node has free ux and uz");
-    assert!(worst < 1e-5);
     Ok(())
 }
 
@@ -156,20 +162,8 @@ fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
     bm.model.add_load(bm.driven_node, Dof::Ry, 0.05)?;
     bm.model.add_load(bm.driven_node, Dof::Uz, -0.3)?;
     let mut system = System::try_new(&bm.model)?;
-    let mut state = system.initial_state();
+    let state = deformed(&system, 0.1, 1e-4, std::f64::consts::FRAC_PI_2, 0.5);
     let n = system.n_free();
-    let dq: Vec<f64> = (0..n)
-        .map(|i| {
-            let (node, dof) = system.dofs.free_dofs[i];
-            let s = (node as f64 * 0.7 + dof.index() as f64).cos();
-            if dof.is_rotation() {
-                0.1 * s
-            } else {
-                1e-4 * s
-            }
-        })
-        .collect();
-    system.update(&mut state, &dq, 0.5);
     let mut a = Assembled::default();
     system.assemble(&state, true, &mut a);
     let cols: Vec<usize> = (0..n)

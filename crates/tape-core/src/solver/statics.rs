@@ -563,8 +563,8 @@ pub fn solve_static(
     };
     let mut path = StaticPath::default();
 
-    // Each control is a sequence of increments; `next` proposes one from the last accepted one.
-    let mut prev: Option<Outcome> = None;
+    // Load-factor increment of the last accepted step (None before the first one).
+    let mut last_dlambda: Option<f64> = None;
     let mut size;
     let mut steps_left;
     let mut done_target = None;
@@ -673,11 +673,8 @@ pub fn solve_static(
                 // A limit point of the load factor: jump to the stable equilibrium beyond it.
                 if let (true, Control::ArcLength { lambda_end, .. }) = (params.jump_at_limit_points, &params.control) {
                     let travel = (lambda_end - saved.lambda).signum();
-                    if (state.lambda - saved.lambda) * travel < 0.0 && prev.is_some() {
-                        let mut offset = prev
-                            .as_ref()
-                            .map_or(1e-3, |p| 0.25 * p.dlambda.abs())
-                            .max(1e-6);
+                    if (state.lambda - saved.lambda) * travel < 0.0 && last_dlambda.is_some() {
+                        let mut offset = last_dlambda.map_or(1e-3, |dl| 0.25 * dl.abs()).max(1e-6);
                         let mut jumped = false;
                         for _ in 0..8 {
                             *state = saved.clone();
@@ -740,7 +737,7 @@ pub fn solve_static(
                 // Arc-length: do not overshoot the final load factor; finish with a load step.
                 if let Control::ArcLength { lambda_end, .. } = &params.control {
                     let start_l = saved.lambda;
-                    let crossed = (start_l - lambda_end) * (state.lambda - lambda_end) < 0.0 && prev.is_some();
+                    let crossed = (start_l - lambda_end) * (state.lambda - lambda_end) < 0.0 && last_dlambda.is_some();
                     if crossed {
                         let mut trial = saved.clone();
                         s.fresh = false;
@@ -810,14 +807,14 @@ pub fn solve_static(
                         let ds0 = arc_ds.expect("set on the first step");
                         size = (size.abs() * ratio).min(ds0 * max_increment_factor);
                         let reached = (state.lambda - lambda_end) * (saved.lambda - lambda_end) <= 0.0;
-                        if reached && prev.is_some() {
+                        if reached && last_dlambda.is_some() {
                             break;
                         }
                     }
                     _ => size = size.signum() * (size.abs() * ratio).min(initial_size),
                 }
-                s.previous = Some((out.dq.clone(), out.dlambda));
-                prev = Some(out);
+                last_dlambda = Some(out.dlambda);
+                s.previous = Some((out.dq, out.dlambda));
                 if !keep_going {
                     path.cancelled = true;
                     break;
