@@ -84,6 +84,7 @@ def solve_static(
     record_fields: bool = True,
     jump: bool = False,
     tol_force: float = 1e-8,
+    mixed_stress: bool = True,
     max_iterations: int = 20,
     max_cutbacks: int = 10,
     target_iterations: int = 5,

@@ -505,8 +505,8 @@ def solve_static(
         Keyword options of :func:`tapespring._core.solve_static`: ``control`` (``"load"``,
         ``"displacement"`` or ``"arc-length"``), ``lambda_end``, ``increments``, ``node``, ``dof``,
         ``delta``, ``initial_increment``, ``max_increment_factor``, ``max_steps``, ``direction``,
-        ``stability``, ``record_fields``, ``tol_force``, ``max_iterations``, ``max_cutbacks``,
-        ``target_iterations``.
+        ``stability``, ``record_fields``, ``tol_force``, ``mixed_stress``, ``max_iterations``,
+        ``max_cutbacks``, ``target_iterations``.
 
     Returns
     -------

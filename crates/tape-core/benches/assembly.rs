@@ -39,6 +39,27 @@ fn element_kernel(c: &mut Criterion) {
     c.bench_function("element internal force only", |b| {
         b.iter(|| e.compute_into(&x, &q, &system.section, &mut f, None));
     });
+    let zero = [Vector3::zeros(); 4];
+    let dx = [Vector3::new(1e-6, 2e-6, -1e-6); 4];
+    let dth = [Vector3::new(1e-3, -2e-3, 1e-3); 4];
+    c.bench_function("element linearised stress", |b| {
+        b.iter(|| e.linearised_stress(&x, &q, &system.section, &dx, &dth));
+    });
+    let stress = e.linearised_stress(&x, &q, &system.section, &zero, &dth);
+    let mut fg = ElementVector::zeros();
+    c.bench_function("element internal force + mixed tangent", |b| {
+        b.iter(|| {
+            e.compute_mixed_into(
+                &x,
+                &q,
+                &system.section,
+                Some(&stress),
+                &mut f,
+                Some(&mut k),
+                Some(&mut fg),
+            )
+        });
+    });
 }
 
 fn assembly_and_solve(c: &mut Criterion) {

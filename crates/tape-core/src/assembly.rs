@@ -15,7 +15,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
 use crate::dof::{DofMap, Slot};
-use crate::element::shell::{ElementMatrix, ElementVector};
+use crate::element::shell::{ElementMatrix, ElementStress, ElementVector};
 use crate::element::ShellElement;
 use crate::error::Result;
 use crate::material::SectionStiffness;
@@ -118,6 +118,8 @@ pub struct System {
     owners: Vec<[usize; 4]>,
     has_slave: Vec<bool>,
     f_buf: Vec<ElementVector>,
+    /// Element forces of the geometric stresses (mixed iteration), for the tie terms.
+    fg_buf: Vec<ElementVector>,
     k_buf: Vec<ElementMatrix>,
     e_buf: Vec<f64>,
     k_scratch_ff: Vec<f64>,
@@ -202,6 +204,7 @@ impl System {
             owners,
             has_slave,
             f_buf: vec![ElementVector::zeros(); n_el],
+            fg_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
             e_buf: vec![0.0; n_el],
             k_scratch_ff: Vec::new(),
@@ -278,9 +281,84 @@ impl System {
             .collect()
     }
 
+    /// Nodal increments `(delta x, theta)` of every node for the free increments `dq` and the
+    /// load-factor increment `dlambda`, to first order (tied nodes follow their reference node).
+    fn nodal_increments(&self, state: &State, dq: &[f64], dlambda: f64) -> Vec<[Vector3<f64>; 2]> {
+        let mut inc = vec![[Vector3::zeros(); 2]; state.x.len()];
+        for (i, v) in inc.iter_mut().enumerate() {
+            if self.dofs.master[i].is_some() {
+                continue;
+            }
+            for d in 0..6 {
+                v[d / 3][d % 3] = match self.dofs.slots[i][d] {
+                    Slot::Free(eq) => dq[eq],
+                    Slot::Constrained(c) => dlambda * self.dofs.constrained[c].value,
+                };
+            }
+        }
+        for (s, m) in self.dofs.master.iter().enumerate() {
+            if let Some(r) = *m {
+                let [du, th] = inc[r];
+                inc[s] = [du + th.cross(&(state.x[s] - state.x[r])), th];
+            }
+        }
+        inc
+    }
+
+    /// Element stresses of the strains linearised at `state` along the increment `(dq, dlambda)`
+    /// (see [`ShellElement::linearised_stress`]), in element order: the stresses of the mixed Newton
+    /// iteration at the state that [`Self::update`] reaches with the same increment.
+    ///
+    /// # Panics
+    /// If `dq.len() != n_free`.
+    pub fn linearised_stresses(&self, state: &State, dq: &[f64], dlambda: f64, out: &mut Vec<ElementStress>) {
+        assert_eq!(dq.len(), self.dofs.n_free);
+        let inc = self.nodal_increments(state, dq, dlambda);
+        let section = &self.section;
+        let kernel = |e: &ShellElement| {
+            let x = e.nodes.map(|n| state.x[n]);
+            let q = e
+                .nodes
+                .map(|n| state.q[n].to_rotation_matrix().into_inner());
+            let dx = e.nodes.map(|n| inc[n][0]);
+            let dth = e.nodes.map(|n| inc[n][1]);
+            e.linearised_stress(&x, &q, section, &dx, &dth)
+        };
+        out.clear();
+        if self.parallel {
+            self.elements
+                .par_iter()
+                .with_min_len(64)
+                .map(kernel)
+                .collect_into_vec(out);
+        } else {
+            out.extend(self.elements.iter().map(kernel));
+        }
+    }
+
     /// Assembles residual, reactions and (if `tangent`) the tangent at `state`.
-    #[allow(clippy::too_many_lines)]
     pub fn assemble(&mut self, state: &State, tangent: bool, out: &mut Assembled) {
+        self.assemble_mixed(state, tangent, None, out);
+    }
+
+    /// As [`Self::assemble`], with the geometric part of the tangent from the element `stress`
+    /// (in element order) when given: the tangent of the mixed Newton iteration (see
+    /// [`ShellElement::compute_mixed_into`]). The residual is always the true one.
+    ///
+    /// # Panics
+    /// If `stress` does not have one entry per element.
+    #[allow(clippy::too_many_lines)]
+    pub fn assemble_mixed(
+        &mut self,
+        state: &State,
+        tangent: bool,
+        stress: Option<&[ElementStress]>,
+        out: &mut Assembled,
+    ) {
+        if let Some(st) = stress {
+            assert_eq!(st.len(), self.elements.len(), "one stress per element");
+        }
+        let stress = stress.filter(|_| tangent);
         let n_free = self.dofs.n_free;
         let n_con = self.dofs.constrained.len();
         let nnz_ff = self.pattern_ff.nnz();
@@ -298,34 +376,47 @@ impl System {
         }
 
         let section = &self.section;
-        let kernel = |e: &ShellElement, f: &mut ElementVector, k: &mut ElementMatrix, en: &mut f64| {
+        let kernel = |i: usize,
+                      e: &ShellElement,
+                      f: &mut ElementVector,
+                      fg: &mut ElementVector,
+                      k: &mut ElementMatrix,
+                      en: &mut f64| {
             let x = e.nodes.map(|n| state.x[n]);
             let q = e
                 .nodes
                 .map(|n| state.q[n].to_rotation_matrix().into_inner());
-            *en = e.compute_into(&x, &q, section, f, tangent.then_some(k));
+            *en = match stress {
+                Some(st) => e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
+                None => e.compute_into(&x, &q, section, f, tangent.then_some(k)),
+            };
         };
         if self.parallel {
             self.elements
                 .par_iter()
                 .zip(self.f_buf.par_iter_mut())
+                .zip(self.fg_buf.par_iter_mut())
                 .zip(self.k_buf.par_iter_mut())
                 .zip(self.e_buf.par_iter_mut())
+                .enumerate()
                 .with_min_len(16)
-                .for_each(|(((e, f), k), en)| kernel(e, f, k, en));
+                .for_each(|(i, ((((e, f), fg), k), en))| kernel(i, e, f, fg, k, en));
         } else {
-            for (((e, f), k), en) in self
+            for (i, ((((e, f), fg), k), en)) in self
                 .elements
                 .iter()
                 .zip(&mut self.f_buf)
+                .zip(&mut self.fg_buf)
                 .zip(&mut self.k_buf)
                 .zip(&mut self.e_buf)
+                .enumerate()
             {
-                kernel(e, f, k, en);
+                kernel(i, e, f, fg, k, en);
             }
         }
 
-        // Full nodal internal forces of tied nodes (before condensation), for the rigid-motion terms.
+        // Full nodal internal forces of tied nodes (before condensation), for the rigid-motion terms
+        // (those of the geometric stresses in the mixed iteration).
         let n_nodes = state.x.len();
         let mut f_node = vec![Vector3::zeros(); n_nodes];
         // Condensed nodal internal forces of independent nodes.
@@ -337,7 +428,8 @@ impl System {
             if self.has_slave[e] {
                 for a in 0..4 {
                     let n = el.nodes[a];
-                    f_node[n] += f.fixed_rows::<3>(6 * a);
+                    let f_full = if stress.is_some() { &self.fg_buf[e] } else { &*f };
+                    f_node[n] += f_full.fixed_rows::<3>(6 * a);
                     if let Some(r) = self.dofs.master[n] {
                         let lever = state.x[n] - state.x[r];
                         condense_node(f, tangent.then_some(&mut *k), a, &lever);

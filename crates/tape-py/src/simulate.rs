@@ -82,6 +82,7 @@ struct StaticOptions {
     record_fields: bool,
     jump: bool,
     tol_force: f64,
+    mixed_stress: bool,
     max_iterations: i64,
     max_cutbacks: i64,
     target_iterations: i64,
@@ -142,6 +143,7 @@ impl StaticOptions {
             newton: NewtonParams {
                 max_iterations: count("max_iterations", self.max_iterations, 1)?,
                 tol_force: self.tol_force,
+                mixed_stress: self.mixed_stress,
                 ..NewtonParams::default()
             },
             max_cutbacks: count("max_cutbacks", self.max_cutbacks, 0)?,
@@ -172,6 +174,7 @@ impl StaticOptions {
         d.set_item("tol_force", params.newton.tol_force)?;
         d.set_item("tol_energy", params.newton.tol_energy)?;
         d.set_item("line_search", params.newton.line_search)?;
+        d.set_item("mixed_stress", params.newton.mixed_stress)?;
         d.set_item("max_iterations", params.newton.max_iterations)?;
         d.set_item("max_cutbacks", params.max_cutbacks)?;
         d.set_item("target_iterations", params.target_iterations)?;
@@ -184,7 +187,7 @@ impl StaticOptions {
 #[pyo3(signature = (
     model, /, *, control = "load", lambda_end = 1.0, increments = 10, node = None, dof = None, delta = None,
     initial_increment = 0.01, max_increment_factor = 10.0, max_steps = 500, direction = 1, stability = false,
-    record_fields = true, jump = false, tol_force = 1e-8, max_iterations = 20, max_cutbacks = 10, target_iterations = 5,
+    record_fields = true, jump = false, tol_force = 1e-8, mixed_stress = true, max_iterations = 20, max_cutbacks = 10, target_iterations = 5,
     progress = None
 ))]
 #[allow(clippy::too_many_arguments, clippy::needless_pass_by_value)]
@@ -205,6 +208,7 @@ pub fn solve_static<'py>(
     record_fields: bool,
     jump: bool,
     tol_force: f64,
+    mixed_stress: bool,
     max_iterations: i64,
     max_cutbacks: i64,
     target_iterations: i64,
@@ -225,6 +229,7 @@ pub fn solve_static<'py>(
         record_fields,
         jump,
         tol_force,
+        mixed_stress,
         max_iterations,
         max_cutbacks,
         target_iterations,
@@ -362,6 +367,7 @@ pub fn bend_tape<'py>(
     s.set_item("target_iterations", arc.target_iterations)?;
     s.set_item("tol_force", arc.newton.tol_force)?;
     s.set_item("tol_energy", arc.newton.tol_energy)?;
+    s.set_item("mixed_stress", arc.newton.mixed_stress)?;
     s.set_item("max_iterations", arc.newton.max_iterations)?;
     s.set_item("max_cutbacks", arc.max_cutbacks)?;
     if let Control::ArcLength {

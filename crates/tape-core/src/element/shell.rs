@@ -73,6 +73,23 @@ pub struct ShellStrains {
     pub drilling: [f64; 4],
 }
 
+/// Generalised stress resultants of an element, integrated over their areas: the work conjugates
+/// of the strain rows of [`ShellStrains`] (energy = sum of stress times strain / 2).
+///
+/// Used by the mixed-stress Newton iteration ([`ShellElement::compute_mixed_into`]): the
+/// geometric part of the tangent takes these stresses instead of those of the current strains.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ElementStress {
+    /// Membrane forces times the Gauss weight, `w C_m eps` [N m], at each Gauss point.
+    pub membrane: [[f64; 3]; 4],
+    /// Bending moments times the Gauss weight, `w C_b kappa` [N m^2], at each Gauss point.
+    pub bending: [[f64; 3]; 4],
+    /// Shear forces conjugate to the tying strains, `k_s G t S gamma` [N m].
+    pub shear: [f64; 4],
+    /// Drilling moments conjugate to the nodal drilling strains, `k_d psi` [N m].
+    pub drilling: [f64; 4],
+}
+
 /// A 4-node shell element with its reference geometry precomputed.
 #[derive(Clone, Debug)]
 pub struct ShellElement {
@@ -290,11 +307,72 @@ impl ShellElement {
         e + 0.5 * kd * s.drilling.iter().map(|p| p * p).sum::<f64>()
     }
 
+    /// Stresses `C (eps + B delta)` of the strains linearised at `(x, q)` in the direction of the
+    /// nodal increments `dx` [m] and spatial rotation increments `dtheta` [rad] (zero increments give
+    /// the stresses of the configuration). This is the stress update of the mixed Newton iteration:
+    /// the stresses follow the linearised kinematics, so the large spurious membrane stresses that
+    /// a displacement predictor or correction produces in a thin shell do not enter the next
+    /// tangent (Magisano, Leonetti & Garcea 2017, CMAME 313:986).
+    #[must_use]
+    pub fn linearised_stress(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        dx: &[Vector3<f64>; 4],
+        dtheta: &[Vector3<f64>; 4],
+    ) -> ElementStress {
+        let (mut t1, mut t2, mut d) = ([Vector3::zeros(); 4], [Vector3::zeros(); 4], [Vector3::zeros(); 4]);
+        for a in 0..4 {
+            (t1[a], t2[a], d[a]) = columns(&q[a]);
+        }
+        let dd: [Vector3<f64>; 4] = std::array::from_fn(|a| dtheta[a].cross(&d[a]));
+        let mut out = ElementStress::default();
+        for (p, g) in self.gp.iter().enumerate() {
+            let (xs, ds) = gradients(&g.dn, x, &d);
+            let (dxs, dds) = gradients(&g.dn, dx, &dd);
+            let eps = Vector3::new(
+                0.5 * xs[0].norm_squared() - g.eps0[0] + xs[0].dot(&dxs[0]),
+                0.5 * xs[1].norm_squared() - g.eps0[1] + xs[1].dot(&dxs[1]),
+                xs[0].dot(&xs[1]) - g.eps0[2] + xs[0].dot(&dxs[1]) + dxs[0].dot(&xs[1]),
+            );
+            let kap = Vector3::new(
+                xs[0].dot(&ds[0]) - g.kap0[0] + dxs[0].dot(&ds[0]) + xs[0].dot(&dds[0]),
+                xs[1].dot(&ds[1]) - g.kap0[1] + dxs[1].dot(&ds[1]) + xs[1].dot(&dds[1]),
+                xs[0].dot(&ds[1]) + xs[1].dot(&ds[0]) - g.kap0[2]
+                    + dxs[0].dot(&ds[1])
+                    + xs[0].dot(&dds[1])
+                    + dxs[1].dot(&ds[0])
+                    + xs[1].dot(&dds[0]),
+            );
+            out.membrane[p] = (sec.membrane * eps * g.w).into();
+            out.bending[p] = (sec.bending * kap * g.w).into();
+        }
+        let mut gam = Vector4::zeros();
+        for t in 0..4 {
+            let (gt, dt) = self.tying_vectors(t, x, &d);
+            let (dgt, ddt) = self.tying_vectors(t, dx, &dd);
+            gam[t] = gt.dot(&dt) - self.gamma0[t] + dgt.dot(&dt) + gt.dot(&ddt);
+        }
+        out.shear = (self.shear_metric * gam * sec.shear).into();
+        let xc = centre_gradient(&self.dn_centre, x);
+        let dxc = centre_gradient(&self.dn_centre, dx);
+        let kd = sec.drilling * self.area * 0.25;
+        for a in 0..4 {
+            let (u, v) = self.drill_vectors(a, &xc);
+            let (du, dv) = self.drill_vectors(a, &dxc);
+            let (dt1, dt2) = (dtheta[a].cross(&t1[a]), dtheta[a].cross(&t2[a]));
+            let psi = 0.5 * (t1[a].dot(&u) - t2[a].dot(&v)) - self.psi0[a];
+            let dpsi = 0.5 * (dt1.dot(&u) + t1[a].dot(&du) - dt2.dot(&v) - t2[a].dot(&dv));
+            out.drilling[a] = kd * (psi + dpsi);
+        }
+        out
+    }
+
     /// Internal force `f` (gradient of the strain energy) and, if `k` is given, the consistent
     /// tangent, in the configuration `(x, q)`; returns the strain energy [J].
     ///
     /// Layout of `f` and `k`: node-major, `[u_x, u_y, u_z, theta_x, theta_y, theta_z]` per node.
-    #[allow(clippy::too_many_lines)]
     pub fn compute_into(
         &self,
         x: &[Vector3<f64>; 4],
@@ -302,6 +380,26 @@ impl ShellElement {
         sec: &SectionStiffness,
         f: &mut ElementVector,
         k: Option<&mut ElementMatrix>,
+    ) -> f64 {
+        self.compute_mixed_into(x, q, sec, None, f, k, None)
+    }
+
+    /// As [`Self::compute_into`], with the geometric part of the tangent (every term in which the
+    /// stresses multiply second derivatives of the strains, including the rotational `-[g]x / 2`)
+    /// taken from `stress` when it is given: the tangent of the mixed (Hellinger-Reissner) Newton
+    /// iteration, whose stresses are extrapolated linearly from the previous iterate (see
+    /// [`Self::linearised_stress`]). `f` is always the true internal force. If `f_geo` is given it
+    /// receives the force of the geometric stresses (`B^T stress`; `f` when `stress` is `None`).
+    #[allow(clippy::too_many_lines, clippy::too_many_arguments)]
+    pub fn compute_mixed_into(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        stress: Option<&ElementStress>,
+        f: &mut ElementVector,
+        k: Option<&mut ElementMatrix>,
+        f_geo: Option<&mut ElementVector>,
     ) -> f64 {
         let (mut t1, mut t2, mut d) = ([Vector3::zeros(); 4], [Vector3::zeros(); 4], [Vector3::zeros(); 4]);
         for a in 0..4 {
@@ -318,13 +416,19 @@ impl ShellElement {
         let mut sxt1 = [[0.0; 4]; 4];
         let mut sxt2 = [[0.0; 4]; 4];
         let tangent = k.is_some();
+        // Geometric stresses of the mixed iteration, and the force gradients they give.
+        let mixed = stress.filter(|_| tangent || f_geo.is_some());
+        let mut gf_x = [Vector3::zeros(); 4];
+        let mut gf_d = [Vector3::zeros(); 4];
+        let mut gf_t1 = [Vector3::zeros(); 4];
+        let mut gf_t2 = [Vector3::zeros(); 4];
         // Material rows of all integration points, column-major by DOF: sqrt(w) L^T B.
         let mut btil = [0.0; DOFS_PER_ELEMENT * N_ROWS];
         let mut n_rows = 0;
         let mut energy = 0.0;
 
         // Membrane and bending at the 2x2 Gauss points.
-        for g in &self.gp {
+        for (gp_index, g) in self.gp.iter().enumerate() {
             let (xs, ds) = gradients(&g.dn, x, &d);
             let eps = Vector3::new(
                 0.5 * xs[0].norm_squared() - g.eps0[0],
@@ -349,6 +453,26 @@ impl ShellElement {
                     + m[2] * (p * ds[1] + r * ds[0]);
                 f_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
             }
+            let (n, m) = match mixed {
+                Some(st) => {
+                    let (n, m) = (
+                        Vector3::from(st.membrane[gp_index]),
+                        Vector3::from(st.bending[gp_index]),
+                    );
+                    for a in 0..4 {
+                        let [p, r] = g.dn[a];
+                        gf_x[a] += n[0] * p * xs[0]
+                            + n[1] * r * xs[1]
+                            + n[2] * (p * xs[1] + r * xs[0])
+                            + m[0] * p * ds[0]
+                            + m[1] * r * ds[1]
+                            + m[2] * (p * ds[1] + r * ds[0]);
+                        gf_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
+                    }
+                    (n, m)
+                }
+                None => (n, m),
+            };
             if tangent {
                 // Rows of B (6 x 24) at this point, premultiplied by sqrt(w) L^T.
                 let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
@@ -415,6 +539,19 @@ impl ShellElement {
                 f_d[a] += qv[t] * self.cd[t][a] * gt[t];
             }
         }
+        let qv = match mixed {
+            Some(st) => {
+                let qg = Vector4::from(st.shear);
+                for t in 0..4 {
+                    for a in 0..4 {
+                        gf_x[a] += qg[t] * self.cg[t][a] * dt[t];
+                        gf_d[a] += qg[t] * self.cd[t][a] * gt[t];
+                    }
+                }
+                qg
+            }
+            None => qv,
+        };
         if tangent {
             let mut rows = [[0.0; DOFS_PER_ELEMENT]; 4];
             for t in 0..4 {
@@ -451,15 +588,23 @@ impl ShellElement {
             energy += 0.5 * kd * psi * psi;
             f_t1[a] += 0.5 * big_psi * u;
             f_t2[a] -= 0.5 * big_psi * v;
+            let geo_psi = mixed.map_or(big_psi, |st| st.drilling[a]);
+            if mixed.is_some() {
+                gf_t1[a] += 0.5 * geo_psi * u;
+                gf_t2[a] -= 0.5 * geo_psi * v;
+            }
             let mut row = [0.0; DOFS_PER_ELEMENT];
             for bb in 0..4 {
                 let [p, r] = self.dn_centre[bb];
                 let (al, be) = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
                 let gx = al * t1[a] + be * t2[a];
                 f_x[bb] += big_psi * gx;
+                if mixed.is_some() {
+                    gf_x[bb] += geo_psi * gx;
+                }
                 row[6 * bb..6 * bb + 3].copy_from_slice(gx.as_slice());
-                sxt1[bb][a] += big_psi * al;
-                sxt2[bb][a] += big_psi * be;
+                sxt1[bb][a] += geo_psi * al;
+                sxt2[bb][a] += geo_psi * be;
             }
             if tangent {
                 row[6 * a + 3..6 * a + 6].copy_from_slice((0.5 * (t1[a].cross(&u) - t2[a].cross(&v))).as_slice());
@@ -477,6 +622,19 @@ impl ShellElement {
             g_rot[a] = d[a].cross(&f_d[a]) + t1[a].cross(&f_t1[a]) + t2[a].cross(&f_t2[a]);
             f.fixed_rows_mut::<3>(6 * a).copy_from(&f_x[a]);
             f.fixed_rows_mut::<3>(6 * a + 3).copy_from(&g_rot[a]);
+        }
+        // From here on the geometric terms use the geometric stresses.
+        if mixed.is_some() {
+            for a in 0..4 {
+                g_rot[a] = d[a].cross(&gf_d[a]) + t1[a].cross(&gf_t1[a]) + t2[a].cross(&gf_t2[a]);
+            }
+            (f_x, f_d, f_t1, f_t2) = (gf_x, gf_d, gf_t1, gf_t2);
+        }
+        if let Some(fg) = f_geo {
+            for a in 0..4 {
+                fg.fixed_rows_mut::<3>(6 * a).copy_from(&f_x[a]);
+                fg.fixed_rows_mut::<3>(6 * a + 3).copy_from(&g_rot[a]);
+            }
         }
 
         // Geometric stiffness and the rotational terms.
@@ -685,6 +843,165 @@ mod tests {
             }
         }
         assert!(worst < 1e-6, "max relative tangent error {worst:e}");
+    }
+
+    /// `sum stress . strain` over all strain rows.
+    fn pairing(st: &ElementStress, s: &ShellStrains) -> f64 {
+        let mut v = 0.0;
+        for p in 0..4 {
+            for i in 0..3 {
+                v += st.membrane[p][i] * s.membrane[p][i] + st.bending[p][i] * s.bending[p][i];
+            }
+        }
+        (0..4)
+            .map(|t| st.shear[t] * s.shear[t] + st.drilling[t] * s.drilling[t])
+            .sum::<f64>()
+            + v
+    }
+
+    #[test]
+    fn mixed_tangent_with_the_own_stresses_is_the_tangent() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let (sec, m) = (section(), mats(&q));
+        let own = e.linearised_stress(&x, &m, &sec, &[Vector3::zeros(); 4], &[Vector3::zeros(); 4]);
+        let (mut f, mut k) = (ElementVector::zeros(), ElementMatrix::zeros());
+        e.compute_into(&x, &m, &sec, &mut f, Some(&mut k));
+        let (mut fm, mut km, mut fg) = (ElementVector::zeros(), ElementMatrix::zeros(), ElementVector::zeros());
+        e.compute_mixed_into(&x, &m, &sec, Some(&own), &mut fm, Some(&mut km), Some(&mut fg));
+        // Same arithmetic up to the order of a few sums: round-off only.
+        assert!(
+            (fm - f).amax() <= 1e-12 * f.amax(),
+            "force differs by {}",
+            (fm - f).amax()
+        );
+        assert!(
+            (fg - f).amax() <= 1e-10 * f.amax(),
+            "geometric force differs by {}",
+            (fg - f).amax()
+        );
+        assert!(
+            (km - k).amax() <= 1e-10 * k.amax(),
+            "tangent differs by {}",
+            (km - k).amax()
+        );
+    }
+
+    #[test]
+    fn linearised_stress_is_exact_to_first_order() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let dx = [
+            Vector3::new(2e-5, -1e-5, 4e-5),
+            Vector3::new(-1e-5, 3e-5, 1e-5),
+            Vector3::new(1e-5, 1e-5, -5e-5),
+            Vector3::new(-3e-5, 2e-5, 2e-5),
+        ];
+        let dth = [
+            Vector3::new(0.02, -0.01, 0.03),
+            Vector3::new(-0.01, 0.02, 0.01),
+            Vector3::new(0.03, 0.01, -0.02),
+            Vector3::new(0.01, -0.03, 0.02),
+        ];
+        let zero = [Vector3::zeros(); 4];
+        let flat = |st: &ElementStress| -> Vec<f64> {
+            let mut v: Vec<f64> = st
+                .membrane
+                .iter()
+                .chain(&st.bending)
+                .flatten()
+                .copied()
+                .collect();
+            v.extend(st.shear.iter().chain(&st.drilling));
+            v
+        };
+        let s0 = flat(&e.linearised_stress(&x, &mats(&q), &sec, &zero, &zero));
+        let mut errors = Vec::new();
+        for h in [1.0, 0.5, 0.25] {
+            let xh: [Vector3<f64>; 4] = std::array::from_fn(|a| x[a] + h * dx[a]);
+            let qh: [UnitQuaternion<f64>; 4] = std::array::from_fn(|a| rotate(&q[a], &(h * dth[a])));
+            let exact = flat(&e.linearised_stress(&xh, &mats(&qh), &sec, &zero, &zero));
+            let hdx = dx.map(|v| h * v);
+            let hdth = dth.map(|v| h * v);
+            let lin = flat(&e.linearised_stress(&x, &mats(&q), &sec, &hdx, &hdth));
+            let change = exact
+                .iter()
+                .zip(&s0)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let err = exact
+                .iter()
+                .zip(&lin)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                err < 0.2 * change,
+                "h = {h}: linearisation error {err:e} vs change {change:e}"
+            );
+            errors.push(err);
+        }
+        // Second-order remainder: halving the increment divides the error by about 4.
+        for w in errors.windows(2) {
+            let rate = (w[0] / w[1]).log2();
+            assert!((rate - 2.0).abs() < 0.15, "remainder order {rate}, errors {errors:?}");
+        }
+    }
+
+    #[test]
+    fn mixed_tangent_is_derivative_of_the_geometric_force() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let zero = [Vector3::zeros(); 4];
+        // Stresses unrelated to the configuration (those of another state, scaled).
+        let (xo, qo) = deformed(&x, &q);
+        let mut st = e.linearised_stress(&xo, &mats(&qo), &sec, &zero, &zero);
+        st.drilling = [3.0e-3, -2.0e-3, 1.0e-3, 4.0e-3];
+        let geo_force = |xx: &[Vector3<f64>; 4], qq: &[UnitQuaternion<f64>; 4]| {
+            let (mut f, mut fg) = (ElementVector::zeros(), ElementVector::zeros());
+            e.compute_mixed_into(xx, &mats(qq), &sec, Some(&st), &mut f, None, Some(&mut fg));
+            fg
+        };
+        // f_geo is the gradient of stress . strain(q) at fixed stress.
+        let fg = geo_force(&x, &q);
+        for j in 0..24 {
+            let h = if j % 6 < 3 { 1e-8 } else { 1e-6 };
+            let (xp, qp) = perturb(&x, &q, j, h);
+            let (xm, qm) = perturb(&x, &q, j, -h);
+            let fd =
+                (pairing(&st, &e.strains(&xp, &mats(&qp))) - pairing(&st, &e.strains(&xm, &mats(&qm)))) / (2.0 * h);
+            assert!(
+                (fd - fg[j]).abs() <= 1e-6 * fg.amax(),
+                "dof {j}: f_geo {}, fd {fd}",
+                fg[j]
+            );
+        }
+        // Mixed tangent = material part (zero stress) + derivative of f_geo at fixed stress.
+        let (mut f, mut k, mut k0) = (ElementVector::zeros(), ElementMatrix::zeros(), ElementMatrix::zeros());
+        e.compute_mixed_into(&x, &mats(&q), &sec, Some(&st), &mut f, Some(&mut k), None);
+        e.compute_mixed_into(
+            &x,
+            &mats(&q),
+            &sec,
+            Some(&ElementStress::default()),
+            &mut f,
+            Some(&mut k0),
+            None,
+        );
+        let geometric = k - k0;
+        let mut worst: f64 = 0.0;
+        for j in 0..24 {
+            let h = if j % 6 < 3 { 1e-9 } else { 1e-7 };
+            let (xp, qp) = perturb(&x, &q, j, h);
+            let (xm, qm) = perturb(&x, &q, j, -h);
+            let col = (geo_force(&xp, &qp) - geo_force(&xm, &qm)) / (2.0 * h);
+            for i in 0..24 {
+                let scale = (k[(i, i)].abs() * k[(j, j)].abs()).sqrt();
+                worst = worst.max((col[i] - geometric[(i, j)]).abs() / scale);
+            }
+        }
+        assert!(worst < 1e-6, "max relative error of the geometric tangent {worst:e}");
     }
 
     #[test]

@@ -25,6 +25,7 @@ use std::time::Instant;
 use super::{Control, StaticParams, StaticPath, StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::dof::Slot;
+use crate::element::shell::ElementStress;
 use crate::error::{Error, Result};
 use crate::linalg::LinearSolver;
 use crate::state::State;
@@ -52,6 +53,10 @@ struct Solver<'a> {
     fresh: bool,
     /// `linear` holds the factorisation of `asm`'s tangent.
     factorised: bool,
+    /// Element stresses of the mixed iteration at the current state (linearised from the last
+    /// iterate), used by the next tangent when `stress_valid`.
+    stress: Vec<ElementStress>,
+    stress_valid: bool,
     /// Residual norm reachable in floating point [N]: a few ulps of the element forces.
     round_off: f64,
     /// Largest reference force met on the path so far [N] (the force scale near zero load).
@@ -74,10 +79,32 @@ struct Solver<'a> {
 impl Solver<'_> {
     fn assemble(&mut self, state: &State) {
         let t = Instant::now();
-        self.system.assemble(state, true, &mut self.asm);
+        let stress = self.stress_valid.then_some(self.stress.as_slice());
+        self.system
+            .assemble_mixed(state, true, stress, &mut self.asm);
         self.stats.assembly_s += t.elapsed().as_secs_f64();
         self.fresh = true;
         self.factorised = false;
+    }
+
+    /// Moves `state` by `(dq, dlambda)`; in the mixed iteration the element stresses follow the
+    /// linearised kinematics of that move.
+    fn advance(&mut self, state: &mut State, dq: &[f64], dlambda: f64) {
+        if self.params.newton.mixed_stress {
+            let t = Instant::now();
+            self.system
+                .linearised_stresses(state, dq, dlambda, &mut self.stress);
+            self.stats.assembly_s += t.elapsed().as_secs_f64();
+            self.stress_valid = true;
+        }
+        self.system.update(state, dq, dlambda);
+    }
+
+    /// Forgets everything computed at the current state (after it was replaced).
+    fn invalidate(&mut self) {
+        self.fresh = false;
+        self.factorised = false;
+        self.stress_valid = false;
     }
 
     fn dot_w(&self, a: &[f64], b: &[f64]) -> f64 {
@@ -206,51 +233,37 @@ impl Solver<'_> {
                 (dlambda0, dq)
             }
         };
-        self.system.update(state, &dq, dlambda0);
+        self.advance(state, &dq, dlambda0);
         let mut acc = dq;
         let mut acc_lambda = dlambda0;
         let mut energy_first = None;
         let max_it = self.params.newton.max_iterations;
         let mut res = f64::INFINITY;
         let mut no_root = 0;
+        // Smallest residual so far and the iteration that reached it: an iteration that has not
+        // improved on it for `stall_iterations` iterations is cycling, not converging, and is cut
+        // back at once rather than after `max_iterations`.
+        let stall_n = match self.params.newton.stall_iterations {
+            0 => usize::MAX / 2,
+            n => n,
+        };
+        let mut best = (f64::INFINITY, 0);
         for it in 1..=max_it {
             self.stats.iterations += 1;
             self.assemble(state);
             let (ok, r) = self.converged(state.lambda, energy_first);
             res = r;
+            log::trace!("Newton iteration {it}: lambda {:.6}, residual {res:.3e}", state.lambda);
             if !res.is_finite() {
                 return Err(Error::Factorisation("non-finite residual".into()));
             }
             if ok {
-                if let (Increment::Arc { .. }, Some((prev_dq, prev_dl))) = (inc, &self.previous) {
-                    // A converged increment that turns back on the path means the step jumped
-                    // across a sharp turn: reject it so that the step is cut back.
-                    let dot = self.dot_w(&acc, prev_dq) + acc_lambda * prev_dl * self.c_lambda;
-                    let norms = ((self.dot_w(&acc, &acc) + acc_lambda * acc_lambda * self.c_lambda)
-                        * (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda))
-                        .sqrt();
-                    if dot <= 0.0 {
-                        return Err(Error::Factorisation(
-                            "the arc-length step turned back on the path".into(),
-                        ));
-                    }
-                    // A bend of more than 60 degrees in one step may have jumped to another branch (seen on a
-                    // 4 mm tape unloading past the heel):
-                    // refine (the driver accepts it once half of the cut-backs are spent).
-                    if dot < 0.5 * norms && self.strict_turns {
-                        return Err(Error::Factorisation(
-                            "the arc-length step bent by more than 60 degrees".into(),
-                        ));
-                    }
-                }
-                return Ok(Outcome {
-                    iterations: it,
-                    residual: res,
-                    dq: acc,
-                    dlambda: acc_lambda,
-                });
+                return self.accept(inc, it, res, acc, acc_lambda);
             }
-            if it == max_it {
+            if res < best.0 {
+                best = (res, it);
+            }
+            if it == max_it || (it >= best.1 + stall_n) {
                 break;
             }
             let (dq_r, dq_b) = self.solve_pair()?;
@@ -303,12 +316,20 @@ impl Solver<'_> {
                 Some((first, _)) => Some((first, e)),
             };
             energy_first = energy;
+            // Converged in force, and the correction just computed is negligible in energy: accept
+            // the current state (its tangent is factorised, ready for the stability check and the
+            // next predictor) instead of paying an assembly to confirm what the energy says.
+            if let Some((first, last)) = energy {
+                if it > 1 && last <= self.params.newton.tol_energy * first && self.converged(state.lambda, None).0 {
+                    return self.accept(inc, it, res, acc, acc_lambda);
+                }
+            }
             let mut alpha = 1.0;
             let saved =
                 (!matches!(inc, Increment::Arc { .. }) && self.params.newton.line_search).then(|| state.clone());
             loop {
                 let scaled: Vec<f64> = step.iter().map(|s| alpha * s).collect();
-                self.system.update(state, &scaled, alpha * dl);
+                self.advance(state, &scaled, alpha * dl);
                 let Some(saved) = &saved else { break };
                 if alpha < 0.1 {
                     break;
@@ -329,11 +350,47 @@ impl Solver<'_> {
             }
             acc_lambda += alpha * dl;
         }
+        let stalled = best.1 + stall_n <= max_it;
         Err(Error::NotConverged {
             lambda: state.lambda,
-            iterations: max_it,
+            iterations: if stalled { best.1 + stall_n } else { max_it },
             residual: res,
-            detail: "Newton iterations exhausted".into(),
+            detail: if stalled {
+                format!("Newton iterations stalled (no progress in {stall_n} iterations)")
+            } else {
+                "Newton iterations exhausted".into()
+            },
+        })
+    }
+
+    /// A converged increment: rejected if it turned back or bent sharply on the arc-length path.
+    fn accept(&self, inc: Increment, iterations: usize, residual: f64, dq: Vec<f64>, dlambda: f64) -> Result<Outcome> {
+        if let (Increment::Arc { .. }, Some((prev_dq, prev_dl))) = (inc, &self.previous) {
+            // A converged increment that turns back on the path means the step jumped
+            // across a sharp turn: reject it so that the step is cut back.
+            let dot = self.dot_w(&dq, prev_dq) + dlambda * prev_dl * self.c_lambda;
+            let norms = ((self.dot_w(&dq, &dq) + dlambda * dlambda * self.c_lambda)
+                * (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda))
+                .sqrt();
+            if dot <= 0.0 {
+                return Err(Error::Factorisation(
+                    "the arc-length step turned back on the path".into(),
+                ));
+            }
+            // A bend of more than 60 degrees in one step may have jumped to another branch (seen on a
+            // 4 mm tape unloading past the heel): refine (the driver accepts it once half of the
+            // cut-backs are spent).
+            if dot < 0.5 * norms && self.strict_turns {
+                return Err(Error::Factorisation(
+                    "the arc-length step bent by more than 60 degrees".into(),
+                ));
+            }
+        }
+        Ok(Outcome {
+            iterations,
+            residual,
+            dq,
+            dlambda,
         })
     }
 
@@ -401,8 +458,8 @@ impl Solver<'_> {
         let n = self.system.n_free();
         let zero = vec![0.0; n];
         self.system.update(state, &zero, lambda - state.lambda);
-        self.fresh = false;
-        self.factorised = false;
+        // A gradient flow on the true potential: exact tangents.
+        self.invalidate();
         let diag: Vec<usize> = (0..n)
             .map(|i| {
                 self.system
@@ -414,7 +471,8 @@ impl Solver<'_> {
         let mut beta: f64 = 1e-2;
         for step in 0..MAX_STEPS {
             self.assemble(state);
-            let (ok, _) = self.converged(state.lambda, None);
+            let (ok, rr) = self.converged(state.lambda, None);
+            log::trace!("relaxation step {step}: beta {beta:.1e}, residual {rr:.3e}");
             if ok && beta <= 1e-6 {
                 self.linear.factorize(&self.asm.k_ff)?;
                 self.stats.factorisations += 1;
@@ -464,14 +522,17 @@ impl Solver<'_> {
                     *a += d;
                 }
             }
+            // The shift that keeps K + C positive definite can be tiny next to diag|K| (a soft mode
+            // of a membrane-stiff shell): let beta go down to 1e-12 before plain Newton, and grow it
+            // back from there, so that soft modes are not crept along with a needlessly large shift.
             if success {
-                beta = (beta / if iterations <= 3 { 4.0 } else { 1.5 }).max(1e-12);
-                if beta <= 1e-6 {
+                beta /= if iterations <= 3 { 4.0 } else { 1.5 };
+                if beta < 1e-12 {
                     beta = 0.0;
                 }
             } else {
                 *state = anchor;
-                beta = (beta * 4.0).max(1e-4);
+                beta = (beta * 4.0).max(1e-12);
                 if beta > 1e4 {
                     break;
                 }
@@ -549,6 +610,8 @@ pub fn solve_static(
         asm: Assembled::default(),
         fresh: false,
         factorised: false,
+        stress: Vec::new(),
+        stress_valid: false,
         round_off,
         path_force: 0.0,
         strict_turns: true,
@@ -704,8 +767,7 @@ pub fn solve_static(
                             });
                             break 'steps;
                         }
-                        s.fresh = false;
-                        s.factorised = false;
+                        s.invalidate();
                         s.assemble(state);
                         let relaxed = Outcome {
                             iterations: 0,
@@ -740,8 +802,7 @@ pub fn solve_static(
                     let crossed = (start_l - lambda_end) * (state.lambda - lambda_end) < 0.0 && last_dlambda.is_some();
                     if crossed {
                         let mut trial = saved.clone();
-                        s.fresh = false;
-                        s.factorised = false;
+                        s.invalidate();
                         if let Ok(o2) = s.increment(&mut trial, Increment::Load(lambda_end - start_l)) {
                             *state = trial;
                             let step = match s.record(state, &o2) {
@@ -758,8 +819,7 @@ pub fn solve_static(
                         }
                         // The final load step failed: retry the crossing with a shorter arc.
                         *state = saved;
-                        s.fresh = false;
-                        s.factorised = false;
+                        s.invalidate();
                         cutbacks += 1;
                         s.stats.cutbacks += 1;
                         if cutbacks > params.max_cutbacks {
@@ -823,8 +883,7 @@ pub fn solve_static(
             }
             Err(err) => {
                 *state = saved;
-                s.fresh = false;
-                s.factorised = false;
+                s.invalidate();
                 cutbacks += 1;
                 s.stats.cutbacks += 1;
                 if cutbacks > params.max_cutbacks {
