@@ -9,15 +9,32 @@
 //! analysed once) is used instead. The pivots of the
 //! LDL^T factorisation give the inertia of `S` (Sylvester's law): the number of negative
 //! eigenvalues that tells whether an equilibrium is stable.
+//!
+//! # Pre-permuted symmetric part
+//!
+//! The AMD permutation `P` is computed once, in [`LinearSolver::try_new`], together with the
+//! pattern of one triangle of `P S P^T` and, for each of its entries, the positions of the entry
+//! and of its transpose in `K`'s pattern; faer's symbolic analysis is done on `P S P^T` with the
+//! identity ordering. Each factorisation then writes that triangle in one gather pass
+//! (`0.5 (k_ij + k_ji)`, which also yields the finiteness, largest entry and largest skew entry of
+//! `K`), and faer factorises it as it is. Why: with the AMD ordering inside faer's symbolic
+//! analysis, faer permutes the whole matrix again at every numeric factorisation
+//! (`permute_self_adjoint_to_unsorted`, ~20 % of the time on the 2 mm tape), after our own
+//! symmetrisation pass over both triangles; the gather touches one triangle and replaces both
+//! (-20 % per factorisation on the 2 mm tape). The triangle's entries are laid out as faer's
+//! permutation would lay them out, so the factors are bit-identical to faer's own. Solves permute
+//! the right-hand side and the solution (`P b`, `P^T x`); the inertia is unchanged by a symmetric
+//! permutation; products with `K` (GMRES) and the LU fallback use `K` in its original order.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, simplicial::SimplicialLdltRef, supernodal::SupernodalLdltRef, LdltRef,
-    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, simplicial::SimplicialLdltRef, supernodal::SupernodalLdltRef, CholeskySymbolicParams,
+    LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -35,16 +52,74 @@ fn factor_par() -> Par {
     Par::Seq
 }
 
+/// One triangle of `P S P^T` (`lower`, else upper), with each entry's position in `K`'s pattern
+/// and that of its transpose; `perm_inv[i]` is the row/column of `P S P^T` of row/column `i` of
+/// `S`. The entries are in the order in which faer's own permutation
+/// (`permute_self_adjoint_to_unsorted`, lower triangle in) writes them: columns of `K` in order,
+/// entries of its lower triangle in order. Faer's simplicial factorisation follows that order, so
+/// its factors and their round-off are exactly those faer computes with its own AMD permutation
+/// (the supernodal factorisation does not depend on the order).
+fn permuted_triangle(
+    pattern: &Pattern,
+    perm_inv: &[usize],
+    transpose_of: &[usize],
+    lower: bool,
+) -> (SymbolicSparseColMat<usize>, Vec<[usize; 2]>) {
+    let n = pattern.nrows;
+    // Calls `f(p, row, column)` for each entry of the triangle, in faer's order.
+    let for_each = |f: &mut dyn FnMut(usize, usize, usize)| {
+        for jo in 0..n {
+            for p in pattern.col_ptr[jo]..pattern.col_ptr[jo + 1] {
+                if pattern.row_idx[p] >= jo {
+                    let (i, j) = (perm_inv[pattern.row_idx[p]], perm_inv[jo]);
+                    let (r, c) = if (i >= j) == lower { (i, j) } else { (j, i) };
+                    f(p, r, c);
+                }
+            }
+        }
+    };
+    let mut col_ptr = vec![0usize; n + 1];
+    for_each(&mut |_, _, c| col_ptr[c + 1] += 1);
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let mut next = col_ptr[..n].to_vec();
+    let mut row_idx = vec![0; col_ptr[n]];
+    let mut src = vec![[0; 2]; col_ptr[n]];
+    for_each(&mut |p, r, c| {
+        row_idx[next[c]] = r;
+        src[next[c]] = [p, transpose_of[p]];
+        next[c] += 1;
+    });
+    (
+        SymbolicSparseColMat::new_unsorted_checked(n, n, col_ptr, None, row_idx),
+        src,
+    )
+}
+
 /// Solver for matrices with a fixed, structurally symmetric pattern.
 pub struct LinearSolver {
+    /// Pattern of `K`, in its original order (products with `K`, LU fallback).
     symbolic: SymbolicSparseColMat<usize>,
-    /// Position of the transposed entry of each stored entry.
-    transpose_of: Vec<usize>,
+    /// Fill-reducing permutation: row/column `i` of `P S P^T` is row/column `perm_fwd[i]` of `S`.
+    perm_fwd: Vec<usize>,
+    /// The triangle of `P S P^T` that the factorisation reads: lower (supernodal) or upper
+    /// (simplicial), entries in faer's order.
+    triangle: SymbolicSparseColMat<usize>,
+    /// Which triangle `triangle` is.
+    side: Side,
+    /// For each entry of `triangle`: position in `K`'s pattern of the entry and of its transpose.
+    src: Vec<[usize; 2]>,
+    /// Symbolic LDL^T of `P S P^T` (identity ordering).
     ldlt: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     work: MemBuffer,
+    /// Values of `K`, kept when it is not symmetric (GMRES) or for the LU fallback.
     values: Vec<f64>,
+    /// Values of `triangle`.
     sym: Vec<f64>,
+    /// Permuted right-hand side / solution of the LDL^T solve.
+    permuted: Vec<f64>,
     skew_free: bool,
     /// Largest column sum of |K| (the 1-norm).
     k_norm: f64,
@@ -61,44 +136,93 @@ pub struct LinearSolver {
 }
 
 impl LinearSolver {
-    /// Symbolic analysis of `pattern`, done once.
+    /// Symbolic analysis of `pattern`, done once: AMD ordering, pattern of the permuted symmetric
+    /// part and its symbolic LDL^T.
     ///
     /// # Errors
-    /// [`Error::Factorisation`] if faer rejects the pattern; [`Error::InvalidModel`] if it is empty.
+    /// [`Error::Factorisation`] if faer rejects the pattern or it is not structurally symmetric;
+    /// [`Error::InvalidModel`] if it is empty.
     pub fn try_new(pattern: &Pattern) -> Result<Self> {
+        Self::with_threshold(pattern, SupernodalThreshold::AUTO)
+    }
+
+    /// [`Self::try_new`] with faer's simplicial/supernodal selection threshold.
+    fn with_threshold(pattern: &Pattern, threshold: SupernodalThreshold) -> Result<Self> {
         let n = pattern.nrows;
         if n == 0 {
             return Err(Error::InvalidModel("the model has no free degree of freedom".into()));
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
-        let mut transpose_of = vec![0; pattern.nnz()];
+        let nnz = pattern.nnz();
+        // Position of the transpose of each entry: walking the columns in order, the entries
+        // (j, i) of each column i are met in increasing j, i.e. in the stored (sorted) order. Every
+        // entry finding its transpose makes the pattern symmetric (the map is injective).
+        let not_symmetric = || Error::Factorisation("the tangent pattern is not structurally symmetric".into());
+        let mut transpose_of = vec![0; nnz];
+        let mut next: Vec<usize> = pattern.col_ptr[..n].to_vec();
         for j in 0..n {
             for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
                 let i = pattern.row_idx[p];
-                transpose_of[p] = pattern
-                    .find(j, i)
-                    .ok_or_else(|| Error::Factorisation("the tangent pattern is not structurally symmetric".into()))?;
+                let t = next[i];
+                if t >= pattern.col_ptr[i + 1] || pattern.row_idx[t] != j {
+                    return Err(not_symmetric());
+                }
+                transpose_of[p] = t;
+                next[i] += 1;
             }
         }
+        // AMD ordering, and simplicial or supernodal factorisation, as faer chooses them (with the
+        // identity ordering faer would count the flops exactly instead of using AMD's estimate,
+        // and sometimes choose the other kind). The symbolic factorisation itself is redone below
+        // on the permuted pattern.
+        let params = || CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: threshold,
+            ..Default::default()
+        };
+        let amd = factorize_symbolic_cholesky(symbolic.as_ref(), Side::Lower, SymmetricOrdering::Amd, params())
+            .map_err(|e| Error::Factorisation(format!("symbolic LDLT: {e:?}")))?;
+        let supernodal = matches!(amd.raw(), SymbolicCholeskyRaw::Supernodal(_));
+        let (perm_fwd, perm_inv) = match amd.perm() {
+            Some(perm) => (perm.arrays().0.to_vec(), perm.arrays().1.to_vec()),
+            None => ((0..n).collect(), (0..n).collect()),
+        };
+        let (upper, upper_src) = permuted_triangle(pattern, &perm_inv, &transpose_of, false);
         let ldlt = factorize_symbolic_cholesky(
-            symbolic.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: if supernodal {
+                    SupernodalThreshold::FORCE_SUPERNODAL
+                } else {
+                    SupernodalThreshold::FORCE_SIMPLICIAL
+                },
+                ..params()
+            },
         )
         .map_err(|e| Error::Factorisation(format!("symbolic LDLT: {e:?}")))?;
-        let work = MemBuffer::new(
-            ldlt.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
-                .or(ldlt.solve_in_place_scratch::<f64>(1, Par::Seq)),
-        );
+        // The triangle that faer's factorisation reads without copying it.
+        let (side, (triangle, src)) = if supernodal {
+            (Side::Lower, permuted_triangle(pattern, &perm_inv, &transpose_of, true))
+        } else {
+            (Side::Upper, (upper, upper_src))
+        };
+        let work = MemBuffer::new(StackReq::any_of(&[
+            ldlt.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            ldlt.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]));
         Ok(Self {
             l_values: vec![0.0; ldlt.len_val()],
             symbolic,
-            transpose_of,
+            perm_fwd,
+            sym: vec![0.0; src.len()],
+            triangle,
+            side,
+            src,
             ldlt,
             work,
             values: Vec::new(),
-            sym: Vec::new(),
+            permuted: vec![0.0; n],
             skew_free: true,
             k_norm: 0.0,
             negative: 0,
@@ -114,65 +238,76 @@ impl LinearSolver {
     /// Numeric factorisation of the matrix with `values` (in pattern order).
     ///
     /// # Errors
-    /// [`Error::Factorisation`] for a non-finite entry or a failed factorisation.
+    /// [`Error::Factorisation`] for a non-finite entry, a wrong number of values or a failed
+    /// factorisation.
     pub fn factorize(&mut self, values: &[f64]) -> Result<()> {
         self.factorised = false;
         self.lu = None;
-        // One pass: copy, symmetric part, finiteness, largest entry and largest skew entry.
-        self.values.clear();
-        self.values.extend_from_slice(values);
-        self.sym.clear();
-        self.sym.reserve(values.len());
-        let (mut max, mut skew, mut finite) = (0.0_f64, 0.0_f64, true);
-        for (v, &t) in values.iter().zip(&self.transpose_of) {
-            let vt = values[t];
-            finite &= v.is_finite();
-            max = max.max(v.abs());
-            skew = skew.max((v - vt).abs());
-            self.sym.push(0.5 * (v + vt));
+        if values.len() != self.symbolic.row_idx().len() {
+            return Err(Error::Factorisation(format!(
+                "{} values for a pattern of {} entries",
+                values.len(),
+                self.symbolic.row_idx().len()
+            )));
         }
-        if !finite {
+        // One pass over the stored triangle of P S P^T (each entry of K is read once, as k_ij or
+        // k_ji): symmetric part, largest |k_ij| and largest |k_ij - k_ji|. The maxima are taken on
+        // the bit patterns of the absolute values, which order non-negative floats as the values
+        // do, with infinities and NaNs above every finite value: one integer max per entry (half
+        // the time of `f64::max` chains, which the NaN rules make long), and finiteness for free.
+        let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
+        for (s, &[p, t]) in self.sym.iter_mut().zip(&self.src) {
+            let (v, vt) = (values[p], values[t]);
+            max_bits = max_bits.max(v.abs().to_bits().max(vt.abs().to_bits()));
+            skew_bits = skew_bits.max((v - vt).abs().to_bits());
+            *s = 0.5 * (v + vt);
+        }
+        let (max, skew) = (f64::from_bits(max_bits), f64::from_bits(skew_bits));
+        if max_bits >= f64::INFINITY.to_bits() {
             let p = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
             return Err(Error::Factorisation(format!(
                 "the tangent has a non-finite entry (position {p})"
             )));
         }
         self.skew_free = 0.5 * skew <= 1e-15 * max;
-        // The 1-norm is only needed by GMRES (non-symmetric matrices).
-        self.k_norm = if self.skew_free {
-            0.0
-        } else {
+        // K itself and its 1-norm are only needed by GMRES (non-symmetric matrices).
+        self.values.clear();
+        self.k_norm = 0.0;
+        if !self.skew_free {
+            self.values.extend_from_slice(values);
             let cp = self.symbolic.col_ptr();
-            (0..self.symbolic.ncols())
+            self.k_norm = (0..self.symbolic.ncols())
                 .map(|j| {
                     values[cp[j]..cp[j + 1]]
                         .iter()
                         .map(|v| v.abs())
                         .sum::<f64>()
                 })
-                .fold(0.0, f64::max)
-        };
+                .fold(0.0, f64::max);
+        }
         self.factorisations += 1;
-        let mat = SparseColMatRef::new(self.symbolic.as_ref(), &self.sym);
-        let ok = self
+        let mat = SparseColMatRef::new(self.triangle.as_ref(), &self.sym);
+        let factorised = self
             .ldlt
             .factorize_numeric_ldlt(
                 &mut self.l_values,
                 mat,
-                Side::Lower,
+                self.side,
                 LdltRegularization::default(),
                 factor_par(),
                 MemStack::new(&mut self.work),
                 Default::default(),
             )
-            .is_ok()
-            && self.l_values.iter().all(|v| v.is_finite());
-        if ok {
-            self.negative = self.count_negative_pivots();
+            .is_ok();
+        if let Some(negative) = factorised.then(|| self.negative_pivots()).flatten() {
+            self.negative = negative;
             self.factorised = true;
             Ok(())
         } else {
             // A zero pivot of the symmetric part: fall back to LU for the solves.
+            if self.values.is_empty() {
+                self.values.extend_from_slice(values);
+            }
             self.factorize_lu()?;
             self.negative = usize::MAX;
             self.factorised = true;
@@ -194,15 +329,26 @@ impl LinearSolver {
         Ok(())
     }
 
-    fn count_negative_pivots(&self) -> usize {
+    /// Number of negative pivots, or `None` if a pivot is not finite. Finite pivots imply a
+    /// finite factor: an infinite or NaN entry `l_ik` (k < i) enters `d_i = s_ii - sum l_ik^2 d_k`
+    /// with a finite non-zero `d_k` (faer stops at a zero pivot), which makes `d_i` infinite or
+    /// NaN; so the n pivots are checked instead of all of L.
+    fn negative_pivots(&self) -> Option<usize> {
         let mut negative = 0;
+        let mut count = |d: f64| {
+            if !d.is_finite() {
+                return false;
+            }
+            negative += usize::from(d < 0.0);
+            true
+        };
         match self.ldlt.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
                 let l = SimplicialLdltRef::new(s, &self.l_values);
                 let cp = s.col_ptr();
-                for j in 0..self.symbolic.nrows() {
-                    if l.values()[cp[j]] < 0.0 {
-                        negative += 1;
+                for j in 0..s.nrows() {
+                    if !count(l.values()[cp[j]]) {
+                        return None;
                     }
                 }
             }
@@ -211,14 +357,14 @@ impl LinearSolver {
                 for k in 0..s.n_supernodes() {
                     let v = l.supernode(k).val();
                     for j in 0..v.ncols() {
-                        if v[(j, j)] < 0.0 {
-                            negative += 1;
+                        if !count(v[(j, j)]) {
+                            return None;
                         }
                     }
                 }
             }
         }
-        negative
+        Some(negative)
     }
 
     /// Number of negative eigenvalues of the symmetric part of the last factorised matrix.
@@ -335,14 +481,21 @@ impl LinearSolver {
         res <= tol
     }
 
+    /// `x <- S^{-1} x`: `P^T (P S P^T)^{-1} P x`.
     fn solve_sym(&mut self, x: &mut [f64]) {
         let n = x.len();
+        for (y, &f) in self.permuted.iter_mut().zip(&self.perm_fwd) {
+            *y = x[f];
+        }
         LdltRef::new(&self.ldlt, &self.l_values).solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(x, n, 1),
+            MatMut::from_column_major_slice_mut(&mut self.permuted, n, 1),
             Par::Seq,
             MemStack::new(&mut self.work),
         );
+        for (y, &f) in self.permuted.iter().zip(&self.perm_fwd) {
+            x[f] = *y;
+        }
     }
 
     /// Solves `K x = rhs` in place with the last factorisation.
@@ -354,29 +507,37 @@ impl LinearSolver {
         if !self.factorised {
             return Err(Error::Factorisation("solve before factorisation".into()));
         }
+        if rhs.len() != self.permuted.len() {
+            return Err(Error::Factorisation(format!(
+                "right-hand side of length {} for {} unknowns",
+                rhs.len(),
+                self.permuted.len()
+            )));
+        }
         let singular = || {
             Error::Factorisation(
                 "the tangent is singular: the model has a mechanism or an unconstrained rigid-body motion".into(),
             )
         };
         if self.lu.is_none() {
-            let b = rhs.to_vec();
-            let b_norm = b.iter().map(|v| v * v).sum::<f64>().sqrt();
-            self.solve_sym(rhs);
             if self.skew_free {
+                self.solve_sym(rhs);
                 return if rhs.iter().all(|v| v.is_finite()) {
                     Ok(())
                 } else {
                     Err(singular())
                 };
             }
+            let b = rhs.to_vec();
+            let b_norm = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+            self.solve_sym(rhs);
             if self.gmres(&b, b_norm, rhs) {
                 return Ok(());
             }
             // GMRES did not converge: the skew part is too large; use LU for this matrix.
+            rhs.copy_from_slice(&b);
             self.lu_fallbacks += 1;
             self.factorize_lu()?;
-            rhs.copy_from_slice(&b);
         }
         let lu = self.lu.as_ref().expect("LU factorised");
         let n = rhs.len();
@@ -386,5 +547,213 @@ impl LinearSolver {
         } else {
             Err(singular())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Deterministic pseudo-random numbers in [-1, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
+    /// A random structurally symmetric pattern of size `n` with a full diagonal, and values
+    /// `K = S + skew * W`: `S` symmetric with entries in [-1, 1] and diagonal in [-3, 3]
+    /// (indefinite), `W` skew-symmetric with entries in [-1, 1].
+    fn random_matrix(n: usize, skew: f64, seed: u64) -> (Pattern, Vec<f64>, DMatrix<f64>) {
+        let mut rng = Lcg(seed);
+        let mut dense = DMatrix::<f64>::zeros(n, n);
+        let mut filled = vec![vec![false; n]; n];
+        for i in 0..n {
+            dense[(i, i)] = 3.0 * rng.next();
+            filled[i][i] = true;
+            for _ in 0..3 {
+                let j = ((rng.next() + 1.0) * 0.5 * n as f64) as usize % n;
+                if j != i {
+                    let (s, w) = (rng.next(), skew * rng.next());
+                    dense[(i, j)] = s + w;
+                    dense[(j, i)] = s - w;
+                    filled[i][j] = true;
+                    filled[j][i] = true;
+                }
+            }
+        }
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in 0..n {
+                if filled[i][j] {
+                    row_idx.push(i);
+                    values.push(dense[(i, j)]);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let pattern = Pattern {
+            nrows: n,
+            col_ptr,
+            row_idx,
+        };
+        (pattern, values, dense)
+    }
+
+    fn negative_eigenvalues_dense(k: &DMatrix<f64>) -> usize {
+        let s = (k + k.transpose()) * 0.5;
+        s.symmetric_eigen()
+            .eigenvalues
+            .iter()
+            .filter(|&&l| l < 0.0)
+            .count()
+    }
+
+    /// Solves `K x = K x_ref` and checks the backward error (round-off for the direct solves, the
+    /// GMRES tolerance otherwise) and the distance to `x_ref`.
+    fn check_solve(solver: &mut LinearSolver, k: &DMatrix<f64>, seed: u64) {
+        let n = k.nrows();
+        let mut rng = Lcg(seed);
+        let x_ref = DVector::from_fn(n, |_, _| rng.next());
+        let b = k * &x_ref;
+        let mut x = b.as_slice().to_vec();
+        solver.solve_in_place(&mut x).expect("solve");
+        let x = DVector::from_vec(x);
+        let backward = (&b - k * &x).norm() / (k.norm() * x.norm() + b.norm());
+        let tol = if solver.skew_free { 1e-14 } else { REFINE_TOL };
+        assert!(backward < tol, "backward error {backward:e}");
+        let forward = (&x - &x_ref).norm() / x_ref.norm();
+        let cond = {
+            let sv = k.clone().singular_values();
+            sv.max() / sv.min()
+        };
+        assert!(
+            forward < 1e-13 * cond,
+            "forward error {forward:e}, condition number {cond:e}"
+        );
+    }
+
+    fn is_supernodal(solver: &LinearSolver) -> bool {
+        matches!(solver.ldlt.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
+    #[test]
+    fn solves_and_counts_negative_eigenvalues() {
+        let n = 80;
+        for (skew, seed) in [(0.0, 1), (0.0, 2), (1e-3, 3), (1e-2, 4)] {
+            let (pattern, values, k) = random_matrix(n, skew, seed);
+            let negative = negative_eigenvalues_dense(&k);
+            assert!(negative > 5 && negative < n - 5, "{negative} negative eigenvalues");
+            for (threshold, supernodal) in [
+                (SupernodalThreshold::FORCE_SIMPLICIAL, false),
+                (SupernodalThreshold::FORCE_SUPERNODAL, true),
+            ] {
+                let mut solver = LinearSolver::with_threshold(&pattern, threshold).expect("symbolic");
+                assert_eq!(is_supernodal(&solver), supernodal);
+                assert!(
+                    solver.perm_fwd.iter().enumerate().any(|(i, &p)| i != p),
+                    "identity ordering"
+                );
+                solver.factorize(&values).expect("factorisation");
+                assert_eq!(solver.skew_free, skew == 0.0);
+                assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
+                // The LDL^T alone solves the symmetric part.
+                let s = (&k + k.transpose()) * 0.5;
+                let b = DVector::from_fn(n, |i, _| (i as f64).sin());
+                let mut x = b.as_slice().to_vec();
+                solver.solve_sym(&mut x);
+                let x = DVector::from_vec(x);
+                let backward = (&b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
+                assert!(backward < 1e-14, "backward error of the symmetric solve {backward:e}");
+                check_solve(&mut solver, &k, seed + 100);
+                check_solve(&mut solver, &k, seed + 200);
+                assert_eq!(solver.lu_fallbacks, 0);
+                assert_eq!(solver.refinement_sweeps > 0, skew > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn large_skew_part_falls_back_to_lu() {
+        let (pattern, values, k) = random_matrix(60, 1.0, 5);
+        let mut solver = LinearSolver::try_new(&pattern).expect("symbolic");
+        solver.factorize(&values).expect("factorisation");
+        assert_eq!(
+            solver.negative_eigenvalues().expect("inertia"),
+            negative_eigenvalues_dense(&k)
+        );
+        check_solve(&mut solver, &k, 6);
+        assert_eq!(solver.lu_fallbacks, 1);
+    }
+
+    #[test]
+    fn zero_pivot_of_the_symmetric_part_falls_back_to_lu() {
+        // Degrees of freedom 0 and r (the first neighbour of 0) are coupled by a skew pair only:
+        // S has two zero rows, K is regular.
+        let (pattern, mut values, mut k) = random_matrix(40, 0.0, 7);
+        let r = pattern.row_idx[pattern.col_ptr[0]..pattern.col_ptr[1]]
+            .iter()
+            .copied()
+            .find(|&i| i != 0)
+            .expect("an off-diagonal entry in column 0");
+        for j in 0..40 {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let i = pattern.row_idx[p];
+                if [0, r].contains(&i) || [0, r].contains(&j) {
+                    let v = if (i, j) == (0, r) {
+                        1.0
+                    } else if (i, j) == (r, 0) {
+                        -1.0
+                    } else {
+                        0.0
+                    };
+                    values[p] = v;
+                    k[(i, j)] = v;
+                }
+            }
+        }
+        let mut solver = LinearSolver::try_new(&pattern).expect("symbolic");
+        solver.factorize(&values).expect("factorisation");
+        assert!(solver.negative_eigenvalues().is_err());
+        check_solve(&mut solver, &k, 8);
+    }
+
+    #[test]
+    fn rejects_a_pattern_that_is_not_structurally_symmetric() {
+        let (pattern, _, _) = random_matrix(30, 0.0, 10);
+        assert!(LinearSolver::try_new(&pattern).is_ok());
+        // Drop one off-diagonal entry (the last one, then the first one, of a column).
+        for last in [true, false] {
+            let mut p = pattern.clone();
+            let position = |j: usize| if last { p.col_ptr[j + 1] - 1 } else { p.col_ptr[j] };
+            let j = (0..30)
+                .find(|&j| p.row_idx[position(j)] != j)
+                .expect("an off-diagonal entry");
+            let k = position(j);
+            p.row_idx.remove(k);
+            for c in &mut p.col_ptr[j + 1..] {
+                *c -= 1;
+            }
+            assert!(LinearSolver::try_new(&p).is_err());
+        }
+    }
+
+    #[test]
+    fn rejects_non_finite_entries() {
+        let (pattern, values, _) = random_matrix(30, 1e-3, 9);
+        let mut solver = LinearSolver::try_new(&pattern).expect("symbolic");
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut v = values.clone();
+            v[17] = bad;
+            assert!(solver.factorize(&v).is_err());
+            assert!(solver.negative_eigenvalues().is_err());
+        }
+        solver.factorize(&values).expect("finite values");
     }
 }
