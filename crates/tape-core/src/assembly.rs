@@ -241,15 +241,8 @@ impl System {
             if self.dofs.master[i].is_some() {
                 continue;
             }
-            let mut v = [0.0; 6];
-            for (d, vd) in v.iter_mut().enumerate() {
-                *vd = match self.dofs.slots[i][d] {
-                    Slot::Free(eq) => dq[eq],
-                    Slot::Constrained(c) => dlambda * self.dofs.constrained[c].value,
-                };
-            }
-            state.x[i] += Vector3::new(v[0], v[1], v[2]);
-            let theta = Vector3::new(v[3], v[4], v[5]);
+            let [du, theta] = self.node_increment(i, dq, dlambda);
+            state.x[i] += du;
             if theta != Vector3::zeros() {
                 state.q[i] = rotate(&state.q[i], &theta);
             }
@@ -281,21 +274,31 @@ impl System {
             .collect()
     }
 
+    /// Increment `(delta x, theta)` of independent node `i` for the free increments `dq` and the
+    /// load-factor increment `dlambda` (constrained DOFs move by `dlambda * value`).
+    fn node_increment(&self, i: usize, dq: &[f64], dlambda: f64) -> [Vector3<f64>; 2] {
+        let mut v = [Vector3::zeros(); 2];
+        for d in 0..6 {
+            v[d / 3][d % 3] = match self.dofs.slots[i][d] {
+                Slot::Free(eq) => dq[eq],
+                Slot::Constrained(c) => dlambda * self.dofs.constrained[c].value,
+            };
+        }
+        v
+    }
+
     /// Nodal increments `(delta x, theta)` of every node for the free increments `dq` and the
     /// load-factor increment `dlambda`, to first order (tied nodes follow their reference node).
     fn nodal_increments(&self, state: &State, dq: &[f64], dlambda: f64) -> Vec<[Vector3<f64>; 2]> {
-        let mut inc = vec![[Vector3::zeros(); 2]; state.x.len()];
-        for (i, v) in inc.iter_mut().enumerate() {
-            if self.dofs.master[i].is_some() {
-                continue;
-            }
-            for d in 0..6 {
-                v[d / 3][d % 3] = match self.dofs.slots[i][d] {
-                    Slot::Free(eq) => dq[eq],
-                    Slot::Constrained(c) => dlambda * self.dofs.constrained[c].value,
-                };
-            }
-        }
+        let mut inc: Vec<[Vector3<f64>; 2]> = (0..state.x.len())
+            .map(|i| {
+                if self.dofs.master[i].is_some() {
+                    [Vector3::zeros(); 2]
+                } else {
+                    self.node_increment(i, dq, dlambda)
+                }
+            })
+            .collect();
         for (s, m) in self.dofs.master.iter().enumerate() {
             if let Some(r) = *m {
                 let [du, th] = inc[r];

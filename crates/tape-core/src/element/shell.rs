@@ -285,6 +285,25 @@ impl ShellElement {
         (gt, dt)
     }
 
+    /// Adds the force gradients (with respect to `x_a` and `d_a`) of the tying-strain shear forces
+    /// `qv`, given the tying vectors `gt`, `dt`.
+    #[inline]
+    fn add_shear_forces(
+        &self,
+        qv: &Vector4<f64>,
+        gt: &[Vector3<f64>; 4],
+        dt: &[Vector3<f64>; 4],
+        f_x: &mut [Vector3<f64>; 4],
+        f_d: &mut [Vector3<f64>; 4],
+    ) {
+        for t in 0..4 {
+            for a in 0..4 {
+                f_x[a] += qv[t] * self.cg[t][a] * dt[t];
+                f_d[a] += qv[t] * self.cd[t][a] * gt[t];
+            }
+        }
+    }
+
     #[inline]
     fn drill_vectors(&self, a: usize, xc: &[Vector3<f64>; 2]) -> (Vector3<f64>, Vector3<f64>) {
         let (c0, s0) = self.drill_ref[a];
@@ -327,32 +346,32 @@ impl ShellElement {
             (t1[a], t2[a], d[a]) = columns(&q[a]);
         }
         let dd: [Vector3<f64>; 4] = std::array::from_fn(|a| dtheta[a].cross(&d[a]));
+        // Strains of the configuration plus their directional derivatives.
+        let s = self.strains(x, q);
         let mut out = ElementStress::default();
         for (p, g) in self.gp.iter().enumerate() {
             let (xs, ds) = gradients(&g.dn, x, &d);
             let (dxs, dds) = gradients(&g.dn, dx, &dd);
-            let eps = Vector3::new(
-                0.5 * xs[0].norm_squared() - g.eps0[0] + xs[0].dot(&dxs[0]),
-                0.5 * xs[1].norm_squared() - g.eps0[1] + xs[1].dot(&dxs[1]),
-                xs[0].dot(&xs[1]) - g.eps0[2] + xs[0].dot(&dxs[1]) + dxs[0].dot(&xs[1]),
-            );
-            let kap = Vector3::new(
-                xs[0].dot(&ds[0]) - g.kap0[0] + dxs[0].dot(&ds[0]) + xs[0].dot(&dds[0]),
-                xs[1].dot(&ds[1]) - g.kap0[1] + dxs[1].dot(&ds[1]) + xs[1].dot(&dds[1]),
-                xs[0].dot(&ds[1]) + xs[1].dot(&ds[0]) - g.kap0[2]
-                    + dxs[0].dot(&ds[1])
-                    + xs[0].dot(&dds[1])
-                    + dxs[1].dot(&ds[0])
-                    + xs[1].dot(&dds[0]),
-            );
+            let eps = Vector3::from(s.membrane[p])
+                + Vector3::new(
+                    xs[0].dot(&dxs[0]),
+                    xs[1].dot(&dxs[1]),
+                    xs[0].dot(&dxs[1]) + dxs[0].dot(&xs[1]),
+                );
+            let kap = Vector3::from(s.bending[p])
+                + Vector3::new(
+                    dxs[0].dot(&ds[0]) + xs[0].dot(&dds[0]),
+                    dxs[1].dot(&ds[1]) + xs[1].dot(&dds[1]),
+                    dxs[0].dot(&ds[1]) + xs[0].dot(&dds[1]) + dxs[1].dot(&ds[0]) + xs[1].dot(&dds[0]),
+                );
             out.membrane[p] = (sec.membrane * eps * g.w).into();
             out.bending[p] = (sec.bending * kap * g.w).into();
         }
-        let mut gam = Vector4::zeros();
+        let mut gam = Vector4::from(s.shear);
         for t in 0..4 {
             let (gt, dt) = self.tying_vectors(t, x, &d);
             let (dgt, ddt) = self.tying_vectors(t, dx, &dd);
-            gam[t] = gt.dot(&dt) - self.gamma0[t] + dgt.dot(&dt) + gt.dot(&ddt);
+            gam[t] += dgt.dot(&dt) + gt.dot(&ddt);
         }
         out.shear = (self.shear_metric * gam * sec.shear).into();
         let xc = centre_gradient(&self.dn_centre, x);
@@ -362,9 +381,8 @@ impl ShellElement {
             let (u, v) = self.drill_vectors(a, &xc);
             let (du, dv) = self.drill_vectors(a, &dxc);
             let (dt1, dt2) = (dtheta[a].cross(&t1[a]), dtheta[a].cross(&t2[a]));
-            let psi = 0.5 * (t1[a].dot(&u) - t2[a].dot(&v)) - self.psi0[a];
             let dpsi = 0.5 * (dt1.dot(&u) + t1[a].dot(&du) - dt2.dot(&v) - t2[a].dot(&dv));
-            out.drilling[a] = kd * (psi + dpsi);
+            out.drilling[a] = kd * (s.drilling[a] + dpsi);
         }
         out
     }
@@ -443,32 +461,14 @@ impl ShellElement {
             let n = sec.membrane * eps * g.w;
             let m = sec.bending * kap * g.w;
             energy += 0.5 * (n.dot(&eps) + m.dot(&kap));
-            for a in 0..4 {
-                let [p, r] = g.dn[a];
-                f_x[a] += n[0] * p * xs[0]
-                    + n[1] * r * xs[1]
-                    + n[2] * (p * xs[1] + r * xs[0])
-                    + m[0] * p * ds[0]
-                    + m[1] * r * ds[1]
-                    + m[2] * (p * ds[1] + r * ds[0]);
-                f_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
-            }
+            add_gauss_forces(&g.dn, &xs, &ds, &n, &m, &mut f_x, &mut f_d);
             let (n, m) = match mixed {
                 Some(st) => {
                     let (n, m) = (
                         Vector3::from(st.membrane[gp_index]),
                         Vector3::from(st.bending[gp_index]),
                     );
-                    for a in 0..4 {
-                        let [p, r] = g.dn[a];
-                        gf_x[a] += n[0] * p * xs[0]
-                            + n[1] * r * xs[1]
-                            + n[2] * (p * xs[1] + r * xs[0])
-                            + m[0] * p * ds[0]
-                            + m[1] * r * ds[1]
-                            + m[2] * (p * ds[1] + r * ds[0]);
-                        gf_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
-                    }
+                    add_gauss_forces(&g.dn, &xs, &ds, &n, &m, &mut gf_x, &mut gf_d);
                     (n, m)
                 }
                 None => (n, m),
@@ -533,21 +533,11 @@ impl ShellElement {
         }
         let qv = self.shear_metric * gam * sec.shear;
         energy += 0.5 * gam.dot(&qv);
-        for t in 0..4 {
-            for a in 0..4 {
-                f_x[a] += qv[t] * self.cg[t][a] * dt[t];
-                f_d[a] += qv[t] * self.cd[t][a] * gt[t];
-            }
-        }
+        self.add_shear_forces(&qv, &gt, &dt, &mut f_x, &mut f_d);
         let qv = match mixed {
             Some(st) => {
                 let qg = Vector4::from(st.shear);
-                for t in 0..4 {
-                    for a in 0..4 {
-                        gf_x[a] += qg[t] * self.cg[t][a] * dt[t];
-                        gf_d[a] += qg[t] * self.cd[t][a] * gt[t];
-                    }
-                }
+                self.add_shear_forces(&qg, &gt, &dt, &mut gf_x, &mut gf_d);
                 qg
             }
             None => qv,
@@ -696,6 +686,31 @@ fn gradients(
         }
     }
     (xs, ds)
+}
+
+/// Adds the force gradients (with respect to `x_a` and `d_a`) of the weighted membrane forces `n`
+/// and bending moments `m` at a Gauss point with shape-function derivatives `dn` and surface
+/// gradients `xs`, `ds`.
+#[inline]
+fn add_gauss_forces(
+    dn: &[[f64; 2]; 4],
+    xs: &[Vector3<f64>; 2],
+    ds: &[Vector3<f64>; 2],
+    n: &Vector3<f64>,
+    m: &Vector3<f64>,
+    f_x: &mut [Vector3<f64>; 4],
+    f_d: &mut [Vector3<f64>; 4],
+) {
+    for a in 0..4 {
+        let [p, r] = dn[a];
+        f_x[a] += n[0] * p * xs[0]
+            + n[1] * r * xs[1]
+            + n[2] * (p * xs[1] + r * xs[0])
+            + m[0] * p * ds[0]
+            + m[1] * r * ds[1]
+            + m[2] * (p * ds[1] + r * ds[0]);
+        f_d[a] += m[0] * p * xs[0] + m[1] * r * xs[1] + m[2] * (p * xs[1] + r * xs[0]);
+    }
 }
 
 #[inline]

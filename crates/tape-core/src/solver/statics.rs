@@ -243,11 +243,9 @@ impl Solver<'_> {
         // Smallest residual so far and the iteration that reached it: an iteration that has not
         // improved on it for `stall_iterations` iterations is cycling, not converging, and is cut
         // back at once rather than after `max_iterations`.
-        let stall_n = match self.params.newton.stall_iterations {
-            0 => usize::MAX / 2,
-            n => n,
-        };
+        let stall_n = self.params.newton.stall_iterations;
         let mut best = (f64::INFINITY, 0);
+        let mut stalled = None;
         for it in 1..=max_it {
             self.stats.iterations += 1;
             self.assemble(state);
@@ -263,7 +261,11 @@ impl Solver<'_> {
             if res < best.0 {
                 best = (res, it);
             }
-            if it == max_it || (it >= best.1 + stall_n) {
+            if stall_n > 0 && it >= best.1 + stall_n {
+                stalled = Some(it);
+                break;
+            }
+            if it == max_it {
                 break;
             }
             let (dq_r, dq_b) = self.solve_pair()?;
@@ -350,15 +352,13 @@ impl Solver<'_> {
             }
             acc_lambda += alpha * dl;
         }
-        let stalled = best.1 + stall_n <= max_it;
         Err(Error::NotConverged {
             lambda: state.lambda,
-            iterations: if stalled { best.1 + stall_n } else { max_it },
+            iterations: stalled.unwrap_or(max_it),
             residual: res,
-            detail: if stalled {
-                format!("Newton iterations stalled (no progress in {stall_n} iterations)")
-            } else {
-                "Newton iterations exhausted".into()
+            detail: match stalled {
+                Some(_) => format!("Newton iterations stalled (no progress in {stall_n} iterations)"),
+                None => "Newton iterations exhausted".into(),
             },
         })
     }
