@@ -4,7 +4,7 @@ Usage::
 
     PYTHONPATH=python python benchmarks/bench_trials.py [--trials 100] [--repeat 3]
 
-Synthetic trials (``tapespring.experiment.samples``) are generated first and
+Synthetic trials (``tapespring.trials.samples``) are generated first and
 written as CSV into a temporary folder (not timed; C3D cannot hold a 1 kHz plate
 beside 800 Hz markers). Then, best of ``--repeat`` runs, it times:
 
@@ -22,8 +22,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from tapespring.experiment import analyze_trials, load_trials, write_csv, write_report
-from tapespring.experiment.samples import make_deployment_trial
+from tapespring.protocols import analyze_trials
+from tapespring.report import write_report
+from tapespring.trials import load_trials, write_csv
+from tapespring.trials.samples import make_deployment_trial
 
 
 def _best(fn, repeat: int) -> tuple[float, object]:

@@ -5,7 +5,7 @@ Usage::
     python examples/make_example_dataset.py OUT_DIR [--trials N] [--seed S]
 
 Writes, in the paper's set-up (markers M1 support, M2 rod, M3 tip, 800 Hz,
-0.05 mm / 0.3 mm noise; see ``tapespring.experiment.samples``):
+0.05 mm / 0.3 mm noise; see ``tapespring.trials.samples``):
 
 - ``OUT_DIR/deployment/``: N opposite-sense and N equal-sense deployments, 10 s,
   as CSV (markers at 800 Hz) with a ``.forces.csv`` force plate at 1 kHz;
@@ -21,8 +21,8 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from tapespring.experiment import write_c3d, write_csv
-from tapespring.experiment.samples import (
+from tapespring.trials import write_c3d, write_csv
+from tapespring.trials.samples import (
     make_deployment_trial,
     make_pull_test_trial,
     make_vibration_trial,

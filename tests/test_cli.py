@@ -1,4 +1,4 @@
-"""Command line `tapespring bend` (and the registration of `tapespring trials`), in-process.
+"""Command line `tapespring bend`, in-process.
 
 Runs use a 4 mm mesh to 30 deg (about 1 s each): through the peak, the snap and onto the folded
 branch, so every summary line has a value.
@@ -96,18 +96,3 @@ def test_bad_value_exits_non_zero_with_a_message(option, value, message, capsys)
     assert code != 0
     assert message in captured.err
     assert captured.out == ""
-
-
-def test_trials_command_is_registered(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["trials", "--help"])
-    assert exc.value.code == 0
-    assert "analyze" in capsys.readouterr().out
-
-
-def test_top_level_help_lists_both_commands(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["--help"])
-    assert exc.value.code == 0
-    out = capsys.readouterr().out
-    assert "bend" in out and "trials" in out

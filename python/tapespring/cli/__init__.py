@@ -1,0 +1,44 @@
+"""Command line: ``tapespring <command>`` (the ``tapespring`` entry point is `main`).
+
+Commands
+--------
+bend
+    Moment-rotation curve of one tape spring in pure bending (paper Fig. 4), with a summary,
+    optional CSV, PNG and JSON outputs (see :mod:`tapespring.cli.bend`).
+trials analyze
+    Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
+
+Each command lives in its own module, with a ``register`` function that adds its parser. The
+parsers are built without importing scipy, matplotlib, ezc3d or the native extension (a command
+imports what it needs when it runs), so ``tapespring --help`` answers at once.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``tapespring`` argument parser with all sub-commands."""
+    # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
+    # own module already imported by the package.
+    from . import bend, trials
+
+    parser = argparse.ArgumentParser(
+        prog="tapespring",
+        description="Nonlinear shell simulation and experimental analysis of tape springs.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    bend.register(sub)
+    trials.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``tapespring`` command; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    return int(args.func(args))

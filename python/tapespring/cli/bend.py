@@ -1,0 +1,203 @@
+"""Command line: ``tapespring bend``.
+
+Moment-rotation curve of one tape spring in pure bending (paper Fig. 4), with a summary,
+optional CSV, PNG and JSON outputs. The solver (`tapespring.bending.bend`) and matplotlib are
+imported by `run`; building the parser imports only `tapespring.bending.BendingSetup` for its
+defaults (numpy).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+__all__ = ["register", "run"]
+
+
+def _positive(name: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not math.isfinite(value) or value <= 0.0:
+            raise argparse.ArgumentTypeError(f"{name} must be finite and > 0 (got {text})")
+        return value
+
+    return parse
+
+
+def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``bend`` command to a CLI.
+
+    Parameters
+    ----------
+    sub
+        The object returned by ``parser.add_subparsers(dest="command")``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``bend`` parser.
+    """
+    from tapespring.bending import BendingSetup
+
+    d = BendingSetup()
+    p = sub.add_parser(
+        "bend",
+        help="moment-rotation curve of a tape spring in pure bending (paper Fig. 4)",
+        description=(
+            "Pure bending of one tape spring: each end section is rigidly tied to a reference "
+            "node at its centroid; one is clamped, the other rotated about y from 0 to "
+            "--theta-max (positive: opposite sense; negative: equal sense, e.g. "
+            "--theta-max=-90). All values in SI units; angles in degrees."
+        ),
+    )
+    p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
+    p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
+    p.add_argument(
+        "--alpha", type=_positive("alpha"), default=d.alpha_deg, help="subtended angle [deg]"
+    )
+    p.add_argument("--thickness", type=_positive("thickness"), default=d.thickness, help="t [m]")
+    p.add_argument(
+        "--youngs-modulus",
+        "-E",
+        type=_positive("Young's modulus"),
+        default=d.youngs_modulus,
+        help="E [Pa]",
+    )
+    p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
+    p.add_argument(
+        "--mesh-size",
+        type=_positive("mesh size"),
+        default=d.mesh_size,
+        help="element size [m] (default 0.002)",
+    )
+    p.add_argument(
+        "--theta-max",
+        type=float,
+        default=d.theta_max_deg,
+        help="final angle [deg] (default 90; negative for equal sense)",
+    )
+    p.add_argument("--unload", action="store_true", help="unload back to 0 (hysteresis)")
+    p.add_argument(
+        "--imperfection",
+        type=float,
+        default=None,
+        help="twist imperfection amplitude [deg] (default 0.1 in equal sense, else 0)",
+    )
+    p.add_argument(
+        "--path",
+        choices=("full", "jump"),
+        default=None,
+        help=(
+            "full: trace the whole equilibrium path, stable and unstable (default in opposite "
+            "sense); jump: follow a slow rotation-controlled test, jumping at snaps to the stable "
+            "equilibrium beyond (default in equal sense, whose path branches)"
+        ),
+    )
+    p.add_argument("--csv", help="write theta_deg, moment_Nm, stable to this CSV file")
+    p.add_argument("--plot", help="write the curve as a PNG (paper Fig. 4)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``tapespring bend``; returns the exit code.
+
+    Returns
+    -------
+    int
+        0 on success, 1 if no equilibrium converged or the path stopped early (error or Ctrl-C),
+        2 on bad input (the message is printed on stderr).
+    """
+    from tapespring.bending import BendingSetup, bend, plot_bending, summarize, write_csv
+
+    if not math.isfinite(args.theta_max) or args.theta_max == 0.0:
+        print("error: --theta-max must be a non-zero angle in degrees", file=sys.stderr)
+        return 2
+    imperfection = args.imperfection
+    if imperfection is None:
+        # Equal-sense bending is a bifurcation: a small twist selects the physical branch.
+        imperfection = 0.1 if args.theta_max < 0 else 0.0
+    setup = BendingSetup(
+        length=args.length,
+        radius=args.radius,
+        alpha_deg=args.alpha,
+        thickness=args.thickness,
+        youngs_modulus=args.youngs_modulus,
+        poisson=args.poisson,
+        mesh_size=args.mesh_size,
+        theta_max_deg=args.theta_max,
+        unload=args.unload,
+        imperfection_deg=imperfection,
+        jump=(args.path or ("jump" if args.theta_max < 0 else "full")) == "jump",
+    )
+    try:
+        result = bend(setup, progress=not (args.no_progress or args.json))
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if result.theta_deg.size == 0:
+        print(f"error: no equilibrium converged: {result.error}", file=sys.stderr)
+        return 1
+    s = summarize(result)
+    if args.csv:
+        write_csv(result, args.csv)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        ax = plot_bending(result)
+        ax.figure.savefig(args.plot, dpi=150)
+        plt.close(ax.figure)
+    if args.json:
+        out = {
+            "theta_deg": result.theta_deg.tolist(),
+            "moment_Nm": result.moment.tolist(),
+            "stable": result.stable.astype(bool).tolist(),
+            "m_max": s.m_max,
+            "theta_at_m_max_deg": s.theta_at_m_max_deg,
+            "m_star": s.m_star,
+            "m_star_analytical": s.m_star_analytical,
+            "theta_snap_deg": s.theta_snap_deg,
+            "theta_heel_deg": s.theta_heel_deg,
+            "ndof": s.ndof,
+            "wall_s": s.wall_s,
+            "error": result.error,
+        }
+        json.dump(out, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        sense = "opposite" if setup.theta_max_deg > 0 else "equal"
+        rel = (s.m_star - s.m_star_analytical) / abs(s.m_star_analytical)
+        lines = [
+            f"tape spring in pure bending ({sense} sense), {s.ndof} DOFs, "
+            f"{len(result.theta_deg)} equilibria, solver wall time {s.wall_s:.2f} s",
+            f"  M_max             = {s.m_max:+.4f} N m at theta = {s.theta_at_m_max_deg:+.2f} deg",
+            f"  M* (theta = {result.theta_deg[result.branch == 0][-1]:+.1f} deg) = "
+            f"{s.m_star:+.4f} N m   analytical (1{'+' if sense == 'opposite' else '-'}nu) D alpha"
+            f" = {s.m_star_analytical:+.4f} N m ({rel:+.1%})",
+        ]
+        if s.theta_snap_deg is not None:
+            lines.append(f"  snap (fold forms) at theta = {s.theta_snap_deg:+.2f} deg")
+        if s.theta_heel_deg is not None:
+            lines.append(f"  fold disappears on unloading at theta = {s.theta_heel_deg:+.2f} deg")
+        if args.csv:
+            lines.append(f"  curve written to {args.csv}")
+        if args.plot:
+            lines.append(f"  plot written to {args.plot}")
+        print("\n".join(lines))
+    if result.cancelled:
+        print("warning: the run was stopped before the final angle", file=sys.stderr)
+        return 1
+    if result.error:
+        print(f"warning: the path stopped early: {result.error}", file=sys.stderr)
+        return 1
+    return 0

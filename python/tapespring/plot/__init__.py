@@ -1,0 +1,30 @@
+"""Figures, with matplotlib (imported on first use of a plotting function).
+
+Every function draws on ``ax`` (a new figure is created only if ``ax`` is None) and returns the
+axes; none calls ``plt.show()``.
+
+Modules
+-------
+trials
+    The paper's figure types for trials and their analyses: bending-angle histories, variation
+    coefficients of the peaks, tip trajectory, force and angle, pull test, free decay, damping
+    series, two-series comparison and peak differences.
+
+The moment-rotation curve of pure bending is `tapespring.bending.plot_bending`.
+"""
+
+from tapespring._lazy import lazy_exports
+
+__all__ = [
+    "plot_angle_histories",
+    "plot_damping_series",
+    "plot_force_and_angle",
+    "plot_free_decay",
+    "plot_peak_differences",
+    "plot_pull_test",
+    "plot_series_comparison",
+    "plot_tip_trajectory",
+    "plot_variation_coefficients",
+]
+
+__getattr__, __dir__ = lazy_exports(__name__, __all__, {"trials": __all__})

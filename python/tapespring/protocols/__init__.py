@@ -1,0 +1,57 @@
+"""The paper's tests: the analysis of one trial and of a set of trials, by kind of test.
+
+SI units throughout (m, s, N, rad); marker roles in `markers` (paper Sec. 4).
+
+Modules
+-------
+registry
+    `KINDS`, `protocol_for` (the `Protocol` of a kind), `analyze_trials`, `TrialsAnalysis`.
+markers
+    `DEFAULT_MARKERS` (support, rod, tip) and the check that a marker has no gap.
+deployment
+    Kind ``"deployment"`` (paper Sec. 4.1): `analyze_deployment`, groups by sense of bending.
+vibration
+    Kind ``"vibration"`` (paper Sec. 5.2): `analyze_vibration`, statistics over sessions.
+pull
+    Kind ``"quasi-static"`` (paper Sec. 4.2): `analyze_pull_trial`.
+
+The names below are imported on first use, so listing `KINDS` imports no protocol.
+"""
+
+from tapespring._lazy import lazy_exports
+
+__all__ = [
+    "DEFAULT_MARKERS",
+    "KINDS",
+    "DeploymentGroup",
+    "DeploymentResult",
+    "Protocol",
+    "PullTestResult",
+    "TrialsAnalysis",
+    "VibrationResult",
+    "analyze_deployment",
+    "analyze_deployment_group",
+    "analyze_pull_group",
+    "analyze_pull_trial",
+    "analyze_trials",
+    "analyze_vibration",
+    "analyze_vibration_group",
+    "protocol_for",
+]
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    __all__,
+    {
+        "deployment": [
+            "DeploymentGroup",
+            "DeploymentResult",
+            "analyze_deployment",
+            "analyze_deployment_group",
+        ],
+        "markers": ["DEFAULT_MARKERS"],
+        "pull": ["PullTestResult", "analyze_pull_group", "analyze_pull_trial"],
+        "registry": ["KINDS", "Protocol", "TrialsAnalysis", "analyze_trials", "protocol_for"],
+        "vibration": ["VibrationResult", "analyze_vibration", "analyze_vibration_group"],
+    },
+)

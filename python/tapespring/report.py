@@ -1,0 +1,203 @@
+"""The report of an analysis of trials: folder of CSV tables and PNG figures, text summary, JSON.
+
+`write_report` writes the tables and figures into a folder, `format_summary`
+renders the summary table printed by the command line, and `summary_dict` the
+numbers as one JSON-ready dictionary (SI units; angles in rad with ``_deg``
+copies for reading).
+
+What is written is the same for every kind of test: the summary table
+(`SUMMARY_HEADER` columns, one `summary_row` per quantity), then the kind's own
+tables and figures. The rows, numbers, tables and figures of a kind come from
+its protocol (`tapespring.protocols.Protocol`); the helpers it writes them with
+(`write_table`, `save_figure`, `summary_json`, `jsonable`) are here.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tapespring.protocols.registry import protocol_for
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from tapespring.protocols.registry import TrialsAnalysis
+    from tapespring.signals.stats import Summary
+
+__all__ = [
+    "SUMMARY_HEADER",
+    "format_summary",
+    "jsonable",
+    "save_figure",
+    "summary_dict",
+    "summary_json",
+    "summary_row",
+    "write_report",
+    "write_table",
+]
+
+#: Columns of the summary table (`summary_row`).
+SUMMARY_HEADER = ["quantity", "unit", "mean", "std", "max diff", "cv [%]", "n"]
+
+
+def summary_json(s: Summary, deg: bool = False) -> dict:
+    """The statistics of one quantity as a JSON-ready dictionary.
+
+    Parameters
+    ----------
+    s : Summary
+        Statistics of one quantity across trials.
+    deg : bool
+        The quantity is an angle [rad]: add ``mean_deg``, ``std_deg`` and ``max_diff_deg``.
+
+    Returns
+    -------
+    dict
+        ``mean``, ``std``, ``max_diff``, ``cv``, ``count`` (NaN written as None).
+    """
+    out = {"mean": s.mean, "std": s.std, "max_diff": s.max_diff, "cv": s.cv, "count": s.count}
+    if deg:
+        out |= {f"{k}_deg": float(np.rad2deg(out[k])) for k in ("mean", "std", "max_diff")}
+    return {k: jsonable(v) for k, v in out.items()}
+
+
+def jsonable(value: object) -> object:
+    """JSON-safe: NaN becomes None, numpy scalars and arrays become Python objects."""
+    if isinstance(value, np.ndarray):
+        return [jsonable(v) for v in value.tolist()]
+    if isinstance(value, float | np.floating):
+        return None if not np.isfinite(value) else float(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, list):
+        return [jsonable(v) for v in value]
+    return value
+
+
+def summary_dict(analysis: TrialsAnalysis) -> dict:
+    """The numbers of an analysis as a JSON-ready dictionary (SI units).
+
+    Parameters
+    ----------
+    analysis : TrialsAnalysis
+
+    Returns
+    -------
+    dict
+        ``kind``, ``n_trials`` and per-kind statistics; NaN is written as None.
+    """
+    out: dict = {"kind": analysis.kind, "n_trials": len(analysis.results)}
+    out |= protocol_for(analysis.kind).summary(analysis)
+    return _jsonable_tree(out)
+
+
+def _jsonable_tree(value: object) -> object:
+    if isinstance(value, dict):
+        return {k: _jsonable_tree(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable_tree(v) for v in value]
+    return jsonable(value)
+
+
+def summary_row(name: str, unit: str, s: Summary, scale: float = 1.0) -> list[str]:
+    """One row of the summary table (`SUMMARY_HEADER`).
+
+    Parameters
+    ----------
+    name, unit : str
+        Quantity and the unit it is shown in.
+    s : Summary
+        Its statistics across trials, in SI units.
+    scale : float
+        Factor from SI to ``unit`` (the variation coefficient is shown in %).
+
+    Returns
+    -------
+    list of str
+    """
+    return [
+        name,
+        unit,
+        f"{s.mean * scale:.4g}",
+        f"{s.std * scale:.3g}",
+        f"{s.max_diff * scale:.3g}",
+        f"{100 * s.cv:.3g}",
+        str(s.count),
+    ]
+
+
+def format_summary(analysis: TrialsAnalysis) -> str:
+    """The summary table printed by ``tapespring trials analyze``.
+
+    Parameters
+    ----------
+    analysis : TrialsAnalysis
+
+    Returns
+    -------
+    str
+        A plain-text table (mean, std, max difference, variation coefficient).
+    """
+    rows = [SUMMARY_HEADER, *protocol_for(analysis.kind).table_rows(analysis)]
+    widths = [max(len(r[i]) for r in rows) for i in range(len(SUMMARY_HEADER))]
+    lines = [f"{analysis.kind}: {len(analysis.results)} trial(s)"]
+    for j, r in enumerate(rows):
+        lines.append(
+            "  ".join(
+                c.ljust(w) if i < 2 else c.rjust(w)
+                for i, (c, w) in enumerate(zip(r, widths, strict=True))
+            )
+        )
+        if j == 0:
+            lines.append("  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def write_table(path: Path, header: Sequence[str], rows: Sequence[Sequence[object]]) -> Path:
+    """Write one CSV table (None and NaN as empty fields); return its path."""
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(header)
+        for row in rows:
+            writer.writerow(["" if v is None else v for v in jsonable(list(row))])
+    return path
+
+
+def save_figure(fig: Figure, path: Path) -> Path:
+    """Save a figure as PNG (120 dpi), close it, and return the path."""
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def write_report(
+    analysis: TrialsAnalysis, folder: str | Path, *, figures: bool = True
+) -> list[Path]:
+    """Write the CSV tables and PNG figures of an analysis into ``folder``.
+
+    Parameters
+    ----------
+    analysis : TrialsAnalysis
+    folder : str or Path
+        Output folder (created if needed).
+    figures : bool
+        Also draw the figures (PNG).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    protocol = protocol_for(analysis.kind)
+    files = [write_table(folder / "summary.csv", SUMMARY_HEADER, protocol.table_rows(analysis))]
+    files += protocol.write_files(analysis, folder, figures)
+    return files

@@ -1,0 +1,109 @@
+"""Quasi-static pull test (paper Sec. 4.2, Fig. 19, Table 2).
+
+The raw force is smoothed with a moving average of ``span`` samples (MATLAB
+``smooth`` semantics, `smooth`; paper: span 101, i.e. 25.3 ms of its force
+record). The maximum force before buckling is the maximum of the smoothed force,
+and its displacement is the displacement at that sample. The test is flagged as
+buckled when the smoothed force afterwards falls below ``(1 - drop_fraction)``
+times that maximum (the sudden drop of Fig. 19).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .smoothing import smooth
+
+__all__ = ["PullTest", "analyze_pull_test"]
+
+
+@dataclass(frozen=True)
+class PullTest:
+    """Result of a quasi-static pull test.
+
+    Attributes
+    ----------
+    displacement : ndarray, shape (m,)
+        Displacement of the pulled point at the force samples [m].
+    force : ndarray, shape (m,)
+        Raw force [N].
+    force_smoothed : ndarray, shape (m,)
+        Smoothed force [N].
+    span : int
+        Smoothing span used [samples].
+    max_force : float
+        Maximum smoothed force before buckling [N].
+    displacement_at_max : float
+        Displacement at the maximum force [m].
+    index_at_max : int
+        Sample index of the maximum.
+    buckled : bool
+        A drop of at least ``drop_fraction`` of the maximum follows it.
+    """
+
+    displacement: np.ndarray
+    force: np.ndarray
+    force_smoothed: np.ndarray
+    span: int
+    max_force: float
+    displacement_at_max: float
+    index_at_max: int
+    buckled: bool
+
+
+def analyze_pull_test(
+    displacement: np.ndarray,
+    force: np.ndarray,
+    *,
+    span: int = 101,
+    drop_fraction: float = 0.2,
+) -> PullTest:
+    """Smoothed force versus displacement, maximum force and its displacement.
+
+    Parameters
+    ----------
+    displacement : ndarray, shape (m,)
+        Displacement of the pulled point, sampled with the force [m].
+    force : ndarray, shape (m,)
+        Force [N], positive in the pulling direction.
+    span : int
+        Smoothing span [samples] (paper: 101).
+    drop_fraction : float
+        Relative force drop after the maximum that counts as buckling, in (0, 1).
+
+    Returns
+    -------
+    PullTest
+
+    Raises
+    ------
+    ValueError
+        If the arrays differ in length or hold no finite force.
+    """
+    d = np.asarray(displacement, dtype=float)
+    f = np.asarray(force, dtype=float)
+    if d.shape != f.shape or d.ndim != 1:
+        raise ValueError(
+            f"displacement and force must be 1-D of equal length, got {d.shape}, {f.shape}"
+        )
+    if not 0 < drop_fraction < 1:
+        raise ValueError(f"drop_fraction must satisfy 0 < drop_fraction < 1, got {drop_fraction}")
+    fs = smooth(f, span)
+    if not np.any(np.isfinite(fs)):
+        raise ValueError("the force record has no finite sample")
+    i = int(np.nanargmax(fs))
+    f_max = float(fs[i])
+    after = fs[i:]
+    buckled = bool(np.nanmin(after) < (1.0 - drop_fraction) * f_max) if f_max > 0 else False
+    return PullTest(
+        displacement=d,
+        force=f,
+        force_smoothed=fs,
+        span=int(span),
+        max_force=f_max,
+        displacement_at_max=float(d[i]),
+        index_at_max=i,
+        buckled=buckled,
+    )

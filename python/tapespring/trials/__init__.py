@@ -1,0 +1,49 @@
+"""Experimental trials of the tape-spring set-up: the data model and its files (paper Secs. 3-4).
+
+SI units throughout (m, s, N, N m); the units of a source file are kept in the metadata.
+
+Modules
+-------
+trial
+    `Trial` (markers, force plates, metadata), `ForcePlate`, `Metadata`, `Gap`, `TrialError`.
+c3d
+    C3D reader and writer (ezc3d, imported only when a C3D file is read or written).
+csv
+    CSV reader and writer (a marker file and an optional ``.forces.csv`` sibling).
+load
+    `read_trial` (reader chosen by suffix), `find_trial_files`, `load_trials` (with progress bar).
+samples
+    Synthetic trials with known answers, for tests, examples and benchmarks.
+
+The names below are imported on first use.
+"""
+
+from tapespring._lazy import lazy_exports
+
+__all__ = [
+    "FORCES_SUFFIX",
+    "SENSES",
+    "ForcePlate",
+    "Gap",
+    "Metadata",
+    "Trial",
+    "TrialError",
+    "find_trial_files",
+    "load_trials",
+    "read_c3d",
+    "read_csv",
+    "read_trial",
+    "write_c3d",
+    "write_csv",
+]
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    __all__,
+    {
+        "c3d": ["read_c3d", "write_c3d"],
+        "csv": ["FORCES_SUFFIX", "read_csv", "write_csv"],
+        "load": ["find_trial_files", "load_trials", "read_trial"],
+        "trial": ["SENSES", "ForcePlate", "Gap", "Metadata", "Trial", "TrialError"],
+    },
+)

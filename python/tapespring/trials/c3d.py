@@ -1,0 +1,286 @@
+"""Reading and writing trials in C3D files (with ezc3d).
+
+Markers come from ``POINT`` (converted from ``POINT:UNITS`` to metres, NaN where
+a marker is missing). Force plates are extracted by ezc3d
+(``extract_forceplat_data=True``) at the analog rate and converted from the
+plate's force and moment units to N and N m. Metadata live in an optional
+``TAPESPRING`` parameter group (``SENSE``, ``TAPE_PAIR``, ``SESSION``).
+
+The C3D format stores analogs at an integer number of samples per marker frame,
+so a force plate at 1 kHz cannot be stored beside markers at 800 Hz; `write_c3d`
+refuses such a trial (use CSV, or record the plate at 4 kHz = 5 x 800 Hz).
+
+ezc3d's ``add_parameter`` turns integer parameters into floats, and the force
+platform extractor then rejects ``FORCE_PLATFORM:USED``, ``TYPE``, ``ZERO`` and
+``CHANNEL``. `write_c3d` therefore adds each of them as floats and then retags
+the stored parameter as an integer one (``type = INT``, integer values) before
+writing; see ``_add_int_parameter``.
+"""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .common import FORCE, FP_CHANNELS, LENGTH, META_KEYS, MOMENT, check_durations, unit_scale
+from .trial import ForcePlate, Metadata, Trial, TrialError
+
+# ezc3d is imported inside the functions that touch a C3D file, so that loading CSV trials (or
+# just importing the trials) does not pay for it.
+if TYPE_CHECKING:
+    import ezc3d
+
+__all__ = ["read_c3d", "write_c3d"]
+
+_C3D_INT = 2  # ezc3d parameter type code for INT (ezc3d.ezc3d.INT)
+
+
+def read_c3d(
+    path: str | Path,
+    *,
+    sense: str | None = None,
+    tape_pair: str | None = None,
+    session: str | None = None,
+) -> Trial:
+    """Read a trial from a C3D file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The C3D file.
+    sense, tape_pair, session : str, optional
+        Override the metadata stored in the file (``TAPESPRING`` group).
+
+    Returns
+    -------
+    Trial
+        Markers in m, force plates (if any) in N and N m at the analog rate.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    TrialError
+        If the file is not a C3D file, is truncated, or has unknown units.
+    """
+    import ezc3d
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        c3d = ezc3d.c3d(str(path))
+        platforms = _force_platforms(c3d, path)
+    except Exception as exc:  # ezc3d raises OSError/RuntimeError with its own wording
+        raise TrialError(path, f"not a readable C3D file ({exc})") from exc
+    header = c3d["header"]["points"]
+    points = c3d["data"]["points"]
+    n = points.shape[2]
+    n_declared = _declared_frames(path)
+    if n_declared is not None and n != n_declared:
+        raise TrialError(path, f"truncated C3D data: {n} of {n_declared} frames")
+    if n < 2:
+        raise TrialError(path, f"the file holds {n} marker frame(s), at least 2 are needed")
+    params = c3d["parameters"]
+    rate = float(header["frame_rate"])
+    if not rate > 0:
+        raise TrialError(path, f"invalid POINT:RATE {rate}")
+    labels = list(params["POINT"]["LABELS"]["value"])
+    unit = (params["POINT"].get("UNITS", {}).get("value") or ["mm"])[0]
+    scale = unit_scale(unit, LENGTH, path, "marker")
+    time = (header["first_frame"] + np.arange(n)) / rate
+    markers = {label.strip(): points[:3, i, :].T * scale for i, label in enumerate(labels)}
+    if len(markers) != len(labels):
+        raise TrialError(path, "duplicate marker labels")
+
+    plates = []
+    for k, pf in enumerate(platforms):
+        analog = c3d["header"]["analogs"]
+        m = pf["force"].shape[1]
+        t_plate = (analog["first_frame"] + np.arange(m)) / analog["frame_rate"]
+        f_scale = unit_scale(pf["unit_force"], FORCE, path, "force")
+        m_scale = unit_scale(pf["unit_moment"], MOMENT, path, "moment")
+        plates.append(
+            ForcePlate(
+                time=t_plate,
+                force=pf["force"].T * f_scale,
+                moment=pf["moment"].T * m_scale,
+                name=f"FP{k + 1}",
+            )
+        )
+    stored = {}
+    group = params.get("TAPESPRING", {})
+    for key in META_KEYS:
+        value = group.get(key.upper(), {}).get("value")
+        if value:
+            stored[key] = str(value[0]).strip() or None
+    overrides = {"sense": sense, "tape_pair": tape_pair, "session": session}
+    stored.update({k: v for k, v in overrides.items() if v is not None})
+    units = {"markers": unit}
+    if plates:
+        units |= {"force": pf["unit_force"], "moment": pf["unit_moment"]}
+    metadata = Metadata(name=path.stem, units=units, source=path, **stored)
+    trial = Trial(time=time, markers=markers, force_plates=tuple(plates), metadata=metadata)
+    check_durations(trial)
+    return trial
+
+
+def _declared_frames(path: Path) -> int | None:
+    """Number of frames declared in the raw C3D header (None if it cannot say).
+
+    ezc3d silently reads a truncated file and rewrites its header to the frames
+    it found, so the declared count is read from the file itself: words 4 and 5
+    of the header block are the first and last frame (1-based, 16-bit, in the
+    byte order of the processor type stored in the parameter block: 84 Intel,
+    85 DEC little-endian, 86 MIPS big-endian). Files of 65535 frames or more
+    cannot state their length there.
+    """
+    with path.open("rb") as fh:
+        head = fh.read(512)
+        param_block = head[0] if head else 0
+        if param_block < 1:
+            return None
+        fh.seek(512 * (param_block - 1))
+        param_head = fh.read(4)
+    if len(head) < 10 or len(param_head) < 4:
+        return None
+    order = ">" if param_head[3] == 86 else "<"
+    first, last = struct.unpack(order + "HH", head[6:10])
+    if last >= 65535 or last < first:
+        return None
+    return last - first + 1
+
+
+def _force_platforms(c3d: ezc3d.c3d, path: Path) -> list[dict]:
+    """Force, moment and units of each force platform, computed by ezc3d.
+
+    ``ezc3d.c3d(path, extract_forceplat_data=True)`` converts force, moment,
+    centre of pressure and free moment frame by frame in Python; the paper's
+    analyses need only force and moment, so call the same ezc3d extractor
+    (``ezc3d.ezc3d.ForcePlatforms``) and convert just those two (3x faster on a
+    4 kHz record). Falls back to the documented path if the wrapper changes.
+    """
+    import ezc3d
+
+    swig = getattr(c3d, "c3d_swig", None)
+    extractor = getattr(getattr(ezc3d, "ezc3d", None), "ForcePlatforms", None)
+    if swig is None or extractor is None:
+        full = ezc3d.c3d(str(path), extract_forceplat_data=True)
+        return list(full["data"].get("platform", []))
+    out = []
+    for pf in extractor(swig).forcePlatforms():
+        force = np.array([v.to_array() for v in pf.forces()]).reshape(-1, 3)
+        moment = np.array([v.to_array() for v in pf.moments()]).reshape(-1, 3)
+        out.append(
+            {
+                "force": force.T,
+                "moment": moment.T,
+                "unit_force": pf.forceUnit(),
+                "unit_moment": pf.momentUnit(),
+            }
+        )
+    return out
+
+
+def _add_int_parameter(c3d: ezc3d.c3d, group: str, name: str, value: np.ndarray) -> None:
+    """Add an integer C3D parameter.
+
+    ``ezc3d.c3d.add_parameter`` stores integers as floats, which the force-platform
+    extractor rejects; add the values as floats, then retag them as integers.
+    """
+    value = np.asarray(value)
+    c3d.add_parameter(group, name, value.astype(float))
+    c3d["parameters"][group][name]["type"] = _C3D_INT
+    c3d["parameters"][group][name]["value"] = value.astype(int)
+
+
+def write_c3d(trial: Trial, path: str | Path) -> Path:
+    """Write a trial to a C3D file (markers in mm, force plates as type-2 plates).
+
+    Parameters
+    ----------
+    trial : Trial
+        The trial. Its time vector must start at a multiple of the sampling
+        interval; the force plates (if any) must share one rate that is an
+        integer multiple of the marker rate, and cover the marker frames.
+    path : str or Path
+        Output file (``.c3d`` is appended by ezc3d if missing).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    TrialError
+        If the force plates cannot be represented in C3D.
+    """
+    import ezc3d
+
+    path = Path(path)
+    if path.suffix != ".c3d":
+        path = path.with_name(path.name + ".c3d")
+    rate = trial.rate
+    n = trial.time.size
+    first_frame = round(trial.time[0] * rate)
+    if first_frame != 0:
+        raise TrialError(path, "C3D writing needs a time vector starting at 0 s")
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = np.array([rate])
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = tuple(trial.markers)
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    points = np.ones((4, len(trial.markers), n))
+    for i, xyz in enumerate(trial.markers.values()):
+        points[:3, i, :] = xyz.T / LENGTH["mm"]
+    c3d["data"]["points"] = points
+
+    if trial.force_plates:
+        plate_rates = [p.rate for p in trial.force_plates]
+        ratio = plate_rates[0] / rate
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise TrialError(
+                path,
+                f"C3D needs the force-plate rate ({plate_rates[0]:g} Hz) to be an integer "
+                f"multiple of the marker rate ({rate:g} Hz); write CSV instead",
+            )
+        ratio = round(ratio)
+        m = n * ratio
+        analogs = []
+        for plate in trial.force_plates:
+            if abs(plate.rate - plate_rates[0]) > 1e-6 * plate_rates[0] or plate.time.size != m:
+                raise TrialError(
+                    path,
+                    f"force plate {plate.name!r} must have {m} samples at {plate_rates[0]:g} Hz "
+                    f"to fit {n} marker frames, got {plate.time.size} at {plate.rate:g} Hz",
+                )
+            analogs.append(plate.force.T)
+            analogs.append(plate.moment.T / MOMENT["N mm"])
+        n_plates = len(trial.force_plates)
+        c3d["parameters"]["ANALOG"]["RATE"]["value"] = np.array([rate * ratio])
+        c3d["parameters"]["ANALOG"]["LABELS"]["value"] = tuple(
+            f"{p.name}_{ch}" for p in trial.force_plates for ch in FP_CHANNELS
+        )
+        c3d["parameters"]["ANALOG"]["UNITS"]["value"] = ["N"] * 3 + ["Nmm"] * 3
+        c3d["parameters"]["ANALOG"]["UNITS"]["value"] *= n_plates
+        c3d["data"]["analogs"] = np.concatenate(analogs)[np.newaxis]
+        _add_int_parameter(c3d, "FORCE_PLATFORM", "USED", np.array([n_plates]))
+        _add_int_parameter(c3d, "FORCE_PLATFORM", "TYPE", np.full(n_plates, 2))
+        _add_int_parameter(c3d, "FORCE_PLATFORM", "ZERO", np.array([1, 0]))
+        channels = np.arange(1, 6 * n_plates + 1).reshape(n_plates, 6).T
+        _add_int_parameter(c3d, "FORCE_PLATFORM", "CHANNEL", channels)
+        c3d.add_parameter("FORCE_PLATFORM", "ORIGIN", np.zeros((3, n_plates)))
+        corners = np.array([[200.0, 200, 0], [-200, 200, 0], [-200, -200, 0], [200, -200, 0]])
+        corners = np.repeat(corners.T[:, :, np.newaxis], n_plates, axis=2)
+        c3d.add_parameter("FORCE_PLATFORM", "CORNERS", corners)
+    meta = trial.metadata
+    for key in META_KEYS:
+        value = getattr(meta, key)
+        if value:
+            c3d.add_parameter("TAPESPRING", key.upper(), [str(value)])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    c3d.write(str(path))
+    return path

@@ -1,0 +1,359 @@
+"""The `Trial` data model: one experimental record of the tape-spring set-up.
+
+A trial holds, in SI units:
+
+- ``time`` [s], shape (n,): the marker sampling instants (uniform rate);
+- ``markers``: marker name -> positions [m], shape (n, 3), NaN where a marker
+  was not seen (occlusion);
+- ``force_plates``: zero or more `ForcePlate` records, each with its own time
+  vector (the force plate runs at its own rate), forces [N] and moments [N m];
+- ``metadata``: sense of bending, tape pair, session, the units found in the
+  source file and the source file itself.
+
+Missing marker samples are never filled silently: `Trial.gaps` lists them and
+`Trial.fill_gaps` interpolates (cubic spline through the valid samples) only the
+gaps not longer than a duration the caller chooses; longer gaps, and gaps that
+touch either end of the record, stay NaN.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+
+__all__ = ["ForcePlate", "Gap", "Metadata", "SENSES", "Trial", "TrialError"]
+
+#: Senses of bending (paper Sec. 2): opposite (M, theta > 0) and equal (M, theta < 0).
+SENSES = ("opposite", "equal")
+
+# Relative tolerance on the sampling interval: a time vector whose steps differ
+# from their mean by more than this is "inconsistent". CSV files written with
+# 9 significant digits round t = 9.99875 s to 1e-8 s, i.e. 1e-5 of a 1.25 ms step.
+_RATE_RTOL = 1e-3
+
+
+class TrialError(ValueError):
+    """A trial (or the file it comes from) is unusable.
+
+    Parameters
+    ----------
+    source : str or Path or None
+        File or trial name the problem belongs to (``None`` if unknown).
+    problem : str
+        What is wrong, in plain words.
+    """
+
+    def __init__(self, source: str | Path | None, problem: str) -> None:
+        self.source = None if source is None else str(source)
+        self.problem = problem
+        super().__init__(f"{self.source}: {problem}" if self.source else problem)
+
+
+def _frozen_array(values: np.ndarray) -> np.ndarray:
+    out = np.array(values, dtype=float, copy=True)
+    out.flags.writeable = False
+    return out
+
+
+def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
+    """Validate a uniformly sampled time vector and return its rate [Hz]."""
+    if time.ndim != 1 or time.size < 2:
+        raise TrialError(source, f"{what} time vector needs at least 2 samples, got {time.size}")
+    if not np.all(np.isfinite(time)):
+        raise TrialError(source, f"{what} time vector contains NaN or inf")
+    dt = np.diff(time)
+    mean_dt = (time[-1] - time[0]) / (time.size - 1)
+    if mean_dt <= 0 or np.any(dt <= 0):
+        raise TrialError(source, f"{what} time vector is not strictly increasing")
+    worst = np.max(np.abs(dt - mean_dt)) / mean_dt
+    if worst > _RATE_RTOL:
+        raise TrialError(
+            source,
+            f"inconsistent {what} sampling rate: steps vary by {100 * worst:.2g} % "
+            f"(allowed {100 * _RATE_RTOL:.2g} %)",
+        )
+    return 1.0 / mean_dt
+
+
+@dataclass(frozen=True)
+class ForcePlate:
+    """Force-plate channels at the plate's own sampling rate.
+
+    Parameters
+    ----------
+    time : ndarray, shape (m,)
+        Sampling instants [s], uniform.
+    force : ndarray, shape (m, 3)
+        Force (Fx, Fy, Fz) [N] in the laboratory frame.
+    moment : ndarray, shape (m, 3)
+        Moment (Mx, My, Mz) [N m] about the plate origin.
+    name : str
+        Label of the plate (``"FP1"``, ...).
+    """
+
+    time: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    name: str = "FP1"
+
+    def __post_init__(self) -> None:
+        time = _frozen_array(self.time)
+        _check_time(time, None, f"force plate {self.name!r}")
+        for label in ("force", "moment"):
+            arr = np.asarray(getattr(self, label), dtype=float)
+            if arr.shape != (time.size, 3):
+                raise TrialError(
+                    None,
+                    f"force plate {self.name!r}: {label} has shape {arr.shape}, "
+                    f"expected ({time.size}, 3)",
+                )
+            object.__setattr__(self, label, _frozen_array(arr))
+        object.__setattr__(self, "time", time)
+
+    @property
+    def rate(self) -> float:
+        """Sampling rate [Hz]."""
+        return (self.time.size - 1) / (self.time[-1] - self.time[0])
+
+
+@dataclass(frozen=True)
+class Metadata:
+    """Descriptive information about a trial.
+
+    Parameters
+    ----------
+    name : str
+        Short name of the trial (the file stem by default).
+    sense : {"opposite", "equal"} or None
+        Sense of the initial bending (paper Sec. 2), if known.
+    tape_pair : str or None
+        Identifier of the pair of tape springs used.
+    session : str or None
+        Identifier of the test session.
+    units : Mapping[str, str]
+        Units found in the source file, e.g. ``{"markers": "mm", "force": "N"}``.
+        The arrays of a `Trial` are always in SI units.
+    source : Path or None
+        File the trial was read from.
+    """
+
+    name: str = ""
+    sense: str | None = None
+    tape_pair: str | None = None
+    session: str | None = None
+    units: Mapping[str, str] = field(default_factory=dict)
+    source: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.sense is not None and self.sense not in SENSES:
+            raise TrialError(
+                self.source, f"sense must be one of {SENSES} or None, got {self.sense!r}"
+            )
+        object.__setattr__(self, "units", MappingProxyType(dict(self.units)))
+
+    @property
+    def label(self) -> str:
+        """The best available identifier: source file, else name."""
+        return str(self.source) if self.source is not None else self.name or "<trial>"
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A run of consecutive missing samples of one marker.
+
+    Attributes
+    ----------
+    marker : str
+        Marker name.
+    start, stop : int
+        First missing sample and one past the last (Python slice convention).
+    start_time : float
+        Time of the first missing sample [s].
+    duration : float
+        Number of missing samples divided by the marker rate [s].
+    at_edge : bool
+        True if the gap touches the first or the last sample (it can then not
+        be interpolated, only extrapolated, which is never done).
+    """
+
+    marker: str
+    start: int
+    stop: int
+    start_time: float
+    duration: float
+    at_edge: bool
+
+    @property
+    def n_samples(self) -> int:
+        """Number of missing samples."""
+        return self.stop - self.start
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One experimental record: markers, force plates and metadata, in SI units.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Marker sampling instants [s], uniform.
+    markers : Mapping[str, ndarray]
+        Marker name -> positions [m], shape (n, 3); NaN marks a missing sample.
+    force_plates : tuple of ForcePlate
+        Force-plate records, each at its own rate.
+    metadata : Metadata
+        Descriptive information.
+
+    Raises
+    ------
+    TrialError
+        If the shapes or the time vector are inconsistent; the message names
+        the source file.
+    """
+
+    time: np.ndarray
+    markers: Mapping[str, np.ndarray]
+    force_plates: tuple[ForcePlate, ...] = ()
+    metadata: Metadata = field(default_factory=Metadata)
+
+    def __post_init__(self) -> None:
+        source = self.metadata.label
+        time = _frozen_array(self.time)
+        _check_time(time, source, "marker")
+        if not self.markers:
+            raise TrialError(source, "the trial has no markers")
+        markers = {}
+        for name, values in self.markers.items():
+            arr = np.asarray(values, dtype=float)
+            if arr.shape != (time.size, 3):
+                raise TrialError(
+                    source, f"marker {name!r} has shape {arr.shape}, expected ({time.size}, 3)"
+                )
+            markers[str(name)] = _frozen_array(arr)
+        plates = tuple(self.force_plates)
+        for plate in plates:
+            if not isinstance(plate, ForcePlate):
+                raise TrialError(source, f"force_plates must hold ForcePlate, got {type(plate)}")
+        object.__setattr__(self, "time", time)
+        object.__setattr__(self, "markers", MappingProxyType(markers))
+        object.__setattr__(self, "force_plates", plates)
+
+    @property
+    def rate(self) -> float:
+        """Marker sampling rate [Hz]."""
+        return (self.time.size - 1) / (self.time[-1] - self.time[0])
+
+    @property
+    def name(self) -> str:
+        """Trial name (metadata name, else the source file stem)."""
+        if self.metadata.name:
+            return self.metadata.name
+        return self.metadata.source.stem if self.metadata.source else "<trial>"
+
+    def marker(self, name: str) -> np.ndarray:
+        """Positions of one marker [m], shape (n, 3).
+
+        Raises
+        ------
+        TrialError
+            If the marker does not exist (the message lists those that do).
+        """
+        try:
+            return self.markers[name]
+        except KeyError:
+            available = ", ".join(self.markers) or "none"
+            raise TrialError(
+                self.metadata.label, f"missing marker {name!r} (available: {available})"
+            ) from None
+
+    def force_plate(self, index: int = 0) -> ForcePlate:
+        """The force plate number ``index`` (0-based).
+
+        Raises
+        ------
+        TrialError
+            If the trial has no such force plate.
+        """
+        if not 0 <= index < len(self.force_plates):
+            raise TrialError(
+                self.metadata.label,
+                f"no force plate {index} (the trial has {len(self.force_plates)})",
+            )
+        return self.force_plates[index]
+
+    def gaps(self) -> tuple[Gap, ...]:
+        """All runs of missing samples, marker by marker.
+
+        A sample is missing if any of its three coordinates is NaN.
+
+        Returns
+        -------
+        tuple of Gap
+            Ordered by marker, then by time.
+        """
+        out = []
+        n = self.time.size
+        dt = 1.0 / self.rate
+        for name, xyz in self.markers.items():
+            missing = np.isnan(xyz).any(axis=1)
+            if not missing.any():
+                continue
+            edges = np.diff(np.concatenate(([0], missing.astype(np.int8), [0])))
+            starts = np.flatnonzero(edges == 1)
+            stops = np.flatnonzero(edges == -1)
+            for a, b in zip(starts, stops, strict=True):
+                out.append(
+                    Gap(
+                        marker=name,
+                        start=int(a),
+                        stop=int(b),
+                        start_time=float(self.time[a]),
+                        duration=float((b - a) * dt),
+                        at_edge=bool(a == 0 or b == n),
+                    )
+                )
+        return tuple(out)
+
+    def fill_gaps(self, max_gap: float) -> Trial:
+        """Interpolate the short interior gaps of every marker.
+
+        Each coordinate is interpolated with a cubic spline
+        (`scipy.interpolate.CubicSpline`) through the valid samples of that
+        marker. Gaps longer than ``max_gap`` and gaps touching either end of
+        the record are left as NaN (see `gaps`).
+
+        Parameters
+        ----------
+        max_gap : float
+            Longest gap filled [s] (compared with `Gap.duration`); must be >= 0.
+
+        Returns
+        -------
+        Trial
+            A new trial (the metadata are kept).
+        """
+        # scipy.interpolate takes longer to import than the rest of the trials together.
+        from scipy.interpolate import CubicSpline
+
+        if not max_gap >= 0:
+            raise ValueError(f"max_gap must satisfy max_gap >= 0, got {max_gap}")
+        gaps = [g for g in self.gaps() if not g.at_edge and g.duration <= max_gap + 1e-12]
+        if not gaps:
+            return self
+        markers = {name: np.array(xyz) for name, xyz in self.markers.items()}
+        for name in {g.marker for g in gaps}:
+            xyz = markers[name]
+            valid = ~np.isnan(xyz).any(axis=1)
+            spline = CubicSpline(self.time[valid], xyz[valid], axis=0)
+            for gap in (g for g in gaps if g.marker == name):
+                xyz[gap.start : gap.stop] = spline(self.time[gap.start : gap.stop])
+        return dataclasses.replace(self, markers=markers)
+
+    def with_metadata(self, **changes: object) -> Trial:
+        """A copy of the trial whose metadata fields are replaced by ``changes``."""
+        return dataclasses.replace(self, metadata=dataclasses.replace(self.metadata, **changes))

@@ -1,0 +1,16 @@
+"""Levels of a held-then-released signal: equilibrium and release."""
+
+import numpy as np
+from tapespring.signals import equilibrium_value, release_index
+
+
+def test_equilibrium_value_is_median_of_tail():
+    t = np.arange(1000) / 100.0
+    y = np.where(t < 5, 10.0, 2.0)
+    assert equilibrium_value(t, y, tail=1.0) == 2.0
+
+
+def test_release_index_finds_first_departure():
+    y = np.concatenate((np.full(50, 1.0), np.linspace(1.0, 0.0, 50)))
+    i = release_index(y, threshold=0.1)
+    assert y[i] < 0.9 <= y[i - 1]

@@ -1,0 +1,52 @@
+"""Deployment phases from the peaks of the bending angle."""
+
+import numpy as np
+import pytest
+from tapespring.signals import (
+    bending_angle,
+    detect_phases,
+    equilibrium_value,
+    extract_peaks,
+    release_index,
+)
+from tapespring.trials.samples import make_deployment_trial
+
+
+def _peaks(trial):
+    theta = bending_angle(trial.marker("M1"), trial.marker("M2"))
+    theta -= equilibrium_value(trial.time, theta)
+    i = release_index(theta, np.deg2rad(2))
+    return extract_peaks(trial.time[i:], theta[i:], None, t_ref=trial.time[i])
+
+
+@pytest.mark.parametrize("sense", ["opposite", "equal"])
+def test_phase_transitions_are_found_at_the_known_peaks(sense):
+    for seed in range(6):
+        trial, truth = make_deployment_trial(sense, seed=seed, spread=0.03)
+        phases = detect_phases(_peaks(trial))
+        assert phases.phase_ii_index == truth.phase_ii_index
+        assert phases.phase_iii_index == truth.phase_iii_index
+        # Boundary instants are those of the starting peaks (peak-time accuracy).
+        assert phases.phase_ii_start == pytest.approx(
+            truth.peak_time[truth.phase_ii_index], abs=0.01
+        )
+        assert phases.phase_iii_start == pytest.approx(
+            truth.peak_time[truth.phase_iii_index], abs=0.01
+        )
+
+
+def test_symmetric_decay_is_all_phase_iii():
+    t = np.arange(0, 5, 1 / 800)
+    y = np.exp(-0.3 * t) * np.cos(2 * np.pi * 5 * t)
+    phases = detect_phases(extract_peaks(t, y, None))
+    assert phases.phase_iii_index == 0
+    assert phases.phase_ii_index is None
+    labels = phases.phase_at(np.array([phases.peak_time[0], 4.0]))
+    np.testing.assert_array_equal(labels, [3, 3])
+
+
+def test_phase_at_labels_instants():
+    trial, truth = make_deployment_trial("opposite")
+    phases = detect_phases(_peaks(trial))
+    labels = phases.phase_at(np.array([0.4, phases.phase_ii_start, phases.phase_iii_start + 1]))
+    np.testing.assert_array_equal(labels, [1, 2, 3])
