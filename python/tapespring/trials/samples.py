@@ -139,7 +139,7 @@ def _deployment_peaks(
     values = np.concatenate((phase_i, phase_ii, phase_iii)) * deg
     values *= 1.0 + spread * rng.standard_normal(values.size)
     # Duration before each peak: a phase starts at the peak from which the
-    # half-cycles take its character (see `phases`), so the first peak of a phase
+    # half-cycles take its character (see `tapespring.signals.phases`), so the first peak of a phase
     # is still reached at the pace of the previous one.
     halves = np.concatenate(
         (
