@@ -1,117 +1,134 @@
-//! Assembly of the condensed residual and tangent.
+//! The discrete system: elements, masses, numbering, and the assembly of its pieces.
 //!
 //! The unknowns are the free DOFs of the independent nodes ([`DofMap`]). A tied node `s` with
 //! reference node `r` moves as `delta x_s = delta x_r + theta_r x (x_s - x_r)`,
 //! `theta_s = theta_r`, so its element rows and columns are mapped onto `r` with
 //! `T = [[I, -[x_s - x_r]x], [0, I]]`, plus the second-order terms of the exact rigid motion.
+//! Forces applied at a lever arm from an independent node (loads and gravity on tied nodes, the
+//! weight of a rigid body at its centre of mass) are condensed the same way.
+//!
+//! Assembly returns the pieces, condensed onto the independent nodes, and leaves their
+//! combination to the solvers (the static residual is `f_int - f_ext`; a dynamic one adds
+//! inertia):
+//!
+//! ```text
+//! f_int   internal force                                   [N, N m]
+//! f_ext   external force at the state's time t: loads value f(t), gravity m g f(t)
+//! df_ext  d f_ext / dt (one-sided slope in the direction of travel)
+//! K       d(f_int - f_ext)/dq: material + geometric stiffness, and the load stiffness of forces
+//!         applied at rotating lever arms
+//! ```
 //!
 //! The sparsity pattern (free x free, and free x constrained for the coupling used by
-//! displacement control) and each element's slots in it are computed once. Each assembly computes
-//! the element blocks in parallel (rayon) or serially into per-element buffers, then scatters the
-//! two halves of the element list into two buffers that are added in a fixed order, so both paths
-//! give bit-identical results.
+//! displacement control) and each element's slots in it are computed once per numbering. Each
+//! assembly computes the element blocks in parallel (rayon) or serially into per-element buffers,
+//! then scatters the two halves of the element list into two buffers that are added in a fixed
+//! order, so both paths give bit-identical results.
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
-use crate::dof::{DofMap, Slot};
+use crate::constraint::{Activity, DofMap, Slot};
+use crate::dof::Dof;
 use crate::element::shell::{ElementMatrix, ElementStress, ElementVector};
 use crate::element::ShellElement;
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::linalg::LinearSolver;
+pub use crate::linalg::Pattern;
 use crate::material::SectionStiffness;
-use crate::model::{Model, NodalLoad};
+use crate::model::{Load, Marker, Model, RigidBody};
 use crate::rotation::{rotate, rotated_vector_hessian, skew};
 use crate::state::State;
+use crate::time_function::TimeFunction;
 
 const NONE: u32 = u32::MAX;
 
-/// Compressed-column pattern.
-#[derive(Clone, Debug, Default)]
-pub struct Pattern {
-    /// Number of rows.
-    pub nrows: usize,
-    /// Column pointers (length ncols + 1).
-    pub col_ptr: Vec<usize>,
-    /// Row indices, sorted within each column.
-    pub row_idx: Vec<usize>,
-}
-
-impl Pattern {
-    fn from_columns(nrows: usize, cols: Vec<Vec<usize>>) -> Self {
-        let mut col_ptr = Vec::with_capacity(cols.len() + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0);
-        for mut c in cols {
-            c.sort_unstable();
-            c.dedup();
-            row_idx.extend_from_slice(&c);
-            col_ptr.push(row_idx.len());
-        }
-        Self {
-            nrows,
-            col_ptr,
-            row_idx,
-        }
-    }
-
-    /// Position of entry `(row, col)`, if it is in the pattern.
-    #[must_use]
-    pub fn find(&self, row: usize, col: usize) -> Option<usize> {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        self.row_idx[a..b].binary_search(&row).ok().map(|p| a + p)
-    }
-
-    /// Number of stored entries.
-    #[must_use]
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
-    /// `y += A x` for a matrix with this pattern and values `val`.
-    pub fn mul_add(&self, val: &[f64], x: &[f64], y: &mut [f64]) {
-        for (j, xj) in x.iter().enumerate() {
-            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
-                y[self.row_idx[p]] += val[p] * xj;
-            }
-        }
-    }
-}
-
-/// Result of one assembly.
+/// The pieces of one assembly, condensed onto the independent nodes.
 #[derive(Clone, Debug, Default)]
 pub struct Assembled {
-    /// Residual `f_int - lambda f_ext` at the free equations [N, N m].
-    pub residual: Vec<f64>,
-    /// Reactions `f_int - lambda f_ext` at the constrained DOFs [N, N m].
-    pub reactions: Vec<f64>,
-    /// External load at the free equations for `lambda = 1` [N, N m].
+    /// Internal force at the free equations [N, N m].
+    pub f_int: Vec<f64>,
+    /// External force at the free equations at the state's time [N, N m].
     pub f_ext: Vec<f64>,
+    /// Time derivative of the external force at the free equations [N/s, N m/s].
+    pub df_ext: Vec<f64>,
+    /// Internal force at the constrained DOFs, in [`DofMap::constrained`] order.
+    pub f_int_c: Vec<f64>,
+    /// External force at the constrained DOFs.
+    pub f_ext_c: Vec<f64>,
     /// Values of the free x free tangent, in [`System::pattern_ff`] order.
     pub k_ff: Vec<f64>,
     /// Values of the free x constrained tangent, in [`System::pattern_fc`] order.
     pub k_fc: Vec<f64>,
     /// Strain energy [J].
     pub energy: f64,
+    /// Potential energy of gravity `-sum m g(t) . x` [J].
+    pub gravity_energy: f64,
 }
 
-/// A model prepared for analysis: elements, DOF map, sparsity pattern and buffers.
+impl Assembled {
+    /// Static residual `f_int - f_ext` at the free equations, into `out`.
+    pub fn residual_into(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.f_int.iter().zip(&self.f_ext).map(|(i, e)| i - e));
+    }
+
+    /// Static residual `f_int - f_ext` at the free equations.
+    #[must_use]
+    pub fn residual(&self) -> Vec<f64> {
+        let mut r = Vec::new();
+        self.residual_into(&mut r);
+        r
+    }
+
+    /// Static reactions `f_int - f_ext` at the constrained DOFs: the forces the supports apply.
+    #[must_use]
+    pub fn reactions(&self) -> Vec<f64> {
+        self.f_int_c
+            .iter()
+            .zip(&self.f_ext_c)
+            .map(|(i, e)| i - e)
+            .collect()
+    }
+}
+
+/// A model prepared for analysis: elements, masses, DOF map, sparsity pattern, linear solver and
+/// buffers.
 pub struct System {
     /// Elements, in mesh order.
     pub elements: Vec<ShellElement>,
+    /// Section stiffness of each part.
+    pub sections: Vec<SectionStiffness>,
+    /// Part (index into [`Self::sections`]) of each element.
+    element_part: Vec<usize>,
     /// DOF numbering.
     pub dofs: DofMap,
-    /// Section stiffness.
-    pub section: SectionStiffness,
-    /// Reference configuration.
+    /// Reference configuration (time 0).
     pub reference: State,
-    /// Nodal loads at load factor 1.
-    pub loads: Vec<NodalLoad>,
+    /// Applied nodal loads (the model's active loads, and transient ones added by analysis steps).
+    pub loads: Vec<Load>,
+    /// Active gravity: acceleration [m/s^2] and time function.
+    pub gravity: Option<(Vector3<f64>, TimeFunction)>,
+    /// Shell mass lumped at each node with the consistent weights of a uniform body force,
+    /// `rho t int N_a dA` [kg].
+    pub node_mass: Vec<f64>,
+    /// Rigid bodies and point masses.
+    pub bodies: Vec<RigidBody>,
+    /// Markers.
+    pub markers: Vec<Marker>,
+    /// Nodal DOFs whose force `f_int - f_ext` is recorded with each converged state (see
+    /// [`System::probe`]).
+    pub probes: Vec<(usize, Dof)>,
     /// Free x free pattern.
     pub pattern_ff: Pattern,
     /// Free x constrained pattern.
     pub pattern_fc: Pattern,
+    /// Linear solver of the free x free tangent (symbolic analysis done once per numbering).
+    pub linear: LinearSolver,
     /// Characteristic length [m] used to weigh rotations against translations in norms.
     pub char_length: f64,
+    /// Direction of travel in time (+1 or -1): selects the one-sided slopes of time functions.
+    pub time_direction: f64,
     /// Per element, 24 x 24 slots (column-major): `< nnz_ff` in K_ff, then K_fc, or NONE.
     slots: Vec<u32>,
     /// Per element, the owner node of each element node.
@@ -128,81 +145,167 @@ pub struct System {
     pub parallel: bool,
 }
 
-impl System {
-    /// Prepares `model` for analysis.
-    ///
-    /// # Errors
-    /// Invalid mesh, section or constraints.
-    pub fn try_new(model: &Model) -> Result<Self> {
-        model.section.validate()?;
-        let triads = model.reference_triads()?;
-        let elements = model.elements(&triads)?;
-        let dofs = DofMap::try_new(model)?;
-        let reference = State {
-            x: model.mesh.nodes.clone(),
-            q: triads,
-            lambda: 0.0,
-        };
-        let owners: Vec<[usize; 4]> = elements
-            .iter()
-            .map(|e| e.nodes.map(|n| dofs.owner(n)))
-            .collect();
-        let has_slave = elements
-            .iter()
-            .map(|e| e.nodes.iter().any(|&n| dofs.master[n].is_some()))
-            .collect();
-        let n_con = dofs.constrained.len();
-        let mut cols_ff = vec![Vec::new(); dofs.n_free];
-        let mut cols_fc = vec![Vec::new(); n_con];
-        let slot_of = |node: usize, d: usize| dofs.slots[node][d];
-        for own in &owners {
-            for &ra in own {
-                for dr in 0..6 {
-                    let Slot::Free(row) = slot_of(ra, dr) else { continue };
-                    for &cb in own {
-                        for dc in 0..6 {
-                            match slot_of(cb, dc) {
-                                Slot::Free(col) => cols_ff[col].push(row),
-                                Slot::Constrained(col) => cols_fc[col].push(row),
-                            }
+/// Pattern, slots and owners of a numbering.
+struct Numbering {
+    pattern_ff: Pattern,
+    pattern_fc: Pattern,
+    slots: Vec<u32>,
+    owners: Vec<[usize; 4]>,
+    has_slave: Vec<bool>,
+}
+
+fn numbering(elements: &[ShellElement], dofs: &DofMap) -> Numbering {
+    let owners: Vec<[usize; 4]> = elements
+        .iter()
+        .map(|e| e.nodes.map(|n| dofs.owner(n)))
+        .collect();
+    let has_slave = elements
+        .iter()
+        .map(|e| e.nodes.iter().any(|&n| dofs.master[n].is_some()))
+        .collect();
+    let n_con = dofs.constrained.len();
+    let mut cols_ff = vec![Vec::new(); dofs.n_free];
+    let mut cols_fc = vec![Vec::new(); n_con];
+    let slot_of = |node: usize, d: usize| dofs.slots[node][d];
+    for own in &owners {
+        for &ra in own {
+            for dr in 0..6 {
+                let Slot::Free(row) = slot_of(ra, dr) else { continue };
+                for &cb in own {
+                    for dc in 0..6 {
+                        match slot_of(cb, dc) {
+                            Slot::Free(col) => cols_ff[col].push(row),
+                            Slot::Constrained(col) => cols_fc[col].push(row),
                         }
                     }
                 }
             }
         }
-        let pattern_ff = Pattern::from_columns(dofs.n_free, cols_ff);
-        let pattern_fc = Pattern::from_columns(dofs.n_free, cols_fc);
-        let nnz_ff = pattern_ff.nnz();
-        let mut slots = vec![NONE; elements.len() * 576];
-        for (e, own) in owners.iter().enumerate() {
-            for j in 0..24 {
-                for i in 0..24 {
-                    let Slot::Free(row) = slot_of(own[i / 6], i % 6) else {
-                        continue;
-                    };
-                    let s = match slot_of(own[j / 6], j % 6) {
-                        Slot::Free(col) => pattern_ff.find(row, col),
-                        Slot::Constrained(col) => pattern_fc.find(row, col).map(|p| p + nnz_ff),
-                    };
-                    slots[e * 576 + j * 24 + i] =
-                        u32::try_from(s.expect("entry is in the pattern")).expect("nnz < 2^32");
+    }
+    // The rotation block of every independent node: lever-arm terms of rigid bodies whose node
+    // carries no element of its own.
+    for i in 0..dofs.slots.len() {
+        if dofs.master[i].is_some() {
+            continue;
+        }
+        for dr in 3..6 {
+            let Slot::Free(row) = slot_of(i, dr) else { continue };
+            for dc in 3..6 {
+                match slot_of(i, dc) {
+                    Slot::Free(col) => cols_ff[col].push(row),
+                    Slot::Constrained(col) => cols_fc[col].push(row),
                 }
             }
         }
+    }
+    let pattern_ff = Pattern::from_columns(dofs.n_free, cols_ff);
+    let pattern_fc = Pattern::from_columns(dofs.n_free, cols_fc);
+    let nnz_ff = pattern_ff.nnz();
+    let mut slots = vec![NONE; elements.len() * 576];
+    for (e, own) in owners.iter().enumerate() {
+        for j in 0..24 {
+            for i in 0..24 {
+                let Slot::Free(row) = slot_of(own[i / 6], i % 6) else {
+                    continue;
+                };
+                let s = match slot_of(own[j / 6], j % 6) {
+                    Slot::Free(col) => pattern_ff.find(row, col),
+                    Slot::Constrained(col) => pattern_fc.find(row, col).map(|p| p + nnz_ff),
+                };
+                slots[e * 576 + j * 24 + i] = u32::try_from(s.expect("entry is in the pattern")).expect("nnz < 2^32");
+            }
+        }
+    }
+    Numbering {
+        pattern_ff,
+        pattern_fc,
+        slots,
+        owners,
+        has_slave,
+    }
+}
+
+/// The active loads and gravity of `model` under `activity`.
+fn active_loads(model: &Model, activity: &Activity) -> (Vec<Load>, Option<(Vector3<f64>, TimeFunction)>) {
+    let loads = model
+        .loads
+        .iter()
+        .zip(&activity.loads)
+        .filter(|(_, on)| **on)
+        .map(|(l, _)| l.clone())
+        .collect();
+    let gravity = model
+        .gravity
+        .as_ref()
+        .filter(|_| activity.gravity)
+        .map(|g| (g.acceleration, g.function.clone()));
+    (loads, gravity)
+}
+
+impl System {
+    /// Prepares `model` for analysis with its initially active constraints and loads.
+    ///
+    /// # Errors
+    /// Invalid mesh, section or constraints.
+    pub fn try_new(model: &Model) -> Result<Self> {
+        Self::try_with(model, &Activity::initial(model))
+    }
+
+    /// Prepares `model` for analysis with the constraints and loads `activity` switches on.
+    ///
+    /// # Errors
+    /// Invalid mesh, section or constraints.
+    pub fn try_with(model: &Model, activity: &Activity) -> Result<Self> {
+        model.validate()?;
+        let triads = model.mesh.reference_triads()?;
+        let mut element_part = vec![0; model.mesh.quads.len()];
+        for (k, part) in model.parts.iter().enumerate() {
+            element_part[part.elements.clone()].fill(k);
+        }
+        let elements = model
+            .mesh
+            .quads
+            .iter()
+            .enumerate()
+            .map(|(e, quad)| {
+                let x = quad.map(|i| model.mesh.nodes[i]);
+                let q = quad.map(|i| triads[i].to_rotation_matrix().into_inner());
+                ShellElement::try_new(*quad, &x, &q).map_err(|err| Error::InvalidMesh(format!("element {e}: {err}")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut node_mass = vec![0.0; model.mesh.n_nodes()];
+        for (e, el) in elements.iter().enumerate() {
+            let s = &model.parts[element_part[e]].section;
+            for (a, w) in el.nodal_areas().iter().enumerate() {
+                node_mass[el.nodes[a]] += s.density * s.thickness * w;
+            }
+        }
+        let dofs = DofMap::try_with(model, activity)?;
+        let num = numbering(&elements, &dofs);
+        let linear = LinearSolver::try_new(&num.pattern_ff)?;
+        let reference = State::at_rest(model.mesh.nodes.clone(), triads);
+        let (loads, gravity) = active_loads(model, activity);
         let n_el = elements.len();
-        let char_length = 0.5 * model.mesh.bounding_box_diagonal();
         Ok(Self {
+            sections: model.parts.iter().map(|p| p.section.stiffness()).collect(),
+            element_part,
             elements,
             dofs,
-            section: model.section.stiffness(),
             reference,
-            loads: model.loads.clone(),
-            pattern_ff,
-            pattern_fc,
-            char_length,
-            slots,
-            owners,
-            has_slave,
+            loads,
+            gravity,
+            node_mass,
+            bodies: model.rigid_bodies.clone(),
+            markers: model.markers.clone(),
+            probes: Vec::new(),
+            pattern_ff: num.pattern_ff,
+            pattern_fc: num.pattern_fc,
+            linear,
+            char_length: 0.5 * model.mesh.bounding_box_diagonal(),
+            time_direction: 1.0,
+            slots: num.slots,
+            owners: num.owners,
+            has_slave: num.has_slave,
             f_buf: vec![ElementVector::zeros(); n_el],
             fg_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
@@ -213,41 +316,112 @@ impl System {
         })
     }
 
+    /// Switches to the constraints and loads of `activity`. The numbering, pattern and symbolic
+    /// factorisation are rebuilt only if the set of constrained DOFs changes; returns whether they
+    /// were.
+    ///
+    /// # Errors
+    /// Invalid constraints (see [`DofMap::try_with`]).
+    pub fn set_activity(&mut self, model: &Model, activity: &Activity) -> Result<bool> {
+        let dofs = DofMap::try_with(model, activity)?;
+        let renumber = !dofs.same_numbering(&self.dofs);
+        if renumber {
+            let num = numbering(&self.elements, &dofs);
+            self.linear = LinearSolver::try_new(&num.pattern_ff)?;
+            self.pattern_ff = num.pattern_ff;
+            self.pattern_fc = num.pattern_fc;
+            self.slots = num.slots;
+            self.owners = num.owners;
+            self.has_slave = num.has_slave;
+        }
+        self.dofs = dofs;
+        (self.loads, self.gravity) = active_loads(model, activity);
+        Ok(renumber)
+    }
+
     /// Number of free equations.
     #[must_use]
     pub fn n_free(&self) -> usize {
         self.dofs.n_free
     }
 
-    /// The reference state with load factor 0.
+    /// Section stiffness of element `e`.
+    #[must_use]
+    pub fn section(&self, e: usize) -> &SectionStiffness {
+        &self.sections[self.element_part[e]]
+    }
+
+    /// Largest membrane stiffness `E t / (1 - nu^2)` of the sections [N/m] (a force scale).
+    #[must_use]
+    pub fn membrane_stiffness(&self) -> f64 {
+        self.sections
+            .iter()
+            .map(|s| s.membrane[(0, 0)])
+            .fold(0.0, f64::max)
+    }
+
+    /// The reference state (time 0, at rest).
     #[must_use]
     pub fn initial_state(&self) -> State {
         self.reference.clone()
     }
 
-    /// Rigid rotation of reference node `r` from its reference orientation.
-    fn tie_rotation(&self, state: &State, r: usize) -> UnitQuaternion<f64> {
+    /// Rigid rotation of node `r` from its reference orientation.
+    fn node_rotation(&self, state: &State, r: usize) -> UnitQuaternion<f64> {
         state.q[r] * self.reference.q[r].inverse()
     }
 
-    /// Updates `state` by the free increments `dq` and the load-factor increment `dlambda`
-    /// (constrained DOFs move by `dlambda * value`), then places tied nodes exactly.
+    /// Increments of the constrained DOFs, in [`DofMap::constrained`] order, when time goes from
+    /// `t` to `t + dt`: `value * (f(t + dt) - f(t))`.
+    #[must_use]
+    pub fn constrained_increments(&self, t: f64, dt: f64) -> Vec<f64> {
+        self.dofs
+            .constrained
+            .iter()
+            .map(|c| c.value * c.function.increment(t, dt))
+            .collect()
+    }
+
+    /// Rates of the constrained DOFs at `t`, `value * f'(t)` (one-sided in the direction of
+    /// travel).
+    #[must_use]
+    pub fn constrained_rates(&self, t: f64) -> Vec<f64> {
+        self.dofs
+            .constrained
+            .iter()
+            .map(|c| c.value * c.function.derivative(t, self.time_direction))
+            .collect()
+    }
+
+    /// Moves `state` by the free increments `dq` and the time increment `dt` (the constrained
+    /// DOFs move as their time functions say), then places tied nodes exactly.
     ///
     /// # Panics
     /// If `dq.len() != n_free`.
-    pub fn update(&self, state: &mut State, dq: &[f64], dlambda: f64) {
+    pub fn update(&self, state: &mut State, dq: &[f64], dt: f64) {
+        let dc = self.constrained_increments(state.t, dt);
+        self.update_with(state, dq, &dc);
+        state.t += dt;
+    }
+
+    /// Moves `state` by the free increments `dq` and the constrained increments `dc` (time is not
+    /// changed), then places tied nodes exactly.
+    ///
+    /// # Panics
+    /// If `dq.len() != n_free` or `dc.len()` is not the number of constrained DOFs.
+    pub fn update_with(&self, state: &mut State, dq: &[f64], dc: &[f64]) {
         assert_eq!(dq.len(), self.dofs.n_free);
+        assert_eq!(dc.len(), self.dofs.constrained.len());
         for i in 0..state.x.len() {
             if self.dofs.master[i].is_some() {
                 continue;
             }
-            let [du, theta] = self.node_increment(i, dq, dlambda);
+            let [du, theta] = self.node_increment(i, dq, dc);
             state.x[i] += du;
             if theta != Vector3::zeros() {
                 state.q[i] = rotate(&state.q[i], &theta);
             }
         }
-        state.lambda += dlambda;
         self.place_tied_nodes(state);
     }
 
@@ -255,7 +429,7 @@ impl System {
     pub fn place_tied_nodes(&self, state: &mut State) {
         for (s, m) in self.dofs.master.iter().enumerate() {
             if let Some(r) = *m {
-                let rot = self.tie_rotation(state, r);
+                let rot = self.node_rotation(state, r);
                 state.x[s] = state.x[r] + rot * (self.reference.x[s] - self.reference.x[r]);
                 state.q[s] = rot * self.reference.q[s];
             }
@@ -275,27 +449,27 @@ impl System {
     }
 
     /// Increment `(delta x, theta)` of independent node `i` for the free increments `dq` and the
-    /// load-factor increment `dlambda` (constrained DOFs move by `dlambda * value`).
-    fn node_increment(&self, i: usize, dq: &[f64], dlambda: f64) -> [Vector3<f64>; 2] {
+    /// constrained increments `dc`.
+    fn node_increment(&self, i: usize, dq: &[f64], dc: &[f64]) -> [Vector3<f64>; 2] {
         let mut v = [Vector3::zeros(); 2];
         for d in 0..6 {
             v[d / 3][d % 3] = match self.dofs.slots[i][d] {
                 Slot::Free(eq) => dq[eq],
-                Slot::Constrained(c) => dlambda * self.dofs.constrained[c].value,
+                Slot::Constrained(c) => dc[c],
             };
         }
         v
     }
 
     /// Nodal increments `(delta x, theta)` of every node for the free increments `dq` and the
-    /// load-factor increment `dlambda`, to first order (tied nodes follow their reference node).
-    fn nodal_increments(&self, state: &State, dq: &[f64], dlambda: f64) -> Vec<[Vector3<f64>; 2]> {
+    /// constrained increments `dc`, to first order (tied nodes follow their reference node).
+    fn nodal_increments(&self, state: &State, dq: &[f64], dc: &[f64]) -> Vec<[Vector3<f64>; 2]> {
         let mut inc: Vec<[Vector3<f64>; 2]> = (0..state.x.len())
             .map(|i| {
                 if self.dofs.master[i].is_some() {
                     [Vector3::zeros(); 2]
                 } else {
-                    self.node_increment(i, dq, dlambda)
+                    self.node_increment(i, dq, dc)
                 }
             })
             .collect();
@@ -308,45 +482,45 @@ impl System {
         inc
     }
 
-    /// Element stresses of the strains linearised at `state` along the increment `(dq, dlambda)`
+    /// Element stresses of the strains linearised at `state` along the increment `(dq, dc)`
     /// (see [`ShellElement::linearised_stress`]), in element order: the stresses of the mixed Newton
-    /// iteration at the state that [`Self::update`] reaches with the same increment.
+    /// iteration at the state that [`Self::update_with`] reaches with the same increment.
     ///
     /// # Panics
     /// If `dq.len() != n_free`.
-    pub fn linearised_stresses(&self, state: &State, dq: &[f64], dlambda: f64, out: &mut Vec<ElementStress>) {
+    pub fn linearised_stresses(&self, state: &State, dq: &[f64], dc: &[f64], out: &mut Vec<ElementStress>) {
         assert_eq!(dq.len(), self.dofs.n_free);
-        let inc = self.nodal_increments(state, dq, dlambda);
-        let section = &self.section;
-        let kernel = |e: &ShellElement| {
-            let x = e.nodes.map(|n| state.x[n]);
-            let q = e
+        let inc = self.nodal_increments(state, dq, dc);
+        let kernel = |(e, el): (usize, &ShellElement)| {
+            let x = el.nodes.map(|n| state.x[n]);
+            let q = el
                 .nodes
                 .map(|n| state.q[n].to_rotation_matrix().into_inner());
-            let dx = e.nodes.map(|n| inc[n][0]);
-            let dth = e.nodes.map(|n| inc[n][1]);
-            e.linearised_stress(&x, &q, section, &dx, &dth)
+            let dx = el.nodes.map(|n| inc[n][0]);
+            let dth = el.nodes.map(|n| inc[n][1]);
+            el.linearised_stress(&x, &q, self.section(e), &dx, &dth)
         };
         out.clear();
         if self.parallel {
             self.elements
                 .par_iter()
+                .enumerate()
                 .with_min_len(64)
                 .map(kernel)
                 .collect_into_vec(out);
         } else {
-            out.extend(self.elements.iter().map(kernel));
+            out.extend(self.elements.iter().enumerate().map(kernel));
         }
     }
 
-    /// Assembles residual, reactions and (if `tangent`) the tangent at `state`.
+    /// Assembles the pieces (and, if `tangent`, the tangent) at `state`.
     pub fn assemble(&mut self, state: &State, tangent: bool, out: &mut Assembled) {
         self.assemble_mixed(state, tangent, None, out);
     }
 
     /// As [`Self::assemble`], with the geometric part of the tangent from the element `stress`
     /// (in element order) when given: the tangent of the mixed Newton iteration (see
-    /// [`ShellElement::compute_mixed_into`]). The residual is always the true one.
+    /// [`ShellElement::compute_mixed_into`]). The forces are always the true ones.
     ///
     /// # Panics
     /// If `stress` does not have one entry per element.
@@ -365,12 +539,14 @@ impl System {
         let n_free = self.dofs.n_free;
         let n_con = self.dofs.constrained.len();
         let nnz_ff = self.pattern_ff.nnz();
-        out.residual.clear();
-        out.residual.resize(n_free, 0.0);
-        out.reactions.clear();
-        out.reactions.resize(n_con, 0.0);
-        out.f_ext.clear();
-        out.f_ext.resize(n_free, 0.0);
+        for v in [&mut out.f_int, &mut out.f_ext, &mut out.df_ext] {
+            v.clear();
+            v.resize(n_free, 0.0);
+        }
+        for v in [&mut out.f_int_c, &mut out.f_ext_c] {
+            v.clear();
+            v.resize(n_con, 0.0);
+        }
         if tangent {
             out.k_ff.clear();
             out.k_ff.resize(nnz_ff, 0.0);
@@ -378,7 +554,7 @@ impl System {
             out.k_fc.resize(self.pattern_fc.nnz(), 0.0);
         }
 
-        let section = &self.section;
+        let (sections, element_part) = (&self.sections, &self.element_part);
         let kernel = |i: usize,
                       e: &ShellElement,
                       f: &mut ElementVector,
@@ -389,6 +565,7 @@ impl System {
             let q = e
                 .nodes
                 .map(|n| state.q[n].to_rotation_matrix().into_inner());
+            let section = &sections[element_part[i]];
             *en = match stress {
                 Some(st) => e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
                 None => e.compute_into(&x, &q, section, f, tangent.then_some(k)),
@@ -445,76 +622,82 @@ impl System {
             }
         }
         if tangent {
-            // Scatter the two halves of the element list into separate buffers (in parallel when
-            // asked) and add them in a fixed order: serial and parallel results are identical.
-            let n_el = self.elements.len();
-            let half = n_el / 2;
-            self.k_scratch_ff.clear();
-            self.k_scratch_ff.resize(nnz_ff, 0.0);
-            self.k_scratch_fc.clear();
-            self.k_scratch_fc.resize(self.pattern_fc.nnz(), 0.0);
-            let (slots, k_buf) = (&self.slots, &self.k_buf);
-            let scatter = |range: std::ops::Range<usize>, ff: &mut [f64], fc: &mut [f64]| {
-                for e in range {
-                    for (s, v) in slots[e * 576..(e + 1) * 576]
-                        .iter()
-                        .zip(k_buf[e].as_slice())
-                    {
-                        if *s == NONE {
-                            continue;
-                        }
-                        let s = *s as usize;
-                        if s < nnz_ff {
-                            ff[s] += v;
-                        } else {
-                            fc[s - nnz_ff] += v;
-                        }
-                    }
-                }
-            };
-            let (sff, sfc) = (&mut self.k_scratch_ff, &mut self.k_scratch_fc);
-            if self.parallel {
-                rayon::join(
-                    || scatter(0..half, &mut out.k_ff, &mut out.k_fc),
-                    || scatter(half..n_el, sff, sfc),
-                );
-            } else {
-                scatter(0..half, &mut out.k_ff, &mut out.k_fc);
-                scatter(half..n_el, sff, sfc);
-            }
-            for (a, b) in out.k_ff.iter_mut().zip(sff.iter()) {
-                *a += b;
-            }
-            for (a, b) in out.k_fc.iter_mut().zip(sfc.iter()) {
-                *a += b;
-            }
+            self.scatter_tangent(out);
         }
 
-        // External loads, condensed onto independent nodes.
+        // External forces on every node at time t and their rates, condensed onto independent
+        // nodes; forces at a lever arm (tied nodes, centres of mass) add the lever's moment and,
+        // in the tangent, the second-order term of its rotation.
+        let t = state.t;
+        let dir = self.time_direction;
         let mut f_ext = vec![[0.0; 6]; n_nodes];
+        let mut df_ext = vec![[0.0; 6]; n_nodes];
+        // External forces applied at tied nodes (before condensation), for the lever terms.
         let mut f_ext_node = vec![Vector3::zeros(); n_nodes];
-        for load in &self.loads {
-            let d = load.dof.index();
-            let owner = self.dofs.owner(load.node);
-            f_ext[owner][d] += load.value;
-            if owner != load.node && d < 3 {
-                f_ext_node[load.node][d] += load.value;
-                let lever = state.x[load.node] - state.x[owner];
-                let m = lever.cross(&Vector3::ith(d, load.value));
+        let mut apply = |node: usize, force: [f64; 6], rate: [f64; 6], f_ext_node: &mut Vec<Vector3<f64>>| {
+            let owner = self.dofs.owner(node);
+            for d in 0..6 {
+                f_ext[owner][d] += force[d];
+                df_ext[owner][d] += rate[d];
+            }
+            if owner != node {
+                let lever = state.x[node] - state.x[owner];
+                let (m, dm) = (
+                    lever.cross(&Vector3::new(force[0], force[1], force[2])),
+                    lever.cross(&Vector3::new(rate[0], rate[1], rate[2])),
+                );
                 for i in 0..3 {
                     f_ext[owner][3 + i] += m[i];
+                    df_ext[owner][3 + i] += dm[i];
                 }
+                f_ext_node[node] += Vector3::new(force[0], force[1], force[2]);
+            }
+        };
+        for load in &self.loads {
+            let (mut force, mut rate) = ([0.0; 6], [0.0; 6]);
+            force[load.dof.index()] = load.value * load.function.value(t);
+            rate[load.dof.index()] = load.value * load.function.derivative(t, dir);
+            apply(load.node, force, rate, &mut f_ext_node);
+        }
+        out.gravity_energy = 0.0;
+        let mut body_terms = Vec::new();
+        if let Some((g, function)) = &self.gravity {
+            let (gt, dg) = (g * function.value(t), g * function.derivative(t, dir));
+            for (n, &m) in self.node_mass.iter().enumerate() {
+                if m == 0.0 {
+                    continue;
+                }
+                let force = [m * gt.x, m * gt.y, m * gt.z, 0.0, 0.0, 0.0];
+                let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
+                apply(n, force, rate, &mut f_ext_node);
+                out.gravity_energy -= m * gt.dot(&state.x[n]);
+            }
+            for body in &self.bodies {
+                let r = body.node;
+                let lever = self.node_rotation(state, r) * body.centre_of_mass;
+                let (w, dw) = (gt * body.mass, dg * body.mass);
+                let (m, dm) = (lever.cross(&w), lever.cross(&dw));
+                for i in 0..3 {
+                    f_ext[r][i] += w[i];
+                    df_ext[r][i] += dw[i];
+                    f_ext[r][3 + i] += m[i];
+                    df_ext[r][3 + i] += dm[i];
+                }
+                out.gravity_energy -= w.dot(&(state.x[r] + lever));
+                body_terms.push((r, lever, -w));
             }
         }
 
-        // Second-order terms of the exact rigid motion of tied nodes (lever arms rotate).
         if tangent {
+            // Second-order terms of the exact rigid motion of tied nodes (lever arms rotate).
             for (s, m) in self.dofs.master.iter().enumerate() {
                 let Some(r) = *m else { continue };
                 let lever = state.x[s] - state.x[r];
-                let f_net = f_node[s] - state.lambda * f_ext_node[s];
-                let h = rotated_vector_hessian(&f_net, &lever) - skew(&lever.cross(&f_net)) * 0.5;
-                self.add_node_block(r, &h, out);
+                let f_net = f_node[s] - f_ext_node[s];
+                self.add_lever_term(r, &lever, &f_net, out);
+            }
+            for (r, lever, f_net) in &body_terms {
+                self.add_lever_term(*r, lever, f_net, out);
             }
         }
 
@@ -523,16 +706,74 @@ impl System {
                 continue;
             }
             for d in 0..6 {
-                let r = f_cond[i][d] - state.lambda * f_ext[i][d];
                 match self.dofs.slots[i][d] {
                     Slot::Free(eq) => {
-                        out.residual[eq] = r;
+                        out.f_int[eq] = f_cond[i][d];
                         out.f_ext[eq] = f_ext[i][d];
+                        out.df_ext[eq] = df_ext[i][d];
                     }
-                    Slot::Constrained(c) => out.reactions[c] = r,
+                    Slot::Constrained(c) => {
+                        out.f_int_c[c] = f_cond[i][d];
+                        out.f_ext_c[c] = f_ext[i][d];
+                    }
                 }
             }
         }
+    }
+
+    /// Scatters the element tangents: the two halves of the element list go into separate
+    /// buffers (in parallel when asked) that are added in a fixed order, so serial and parallel
+    /// results are identical.
+    fn scatter_tangent(&mut self, out: &mut Assembled) {
+        let nnz_ff = self.pattern_ff.nnz();
+        let n_el = self.elements.len();
+        let half = n_el / 2;
+        self.k_scratch_ff.clear();
+        self.k_scratch_ff.resize(nnz_ff, 0.0);
+        self.k_scratch_fc.clear();
+        self.k_scratch_fc.resize(self.pattern_fc.nnz(), 0.0);
+        let (slots, k_buf) = (&self.slots, &self.k_buf);
+        let scatter = |range: std::ops::Range<usize>, ff: &mut [f64], fc: &mut [f64]| {
+            for e in range {
+                for (s, v) in slots[e * 576..(e + 1) * 576]
+                    .iter()
+                    .zip(k_buf[e].as_slice())
+                {
+                    if *s == NONE {
+                        continue;
+                    }
+                    let s = *s as usize;
+                    if s < nnz_ff {
+                        ff[s] += v;
+                    } else {
+                        fc[s - nnz_ff] += v;
+                    }
+                }
+            }
+        };
+        let (sff, sfc) = (&mut self.k_scratch_ff, &mut self.k_scratch_fc);
+        if self.parallel {
+            rayon::join(
+                || scatter(0..half, &mut out.k_ff, &mut out.k_fc),
+                || scatter(half..n_el, sff, sfc),
+            );
+        } else {
+            scatter(0..half, &mut out.k_ff, &mut out.k_fc);
+            scatter(half..n_el, sff, sfc);
+        }
+        for (a, b) in out.k_ff.iter_mut().zip(sff.iter()) {
+            *a += b;
+        }
+        for (a, b) in out.k_fc.iter_mut().zip(sfc.iter()) {
+            *a += b;
+        }
+    }
+
+    /// Adds the derivative of the moment `lever x f_net` about independent node `r` with respect
+    /// to `r`'s rotation (the lever rotates with it, `f_net` held): `[f_net]x [lever]x`.
+    fn add_lever_term(&self, r: usize, lever: &Vector3<f64>, f_net: &Vector3<f64>, out: &mut Assembled) {
+        let h = rotated_vector_hessian(f_net, lever) - skew(&lever.cross(f_net)) * 0.5;
+        self.add_node_block(r, &h, out);
     }
 
     /// Adds a 3x3 block to the rotation-rotation block of independent node `r`.
@@ -556,6 +797,49 @@ impl System {
                 }
             }
         }
+    }
+
+    /// Positions [m] of the markers in `state`.
+    #[must_use]
+    pub fn marker_positions(&self, state: &State) -> Vec<Vector3<f64>> {
+        self.markers
+            .iter()
+            .map(|m| state.x[m.node] + self.node_rotation(state, m.node) * m.offset)
+            .collect()
+    }
+
+    /// Rotation vectors [rad] of the markers (of their nodes) from the reference configuration.
+    #[must_use]
+    pub fn marker_rotations(&self, state: &State) -> Vec<Vector3<f64>> {
+        self.markers
+            .iter()
+            .map(|m| self.node_rotation(state, m.node).scaled_axis())
+            .collect()
+    }
+
+    /// The nodal forces `f_int - f_ext` of `asm` at the DOFs of [`System::probes`]: the reaction
+    /// of a constrained DOF, the residual of a free one, NaN at a tied node (whose DOFs are not
+    /// unknowns).
+    #[must_use]
+    pub fn probe(&self, asm: &Assembled) -> Vec<f64> {
+        self.probes
+            .iter()
+            .map(|&(node, dof)| {
+                if node >= self.dofs.slots.len() || self.dofs.master[node].is_some() {
+                    return f64::NAN;
+                }
+                match self.dofs.slots[node][dof.index()] {
+                    Slot::Free(eq) => asm.f_int[eq] - asm.f_ext[eq],
+                    Slot::Constrained(c) => asm.f_int_c[c] - asm.f_ext_c[c],
+                }
+            })
+            .collect()
+    }
+
+    /// Total mass [kg] carried by the system (lumped shell mass and rigid bodies).
+    #[must_use]
+    pub fn total_mass(&self) -> f64 {
+        self.node_mass.iter().sum::<f64>() + self.bodies.iter().map(|b| b.mass).sum::<f64>()
     }
 }
 

@@ -15,20 +15,66 @@ pub enum Error {
     /// The sparse factorisation failed (singular tangent: a mechanism or an unconstrained rigid-body mode).
     #[error("factorisation failed: {0}")]
     Factorisation(String),
-    /// Newton iterations did not converge even after the increment was cut back to its minimum.
-    #[error(
-        "no convergence at load factor {lambda:.6e} after {iterations} iterations (residual {residual:.3e}); {detail}"
-    )]
+    /// An increment did not converge even after it was cut back to its minimum.
+    #[error("no convergence{} at t = {t:.6e} (load factor in static steps): {detail}", in_step(.step))]
     NotConverged {
-        /// Load factor (or time) of the last converged state.
-        lambda: f64,
-        /// Newton iterations spent on the failed attempt.
+        /// Name of the analysis step, when run by [`crate::analysis::run`].
+        step: Option<String>,
+        /// Time (load factor in static steps) of the last converged state.
+        t: f64,
+        /// Newton iterations spent on the last failed attempt.
         iterations: usize,
-        /// Residual norm at the last iteration [N].
+        /// Residual norm at the last iteration of that attempt [N] (NaN if it had none).
         residual: f64,
-        /// What was tried.
+        /// What was tried and why it failed.
         detail: String,
     },
+    /// A step ran out of increments before reaching its end.
+    #[error(
+        "step limit reached{}: {steps} increments brought t to {t:.6e}, short of {target:.6e}; raise the step's max_steps (or its initial increment)",
+        in_step(.step)
+    )]
+    StepLimit {
+        /// Name of the analysis step, when run by [`crate::analysis::run`].
+        step: Option<String>,
+        /// Time (load factor) reached.
+        t: f64,
+        /// Increments used.
+        steps: usize,
+        /// Where the step was going.
+        target: f64,
+    },
+}
+
+fn in_step(step: &Option<String>) -> String {
+    step.as_ref()
+        .map(|s| format!(" in step '{s}'"))
+        .unwrap_or_default()
+}
+
+impl Error {
+    /// The same error, attributed to the analysis step `name`.
+    #[must_use]
+    pub fn in_step(mut self, name: &str) -> Self {
+        if let Self::NotConverged { step, .. } | Self::StepLimit { step, .. } = &mut self {
+            *step = Some(name.to_owned());
+        }
+        self
+    }
+}
+
+impl Error {
+    /// The same error with `context` prepended to its message (for the variants that carry one).
+    #[must_use]
+    pub fn context(self, context: &str) -> Self {
+        match self {
+            Self::InvalidParameter(m) => Self::InvalidParameter(format!("{context}: {m}")),
+            Self::InvalidMesh(m) => Self::InvalidMesh(format!("{context}: {m}")),
+            Self::InvalidModel(m) => Self::InvalidModel(format!("{context}: {m}")),
+            Self::Factorisation(m) => Self::Factorisation(format!("{context}: {m}")),
+            other => other,
+        }
+    }
 }
 
 /// Result alias of the crate.

@@ -21,13 +21,22 @@ pub mod rotation;
 pub mod samples;
 
 pub use error::{Error, Result};
+pub mod analysis;
 pub mod assembly;
+pub mod constraint;
 pub mod dof;
 pub mod linalg;
 pub mod model;
+pub mod options;
+pub mod output;
 pub mod solver;
 pub mod state;
+pub mod time_function;
 
+pub use analysis::{run, RunResult, Step, StepKind};
 pub use assembly::System;
-pub use model::{Dof, Model};
+pub use dof::Dof;
+pub use model::Model;
+pub use output::{History, Outputs};
 pub use state::State;
+pub use time_function::TimeFunction;

@@ -38,8 +38,60 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
-use crate::assembly::Pattern;
 use crate::error::{Error, Result};
+
+/// Compressed-column pattern.
+#[derive(Clone, Debug, Default)]
+pub struct Pattern {
+    /// Number of rows.
+    pub nrows: usize,
+    /// Column pointers (length ncols + 1).
+    pub col_ptr: Vec<usize>,
+    /// Row indices, sorted within each column.
+    pub row_idx: Vec<usize>,
+}
+
+impl Pattern {
+    /// Pattern with the given row indices per column (sorted and deduplicated here).
+    pub fn from_columns(nrows: usize, cols: Vec<Vec<usize>>) -> Self {
+        let mut col_ptr = Vec::with_capacity(cols.len() + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for mut c in cols {
+            c.sort_unstable();
+            c.dedup();
+            row_idx.extend_from_slice(&c);
+            col_ptr.push(row_idx.len());
+        }
+        Self {
+            nrows,
+            col_ptr,
+            row_idx,
+        }
+    }
+
+    /// Position of entry `(row, col)`, if it is in the pattern.
+    #[must_use]
+    pub fn find(&self, row: usize, col: usize) -> Option<usize> {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        self.row_idx[a..b].binary_search(&row).ok().map(|p| a + p)
+    }
+
+    /// Number of stored entries.
+    #[must_use]
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// `y += A x` for a matrix with this pattern and values `val`.
+    pub fn mul_add(&self, val: &[f64], x: &[f64], y: &mut [f64]) {
+        for (j, xj) in x.iter().enumerate() {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[p]] += val[p] * xj;
+            }
+        }
+    }
+}
 
 /// Backward error at which GMRES stops (a few hundred ulps).
 const REFINE_TOL: f64 = 1e-13;

@@ -20,12 +20,48 @@ pub mod generate;
 
 use std::collections::BTreeMap;
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
+/// A rigid placement `x -> R x + translation`, with `R = exp(rotation^)` (rotation vector [rad]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Placement {
+    /// Rotation vector [rad] (axis times angle), applied first, about the origin.
+    pub rotation: Vector3<f64>,
+    /// Translation [m], applied after the rotation.
+    pub translation: Vector3<f64>,
+}
+
+impl Placement {
+    /// The placed position of `x` [m].
+    #[must_use]
+    pub fn apply(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        UnitQuaternion::from_scaled_axis(self.rotation) * x + self.translation
+    }
+
+    /// Checks that every component is finite.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a non-finite component.
+    pub fn validate(&self) -> Result<()> {
+        if self.rotation.iter().chain(self.translation.iter()).all(|c| c.is_finite()) {
+            Ok(())
+        } else {
+            Err(Error::InvalidParameter(format!(
+                "placement must be finite (rotation {:?}, translation {:?})",
+                self.rotation.as_slice(),
+                self.translation.as_slice()
+            )))
+        }
+    }
+}
+
 /// A shell mesh: coordinates [m], quadrilateral connectivity and named node sets.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Mesh {
     /// Node coordinates in the reference configuration [m].
     pub nodes: Vec<Vector3<f64>>,
@@ -118,7 +154,8 @@ impl Mesh {
                 }
             }
             // Corner normals must all be non-zero and point the same way: this rejects collapsed,
-            // bow-tie and inverted (non-convex) quadrilaterals.
+            // bow-tie and inverted (non-convex) quadrilaterals. Both tests compare quantities of
+            // the same dimension (area, area squared), so they hold at any length scale.
             let x = quad.map(|n| self.nodes[n]);
             let diag = (x[2] - x[0]).cross(&(x[3] - x[1]));
             let scale = (x[2] - x[0]).norm() * (x[3] - x[1]).norm();
@@ -127,7 +164,7 @@ impl Mesh {
             }
             for a in 0..4 {
                 let c = (x[(a + 1) % 4] - x[a]).cross(&(x[(a + 3) % 4] - x[a]));
-                if c.dot(&diag) <= 1e-8 * scale {
+                if c.dot(&diag) <= 1e-8 * scale * scale {
                     return Err(Error::InvalidMesh(format!(
                         "element {e} is degenerate or inverted at its corner node {} (non-convex or twisted quadrilateral)",
                         quad[a]
@@ -161,5 +198,165 @@ impl Mesh {
         } else {
             (hi - lo).norm()
         }
+    }
+
+    /// Reference nodal triads `[t1, t2, D]`: `D` is the average of the unit normals of the elements
+    /// around the node; nodes without elements get the identity.
+    ///
+    /// # Errors
+    /// [`Error::InvalidMesh`] where neighbouring normals cancel (inconsistent orientation).
+    pub fn reference_triads(&self) -> Result<Vec<UnitQuaternion<f64>>> {
+        let n = self.n_nodes();
+        let mut normal = vec![Vector3::zeros(); n];
+        let mut count = vec![0usize; n];
+        for quad in &self.quads {
+            let x = quad.map(|i| self.nodes[i]);
+            for a in 0..4 {
+                let c = (x[(a + 1) % 4] - x[a]).cross(&(x[(a + 3) % 4] - x[a]));
+                normal[quad[a]] += c.normalize();
+                count[quad[a]] += 1;
+            }
+        }
+        let mut triads = Vec::with_capacity(n);
+        for (i, (nrm, &c)) in normal.iter().zip(&count).enumerate() {
+            if c == 0 {
+                triads.push(UnitQuaternion::identity());
+                continue;
+            }
+            if nrm.norm() < 0.5 {
+                return Err(Error::InvalidMesh(format!(
+                    "the element normals around node {i} cancel out: neighbouring elements are oriented inconsistently"
+                )));
+            }
+            let d = nrm.normalize();
+            let axis = if d.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+            let t1 = (axis - d * d.dot(&axis)).normalize();
+            let t2 = d.cross(&t1);
+            triads.push(UnitQuaternion::from_matrix(&Matrix3::from_columns(&[t1, t2, d])));
+        }
+        Ok(triads)
+    }
+
+    /// The mesh moved rigidly by `placement` (node sets kept).
+    #[must_use]
+    pub fn placed(&self, placement: &Placement) -> Self {
+        Self {
+            nodes: self.nodes.iter().map(|x| placement.apply(x)).collect(),
+            quads: self.quads.clone(),
+            node_sets: self.node_sets.clone(),
+        }
+    }
+
+    /// Index of the node nearest to `p` [m] (the lowest index among equally near nodes); `None`
+    /// for a mesh without nodes.
+    #[must_use]
+    pub fn nearest_node(&self, p: &Vector3<f64>) -> Option<usize> {
+        (0..self.nodes.len()).min_by(|&a, &b| {
+            (self.nodes[a] - p)
+                .norm_squared()
+                .total_cmp(&(self.nodes[b] - p).norm_squared())
+                .then(a.cmp(&b))
+        })
+    }
+
+    /// Nodes inside the axis-aligned box `[lo, hi]` [m] (bounds included), in index order.
+    #[must_use]
+    pub fn nodes_in_box(&self, lo: &Vector3<f64>, hi: &Vector3<f64>) -> Vec<usize> {
+        (0..self.nodes.len())
+            .filter(|&i| (0..3).all(|k| self.nodes[i][k] >= lo[k] && self.nodes[i][k] <= hi[k]))
+            .collect()
+    }
+
+    /// Corner nodes: nodes used by exactly one element (the four corners of a structured patch).
+    #[must_use]
+    pub fn corner_nodes(&self) -> Vec<usize> {
+        let mut count = vec![0usize; self.nodes.len()];
+        for quad in &self.quads {
+            for &n in quad {
+                count[n] += 1;
+            }
+        }
+        (0..self.nodes.len()).filter(|&i| count[i] == 1).collect()
+    }
+
+    /// The node nearest to each of `points` [m].
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] if a point is farther than `tolerance` [m] from every node, or the
+    /// mesh has no node.
+    pub fn nodes_at(&self, points: &[Vector3<f64>], tolerance: f64) -> Result<Vec<usize>> {
+        points
+            .iter()
+            .map(|p| {
+                let n = self
+                    .nearest_node(p)
+                    .ok_or_else(|| Error::InvalidModel("the mesh has no node".into()))?;
+                let d = (self.nodes[n] - p).norm();
+                if d <= tolerance {
+                    Ok(n)
+                } else {
+                    Err(Error::InvalidModel(format!(
+                        "no node within {tolerance} m of the point {:?} (nearest: node {n} at {d:.3e} m)",
+                        p.as_slice()
+                    )))
+                }
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(h: f64) -> Mesh {
+        let nodes = vec![
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(h, 0.0, 0.0),
+            Vector3::new(2.0 * h, 0.0, 0.0),
+            Vector3::new(0.0, h, 0.0),
+            Vector3::new(h, h, 0.0),
+            Vector3::new(2.0 * h, h, 0.0),
+        ];
+        Mesh::try_new(nodes, vec![[0, 1, 4, 3], [1, 2, 5, 4]]).expect("valid mesh")
+    }
+
+    #[test]
+    fn validity_does_not_depend_on_the_length_scale() {
+        for h in [1e-6, 1e-4, 1e-2, 1.0, 1e3] {
+            assert!(square(h).validate().is_ok(), "h = {h}");
+        }
+    }
+
+    #[test]
+    fn queries_find_nearest_box_corner_and_point_nodes() {
+        let m = square(1.0);
+        assert_eq!(m.nearest_node(&Vector3::new(1.1, 0.8, 0.3)), Some(4));
+        assert_eq!(m.nodes_in_box(&Vector3::new(0.5, -1.0, -1.0), &Vector3::new(2.0, 0.5, 1.0)), vec![1, 2]);
+        assert_eq!(m.corner_nodes(), vec![0, 2, 3, 5]);
+        assert_eq!(
+            m.nodes_at(&[Vector3::new(2.0, 1.0, 0.0), Vector3::new(0.0, 0.01, 0.0)], 0.05).unwrap(),
+            vec![5, 0]
+        );
+        assert!(m.nodes_at(&[Vector3::new(0.5, 0.5, 0.0)], 0.1).is_err());
+        assert_eq!(Mesh::default().nearest_node(&Vector3::zeros()), None);
+    }
+
+    #[test]
+    fn placement_moves_nodes_rigidly() {
+        let m = square(1.0);
+        let p = Placement {
+            rotation: Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            translation: Vector3::new(1.0, 2.0, 3.0),
+        };
+        let placed = m.placed(&p);
+        assert!((placed.nodes[1] - Vector3::new(1.0, 3.0, 3.0)).norm() < 1e-15);
+        assert_eq!(placed.quads, m.quads);
+        assert!(Placement {
+            rotation: Vector3::new(f64::NAN, 0.0, 0.0),
+            ..Placement::default()
+        }
+        .validate()
+        .is_err());
     }
 }

@@ -1,109 +1,72 @@
-//! A model: mesh + shell section + constraints + loads, as the user describes it.
+//! A model: the pure description (serde) of what is simulated.
 //!
-//! Constraints act on the six nodal degrees of freedom ([`Dof`]):
-//! * fixed DOFs (held at their reference value);
-//! * prescribed DOFs, whose value follows the load factor: `u = lambda * value` for a translation
-//!   [m]; for a rotation, the spatial rotation increments about the global axis follow
-//!   `lambda * value` [rad] (exact for a rotation about a fixed axis with the other two rotation
-//!   components fixed or prescribed, which is how bending is driven);
-//! * rigid ties: every node of a set follows a reference node exactly, at any rotation:
-//!   `x_s = x_r + R_r (X_s - X_r)`, `Q_s = R_r Q_s0`.
+//! * **Parts**: shell meshes placed by a rigid transform, each with its own [`ShellSection`]; all
+//!   nodes and elements live in one [`Mesh`], a part owning a range of its elements. The node
+//!   sets of a part are named `"<part>.<set>"` (plain `"<set>"` for a part named `""`).
+//! * **Rigid bodies and point masses** at reference nodes: mass, centre of mass, inertia.
+//! * **Rigid ties**: every node of a set follows a reference node exactly, at any rotation:
+//!   `x_s = x_r + R_r (X_s - X_r)`, `Q_s = R_r Q_s0`. The reference node of a rigid body carries
+//!   the shell nodes tied to it.
+//! * **Constraints** on the six nodal DOFs ([`Dof`]): while active, a constrained DOF moves by
+//!   `value * (f(t) - f(t_on))` from where it was when the constraint was switched on (`f` its
+//!   [`TimeFunction`]; `value = 0` holds it). For a rotation, the spatial rotation increments about
+//!   the global axis follow that law (exact for a rotation about a fixed axis with the other two
+//!   rotation components held, which is how bending is driven).
+//! * **Loads**: nodal forces [N] and moments [N m] of fixed direction, `value * f(t)`.
+//! * **Gravity**: an acceleration [m/s^2] acting on all mass (shell density and rigid bodies),
+//!   `g * f(t)`, with consistent nodal loads.
+//! * **Markers**: named points rigidly attached to a node, whose positions and rotations are
+//!   recorded.
 //!
-//! Loads are nodal forces [N] and moments [N m] of fixed direction, scaled by the load factor.
+//! Constraints, loads and gravity carry an optional `id` and an initial `active` flag, so that an
+//! analysis step can switch them on and off by id (several items may share an id). In static steps
+//! the load factor plays the role of time.
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use std::ops::Range;
+
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::element::ShellElement;
 use crate::error::{Error, Result};
 use crate::material::ShellSection;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Placement};
+use crate::time_function::TimeFunction;
 
-/// A nodal degree of freedom.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum Dof {
-    /// Translation along x [m].
-    Ux = 0,
-    /// Translation along y [m].
-    Uy = 1,
-    /// Translation along z [m].
-    Uz = 2,
-    /// Rotation about x [rad].
-    Rx = 3,
-    /// Rotation about y [rad].
-    Ry = 4,
-    /// Rotation about z [rad].
-    Rz = 5,
+pub use crate::dof::Dof;
+
+/// A shell part: a range of the model's elements with one section.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Part {
+    /// Name (prefix of its node sets).
+    pub name: String,
+    /// Section of every element of the part.
+    pub section: ShellSection,
+    /// Indices of its elements in [`Mesh::quads`].
+    pub elements: Range<usize>,
 }
 
-impl Dof {
-    /// All six DOFs in order.
-    pub const ALL: [Dof; 6] = [Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz];
-    /// The three translations.
-    pub const TRANSLATIONS: [Dof; 3] = [Dof::Ux, Dof::Uy, Dof::Uz];
-    /// The three rotations.
-    pub const ROTATIONS: [Dof; 3] = [Dof::Rx, Dof::Ry, Dof::Rz];
-
-    /// DOF from its index 0..6.
-    ///
-    /// # Errors
-    /// [`Error::InvalidModel`] for an index >= 6.
-    pub fn try_from_index(i: usize) -> Result<Self> {
-        Self::ALL
-            .get(i)
-            .copied()
-            .ok_or_else(|| Error::InvalidModel(format!("DOF index {i} is not in 0..6")))
-    }
-
-    /// DOF from its name (`ux`, `uy`, `uz`, `rx`, `ry`, `rz`, case-insensitive).
-    ///
-    /// # Errors
-    /// [`Error::InvalidModel`] for an unknown name.
-    pub fn try_from_name(name: &str) -> Result<Self> {
-        let all = ["ux", "uy", "uz", "rx", "ry", "rz"];
-        all.iter()
-            .position(|n| n.eq_ignore_ascii_case(name))
-            .map(|i| Self::ALL[i])
-            .ok_or_else(|| Error::InvalidModel(format!("unknown DOF '{name}' (expected one of {all:?})")))
-    }
-
-    /// Index 0..6 of the DOF within its node.
-    #[must_use]
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// Whether this is a rotation.
-    #[must_use]
-    pub fn is_rotation(self) -> bool {
-        self.index() >= 3
-    }
-}
-
-/// A DOF whose value follows the load factor (`value` at `lambda = 1`; 0 for a fixed DOF).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Prescribed {
-    /// Node index.
+/// A rigid body (or a point mass) carried by a reference node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBody {
+    /// Reference node (its rotation is the body's rotation).
     pub node: usize,
-    /// Which DOF.
-    pub dof: Dof,
-    /// Value at load factor 1 [m or rad].
-    pub value: f64,
-}
-
-/// A nodal force or moment of fixed direction, scaled by the load factor.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NodalLoad {
-    /// Node index.
-    pub node: usize,
-    /// Force component (`Ux..Uz`, [N]) or moment component (`Rx..Rz`, [N m]).
-    pub dof: Dof,
-    /// Value at load factor 1.
-    pub value: f64,
+    /// Mass [kg], >= 0.
+    pub mass: f64,
+    /// Centre of mass relative to the reference node, in the reference configuration [m]; it
+    /// rotates with the node.
+    #[serde(default = "Vector3::zeros")]
+    pub centre_of_mass: Vector3<f64>,
+    /// Inertia tensor about the centre of mass, global axes of the reference configuration
+    /// [kg m^2]; symmetric positive semi-definite (zero for a point mass).
+    #[serde(default = "Matrix3::zeros")]
+    pub inertia: Matrix3<f64>,
 }
 
 /// A rigid tie of a set of nodes to a reference node.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Tie {
     /// Tied (slave) nodes.
     pub nodes: Vec<usize>,
@@ -111,39 +74,205 @@ pub struct Tie {
     pub reference: usize,
 }
 
-/// A shell model.
-#[derive(Clone, Debug)]
+/// A constrained DOF: held, or moved by `value * (f(t) - f(t_on))` while active.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Constraint {
+    /// Identifier used by analysis steps to switch it (several constraints may share one).
+    #[serde(default)]
+    pub id: Option<String>,
+    /// Node index.
+    pub node: usize,
+    /// Which DOF.
+    pub dof: Dof,
+    /// Amplitude [m or rad] (0 holds the DOF where it is).
+    #[serde(default)]
+    pub value: f64,
+    /// Time function of the motion.
+    #[serde(default)]
+    pub function: TimeFunction,
+    /// Active at the start of the analysis.
+    #[serde(default = "yes")]
+    pub active: bool,
+}
+
+/// The previous name of [`Constraint`].
+pub type Prescribed = Constraint;
+
+/// A nodal force or moment of fixed direction, `value * f(t)` while active.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Load {
+    /// Identifier used by analysis steps to switch it.
+    #[serde(default)]
+    pub id: Option<String>,
+    /// Node index.
+    pub node: usize,
+    /// Force component (`Ux..Uz`, [N]) or moment component (`Rx..Rz`, [N m]).
+    pub dof: Dof,
+    /// Amplitude.
+    pub value: f64,
+    /// Time function.
+    #[serde(default)]
+    pub function: TimeFunction,
+    /// Active at the start of the analysis.
+    #[serde(default = "yes")]
+    pub active: bool,
+}
+
+/// The previous name of [`Load`].
+pub type NodalLoad = Load;
+
+/// Gravity: a uniform acceleration field `acceleration * f(t)` acting on all mass.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gravity {
+    /// Identifier used by analysis steps to switch it.
+    #[serde(default)]
+    pub id: Option<String>,
+    /// Acceleration of gravity [m/s^2], e.g. `(0, 0, -9.81)`.
+    pub acceleration: Vector3<f64>,
+    /// Time function (`Constant` for gravity present from the start).
+    #[serde(default)]
+    pub function: TimeFunction,
+    /// Active at the start of the analysis.
+    #[serde(default = "yes")]
+    pub active: bool,
+}
+
+/// A named point rigidly attached to a node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Marker {
+    /// Unique name.
+    pub name: String,
+    /// Node it follows.
+    pub node: usize,
+    /// Position relative to the node in the reference configuration [m]; rotates with the node.
+    #[serde(default = "Vector3::zeros")]
+    pub offset: Vector3<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A model: parts, rigid bodies, ties, constraints, loads, gravity and markers.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Model {
-    /// The mesh; reference nodes added with [`Model::add_node`] are appended to its nodes.
+    /// All nodes, elements and node sets; reference nodes added with [`Model::add_node`] are
+    /// appended to the nodes.
     pub mesh: Mesh,
-    /// Section of every element.
-    pub section: ShellSection,
-    /// Constrained DOFs (fixed ones have value 0), at most one entry per (node, DOF).
-    pub constraints: Vec<Prescribed>,
+    /// Shell parts (each element belongs to exactly one).
+    pub parts: Vec<Part>,
+    /// Rigid bodies and point masses.
+    #[serde(default)]
+    pub rigid_bodies: Vec<RigidBody>,
     /// Rigid ties.
+    #[serde(default)]
     pub ties: Vec<Tie>,
+    /// Constraints.
+    #[serde(default)]
+    pub constraints: Vec<Constraint>,
     /// Nodal loads.
-    pub loads: Vec<NodalLoad>,
+    #[serde(default)]
+    pub loads: Vec<Load>,
+    /// Gravity, if any.
+    #[serde(default)]
+    pub gravity: Option<Gravity>,
+    /// Markers.
+    #[serde(default)]
+    pub markers: Vec<Marker>,
+}
+
+fn finite3(v: &Vector3<f64>) -> bool {
+    v.iter().all(|c| c.is_finite())
 }
 
 impl Model {
-    /// A model of `mesh` with one `section` for all elements.
+    /// A model of one part, `mesh` with `section`, named `""` (its node sets keep their names).
     ///
     /// # Errors
-    /// Invalid section or mesh.
+    /// Invalid section or mesh, or a mesh without elements.
     pub fn try_new(mesh: Mesh, section: ShellSection) -> Result<Self> {
-        section.validate()?;
-        mesh.validate()?;
+        let mut model = Self::default();
+        model.add_part("", mesh, section, &Placement::default())?;
+        Ok(model)
+    }
+
+    /// Adds a part: `mesh` moved by `placement`, with `section`; returns the part's index. Its
+    /// node sets are added as `"<name>.<set>"` (`"<set>"` if `name` is empty), and the set
+    /// `"<name>"` holds all its nodes when `name` is not empty.
+    ///
+    /// # Errors
+    /// Invalid section, mesh or placement, a mesh without elements, or a part name already used.
+    pub fn add_part(&mut self, name: &str, mesh: Mesh, section: ShellSection, placement: &Placement) -> Result<usize> {
+        section
+            .validate()
+            .map_err(|e| Error::InvalidParameter(format!("part '{name}': {e}")))?;
+        placement.validate()?;
+        mesh.validate()
+            .map_err(|e| Error::InvalidMesh(format!("part '{name}': {e}")))?;
         if mesh.quads.is_empty() {
-            return Err(Error::InvalidMesh("the mesh has no element".into()));
+            return Err(Error::InvalidMesh(format!("part '{name}': the mesh has no element")));
         }
-        Ok(Self {
-            mesh,
+        if self.parts.iter().any(|p| p.name == name) {
+            return Err(Error::InvalidModel(format!("a part named '{name}' already exists")));
+        }
+        let set_name = |set: &str| {
+            if name.is_empty() {
+                set.to_owned()
+            } else {
+                format!("{name}.{set}")
+            }
+        };
+        let new_sets: Vec<String> = mesh.node_sets.keys().map(|s| set_name(s)).collect();
+        if let Some(clash) = new_sets
+            .iter()
+            .chain(std::iter::once(&name.to_owned()).filter(|n| !n.is_empty()))
+            .find(|s| self.mesh.node_sets.contains_key(*s))
+        {
+            return Err(Error::InvalidModel(format!("node set '{clash}' already exists")));
+        }
+        let offset = self.mesh.nodes.len();
+        let first = self.mesh.quads.len();
+        self.mesh
+            .nodes
+            .extend(mesh.nodes.iter().map(|x| placement.apply(x)));
+        self.mesh
+            .quads
+            .extend(mesh.quads.iter().map(|q| q.map(|n| n + offset)));
+        for (set, nodes) in &mesh.node_sets {
+            self.mesh
+                .node_sets
+                .insert(set_name(set), nodes.iter().map(|n| n + offset).collect());
+        }
+        if !name.is_empty() {
+            self.mesh
+                .node_sets
+                .insert(name.to_owned(), (offset..self.mesh.nodes.len()).collect());
+        }
+        self.parts.push(Part {
+            name: name.to_owned(),
             section,
-            constraints: Vec::new(),
-            ties: Vec::new(),
-            loads: Vec::new(),
-        })
+            elements: first..self.mesh.quads.len(),
+        });
+        Ok(self.parts.len() - 1)
+    }
+
+    /// The section of element `e`.
+    ///
+    /// # Panics
+    /// If `e` belongs to no part.
+    #[must_use]
+    pub fn section_of(&self, e: usize) -> &ShellSection {
+        &self
+            .parts
+            .iter()
+            .find(|p| p.elements.contains(&e))
+            .expect("every element belongs to a part")
+            .section
     }
 
     fn check_node(&self, node: usize) -> Result<()> {
@@ -162,31 +291,50 @@ impl Model {
     /// # Errors
     /// [`Error::InvalidModel`] for a non-finite coordinate.
     pub fn add_node(&mut self, x: Vector3<f64>) -> Result<usize> {
-        if !x.iter().all(|c| c.is_finite()) {
+        if !finite3(&x) {
             return Err(Error::InvalidModel(format!(
-                "node coordinates must be finite (got {x:?})"
+                "node coordinates must be finite (got {:?})",
+                x.as_slice()
             )));
         }
         self.mesh.nodes.push(x);
         Ok(self.mesh.nodes.len() - 1)
     }
 
-    /// Constrains `dof` of `node` to `lambda * value` (use `value = 0` to fix it). A later call on the
-    /// same DOF replaces the earlier one.
+    /// Adds a constraint. One replaces an earlier one on the same (node, DOF) with the same id.
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] for an unknown node, a non-finite value or an invalid function.
+    pub fn add_constraint(&mut self, c: Constraint) -> Result<()> {
+        self.check_node(c.node)?;
+        if !c.value.is_finite() {
+            return Err(Error::InvalidModel(format!(
+                "prescribed value of {} at node {} is not finite",
+                c.dof.name(),
+                c.node
+            )));
+        }
+        c.function.validate()?;
+        self.constraints
+            .retain(|o| !(o.node == c.node && o.dof == c.dof && o.id == c.id));
+        self.constraints.push(c);
+        Ok(())
+    }
+
+    /// Constrains `dof` of `node` to move by `t * value` (the load factor times `value`; use
+    /// `value = 0` to fix it). A later call on the same DOF replaces the earlier one.
     ///
     /// # Errors
     /// [`Error::InvalidModel`] for an unknown node or a non-finite value.
     pub fn prescribe(&mut self, node: usize, dof: Dof, value: f64) -> Result<()> {
-        self.check_node(node)?;
-        if !value.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "prescribed value of {dof:?} at node {node} is not finite"
-            )));
-        }
-        self.constraints
-            .retain(|c| !(c.node == node && c.dof == dof));
-        self.constraints.push(Prescribed { node, dof, value });
-        Ok(())
+        self.add_constraint(Constraint {
+            id: None,
+            node,
+            dof,
+            value,
+            function: TimeFunction::Linear,
+            active: true,
+        })
     }
 
     /// Fixes the given DOFs of every node in `nodes`.
@@ -224,72 +372,243 @@ impl Model {
         Ok(())
     }
 
-    /// Adds a nodal force [N] (translation DOF) or moment [N m] (rotation DOF) at load factor 1.
+    /// Adds a load.
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] for an unknown node, a non-finite value or an invalid function.
+    pub fn add_load_with(&mut self, load: Load) -> Result<()> {
+        self.check_node(load.node)?;
+        if !load.value.is_finite() {
+            return Err(Error::InvalidModel(format!(
+                "load on {} at node {} is not finite",
+                load.dof.name(),
+                load.node
+            )));
+        }
+        load.function.validate()?;
+        self.loads.push(load);
+        Ok(())
+    }
+
+    /// Adds a nodal force [N] (translation DOF) or moment [N m] (rotation DOF) proportional to
+    /// the load factor (`value` at load factor 1).
     ///
     /// # Errors
     /// [`Error::InvalidModel`] for an unknown node or a non-finite value.
     pub fn add_load(&mut self, node: usize, dof: Dof, value: f64) -> Result<()> {
-        self.check_node(node)?;
-        if !value.is_finite() {
+        self.add_load_with(Load {
+            id: None,
+            node,
+            dof,
+            value,
+            function: TimeFunction::Linear,
+            active: true,
+        })
+    }
+
+    /// Adds a rigid body (or a point mass: zero inertia and offset) at its reference node.
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] for an unknown node, a second body on the same node, a negative or
+    /// non-finite mass, a non-finite offset, or an inertia tensor that is not symmetric positive
+    /// semi-definite.
+    pub fn add_rigid_body(&mut self, body: RigidBody) -> Result<()> {
+        self.check_rigid_body(&body)?;
+        if self.rigid_bodies.iter().any(|b| b.node == body.node) {
             return Err(Error::InvalidModel(format!(
-                "load on {dof:?} at node {node} is not finite"
+                "node {} already carries a rigid body",
+                body.node
             )));
         }
-        self.loads.push(NodalLoad { node, dof, value });
+        self.rigid_bodies.push(body);
         Ok(())
     }
 
-    /// Reference nodal triads `[t1, t2, D]`: `D` is the average of the unit normals of the elements
-    /// around the node; nodes without elements get the identity.
-    ///
-    /// # Errors
-    /// [`Error::InvalidMesh`] where neighbouring normals cancel (inconsistent orientation).
-    pub fn reference_triads(&self) -> Result<Vec<UnitQuaternion<f64>>> {
-        let n = self.mesh.n_nodes();
-        let mut normal = vec![Vector3::zeros(); n];
-        let mut count = vec![0usize; n];
-        for quad in &self.mesh.quads {
-            let x = quad.map(|i| self.mesh.nodes[i]);
-            for a in 0..4 {
-                let c = (x[(a + 1) % 4] - x[a]).cross(&(x[(a + 3) % 4] - x[a]));
-                normal[quad[a]] += c.normalize();
-                count[quad[a]] += 1;
-            }
+    fn check_rigid_body(&self, body: &RigidBody) -> Result<()> {
+        self.check_node(body.node)?;
+        let n = body.node;
+        if !(body.mass.is_finite() && body.mass >= 0.0) {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: mass must be finite and >= 0 (got {})",
+                body.mass
+            )));
         }
-        let mut triads = Vec::with_capacity(n);
-        for (i, (nrm, &c)) in normal.iter().zip(&count).enumerate() {
-            if c == 0 {
-                triads.push(UnitQuaternion::identity());
-                continue;
-            }
-            if nrm.norm() < 0.5 {
-                return Err(Error::InvalidMesh(format!(
-                    "the element normals around node {i} cancel out: neighbouring elements are oriented inconsistently"
-                )));
-            }
-            let d = nrm.normalize();
-            let axis = if d.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
-            let t1 = (axis - d * d.dot(&axis)).normalize();
-            let t2 = d.cross(&t1);
-            triads.push(UnitQuaternion::from_matrix(&Matrix3::from_columns(&[t1, t2, d])));
+        if !finite3(&body.centre_of_mass) {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: centre of mass must be finite"
+            )));
         }
-        Ok(triads)
+        let j = &body.inertia;
+        let scale = j.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if !j.iter().all(|v| v.is_finite()) || (j - j.transpose()).amax() > 1e-12 * scale {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: the inertia tensor must be finite and symmetric"
+            )));
+        }
+        let eigen = j.symmetric_eigenvalues();
+        if eigen.iter().any(|&l| l < -1e-12 * scale) {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: the inertia tensor must be positive semi-definite (eigenvalues {:?})",
+                eigen.as_slice()
+            )));
+        }
+        Ok(())
     }
 
-    /// Builds the elements in the reference configuration.
+    /// Sets gravity.
     ///
     /// # Errors
-    /// [`Error::InvalidMesh`] naming a degenerate or mis-oriented element.
-    pub fn elements(&self, triads: &[UnitQuaternion<f64>]) -> Result<Vec<ShellElement>> {
-        self.mesh
-            .quads
-            .iter()
-            .enumerate()
-            .map(|(e, quad)| {
-                let x = quad.map(|i| self.mesh.nodes[i]);
-                let q = quad.map(|i| triads[i].to_rotation_matrix().into_inner());
-                ShellElement::try_new(*quad, &x, &q).map_err(|err| Error::InvalidMesh(format!("element {e}: {err}")))
-            })
-            .collect()
+    /// [`Error::InvalidParameter`] for a non-finite acceleration or an invalid function.
+    pub fn set_gravity(&mut self, gravity: Gravity) -> Result<()> {
+        if !finite3(&gravity.acceleration) {
+            return Err(Error::InvalidParameter(format!(
+                "gravity acceleration must be finite (got {:?})",
+                gravity.acceleration.as_slice()
+            )));
+        }
+        gravity.function.validate()?;
+        self.gravity = Some(gravity);
+        Ok(())
     }
+
+    /// Adds a marker.
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] for an unknown node, an empty or repeated name, or a non-finite
+    /// offset.
+    pub fn add_marker(&mut self, marker: Marker) -> Result<()> {
+        self.check_node(marker.node)?;
+        if marker.name.is_empty() || self.markers.iter().any(|m| m.name == marker.name) {
+            return Err(Error::InvalidModel(format!(
+                "marker names must be unique and non-empty (got '{}')",
+                marker.name
+            )));
+        }
+        if !finite3(&marker.offset) {
+            return Err(Error::InvalidModel(format!(
+                "marker '{}': offset must be finite",
+                marker.name
+            )));
+        }
+        self.markers.push(marker);
+        Ok(())
+    }
+
+    /// Whether `id` names a constraint, a load or the gravity field.
+    #[must_use]
+    pub fn has_id(&self, id: &str) -> bool {
+        let is = |o: &Option<String>| o.as_deref() == Some(id);
+        self.constraints.iter().any(|c| is(&c.id))
+            || self.loads.iter().any(|l| is(&l.id))
+            || self.gravity.as_ref().is_some_and(|g| is(&g.id))
+    }
+
+    /// Checks a whole model, as one read from a file must be: mesh, parts covering every element
+    /// once with valid sections, indices, values, functions, rigid bodies and markers.
+    ///
+    /// # Errors
+    /// The first problem found, naming it.
+    pub fn validate(&self) -> Result<()> {
+        self.mesh.validate()?;
+        let mut next = 0;
+        for p in &self.parts {
+            p.section
+                .validate()
+                .map_err(|e| Error::InvalidParameter(format!("part '{}': {e}", p.name)))?;
+            if p.elements.start != next || p.elements.end < p.elements.start {
+                return Err(Error::InvalidModel(format!(
+                    "part '{}': its elements {:?} do not follow the previous part's",
+                    p.name, p.elements
+                )));
+            }
+            next = p.elements.end;
+        }
+        if next != self.mesh.quads.len() {
+            return Err(Error::InvalidModel(format!(
+                "the parts cover {next} elements, the mesh has {}",
+                self.mesh.quads.len()
+            )));
+        }
+        if self.mesh.quads.is_empty() {
+            return Err(Error::InvalidMesh("the model has no element".into()));
+        }
+        for (name, set) in &self.mesh.node_sets {
+            if let Some(&bad) = set.iter().find(|&&n| n >= self.mesh.n_nodes()) {
+                return Err(Error::InvalidModel(format!("node set '{name}' names node {bad}, which does not exist")));
+            }
+        }
+        for t in &self.ties {
+            self.check_node(t.reference)?;
+            for &n in &t.nodes {
+                self.check_node(n)?;
+            }
+        }
+        for c in &self.constraints {
+            self.check_node(c.node)?;
+            if !c.value.is_finite() {
+                return Err(Error::InvalidModel(format!("constraint at node {} is not finite", c.node)));
+            }
+            c.function.validate()?;
+        }
+        for l in &self.loads {
+            self.check_node(l.node)?;
+            if !l.value.is_finite() {
+                return Err(Error::InvalidModel(format!("load at node {} is not finite", l.node)));
+            }
+            l.function.validate()?;
+        }
+        for (i, b) in self.rigid_bodies.iter().enumerate() {
+            self.check_rigid_body(b)?;
+            if self.rigid_bodies[..i].iter().any(|o| o.node == b.node) {
+                return Err(Error::InvalidModel(format!("node {} carries two rigid bodies", b.node)));
+            }
+        }
+        if let Some(g) = &self.gravity {
+            if !finite3(&g.acceleration) {
+                return Err(Error::InvalidParameter("gravity acceleration must be finite".into()));
+            }
+            g.function.validate()?;
+        }
+        for (i, m) in self.markers.iter().enumerate() {
+            self.check_node(m.node)?;
+            if m.name.is_empty() || self.markers[..i].iter().any(|o| o.name == m.name) || !finite3(&m.offset) {
+                return Err(Error::InvalidModel(format!("marker '{}' is invalid or repeated", m.name)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Total mass [kg]: shells (density times thickness times reference area) and rigid bodies.
+    #[must_use]
+    pub fn total_mass(&self) -> f64 {
+        let shells: f64 = self
+            .parts
+            .iter()
+            .map(|p| {
+                let area: f64 = self.mesh.quads[p.elements.clone()]
+                    .iter()
+                    .map(|q| quad_area(&q.map(|n| self.mesh.nodes[n])))
+                    .sum();
+                p.section.density * p.section.thickness * area
+            })
+            .sum();
+        shells + self.rigid_bodies.iter().map(|b| b.mass).sum::<f64>()
+    }
+}
+
+/// Area of a (possibly warped) bilinear quadrilateral by the 2 x 2 Gauss rule [m^2].
+fn quad_area(x: &[Vector3<f64>; 4]) -> f64 {
+    use crate::element::quadrature::{bilinear, GAUSS_2X2};
+    GAUSS_2X2
+        .iter()
+        .map(|&(xi, eta)| {
+            let (_, dn) = bilinear(xi, eta);
+            let (mut g1, mut g2) = (Vector3::zeros(), Vector3::zeros());
+            for a in 0..4 {
+                g1 += dn[a][0] * x[a];
+                g2 += dn[a][1] * x[a];
+            }
+            g1.cross(&g2).norm()
+        })
+        .sum()
 }

@@ -1,14 +1,16 @@
-//! Canonical problems shared by tests, benchmarks and the Python front end.
+//! Canonical problems shared by tests and benchmarks (test fixtures; the scenarios users run live
+//! in the Python package).
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::{run, Step};
 use crate::error::{Error, Result};
 use crate::material::ShellSection;
 use crate::mesh::generate::{apply_twist_imperfection, tape_spring, TapeGeometry};
 use crate::model::{Dof, Model};
-use crate::solver::{solve_static, Control, NewtonParams, StaticParams, StaticPath, StaticStep, Stats};
-use crate::System;
+use crate::output::Outputs;
+use crate::solver::{Control, NewtonParams, StaticParams, Stats};
 
 /// Pure bending of one tape spring (paper Sec. 2, Fig. 4).
 ///
@@ -200,57 +202,47 @@ impl TapeBending {
         }
     }
 
-    /// Traces the bending curve (and the unloading branch if asked), calling `progress` with the
-    /// current angle [rad] after each converged step (return `false` to stop).
+    /// The analysis steps: loading (`"load"`, load factor 0 to 1) and, if asked, unloading
+    /// (`"unload"`, back to 0).
+    #[must_use]
+    pub fn steps(&self) -> Vec<Step> {
+        let mut steps = vec![Step::new_static("load", self.params(1.0, 1.0))];
+        if self.unload {
+            steps.push(Step::new_static("unload", self.params(0.0, -1.0)));
+        }
+        steps
+    }
+
+    /// Traces the bending curve (and the unloading branch if asked) with [`run`], calling
+    /// `progress` with the current angle [rad] after each converged step (return `false` to stop).
+    /// The points are the converged states after the initial one.
     ///
     /// # Errors
     /// Invalid parameters; failures during the analysis are reported in [`BendingCurve::error`].
     pub fn run(&self, progress: &mut dyn FnMut(f64) -> bool) -> Result<BendingCurve> {
         let bm = self.build()?;
-        let mut system = System::try_new(&bm.model)?;
-        let mut state = system.initial_state();
-        let mut curve = BendingCurve {
-            ndof: system.n_free(),
-            ..BendingCurve::default()
+        let outputs = Outputs {
+            reactions: vec![(bm.driven_node, Dof::Ry)],
+            field_interval: 0,
         };
-        let branches: &[(f64, f64)] = if self.unload {
-            &[(1.0, 1.0), (0.0, -1.0)]
-        } else {
-            &[(1.0, 1.0)]
-        };
-        for (branch, &(lambda_end, direction)) in branches.iter().enumerate() {
-            let params = self.params(lambda_end, direction);
-            let theta_max = self.theta_max;
-            let mut cb = |s: &StaticStep, _: &Stats| progress(s.lambda * theta_max);
-            let path = solve_static(&mut system, &mut state, &params, &mut cb)?;
-            self.collect(&bm, &path, u8::try_from(branch).unwrap_or(u8::MAX), &mut curve);
-            curve.stats.steps += path.stats.steps;
-            curve.stats.iterations += path.stats.iterations;
-            curve.stats.cutbacks += path.stats.cutbacks;
-            curve.stats.factorisations += path.stats.factorisations;
-            curve.stats.refinement_sweeps += path.stats.refinement_sweeps;
-            curve.stats.lu_fallbacks += path.stats.lu_fallbacks;
-            curve.stats.assembly_s += path.stats.assembly_s;
-            curve.stats.solve_s += path.stats.solve_s;
-            curve.stats.wall_s += path.stats.wall_s;
-            if path.error.is_some() || path.cancelled {
-                curve.error = path.error;
-                curve.cancelled = path.cancelled;
-                break;
-            }
-        }
-        Ok(curve)
-    }
-
-    fn collect(&self, bm: &BendingModel, path: &StaticPath, branch: u8, curve: &mut BendingCurve) {
-        for s in &path.steps {
-            curve.points.push(BendingPoint {
-                theta: s.lambda * self.theta_max,
-                moment: s.reactions[bm.moment_index],
-                negative_eigenvalues: s.negative_eigenvalues.unwrap_or(0),
-                branch,
-                jump: s.jump,
-            });
-        }
+        let theta_max = self.theta_max;
+        let result = run(&bm.model, &self.steps(), &outputs, &mut |p| progress(p.t * theta_max))?;
+        let h = &result.history;
+        let points = (1..h.len())
+            .map(|i| BendingPoint {
+                theta: h.t[i] * theta_max,
+                moment: h.reactions[i],
+                negative_eigenvalues: usize::try_from(h.negative_eigenvalues[i]).unwrap_or(0),
+                branch: u8::try_from(h.step[i]).unwrap_or(u8::MAX),
+                jump: h.jump[i],
+            })
+            .collect();
+        Ok(BendingCurve {
+            points,
+            ndof: h.ndof.first().copied().unwrap_or(0),
+            stats: result.stats,
+            error: result.error,
+            cancelled: result.cancelled,
+        })
     }
 }

@@ -1,52 +1,24 @@
-//! Nonlinear solvers: parameters, statistics and recorded results.
+//! Nonlinear solvers: settings, statistics, recorded results, and the pieces the static and
+//! dynamic drivers share ([`newton`], [`control`]).
 
+pub mod control;
+mod events;
+pub mod newton;
+mod relax;
 pub mod statics;
 
 use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
 
+use crate::dof::Dof;
 use crate::error::{Error, Result};
-use crate::model::Dof;
+use crate::options::Options;
 
+pub use control::StepController;
+pub use newton::NewtonParams;
 pub use statics::solve_static;
 
-/// Newton-Raphson settings.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NewtonParams {
-    /// Maximum iterations per increment (>= 1).
-    pub max_iterations: usize,
-    /// Convergence when the weighted residual norm is below `tol_force` times the reference force
-    /// (external load and reactions), in (0, 1).
-    pub tol_force: f64,
-    /// ... and the energy norm `|dq . r|` of the last correction is below `tol_energy` times that of
-    /// the first, in (0, 1).
-    pub tol_energy: f64,
-    /// Backtracking line search on the residual norm (load and displacement control).
-    pub line_search: bool,
-    /// Mixed-stress iteration: the geometric part of each tangent takes the element stresses
-    /// extrapolated linearly from the previous iterate, `C (eps + B dq)`, instead of those of the
-    /// current strains (Newton's method on the Hellinger-Reissner form, Magisano, Leonetti & Garcea
-    /// 2017). Same equilibrium path and quadratic convergence; far fewer iterations for thin
-    /// shells, whose predictors and corrections create large spurious membrane stresses.
-    pub mixed_stress: bool,
-    /// An increment whose residual norm has not reached a new low for this many iterations is
-    /// cycling and is cut back at once (0: only after `max_iterations`).
-    pub stall_iterations: usize,
-}
-
-impl Default for NewtonParams {
-    fn default() -> Self {
-        Self {
-            max_iterations: 20,
-            tol_force: 1e-8,
-            tol_energy: 1e-16,
-            line_search: true,
-            mixed_stress: true,
-            stall_iterations: 4,
-        }
-    }
-}
-
-/// How the load factor is driven.
+/// How the load factor of a static step is driven.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Control {
     /// Load (and prescribed-motion) control: the load factor goes from its current value to
@@ -58,7 +30,8 @@ pub enum Control {
         increments: usize,
     },
     /// Displacement control (Batoz-Dhatt): the free DOF `dof` of `node` is moved by `delta` [m or
-    /// rad] in `increments` increments; the load factor is an unknown.
+    /// rad] in `increments` increments (more if Newton needs smaller ones); the load factor is an
+    /// unknown.
     Displacement {
         /// Controlled node.
         node: usize,
@@ -85,6 +58,28 @@ pub enum Control {
     },
 }
 
+impl Control {
+    /// Name of the control in option maps.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Load { .. } => "load",
+            Self::Displacement { .. } => "displacement",
+            Self::ArcLength { .. } => "arc-length",
+        }
+    }
+}
+
+/// A reaction monitored along an arc-length path: its extrema are located, and segments of the
+/// path along which it changes much are refined.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Monitor {
+    /// Node of the reaction.
+    pub node: usize,
+    /// DOF of the reaction (must be constrained).
+    pub dof: Dof,
+}
+
 /// Settings of a static analysis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StaticParams {
@@ -92,7 +87,7 @@ pub struct StaticParams {
     pub control: Control,
     /// Newton settings.
     pub newton: NewtonParams,
-    /// Successive halvings of an increment before giving up (>= 0).
+    /// Successive halvings of an increment before giving up (in [0, 60]).
     pub max_cutbacks: usize,
     /// Newton iterations aimed at per increment; the increment grows or shrinks towards it.
     pub target_iterations: usize,
@@ -104,6 +99,20 @@ pub struct StaticParams {
     /// stable equilibrium beyond the limit instead of following the unstable branch, as a test
     /// driven slowly by the same loads or prescribed motions does (see [`statics`]).
     pub jump_at_limit_points: bool,
+    /// Arc-length only: locate the limit points of the load factor (where the path turns back in
+    /// load factor) to within `event_tolerance` and record them on the path.
+    pub locate_limit_points: bool,
+    /// Arc-length only: a reaction whose extrema are located (to within `event_tolerance` in load
+    /// factor) and along which the path is refined (see `refine_change`).
+    pub monitor: Option<Monitor>,
+    /// Tolerance of located limit points and extrema, in load factor (> 0).
+    pub event_tolerance: f64,
+    /// With a monitor: a converged step longer than `refine_span` in load factor over which the
+    /// monitored reaction changes by more than this fraction of its magnitude is refined by extra
+    /// equilibria in between (0: no refinement).
+    pub refine_change: f64,
+    /// See `refine_change` (load factor, > 0).
+    pub refine_span: f64,
 }
 
 impl Default for StaticParams {
@@ -119,9 +128,35 @@ impl Default for StaticParams {
             stability: false,
             record_fields: true,
             jump_at_limit_points: false,
+            locate_limit_points: false,
+            monitor: None,
+            event_tolerance: 1e-4,
+            refine_change: 0.0,
+            refine_span: 1e-2,
         }
     }
 }
+
+/// Options of each control in flat option maps.
+const LOAD_OPTIONS: [&str; 2] = ["lambda_end", "increments"];
+const DISPLACEMENT_OPTIONS: [&str; 4] = ["node", "dof", "delta", "increments"];
+const ARC_OPTIONS: [&str; 5] = [
+    "lambda_end",
+    "initial_increment",
+    "max_increment_factor",
+    "max_steps",
+    "direction",
+];
+/// Options that apply to arc-length control only (beside those of the control itself).
+const ARC_ONLY: [&str; 7] = [
+    "jump",
+    "locate_limit_points",
+    "monitor_node",
+    "monitor_dof",
+    "event_tolerance",
+    "refine_change",
+    "refine_span",
+];
 
 impl StaticParams {
     /// Checks every setting.
@@ -129,27 +164,30 @@ impl StaticParams {
     /// # Errors
     /// [`Error::InvalidParameter`] naming the bad setting.
     pub fn validate(&self) -> Result<()> {
-        let bad = |s: &str| Err(Error::InvalidParameter(s.to_owned()));
-        let n = &self.newton;
-        if n.max_iterations == 0 {
-            return bad("max_iterations must be >= 1");
+        let bad = |s: String| Err(Error::InvalidParameter(s));
+        self.newton.validate()?;
+        if !(1..=1000).contains(&self.target_iterations) {
+            return bad(format!("target_iterations must lie in [1, 1000] (got {})", self.target_iterations));
         }
-        let in_unit = |v: f64| v > 0.0 && v < 1.0;
-        if !(in_unit(n.tol_force) && in_unit(n.tol_energy)) {
-            return bad("Newton tolerances must lie in (0, 1)");
-        }
-        if self.target_iterations == 0 {
-            return bad("target_iterations must be >= 1");
+        if self.max_cutbacks > 60 {
+            return bad(format!(
+                "max_cutbacks must lie in [0, 60] (got {}): 60 halvings already reach round-off",
+                self.max_cutbacks
+            ));
         }
         match &self.control {
             Control::Load { lambda_end, increments } => {
                 if !lambda_end.is_finite() || *increments == 0 {
-                    return bad("load control needs a finite lambda_end and increments >= 1");
+                    return bad(format!(
+                        "load control needs a finite lambda_end and increments >= 1 (got {lambda_end}, {increments})"
+                    ));
                 }
             }
             Control::Displacement { delta, increments, .. } => {
                 if !delta.is_finite() || *delta == 0.0 || *increments == 0 {
-                    return bad("displacement control needs a finite non-zero delta and increments >= 1");
+                    return bad(format!(
+                        "displacement control needs a finite non-zero delta and increments >= 1 (got {delta}, {increments})"
+                    ));
                 }
             }
             Control::ArcLength {
@@ -159,17 +197,177 @@ impl StaticParams {
                 max_steps,
                 direction,
             } => {
-                let increment_ok = initial_increment.is_finite() && *initial_increment > 0.0;
-                if !lambda_end.is_finite() || !increment_ok {
-                    return bad("arc-length needs a finite lambda_end and initial_increment > 0");
+                if !lambda_end.is_finite() {
+                    return bad(format!("arc-length needs a finite lambda_end (got {lambda_end})"));
                 }
-                let factor_ok = *max_increment_factor >= 1.0;
-                if !factor_ok || *max_steps == 0 || direction.abs() != 1.0 {
-                    return bad("arc-length needs max_increment_factor >= 1, max_steps >= 1 and direction +1 or -1");
+                if !(initial_increment.is_finite() && *initial_increment > 0.0) {
+                    return bad(format!("initial_increment must be finite and > 0 (got {initial_increment})"));
+                }
+                if !(max_increment_factor.is_finite() && *max_increment_factor >= 1.0) {
+                    return bad(format!("max_increment_factor must be finite and >= 1 (got {max_increment_factor})"));
+                }
+                if *max_steps == 0 {
+                    return bad("max_steps must be >= 1".into());
+                }
+                if direction.abs() != 1.0 {
+                    return bad(format!("direction must be +1 or -1 (got {direction})"));
                 }
             }
         }
+        let arc = matches!(self.control, Control::ArcLength { .. });
+        if !arc && (self.jump_at_limit_points || self.locate_limit_points || self.monitor.is_some()) {
+            return bad(format!(
+                "jump, locate_limit_points and a monitor apply to arc-length control only (control is '{}')",
+                self.control.name()
+            ));
+        }
+        if !(self.event_tolerance.is_finite() && self.event_tolerance > 0.0) {
+            return bad(format!("event_tolerance must be finite and > 0 (got {})", self.event_tolerance));
+        }
+        if !(self.refine_change.is_finite() && self.refine_change >= 0.0) {
+            return bad(format!("refine_change must be finite and >= 0 (got {})", self.refine_change));
+        }
+        if !(self.refine_span.is_finite() && self.refine_span > 0.0) {
+            return bad(format!("refine_span must be finite and > 0 (got {})", self.refine_span));
+        }
+        if self.refine_change > 0.0 && self.monitor.is_none() {
+            return bad("refine_change needs a monitor (monitor_node and monitor_dof)".into());
+        }
         Ok(())
+    }
+
+    /// Reads the settings from a flat option map such as `{"control": "arc-length",
+    /// "lambda_end": 1.0, "tol_force": 1e-6}`: the control's own options, the Newton options,
+    /// and the others of [`StaticParams`] (`monitor_node` and `monitor_dof` for the monitor;
+    /// `jump` for `jump_at_limit_points`); defaults for those absent. Validates the result.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming an option of the wrong type, one that does not apply to
+    /// the chosen control, an unknown one, or an invalid value.
+    pub fn from_options(mut o: Options) -> Result<Self> {
+        let d = Self::default();
+        let name: String = o.take_or("control", "load".to_owned())?;
+        let control = match name.to_ascii_lowercase().as_str() {
+            "load" => Control::Load {
+                lambda_end: o.take_or("lambda_end", 1.0)?,
+                increments: o.take_or("increments", 10)?,
+            },
+            "displacement" => {
+                let (Some(node), Some(dof), Some(delta)) = (o.take("node")?, o.take("dof")?, o.take("delta")?) else {
+                    return Err(Error::InvalidParameter(
+                        "control 'displacement' needs node, dof and delta (the total change of that DOF)".into(),
+                    ));
+                };
+                Control::Displacement {
+                    node,
+                    dof,
+                    delta,
+                    increments: o.take_or("increments", 10)?,
+                }
+            }
+            "arc-length" | "arc_length" | "arclength" => Control::ArcLength {
+                lambda_end: o.take_or("lambda_end", 1.0)?,
+                initial_increment: o.take_or("initial_increment", 0.01)?,
+                max_increment_factor: o.take_or("max_increment_factor", 10.0)?,
+                max_steps: o.take_or("max_steps", 500)?,
+                direction: o.take_or("direction", 1.0)?,
+            },
+            other => {
+                return Err(Error::InvalidParameter(format!(
+                    "unknown control '{other}' (expected 'load', 'displacement' or 'arc-length')"
+                )))
+            }
+        };
+        let arc = matches!(control, Control::ArcLength { .. });
+        let newton = NewtonParams::read(&mut o)?;
+        let mut p = Self {
+            newton,
+            max_cutbacks: o.take_or("max_cutbacks", d.max_cutbacks)?,
+            target_iterations: o.take_or("target_iterations", d.target_iterations)?,
+            stability: o.take_or("stability", d.stability)?,
+            record_fields: o.take_or("record_fields", d.record_fields)?,
+            control,
+            ..d
+        };
+        if arc {
+            p.jump_at_limit_points = o.take_or("jump", d.jump_at_limit_points)?;
+            p.locate_limit_points = o.take_or("locate_limit_points", d.locate_limit_points)?;
+            p.monitor = match (o.take("monitor_node")?, o.take("monitor_dof")?) {
+                (Some(node), Some(dof)) => Some(Monitor { node, dof }),
+                (None, None) => None,
+                _ => {
+                    return Err(Error::InvalidParameter(
+                        "a monitor needs both monitor_node and monitor_dof".into(),
+                    ))
+                }
+            };
+            p.event_tolerance = o.take_or("event_tolerance", d.event_tolerance)?;
+            p.refine_change = o.take_or("refine_change", d.refine_change)?;
+            p.refine_span = o.take_or("refine_span", d.refine_span)?;
+        }
+        let others: Vec<&str> = LOAD_OPTIONS
+            .iter()
+            .chain(&DISPLACEMENT_OPTIONS)
+            .chain(&ARC_OPTIONS)
+            .chain(&ARC_ONLY)
+            .copied()
+            .collect();
+        o.finish(&others, &format!("control '{}'", p.control.name()))?;
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The settings as a flat option map (every option, defaults included): what
+    /// [`StaticParams::from_options`] reads back.
+    #[must_use]
+    pub fn to_options(&self) -> Map<String, Value> {
+        let mut m = Map::new();
+        m.insert("control".into(), self.control.name().into());
+        match &self.control {
+            Control::Load { lambda_end, increments } => {
+                m.insert("lambda_end".into(), (*lambda_end).into());
+                m.insert("increments".into(), (*increments).into());
+            }
+            Control::Displacement {
+                node,
+                dof,
+                delta,
+                increments,
+            } => {
+                m.insert("node".into(), (*node).into());
+                m.insert("dof".into(), dof.name().into());
+                m.insert("delta".into(), (*delta).into());
+                m.insert("increments".into(), (*increments).into());
+            }
+            Control::ArcLength {
+                lambda_end,
+                initial_increment,
+                max_increment_factor,
+                max_steps,
+                direction,
+            } => {
+                m.insert("lambda_end".into(), (*lambda_end).into());
+                m.insert("initial_increment".into(), (*initial_increment).into());
+                m.insert("max_increment_factor".into(), (*max_increment_factor).into());
+                m.insert("max_steps".into(), (*max_steps).into());
+                m.insert("direction".into(), (*direction).into());
+                m.insert("jump".into(), self.jump_at_limit_points.into());
+                m.insert("locate_limit_points".into(), self.locate_limit_points.into());
+                if let Some(mon) = &self.monitor {
+                    m.insert("monitor_node".into(), mon.node.into());
+                    m.insert("monitor_dof".into(), mon.dof.name().into());
+                }
+                m.insert("event_tolerance".into(), self.event_tolerance.into());
+                m.insert("refine_change".into(), self.refine_change.into());
+                m.insert("refine_span".into(), self.refine_span.into());
+            }
+        }
+        self.newton.write(&mut m);
+        m.insert("max_cutbacks".into(), self.max_cutbacks.into());
+        m.insert("target_iterations".into(), self.target_iterations.into());
+        m.insert("stability".into(), self.stability.into());
+        m.insert("record_fields".into(), self.record_fields.into());
+        m
     }
 }
 
@@ -188,12 +386,40 @@ pub struct Stats {
     pub refinement_sweeps: usize,
     /// Linear solves that fell back to LU.
     pub lu_fallbacks: usize,
+    /// Symbolic analyses (one per numbering of the unknowns).
+    pub symbolic_analyses: usize,
     /// Time in assembly [s].
     pub assembly_s: f64,
     /// Time in factorisation and solves [s].
     pub solve_s: f64,
     /// Wall time [s].
     pub wall_s: f64,
+}
+
+impl Stats {
+    /// Adds the counters and timings of `other`.
+    pub fn add(&mut self, other: &Stats) {
+        self.steps += other.steps;
+        self.iterations += other.iterations;
+        self.cutbacks += other.cutbacks;
+        self.factorisations += other.factorisations;
+        self.refinement_sweeps += other.refinement_sweeps;
+        self.lu_fallbacks += other.lu_fallbacks;
+        self.symbolic_analyses += other.symbolic_analyses;
+        self.assembly_s += other.assembly_s;
+        self.solve_s += other.solve_s;
+        self.wall_s += other.wall_s;
+    }
+}
+
+/// What a recorded state marks on the path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Event {
+    /// A limit point of the load factor (the path turns back in load factor).
+    LimitPoint,
+    /// An extremum of the monitored reaction.
+    MonitorExtremum,
 }
 
 /// One converged equilibrium state.
@@ -207,7 +433,9 @@ pub struct StaticStep {
     pub residual: f64,
     /// Strain energy [J].
     pub energy: f64,
-    /// Reactions at the constrained DOFs, in [`crate::dof::DofMap::constrained`] order [N, N m].
+    /// Potential energy of gravity [J].
+    pub gravity_energy: f64,
+    /// Reactions at the constrained DOFs, in [`crate::constraint::DofMap::constrained`] order [N, N m].
     pub reactions: Vec<f64>,
     /// Negative eigenvalues of the tangent (0 = stable), if requested.
     pub negative_eigenvalues: Option<usize>,
@@ -215,14 +443,27 @@ pub struct StaticStep {
     pub displacements: Vec<[f64; 3]>,
     /// Nodal rotation vectors [rad] (empty unless fields are recorded).
     pub rotations: Vec<[f64; 3]>,
+    /// Positions of the model's markers [m].
+    pub markers: Vec<[f64; 3]>,
+    /// Rotation vectors of the model's markers from the reference configuration [rad].
+    pub marker_rotations: Vec<[f64; 3]>,
+    /// Nodal forces `f_int - f_ext` at the DOFs of [`crate::assembly::System::probes`] [N, N m]:
+    /// the reaction where the DOF is constrained, the (vanishing) residual where it is free, NaN
+    /// at a tied node.
+    pub probes: Vec<f64>,
     /// True if this state was reached by a jump from the previous one (a snap at fixed load factor).
     pub jump: bool,
+    /// The event this state marks, if it was located as one.
+    pub event: Option<Event>,
+    /// Arc-length position of the state from the step's start (path order: states inserted by
+    /// location or refinement fall between their neighbours).
+    pub arc: f64,
 }
 
 /// The equilibrium path followed by a static analysis.
 #[derive(Debug, Default)]
 pub struct StaticPath {
-    /// Converged states, in order.
+    /// Converged states, in path order.
     pub steps: Vec<StaticStep>,
     /// Why the analysis stopped early, if it did (the converged steps are kept).
     pub error: Option<Error>,
@@ -230,4 +471,66 @@ pub struct StaticPath {
     pub stats: Stats,
     /// True if the caller's progress callback asked to stop.
     pub cancelled: bool,
+}
+
+/// Why an increment was rejected (an internal event of the drivers, not an error: the increment
+/// is cut back and retried; it becomes an [`Error::NotConverged`] only when cut-backs run out).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Rejection {
+    /// Newton did not converge.
+    NotConverged { iterations: usize, residual: f64, stalled: bool },
+    /// The tangent could not be factorised or solved.
+    Singular(String),
+    /// The residual became NaN or infinite.
+    NonFinite,
+    /// The arc-length constraint has no real root.
+    NoArcRoot,
+    /// A converged arc-length step went back along the path.
+    TurnedBack,
+    /// A converged arc-length step bent by more than 60 degrees.
+    BentSharply,
+    /// The controlled DOF of displacement control does not respond to the load.
+    NoResponse,
+    /// The step that was to land on the final load factor failed.
+    Landing,
+}
+
+impl From<Error> for Rejection {
+    fn from(e: Error) -> Self {
+        Self::Singular(e.to_string())
+    }
+}
+
+impl std::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NotConverged {
+                iterations,
+                residual,
+                stalled: true,
+            } => write!(f, "Newton iterations stalled after {iterations} (residual {residual:.3e} N)"),
+            Self::NotConverged {
+                iterations, residual, ..
+            } => write!(f, "Newton did not converge in {iterations} iterations (residual {residual:.3e} N)"),
+            Self::Singular(msg) => write!(f, "singular tangent ({msg})"),
+            Self::NonFinite => write!(f, "the residual became non-finite"),
+            Self::NoArcRoot => write!(f, "the arc-length constraint has no real root"),
+            Self::TurnedBack => write!(f, "the arc-length step turned back on the path"),
+            Self::BentSharply => write!(f, "the arc-length step bent by more than 60 degrees"),
+            Self::NoResponse => write!(f, "the controlled DOF does not respond to the load"),
+            Self::Landing => write!(f, "the final step onto lambda_end failed"),
+        }
+    }
+}
+
+impl Rejection {
+    /// `(iterations, residual)` of a Newton failure, `(0, NaN)` otherwise.
+    pub fn newton(&self) -> (usize, f64) {
+        match self {
+            Self::NotConverged {
+                iterations, residual, ..
+            } => (*iterations, *residual),
+            _ => (0, f64::NAN),
+        }
+    }
 }

@@ -34,9 +34,9 @@ fn bend(mixed: bool) -> Result<(Vec<f64>, usize, usize)> {
     let path = solve_static(&mut system, &mut state, &params, &mut |_, _| true)?;
     assert!(path.error.is_none(), "mixed = {mixed}: {:?}", path.error);
     assert!(
-        (state.lambda - 1.0).abs() < 1e-12,
+        (state.t - 1.0).abs() < 1e-12,
         "mixed = {mixed}: stopped at {}",
-        state.lambda
+        state.t
     );
     let moments = path
         .steps

@@ -64,7 +64,7 @@ fn newton_corrections(mixed: bool) -> Result<(Vec<f64>, Vec<f64>, f64, f64)> {
     for it in 0..8 {
         let geometric = (mixed && it > 0).then_some(stress.as_slice());
         system.assemble_mixed(&state, true, geometric, &mut a);
-        res.push(a.residual.iter().map(|r| r * r).sum::<f64>().sqrt());
+        res.push(a.residual().iter().map(|r| r * r).sum::<f64>().sqrt());
         if *res.last().expect("pushed") < 1e-12 {
             break;
         }
@@ -78,7 +78,7 @@ fn newton_corrections(mixed: bool) -> Result<(Vec<f64>, Vec<f64>, f64, f64)> {
             }
         }
         solver.factorize(&a.k_ff)?;
-        let mut dq: Vec<f64> = a.residual.iter().map(|r| -r).collect();
+        let mut dq: Vec<f64> = a.residual().iter().map(|r| -r).collect();
         solver.solve_in_place(&mut dq)?;
         corr.push(
             dq.iter()
@@ -88,7 +88,8 @@ fn newton_corrections(mixed: bool) -> Result<(Vec<f64>, Vec<f64>, f64, f64)> {
                 .sqrt(),
         );
         if mixed {
-            system.linearised_stresses(&state, &dq, 0.0, &mut stress);
+            let dc = system.constrained_increments(state.t, 0.0);
+            system.linearised_stresses(&state, &dq, &dc, &mut stress);
         }
         system.update(&mut state, &dq, 0.0);
     }

@@ -243,6 +243,20 @@ impl ShellElement {
         self.area
     }
 
+    /// Consistent nodal areas `int N_a dA` over the reference surface [m^2] (2 x 2 Gauss rule):
+    /// the nodal weights of a uniform load per unit area; they sum to the area.
+    #[must_use]
+    pub fn nodal_areas(&self) -> [f64; 4] {
+        let mut w = [0.0; 4];
+        for (gp, &(xi, eta)) in self.gp.iter().zip(&GAUSS_2X2) {
+            let (n, _) = bilinear(xi, eta);
+            for a in 0..4 {
+                w[a] += n[a] * gp.w;
+            }
+        }
+        w
+    }
+
     /// Strains in the configuration `(x, q)` (zero in the reference configuration).
     #[must_use]
     pub fn strains(&self, x: &[Vector3<f64>; 4], q: &[Matrix3<f64>; 4]) -> ShellStrains {

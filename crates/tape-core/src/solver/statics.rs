@@ -1,87 +1,117 @@
-//! Static equilibrium paths: `r(q, lambda) = f_int(q) - lambda f_ext = 0` at the free DOFs, with
-//! the constrained DOFs at `lambda * value`.
+//! Static equilibrium paths: `r(q, t) = f_int(q) - f_ext(t) = 0` at the free DOFs, with the
+//! constrained DOFs moving as their time functions say; in static steps the load factor `lambda`
+//! plays the role of time `t`.
 //!
 //! Every increment is a bordered Newton iteration: with `K = dr/dq` and
-//! `b = -dr/dlambda = f_ext - K_fc * values`, each iteration solves `K dq_r = -r` and `K dq_b = b`
-//! (one factorisation, two solves) and sets `dq = dq_r + dlambda dq_b`, where `dlambda` comes from
-//! the control equation: zero (load control), the controlled DOF fixed (displacement control, Batoz
-//! & Dhatt 1979), or the arc-length constraint
-//! `|Dq|_W^2 + Dlambda^2 c = Ds^2` (Crisfield 1981), whose root is chosen at the smallest angle with
-//! the predictor. The first predictor follows the tangent in the requested direction; later ones
-//! follow the tangent at the converged state (when its factorisation is at hand from the
-//! stability count) oriented like the previous increment (Feng et al. 1996), or else, and always
-//! after a cut-back, extrapolate the previous converged increment (secant predictor). A converged
-//! increment that turns back on the path (negative inner product with the previous one) is
-//! rejected and cut back, and one that bends by more than 60 degrees is refined, so limit points,
-//! snap-through and snap-back are passed without reversing or jumping branches. Norms weigh rotations by the
-//! characteristic length `L_c` of the model.
+//! `b = -dr/dlambda = df_ext/dt - K_fc * rates`, each iteration solves `K dq_r = -r` and
+//! `K dq_b = b` (one factorisation, two solves) and sets `dq = dq_r + dlambda dq_b`, where `dlambda`
+//! comes from the control equation: zero (load control), the controlled DOF fixed (displacement
+//! control, Batoz & Dhatt 1979), or the arc-length constraint `|Dq|_W^2 + Dlambda^2 c = Ds^2`
+//! (Crisfield 1981), whose root is chosen at the smallest angle with the predictor. The first
+//! predictor follows the tangent in the requested direction; later ones follow the tangent at the
+//! converged state (when its factorisation is at hand from the stability count) oriented like the
+//! previous increment (Feng et al. 1996), or else, and always after a cut-back, extrapolate the
+//! previous converged increment (secant predictor). A converged increment that turns back on the
+//! path (negative inner product with the previous one) is rejected and cut back, and one that bends
+//! by more than 60 degrees is refined, so limit points, snap-through and snap-back are passed
+//! without reversing or jumping branches. Norms weigh rotations by the characteristic length `L_c`
+//! of the model.
 //!
-//! An increment that fails (no convergence, singular tangent, no arc-length root, non-finite
-//! values) is restarted from the last converged state with half the increment, up to
-//! `max_cutbacks` times; then the analysis stops with [`Error::NotConverged`] and the path so far.
+//! The driver is a loop of *propose* (the next increment from the [`StepController`]), *attempt*
+//! (the Newton iteration), then *accept* (record the state, adapt the increment) or *reject* (restore
+//! the last converged state, halve the increment). An increment is rejected for the reasons of
+//! [`Rejection`]; after `max_cutbacks` successive halvings, or once the increment is below
+//! round-off, the analysis stops with [`Error::NotConverged`] and the path so far.
+//!
+//! On an arc-length path, limit points of the load factor and extrema of a monitored reaction
+//! can be located (see [`super::StaticParams`]): once a converged step shows the path turned
+//! (the load factor, or the monitored reaction, changed its sense of variation), the extremum is
+//! searched for between the last three converged states by solving for equilibria on hyperplanes
+//! across the chord of that stretch (`(z - z_a) . c = s |c|^2`, `z = (q, lambda)`, a linear
+//! constraint in the bordered system), with a parabolic search in `s`, and recorded at its place in
+//! path order. The path itself (its converged steps) is unchanged by this: the located states are
+//! inserted, and the solver resumes from the state it had reached.
 
 use std::time::Instant;
 
-use super::{Control, StaticParams, StaticPath, StaticStep, Stats};
+use super::control::{GiveUp, StepController};
+use super::events::{after_step, Point};
+use super::newton::{Convergence, Stall};
+use super::{Control, Rejection, StaticParams, StaticPath, StaticStep, Stats};
 use crate::assembly::{Assembled, System};
-use crate::dof::Slot;
+use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
 use crate::error::{Error, Result};
-use crate::linalg::LinearSolver;
 use crate::state::State;
 
 /// What one increment does.
-#[derive(Clone, Copy, Debug)]
-enum Increment {
+#[derive(Clone, Debug)]
+pub(super) enum Increment {
     Load(f64),
-    Displacement { eq: usize, delta: f64 },
-    Arc { ds: f64, direction: f64 },
+    Displacement {
+        eq: usize,
+        delta: f64,
+    },
+    Arc {
+        ds: f64,
+        direction: f64,
+    },
+    /// Equilibrium on the hyperplane through `z_start + fraction c` normal to the chord
+    /// `c = (chord, chord_lambda)` (in the arc-length metric): predictor `fraction c`, then
+    /// corrections orthogonal to `c` (Riks' normal plane).
+    Plane {
+        chord: Vec<f64>,
+        chord_lambda: f64,
+        fraction: f64,
+    },
 }
 
-struct Outcome {
-    iterations: usize,
-    residual: f64,
-    dq: Vec<f64>,
-    dlambda: f64,
+pub(super) struct Outcome {
+    pub iterations: usize,
+    pub residual: f64,
+    pub dq: Vec<f64>,
+    pub dlambda: f64,
 }
 
-struct Solver<'a> {
-    system: &'a mut System,
-    linear: LinearSolver,
-    asm: Assembled,
-    /// `asm` holds residual and tangent of the current state.
-    fresh: bool,
-    /// `linear` holds the factorisation of `asm`'s tangent.
-    factorised: bool,
+pub(super) struct Driver<'a> {
+    pub system: &'a mut System,
+    pub asm: Assembled,
+    /// Static residual `f_int - f_ext` of `asm`.
+    pub r: Vec<f64>,
+    /// `asm` holds the pieces and tangent of the current state.
+    pub fresh: bool,
+    /// `system.linear` holds the factorisation of `asm`'s tangent.
+    pub factorised: bool,
     /// Element stresses of the mixed iteration at the current state (linearised from the last
     /// iterate), used by the next tangent when `stress_valid`.
-    stress: Vec<ElementStress>,
-    stress_valid: bool,
-    /// Residual norm reachable in floating point [N]: a few ulps of the element forces.
-    round_off: f64,
-    /// Largest reference force met on the path so far [N] (the force scale near zero load).
-    path_force: f64,
+    pub stress: Vec<ElementStress>,
+    pub stress_valid: bool,
+    pub conv: Convergence,
+    force_floor: f64,
     /// Reject arc-length steps that bend sharply (cleared after repeated cut-backs).
     strict_turns: bool,
     /// Use the tangent predictor when a factorisation of the converged state is at hand (off
     /// after a cut-back: the secant predictor is safer at sharp turns).
     tangent_predictor: bool,
     /// Increment of the last converged step, for the arc-length secant predictor.
-    previous: Option<(Vec<f64>, f64)>,
-    weights: Vec<f64>,
-    values: Vec<f64>,
+    pub previous: Option<(Vec<f64>, f64)>,
+    pub weights: Vec<f64>,
+    /// Rates of the constrained DOFs, `value f'(t)`, at the current state.
+    rates: Vec<f64>,
+    /// Weight of the load factor in the arc-length norm: `|rates|_W^2`.
     c_lambda: f64,
-    params: &'a StaticParams,
-    stats: Stats,
-    force_floor: f64,
+    pub params: &'a StaticParams,
+    pub stats: Stats,
 }
 
-impl Solver<'_> {
-    fn assemble(&mut self, state: &State) {
+impl Driver<'_> {
+    pub fn assemble(&mut self, state: &State) {
         let t = Instant::now();
         let stress = self.stress_valid.then_some(self.stress.as_slice());
         self.system
             .assemble_mixed(state, true, stress, &mut self.asm);
+        self.asm.residual_into(&mut self.r);
+        self.rates = self.system.constrained_rates(state.t);
         self.stats.assembly_s += t.elapsed().as_secs_f64();
         self.fresh = true;
         self.factorised = false;
@@ -90,24 +120,26 @@ impl Solver<'_> {
     /// Moves `state` by `(dq, dlambda)`; in the mixed iteration the element stresses follow the
     /// linearised kinematics of that move.
     fn advance(&mut self, state: &mut State, dq: &[f64], dlambda: f64) {
+        let dc = self.system.constrained_increments(state.t, dlambda);
         if self.params.newton.mixed_stress {
             let t = Instant::now();
             self.system
-                .linearised_stresses(state, dq, dlambda, &mut self.stress);
+                .linearised_stresses(state, dq, &dc, &mut self.stress);
             self.stats.assembly_s += t.elapsed().as_secs_f64();
             self.stress_valid = true;
         }
-        self.system.update(state, dq, dlambda);
+        self.system.update_with(state, dq, &dc);
+        state.t += dlambda;
     }
 
     /// Forgets everything computed at the current state (after it was replaced).
-    fn invalidate(&mut self) {
+    pub fn invalidate(&mut self) {
         self.fresh = false;
         self.factorised = false;
         self.stress_valid = false;
     }
 
-    fn dot_w(&self, a: &[f64], b: &[f64]) -> f64 {
+    pub fn dot_w(&self, a: &[f64], b: &[f64]) -> f64 {
         a.iter()
             .zip(b)
             .zip(&self.weights)
@@ -115,7 +147,7 @@ impl Solver<'_> {
             .sum()
     }
 
-    fn force_norm(&self, f: &[f64]) -> f64 {
+    pub fn force_norm(&self, f: &[f64]) -> f64 {
         f.iter()
             .zip(&self.weights)
             .map(|(v, w)| v * v / w)
@@ -129,63 +161,82 @@ impl Solver<'_> {
             .dofs
             .constrained
             .iter()
-            .zip(&self.asm.reactions)
-            .map(|(c, r)| if c.dof.is_rotation() { r * r / lc2 } else { r * r })
+            .zip(self.asm.f_int_c.iter().zip(&self.asm.f_ext_c))
+            .map(|(c, (i, e))| {
+                let r = i - e;
+                if c.dof.is_rotation() {
+                    r * r / lc2
+                } else {
+                    r * r
+                }
+            })
             .sum::<f64>()
             .sqrt()
     }
 
-    fn reference_force(&self, lambda: f64) -> f64 {
-        (lambda.abs() * self.force_norm(&self.asm.f_ext))
+    pub fn reference_force(&self) -> f64 {
+        self.force_norm(&self.asm.f_ext)
             .max(self.reaction_norm())
             .max(self.force_floor)
     }
 
-    /// `b = f_ext - K_fc values`.
+    /// `b = df_ext/dt - K_fc rates`.
     fn load_vector(&self) -> Vec<f64> {
-        let mut b = self.asm.f_ext.clone();
+        let mut b = self.asm.df_ext.clone();
         let mut kv = vec![0.0; b.len()];
         self.system
             .pattern_fc
-            .mul_add(&self.asm.k_fc, &self.values, &mut kv);
+            .mul_add(&self.asm.k_fc, &self.rates, &mut kv);
         for (bi, k) in b.iter_mut().zip(kv) {
             *bi -= k;
         }
         b
     }
 
-    /// Factorises the current tangent and returns `(dq_r, dq_b)`.
-    fn solve_pair(&mut self) -> Result<(Vec<f64>, Vec<f64>)> {
-        let t = Instant::now();
+    /// Factorises the current tangent (if not done yet).
+    pub fn factorise(&mut self) -> Result<()> {
         if !self.factorised {
-            self.linear.factorize(&self.asm.k_ff)?;
+            let t = Instant::now();
+            self.system.linear.factorize(&self.asm.k_ff)?;
             self.stats.factorisations += 1;
             self.factorised = true;
+            self.stats.solve_s += t.elapsed().as_secs_f64();
         }
-        let mut dq_r: Vec<f64> = self.asm.residual.iter().map(|r| -r).collect();
-        self.linear.solve_in_place(&mut dq_r)?;
+        Ok(())
+    }
+
+    /// Factorises the current tangent and returns `(dq_r, dq_b)`.
+    pub fn solve_pair(&mut self) -> Result<(Vec<f64>, Vec<f64>)> {
+        self.factorise()?;
+        let t = Instant::now();
+        let mut dq_r: Vec<f64> = self.r.iter().map(|r| -r).collect();
+        self.system.linear.solve_in_place(&mut dq_r)?;
         let mut dq_b = self.load_vector();
-        self.linear.solve_in_place(&mut dq_b)?;
+        self.system.linear.solve_in_place(&mut dq_b)?;
         self.stats.solve_s += t.elapsed().as_secs_f64();
         Ok((dq_r, dq_b))
     }
 
-    fn converged(&self, lambda: f64, energy: Option<(f64, f64)>) -> (bool, f64) {
-        let res = self.force_norm(&self.asm.residual);
-        let tol = self.params.newton.tol_force * self.reference_force(lambda);
-        let ok_force = res <= tol.max(self.round_off);
-        // The energy ratio cannot go below round-off on tiny increments: a residual a hundred times
-        // below the force tolerance, or at the round-off floor, is converged whatever the energy
-        // ratio says.
-        let ok_energy = energy.is_none_or(|(first, last)| last <= self.params.newton.tol_energy * first)
-            || res <= (0.01 * tol).max(self.round_off);
-        (ok_force && ok_energy && res.is_finite(), res)
+    pub fn converged(&self, energy: Option<(f64, f64)>) -> (bool, f64) {
+        let res = self.force_norm(&self.r);
+        (self.conv.test(res, self.reference_force(), energy), res)
     }
 
-    /// One increment from the converged `state`; on error the state is left modified.
+    /// Norm of an increment in the arc-length metric.
+    pub fn arc_norm(&self, dq: &[f64], dlambda: f64) -> f64 {
+        (self.dot_w(dq, dq) + dlambda * dlambda * self.c_lambda).sqrt()
+    }
+
+    /// Inner product of two increments in the arc-length metric.
+    pub fn arc_dot(&self, a: (&[f64], f64), b: (&[f64], f64)) -> f64 {
+        self.dot_w(a.0, b.0) + a.1 * b.1 * self.c_lambda
+    }
+
+    /// One increment from the converged `state`; on rejection the state is left modified.
     #[allow(clippy::too_many_lines)]
-    fn increment(&mut self, state: &mut State, inc: Increment) -> Result<Outcome> {
-        if !self.fresh {
+    pub fn increment(&mut self, state: &mut State, inc: &Increment) -> std::result::Result<Outcome, Rejection> {
+        // The plane's predictor needs nothing of the start state.
+        if !self.fresh && !matches!(inc, Increment::Plane { .. }) {
             self.assemble(state);
         }
         let tangent_predictor = self.factorised && self.tangent_predictor;
@@ -194,7 +245,7 @@ impl Solver<'_> {
                 // Tangent predictor from the factorisation already made for the stability count,
                 // oriented like the previous increment (Feng et al. 1996).
                 let mut dq_b = self.load_vector();
-                self.linear.solve_in_place(&mut dq_b)?;
+                self.system.linear.solve_in_place(&mut dq_b)?;
                 let sign = if self.dot_w(prev_dq, &dq_b) + prev_dl * self.c_lambda >= 0.0 {
                     1.0
                 } else {
@@ -210,22 +261,29 @@ impl Solver<'_> {
                 let scale = ds / norm;
                 (scale * prev_dl, prev_dq.iter().map(|v| scale * v).collect())
             }
+            (
+                Increment::Plane {
+                    chord,
+                    chord_lambda,
+                    fraction,
+                },
+                _,
+            ) => (fraction * chord_lambda, chord.iter().map(|c| fraction * c).collect()),
             _ => {
                 let (dq_r, dq_b) = self.solve_pair()?;
                 let (dlambda0, mut dq) = match inc {
-                    Increment::Load(dl) => (dl, dq_r),
+                    Increment::Load(dl) => (*dl, dq_r),
                     Increment::Displacement { eq, delta } => {
-                        if dq_b[eq].abs() < 1e-300 {
-                            return Err(Error::Factorisation(
-                                "the controlled DOF does not respond to the load".into(),
-                            ));
+                        if dq_b[*eq].abs() < 1e-300 {
+                            return Err(Rejection::NoResponse);
                         }
-                        ((delta - dq_r[eq]) / dq_b[eq], dq_r)
+                        ((delta - dq_r[*eq]) / dq_b[*eq], dq_r)
                     }
                     Increment::Arc { ds, direction } => {
                         let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
                         (direction * ds / norm, vec![0.0; dq_b.len()])
                     }
+                    Increment::Plane { .. } => unreachable!("handled above"),
                 };
                 for (d, b) in dq.iter_mut().zip(&dq_b) {
                     *d += dlambda0 * b;
@@ -240,29 +298,27 @@ impl Solver<'_> {
         let max_it = self.params.newton.max_iterations;
         let mut res = f64::INFINITY;
         let mut no_root = 0;
-        // Smallest residual so far and the iteration that reached it: an iteration that has not
-        // improved on it for `stall_iterations` iterations is cycling, not converging, and is cut
-        // back at once rather than after `max_iterations`.
-        let stall_n = self.params.newton.stall_iterations;
-        let mut best = (f64::INFINITY, 0);
-        let mut stalled = None;
+        // An iteration that has not improved on its best residual for `stall_iterations`
+        // iterations is cycling, not converging, and is cut back at once rather than after
+        // `max_iterations`.
+        let mut stall = Stall::new(self.params.newton.stall_iterations);
+        let mut stalled = false;
+        let mut last_it = max_it;
         for it in 1..=max_it {
             self.stats.iterations += 1;
             self.assemble(state);
-            let (ok, r) = self.converged(state.lambda, energy_first);
+            let (ok, r) = self.converged(energy_first);
             res = r;
-            log::trace!("Newton iteration {it}: lambda {:.6}, residual {res:.3e}", state.lambda);
+            log::trace!("Newton iteration {it}: t {:.6}, residual {res:.3e}", state.t);
             if !res.is_finite() {
-                return Err(Error::Factorisation("non-finite residual".into()));
+                return Err(Rejection::NonFinite);
             }
             if ok {
-                return self.accept(inc, it, res, acc, acc_lambda);
+                return self.checked(inc, it, res, acc, acc_lambda);
             }
-            if res < best.0 {
-                best = (res, it);
-            }
-            if stall_n > 0 && it >= best.1 + stall_n {
-                stalled = Some(it);
+            if stall.stalled(it, res) {
+                stalled = true;
+                last_it = it;
                 break;
             }
             if it == max_it {
@@ -271,7 +327,7 @@ impl Solver<'_> {
             let (dq_r, dq_b) = self.solve_pair()?;
             let dl = match inc {
                 Increment::Load(_) => 0.0,
-                Increment::Displacement { eq, .. } => -dq_r[eq] / dq_b[eq],
+                Increment::Displacement { eq, .. } => -dq_r[*eq] / dq_b[*eq],
                 Increment::Arc { ds, .. } => {
                     let u: Vec<f64> = acc.iter().zip(&dq_r).map(|(a, r)| a + r).collect();
                     let a = self.dot_w(&dq_b, &dq_b) + self.c_lambda;
@@ -281,9 +337,7 @@ impl Solver<'_> {
                     if disc < 0.0 {
                         no_root += 1;
                         if no_root > 2 {
-                            return Err(Error::Factorisation(
-                                "the arc-length constraint has no real root".into(),
-                            ));
+                            return Err(Rejection::NoArcRoot);
                         }
                         -b / (2.0 * a)
                     } else {
@@ -300,21 +354,34 @@ impl Solver<'_> {
                         }
                     }
                 }
+                Increment::Plane {
+                    chord,
+                    chord_lambda,
+                    fraction,
+                } => {
+                    // The corrections stay orthogonal to the chord:
+                    // (acc - fraction c + dq_r + dl dq_b) . c = 0.
+                    let c2 = self.arc_dot((chord, *chord_lambda), (chord, *chord_lambda));
+                    let num = fraction * c2
+                        - self.arc_dot((&acc, acc_lambda), (chord, *chord_lambda))
+                        - self.dot_w(&dq_r, chord);
+                    let den = self.dot_w(&dq_b, chord) + chord_lambda * self.c_lambda;
+                    if den.abs() < 1e-300 {
+                        return Err(Rejection::NoArcRoot);
+                    }
+                    num / den
+                }
             };
             let step: Vec<f64> = dq_r.iter().zip(&dq_b).map(|(r, b)| r + dl * b).collect();
             let e = self
-                .asm
-                .residual
+                .r
                 .iter()
                 .zip(&step)
                 .map(|(r, s)| r * s)
                 .sum::<f64>()
                 .abs();
             let energy = match energy_first {
-                None => {
-                    energy_first = Some((e.max(1e-300), e));
-                    energy_first
-                }
+                None => Some((e.max(1e-300), e)),
                 Some((first, _)) => Some((first, e)),
             };
             energy_first = energy;
@@ -322,13 +389,13 @@ impl Solver<'_> {
             // the current state (its tangent is factorised, ready for the stability check and the
             // next predictor) instead of paying an assembly to confirm what the energy says.
             if let Some((first, last)) = energy {
-                if it > 1 && last <= self.params.newton.tol_energy * first && self.converged(state.lambda, None).0 {
-                    return self.accept(inc, it, res, acc, acc_lambda);
+                if it > 1 && last <= self.params.newton.tol_energy * first && self.converged(None).0 {
+                    return self.checked(inc, it, res, acc, acc_lambda);
                 }
             }
+            let line_search = matches!(inc, Increment::Load(_) | Increment::Displacement { .. });
             let mut alpha = 1.0;
-            let saved =
-                (!matches!(inc, Increment::Arc { .. }) && self.params.newton.line_search).then(|| state.clone());
+            let saved = (line_search && self.params.newton.line_search).then(|| state.clone());
             loop {
                 let scaled: Vec<f64> = step.iter().map(|s| alpha * s).collect();
                 self.advance(state, &scaled, alpha * dl);
@@ -338,9 +405,10 @@ impl Solver<'_> {
                 }
                 let t = Instant::now();
                 self.system.assemble(state, false, &mut self.asm);
+                self.asm.residual_into(&mut self.r);
                 self.stats.assembly_s += t.elapsed().as_secs_f64();
                 self.fresh = false;
-                let new_res = self.force_norm(&self.asm.residual);
+                let new_res = self.force_norm(&self.r);
                 if new_res.is_finite() && new_res <= res {
                     break;
                 }
@@ -352,19 +420,22 @@ impl Solver<'_> {
             }
             acc_lambda += alpha * dl;
         }
-        Err(Error::NotConverged {
-            lambda: state.lambda,
-            iterations: stalled.unwrap_or(max_it),
+        Err(Rejection::NotConverged {
+            iterations: last_it,
             residual: res,
-            detail: match stalled {
-                Some(_) => format!("Newton iterations stalled (no progress in {stall_n} iterations)"),
-                None => "Newton iterations exhausted".into(),
-            },
+            stalled,
         })
     }
 
     /// A converged increment: rejected if it turned back or bent sharply on the arc-length path.
-    fn accept(&self, inc: Increment, iterations: usize, residual: f64, dq: Vec<f64>, dlambda: f64) -> Result<Outcome> {
+    fn checked(
+        &self,
+        inc: &Increment,
+        iterations: usize,
+        residual: f64,
+        dq: Vec<f64>,
+        dlambda: f64,
+    ) -> std::result::Result<Outcome, Rejection> {
         if let (Increment::Arc { .. }, Some((prev_dq, prev_dl))) = (inc, &self.previous) {
             // A converged increment that turns back on the path means the step jumped
             // across a sharp turn: reject it so that the step is cut back.
@@ -373,17 +444,13 @@ impl Solver<'_> {
                 * (self.dot_w(prev_dq, prev_dq) + prev_dl * prev_dl * self.c_lambda))
                 .sqrt();
             if dot <= 0.0 {
-                return Err(Error::Factorisation(
-                    "the arc-length step turned back on the path".into(),
-                ));
+                return Err(Rejection::TurnedBack);
             }
             // A bend of more than 60 degrees in one step may have jumped to another branch (seen on a
             // 4 mm tape unloading past the heel): refine (the driver accepts it once half of the
             // cut-backs are spent).
             if dot < 0.5 * norms && self.strict_turns {
-                return Err(Error::Factorisation(
-                    "the arc-length step bent by more than 60 degrees".into(),
-                ));
+                return Err(Rejection::BentSharply);
             }
         }
         Ok(Outcome {
@@ -394,16 +461,13 @@ impl Solver<'_> {
         })
     }
 
-    fn record(&mut self, state: &State, out: &Outcome) -> Result<StaticStep> {
+    /// The converged `state` as a recorded step (stability count if asked).
+    pub fn record(&mut self, state: &State, out: &Outcome) -> Result<StaticStep> {
         let negative_eigenvalues = if self.params.stability {
-            let t = Instant::now();
             // The LDL^T of the converged tangent is the one factorised for the convergence check.
-            if !self.factorised {
-                self.linear.factorize(&self.asm.k_ff)?;
-                self.stats.factorisations += 1;
-                self.factorised = true;
-            }
-            let n = self.linear.negative_eigenvalues()?;
+            self.factorise()?;
+            let t = Instant::now();
+            let n = self.system.linear.negative_eigenvalues()?;
             self.stats.solve_s += t.elapsed().as_secs_f64();
             Some(n)
         } else {
@@ -422,129 +486,75 @@ impl Solver<'_> {
         } else {
             (Vec::new(), Vec::new())
         };
+        let markers = self
+            .system
+            .marker_positions(state)
+            .iter()
+            .map(|x| (*x).into())
+            .collect();
+        let marker_rotations = self
+            .system
+            .marker_rotations(state)
+            .iter()
+            .map(|x| (*x).into())
+            .collect();
+        let probes = self.system.probe(&self.asm);
         Ok(StaticStep {
-            lambda: state.lambda,
+            lambda: state.t,
             iterations: out.iterations,
             residual: out.residual,
             energy: self.asm.energy,
-            reactions: self.asm.reactions.clone(),
+            gravity_energy: self.asm.gravity_energy,
+            reactions: self.asm.reactions(),
             negative_eigenvalues,
             displacements,
             rotations,
+            markers,
+            marker_rotations,
+            probes,
             jump: false,
+            event: None,
+            arc: 0.0,
         })
     }
 
     /// Weighted distance between two configurations (translations [m], rotations times `L_c`).
-    fn distance(&self, a: &State, b: &State) -> f64 {
+    pub fn distance(&self, a: &State, b: &State) -> f64 {
         let lc2 = self.system.char_length.powi(2);
         a.x.iter()
             .zip(&b.x)
             .zip(a.q.iter().zip(&b.q))
-            .map(|((xa, xb), (qa, qb))| {
-                (xa - xb).norm_squared() + lc2 * (qa * qb.inverse()).scaled_axis().norm_squared()
-            })
+            .map(|((xa, xb), (qa, qb))| (xa - xb).norm_squared() + lc2 * (qa * qb.inverse()).scaled_axis().norm_squared())
             .sum::<f64>()
             .sqrt()
     }
 
-    /// Moves the load factor to `lambda` and relaxes `state` to a stable equilibrium there by
-    /// pseudo-transient continuation: each pseudo-time step solves
-    /// `r(q) + C (q - q_k) = 0` with `C = beta diag|K|`, `beta` large enough that `K + C` is positive
-    /// definite, so every step descends the potential (an implicit gradient flow); `beta` shrinks as
-    /// steps succeed, ending in plain Newton at a stable equilibrium. Returns the pseudo-steps used.
-    fn relax(&mut self, state: &mut State, lambda: f64) -> Result<usize> {
-        const MAX_STEPS: usize = 400;
-        let n = self.system.n_free();
-        let zero = vec![0.0; n];
-        self.system.update(state, &zero, lambda - state.lambda);
-        // A gradient flow on the true potential: exact tangents.
-        self.invalidate();
-        let diag: Vec<usize> = (0..n)
-            .map(|i| {
-                self.system
-                    .pattern_ff
-                    .find(i, i)
-                    .expect("diagonal entries are in the pattern")
-            })
-            .collect();
-        let mut beta: f64 = 1e-2;
-        for step in 0..MAX_STEPS {
-            self.assemble(state);
-            let (ok, rr) = self.converged(state.lambda, None);
-            log::trace!("relaxation step {step}: beta {beta:.1e}, residual {rr:.3e}");
-            if ok && beta <= 1e-6 {
-                self.linear.factorize(&self.asm.k_ff)?;
-                self.stats.factorisations += 1;
-                self.factorised = true;
-                if self.linear.negative_eigenvalues()? == 0 {
-                    return Ok(step);
-                }
-                beta = beta.max(1e-3);
-            }
-            let anchor = state.clone();
-            let mut acc = vec![0.0; n];
-            let mut success = false;
-            let mut iterations = 0;
-            for it in 0..15 {
-                iterations = it + 1;
-                if it > 0 {
-                    self.assemble(state);
-                }
-                let mut k = self.asm.k_ff.clone();
-                let mut r = self.asm.residual.clone();
-                for (i, &p) in diag.iter().enumerate() {
-                    let c = beta * self.asm.k_ff[p].abs().max(1e-12);
-                    k[p] += c;
-                    r[i] += c * acc[i];
-                }
-                let res = self.force_norm(&r);
-                if it > 0
-                    && res <= self.params.newton.tol_force * self.reference_force(state.lambda).max(self.round_off)
-                {
-                    success = true;
-                    break;
-                }
-                let t = std::time::Instant::now();
-                self.linear.factorize(&k)?;
-                self.stats.factorisations += 1;
-                self.factorised = false;
-                if self.linear.negative_eigenvalues().unwrap_or(1) > 0 {
-                    // K + C must be positive definite for a descent step.
-                    break;
-                }
-                let mut dq: Vec<f64> = r.iter().map(|v| -v).collect();
-                self.linear.solve_in_place(&mut dq)?;
-                self.stats.solve_s += t.elapsed().as_secs_f64();
-                self.stats.iterations += 1;
-                self.system.update(state, &dq, 0.0);
-                for (a, d) in acc.iter_mut().zip(&dq) {
-                    *a += d;
-                }
-            }
-            // The shift that keeps K + C positive definite can be tiny next to diag|K| (a soft mode
-            // of a membrane-stiff shell): let beta go down to 1e-12 before plain Newton, and grow it
-            // back from there, so that soft modes are not crept along with a needlessly large shift.
-            if success {
-                beta /= if iterations <= 3 { 4.0 } else { 1.5 };
-                if beta < 1e-12 {
-                    beta = 0.0;
-                }
-            } else {
-                *state = anchor;
-                beta = (beta * 4.0).max(1e-12);
-                if beta > 1e4 {
-                    break;
-                }
-            }
-        }
-        Err(Error::NotConverged {
-            lambda: state.lambda,
-            iterations: MAX_STEPS,
-            residual: self.force_norm(&self.asm.residual),
-            detail: "relaxation past a limit point found no stable equilibrium".into(),
-        })
+    /// Index of the reaction of `monitor` among the constrained DOFs.
+    pub fn monitor_index(&self) -> Option<usize> {
+        let m = self.params.monitor?;
+        self.system
+            .dofs
+            .constrained
+            .iter()
+            .position(|c| c.node == m.node && c.dof == m.dof)
     }
+}
+
+/// The driver's bookkeeping of one path, between propose, attempt, accept and reject.
+struct PathState {
+    control: StepController,
+    /// Load-factor increment of the last accepted step (None before the first one).
+    last_dlambda: Option<f64>,
+    /// Steps left (arc-length: `max_steps`).
+    steps_left: usize,
+    /// Arc length of the first step (arc-length only), once known.
+    arc_ds: Option<f64>,
+    /// Displacement control: distance travelled.
+    travelled: f64,
+    /// Arc-length position of the current state from the start of the path.
+    arc: f64,
+    /// Converged states kept for the location of events and refinement (cleared at jumps).
+    history: Vec<Point>,
 }
 
 /// Follows the static equilibrium path of `system` from `state` as `params` says, calling
@@ -554,6 +564,7 @@ impl Solver<'_> {
 /// # Errors
 /// Invalid parameters or a model with nothing to solve are returned at once; failures during the
 /// analysis are reported in [`StaticPath::error`] with the converged steps kept.
+#[allow(clippy::too_many_lines)]
 pub fn solve_static(
     system: &mut System,
     state: &mut State,
@@ -562,9 +573,23 @@ pub fn solve_static(
 ) -> Result<StaticPath> {
     params.validate()?;
     let start = Instant::now();
-    let values: Vec<f64> = system.dofs.constrained.iter().map(|c| c.value).collect();
-    let has_motion = values.iter().any(|v| *v != 0.0);
-    let has_load = system.loads.iter().any(|l| l.value != 0.0);
+    let arc_control = matches!(params.control, Control::ArcLength { .. });
+    let lambda_end = match &params.control {
+        Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => Some(*lambda_end),
+        Control::Displacement { .. } => None,
+    };
+    system.time_direction = match (lambda_end, &params.control) {
+        (Some(end), Control::ArcLength { direction, .. }) if end == state.t => *direction,
+        (Some(end), _) if end < state.t => -1.0,
+        _ => 1.0,
+    };
+    let rates = system.constrained_rates(state.t);
+    let has_motion = rates.iter().any(|v| *v != 0.0) || system.dofs.constrained.iter().any(|c| c.value != 0.0);
+    let has_load = system.loads.iter().any(|l| l.value != 0.0)
+        || system
+            .gravity
+            .as_ref()
+            .is_some_and(|(g, _)| *g != nalgebra::Vector3::zeros() && system.total_mass() > 0.0);
     if !has_load && !has_motion {
         return Err(Error::InvalidModel(
             "the analysis has no load and no prescribed motion".into(),
@@ -575,22 +600,17 @@ pub fn solve_static(
             "the model has no constraint against rigid-body motion".into(),
         ));
     }
-    let linear = LinearSolver::try_new(&system.pattern_ff)?;
     let lc2 = system.char_length.powi(2);
     let c_lambda: f64 = system
         .dofs
         .constrained
         .iter()
-        .map(|c| {
-            if c.dof.is_rotation() {
-                lc2 * c.value * c.value
-            } else {
-                c.value * c.value
-            }
-        })
+        .zip(&rates)
+        .map(|(c, v)| if c.dof.is_rotation() { lc2 * v * v } else { v * v })
         .sum();
     let weights = system.free_weights();
-    let force_floor = 1e-13 * system.section.membrane[(0, 0)] * system.char_length;
+    let membrane = system.membrane_stiffness();
+    let force_floor = 1e-13 * membrane * system.char_length;
     // Element forces are sums of terms of size E t |x| that cancel: the residual cannot go below a
     // few ulps of them (measured: about eps E t |x| per node).
     let x_max = system
@@ -600,42 +620,45 @@ pub fn solve_static(
         .map(|x| x.norm())
         .fold(0.0, f64::max);
     // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
-    let round_off = f64::EPSILON
-        * system.section.membrane[(0, 0)]
-        * (x_max + system.char_length)
-        * (system.reference.x.len() as f64).sqrt();
-    let mut s = Solver {
+    #[allow(clippy::cast_precision_loss)]
+    let round_off = f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
+    let linear_counts = (
+        system.linear.refinement_sweeps,
+        system.linear.lu_fallbacks,
+    );
+    let mut s = Driver {
         system,
-        linear,
         asm: Assembled::default(),
+        r: Vec::new(),
         fresh: false,
         factorised: false,
         stress: Vec::new(),
         stress_valid: false,
-        round_off,
-        path_force: 0.0,
+        conv: Convergence {
+            tol_force: params.newton.tol_force,
+            tol_energy: params.newton.tol_energy,
+            round_off,
+        },
+        force_floor,
         strict_turns: true,
         tangent_predictor: true,
         previous: None,
         weights,
-        values,
+        rates,
         c_lambda,
         params,
         stats: Stats::default(),
-        force_floor,
     };
     let mut path = StaticPath::default();
 
-    // Load-factor increment of the last accepted step (None before the first one).
-    let mut last_dlambda: Option<f64> = None;
-    let mut size;
-    let mut steps_left;
-    let mut done_target = None;
-    match &params.control {
+    // Smallest increment worth trying: below it, the increment is lost in the load factor's or
+    // the controlled DOF's round-off.
+    let scale = state.t.abs().max(lambda_end.map_or(0.0, f64::abs)).max(1.0);
+    let (size, steps_left, max_size) = match &params.control {
         Control::Load { lambda_end, increments } => {
-            size = (lambda_end - state.lambda) / *increments as f64;
-            steps_left = usize::MAX;
-            done_target = Some(*lambda_end);
+            #[allow(clippy::cast_precision_loss)]
+            let size = (lambda_end - state.t) / *increments as f64;
+            (size, usize::MAX, size.abs())
         }
         Control::Displacement {
             node,
@@ -647,285 +670,323 @@ pub fn solve_static(
             if node >= s.system.dofs.slots.len() {
                 return Err(Error::InvalidModel(format!("controlled node {node} does not exist")));
             }
-            let Slot::Free(_) = s.system.dofs.slots[s.system.dofs.owner(node)][dof.index()] else {
-                return Err(Error::InvalidModel(format!(
-                    "controlled DOF {dof:?} of node {node} is not free"
-                )));
-            };
             if s.system.dofs.master[node].is_some() {
                 return Err(Error::InvalidModel(format!(
                     "controlled node {node} is rigidly tied; control its reference node"
                 )));
             }
-            size = delta / *increments as f64;
-            steps_left = *increments;
+            let Slot::Free(_) = s.system.dofs.slots[node][dof.index()] else {
+                return Err(Error::InvalidModel(format!(
+                    "controlled DOF {} of node {node} is not free",
+                    dof.name()
+                )));
+            };
+            #[allow(clippy::cast_precision_loss)]
+            let size = delta / *increments as f64;
+            (size, usize::MAX, size.abs())
         }
         Control::ArcLength {
             initial_increment,
             direction,
             max_steps,
             ..
-        } => {
-            size = initial_increment * direction;
-            steps_left = *max_steps;
-        }
+        } => (initial_increment * direction, *max_steps, f64::INFINITY),
+    };
+    let min_size = match &params.control {
+        Control::Displacement { delta, .. } => 1e-14 * delta.abs(),
+        _ => 1e-14 * scale,
+    };
+    let mut p = PathState {
+        control: StepController::new(size, max_size, min_size, params.target_iterations, params.max_cutbacks),
+        last_dlambda: None,
+        steps_left,
+        arc_ds: None,
+        travelled: 0.0,
+        arc: 0.0,
+        history: Vec::new(),
+    };
+    let locate = arc_control && (params.locate_limit_points || params.monitor.is_some());
+    let monitor = s.monitor_index();
+    if let (Some(m), None) = (params.monitor, monitor) {
+        return Err(Error::InvalidModel(format!(
+            "the monitored reaction ({} of node {}) is not a constrained DOF",
+            m.dof.name(),
+            m.node
+        )));
     }
-    let initial_size = size.abs();
-    let mut travelled = 0.0;
-    let mut arc_ds: Option<f64> = None;
-    let mut cutbacks = 0;
-    'steps: while steps_left > 0 {
-        if let Some(end) = done_target {
-            let remaining = end - state.lambda;
+    if locate {
+        // The start of the path is the first point of the location history (the assembly is the
+        // one the first increment needs anyway).
+        s.assemble(state);
+        let reactions = s.asm.reactions();
+        p.history.push(Point {
+            state: state.clone(),
+            arc: 0.0,
+            monitor: monitor.map_or(0.0, |i| reactions[i]),
+        });
+    }
+    'steps: while p.steps_left > 0 {
+        // Propose.
+        if let (Some(end), false) = (lambda_end, arc_control) {
+            let remaining = end - state.t;
             if remaining.abs() <= 1e-12 * end.abs().max(1.0) {
                 break;
             }
-            if size.abs() > remaining.abs() {
-                size = remaining;
+            if p.control.size.abs() > remaining.abs() {
+                p.control.size = remaining;
             }
         }
         if let Control::Displacement { delta, .. } = &params.control {
-            let remaining = delta - travelled;
+            let remaining = delta - p.travelled;
             if remaining.abs() <= 1e-12 * delta.abs() {
                 break;
             }
-            if size.abs() > remaining.abs() {
-                size = remaining;
+            if p.control.size.abs() > remaining.abs() {
+                p.control.size = remaining;
             }
         }
         let inc = match &params.control {
-            Control::Load { .. } => Increment::Load(size),
+            Control::Load { .. } => Increment::Load(p.control.size),
             Control::Displacement { node, dof, .. } => {
                 let Slot::Free(eq) = s.system.dofs.slots[*node][dof.index()] else {
-                    unreachable!()
+                    unreachable!("checked above")
                 };
-                Increment::Displacement { eq, delta: size }
+                Increment::Displacement {
+                    eq,
+                    delta: p.control.size,
+                }
             }
             Control::ArcLength {
                 direction,
                 initial_increment,
                 lambda_end,
+                max_increment_factor,
                 ..
             } => {
-                if arc_ds.is_none() {
+                if p.arc_ds.is_none() {
                     // First step: the arc length that gives the requested load-factor increment.
                     if !s.fresh {
                         s.assemble(state);
                     }
-                    let (_, dq_b) = match s.solve_pair() {
-                        Ok(v) => v,
+                    let dq_b = match s.solve_pair() {
+                        Ok((_, b)) => b,
                         Err(e) => {
                             path.error = Some(e);
                             break 'steps;
                         }
                     };
-                    arc_ds = Some(initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt());
-                    size = arc_ds.expect("set");
+                    let ds = initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt();
+                    if !(ds.is_finite() && ds > 0.0) {
+                        return Err(Error::InvalidModel(
+                            "arc-length control needs a load or a prescribed motion that changes with the load factor and acts on the free DOFs"
+                                .into(),
+                        ));
+                    }
+                    p.arc_ds = Some(ds);
+                    p.control.size = ds;
+                    p.control.max_size = ds * max_increment_factor;
+                    p.control.min_size = 1e-14 * ds / initial_increment * scale;
                 }
                 // Without a previous increment (first step, or after a jump) head for lambda_end.
-                let towards = (lambda_end - state.lambda).signum();
+                let towards = (lambda_end - state.t).signum();
                 Increment::Arc {
-                    ds: size.abs(),
+                    ds: p.control.size.abs(),
                     direction: if towards == 0.0 { *direction } else { towards },
                 }
             }
         };
+        // Attempt.
         let saved = state.clone();
-        match s.increment(state, inc) {
-            Ok(out) => {
-                // A limit point of the load factor: jump to the stable equilibrium beyond it.
-                if let (true, Control::ArcLength { lambda_end, .. }) = (params.jump_at_limit_points, &params.control) {
-                    let travel = (lambda_end - saved.lambda).signum();
-                    if (state.lambda - saved.lambda) * travel < 0.0 && last_dlambda.is_some() {
-                        let mut offset = last_dlambda.map_or(1e-3, |dl| 0.25 * dl.abs()).max(1e-6);
-                        let mut jumped = false;
-                        for _ in 0..8 {
-                            *state = saved.clone();
-                            match s.relax(state, saved.lambda + travel * offset) {
-                                Ok(_) => {
-                                    if s.distance(state, &saved) > 0.5 * size.abs() {
-                                        jumped = true;
-                                        break;
-                                    }
-                                    // Still on the same branch: the limit lies further on.
-                                    offset *= 2.0;
-                                }
-                                Err(e) => {
-                                    *state = saved.clone();
-                                    path.error = Some(e);
-                                    break 'steps;
-                                }
-                            }
-                        }
-                        if !jumped {
-                            *state = saved.clone();
-                            path.error = Some(Error::NotConverged {
-                                lambda: state.lambda,
-                                iterations: 0,
-                                residual: f64::NAN,
-                                detail: "no stable equilibrium found beyond the limit point".into(),
-                            });
-                            break 'steps;
-                        }
-                        s.invalidate();
-                        s.assemble(state);
-                        let relaxed = Outcome {
-                            iterations: 0,
-                            residual: 0.0,
-                            dq: Vec::new(),
-                            dlambda: 0.0,
-                        };
-                        match s.record(state, &relaxed) {
-                            Ok(mut st) => {
-                                st.jump = true;
-                                s.stats.steps += 1;
-                                let keep_going = progress(&st, &s.stats);
-                                path.steps.push(st);
-                                if !keep_going {
-                                    path.cancelled = true;
-                                    break 'steps;
-                                }
-                            }
-                            Err(e) => {
-                                path.error = Some(e);
-                                break 'steps;
-                            }
-                        }
-                        s.previous = None;
-                        cutbacks = 0;
-                        continue 'steps;
-                    }
-                }
-                // Arc-length: do not overshoot the final load factor; finish with a load step.
-                if let Control::ArcLength { lambda_end, .. } = &params.control {
-                    let start_l = saved.lambda;
-                    let crossed = (start_l - lambda_end) * (state.lambda - lambda_end) < 0.0 && last_dlambda.is_some();
-                    if crossed {
-                        let mut trial = saved.clone();
-                        s.invalidate();
-                        if let Ok(o2) = s.increment(&mut trial, Increment::Load(lambda_end - start_l)) {
-                            *state = trial;
-                            let step = match s.record(state, &o2) {
-                                Ok(st) => st,
-                                Err(e) => {
-                                    path.error = Some(e);
-                                    break;
-                                }
-                            };
-                            s.stats.steps += 1;
-                            path.steps.push(step);
-                            let _ = progress(path.steps.last().expect("pushed"), &s.stats);
-                            break;
-                        }
-                        // The final load step failed: retry the crossing with a shorter arc.
-                        *state = saved;
-                        s.invalidate();
-                        cutbacks += 1;
-                        s.stats.cutbacks += 1;
-                        if cutbacks > params.max_cutbacks {
-                            path.error = Some(Error::NotConverged {
-                                lambda: state.lambda,
-                                iterations: 0,
-                                residual: f64::NAN,
-                                detail: format!("could not land on the final load factor {lambda_end}"),
-                            });
-                            break;
-                        }
-                        size *= 0.5;
-                        continue 'steps;
-                    }
-                }
-                cutbacks = 0;
-                s.strict_turns = true;
-                s.tangent_predictor = true;
-                s.path_force = s
-                    .path_force
-                    .max((state.lambda.abs() * s.force_norm(&s.asm.f_ext)).max(s.reaction_norm()));
-                let step = match s.record(state, &out) {
-                    Ok(st) => st,
-                    Err(e) => {
-                        path.error = Some(e);
-                        break;
-                    }
-                };
-                s.stats.steps += 1;
-                let keep_going = progress(&step, &s.stats);
-                path.steps.push(step);
-                if let Control::Displacement { .. } = &params.control {
-                    travelled += size;
-                }
-                // Adapt the increment to the Newton effort.
-                let ratio = (params.target_iterations as f64 / out.iterations.max(1) as f64)
-                    .sqrt()
-                    .clamp(0.5, 2.0);
-                match &params.control {
-                    Control::ArcLength {
-                        max_increment_factor,
-                        lambda_end,
-                        ..
-                    } => {
-                        let ds0 = arc_ds.expect("set on the first step");
-                        size = (size.abs() * ratio).min(ds0 * max_increment_factor);
-                        let reached = (state.lambda - lambda_end) * (saved.lambda - lambda_end) <= 0.0;
-                        if reached && last_dlambda.is_some() {
-                            break;
-                        }
-                    }
-                    _ => size = size.signum() * (size.abs() * ratio).min(initial_size),
-                }
-                last_dlambda = Some(out.dlambda);
-                s.previous = Some((out.dq, out.dlambda));
-                if !keep_going {
-                    path.cancelled = true;
-                    break;
-                }
-                steps_left = steps_left.saturating_sub(1);
-            }
-            Err(err) => {
+        let outcome = s.increment(state, &inc);
+        let out = match outcome {
+            Ok(out) => out,
+            Err(rejection) => {
+                // Reject.
                 *state = saved;
                 s.invalidate();
-                cutbacks += 1;
                 s.stats.cutbacks += 1;
-                if cutbacks > params.max_cutbacks {
-                    let detail = format!("increment cut back {} times; last failure: {err}", params.max_cutbacks);
-                    let (iterations, residual) = match err {
-                        Error::NotConverged {
-                            iterations, residual, ..
-                        } => (iterations, residual),
-                        _ => (0, f64::NAN),
-                    };
-                    path.error = Some(Error::NotConverged {
-                        lambda: state.lambda,
-                        iterations,
-                        residual,
-                        detail,
-                    });
+                log::debug!("increment rejected at t = {}: {rejection}; cutting back", state.t);
+                if let Err(why) = p.control.reject() {
+                    path.error = Some(give_up(&p, why, &rejection, state, params));
                     break;
                 }
-                size *= 0.5;
-                s.strict_turns = cutbacks < params.max_cutbacks / 2;
+                s.strict_turns = p.control.cutbacks < params.max_cutbacks / 2;
                 s.tangent_predictor = false;
-                log::debug!("increment failed at lambda = {}: {err}; cutting back", state.lambda);
+                continue;
+            }
+        };
+        // A limit point of the load factor: jump to the stable equilibrium beyond it.
+        if let (true, Some(end)) = (params.jump_at_limit_points && arc_control, lambda_end) {
+            let travel = (end - saved.t).signum();
+            if (state.t - saved.t) * travel < 0.0 && p.last_dlambda.is_some() {
+                match s.jump(state, &saved, travel, p.last_dlambda, p.control.size.abs()) {
+                    Ok(()) => {}
+                    Err(e) => {
+                        *state = saved;
+                        path.error = Some(e);
+                        break 'steps;
+                    }
+                }
+                let relaxed = Outcome {
+                    iterations: 0,
+                    residual: 0.0,
+                    dq: Vec::new(),
+                    dlambda: 0.0,
+                };
+                match s.record(state, &relaxed) {
+                    Ok(mut st) => {
+                        st.jump = true;
+                        p.arc += s.distance(state, &saved);
+                        st.arc = p.arc;
+                        s.stats.steps += 1;
+                        let keep_going = progress(&st, &s.stats);
+                        path.steps.push(st);
+                        if !keep_going {
+                            path.cancelled = true;
+                            break 'steps;
+                        }
+                    }
+                    Err(e) => {
+                        path.error = Some(e);
+                        break 'steps;
+                    }
+                }
+                s.previous = None;
+                p.history.clear();
+                if locate {
+                    let reactions = s.asm.reactions();
+                    p.history.push(Point {
+                        state: state.clone(),
+                        arc: p.arc,
+                        monitor: monitor.map_or(0.0, |i| reactions[i]),
+                    });
+                }
+                p.control.cutbacks = 0;
+                continue 'steps;
             }
         }
+        // Arc-length: do not overshoot the final load factor; finish with a load step.
+        if let (true, Some(end)) = (arc_control, lambda_end) {
+            let start_l = saved.t;
+            let crossed = (start_l - end) * (state.t - end) < 0.0 && p.last_dlambda.is_some();
+            if crossed {
+                let mut trial = saved.clone();
+                s.invalidate();
+                if let Ok(o2) = s.increment(&mut trial, &Increment::Load(end - start_l)) {
+                    *state = trial;
+                    let mut step = match s.record(state, &o2) {
+                        Ok(st) => st,
+                        Err(e) => {
+                            path.error = Some(e);
+                            break;
+                        }
+                    };
+                    p.arc += s.arc_norm(&o2.dq, o2.dlambda);
+                    step.arc = p.arc;
+                    s.stats.steps += 1;
+                    path.steps.push(step);
+                    let _ = progress(path.steps.last().expect("pushed"), &s.stats);
+                    break;
+                }
+                // The final load step failed: retry the crossing with a shorter arc.
+                *state = saved;
+                s.invalidate();
+                s.stats.cutbacks += 1;
+                if let Err(why) = p.control.reject() {
+                    path.error = Some(give_up(&p, why, &Rejection::Landing, state, params));
+                    break;
+                }
+                continue 'steps;
+            }
+        }
+        // Accept.
+        s.strict_turns = true;
+        s.tangent_predictor = true;
+        let mut step = match s.record(state, &out) {
+            Ok(st) => st,
+            Err(e) => {
+                path.error = Some(e);
+                break;
+            }
+        };
+        p.arc += s.arc_norm(&out.dq, out.dlambda);
+        step.arc = p.arc;
+        s.stats.steps += 1;
+        let keep_going = progress(&step, &s.stats);
+        path.steps.push(step);
+        if let Control::Displacement { .. } = &params.control {
+            p.travelled += p.control.size;
+        }
+        if locate {
+            let monitor = monitor.map_or(0.0, |i| path.steps.last().expect("pushed").reactions[i]);
+            p.history.push(Point {
+                state: state.clone(),
+                arc: p.arc,
+                monitor,
+            });
+            if let Err(e) = after_step(&mut s, &p.history, &mut path) {
+                path.error = Some(e);
+                break;
+            }
+        }
+        // Adapt the increment to the Newton effort.
+        p.control.accept(out.iterations);
+        if let (true, Some(end)) = (arc_control, lambda_end) {
+            let reached = (state.t - end) * (saved.t - end) <= 0.0;
+            if reached && p.last_dlambda.is_some() {
+                break;
+            }
+        }
+        p.last_dlambda = Some(out.dlambda);
+        s.previous = Some((out.dq, out.dlambda));
+        if !keep_going {
+            path.cancelled = true;
+            break;
+        }
+        p.steps_left = p.steps_left.saturating_sub(1);
     }
-    if let Control::ArcLength {
-        lambda_end, max_steps, ..
-    } = &params.control
-    {
-        let short = (state.lambda - lambda_end).abs() > 1e-9 * lambda_end.abs().max(1.0);
+    if let (true, Some(end), Control::ArcLength { max_steps, .. }) = (arc_control, lambda_end, &params.control) {
+        let short = (state.t - end).abs() > 1e-9 * end.abs().max(1.0);
         if path.error.is_none() && !path.cancelled && short {
-            path.error = Some(Error::NotConverged {
-                lambda: state.lambda,
-                iterations: 0,
-                residual: f64::NAN,
-                detail: format!("{max_steps} arc-length steps used before the load factor reached {lambda_end}"),
+            path.error = Some(Error::StepLimit {
+                step: None,
+                t: state.t,
+                steps: *max_steps,
+                target: end,
             });
         }
     }
-    s.stats.refinement_sweeps = s.linear.refinement_sweeps;
-    s.stats.lu_fallbacks = s.linear.lu_fallbacks;
+    if locate {
+        path.steps.sort_by(|a, b| a.arc.total_cmp(&b.arc));
+    }
+    s.stats.refinement_sweeps = s.system.linear.refinement_sweeps - linear_counts.0;
+    s.stats.lu_fallbacks = s.system.linear.lu_fallbacks - linear_counts.1;
     s.stats.wall_s = start.elapsed().as_secs_f64();
     path.stats = s.stats;
     Ok(path)
+}
+
+/// The error that ends a path whose increment could not be made to converge.
+fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams) -> Error {
+    let (iterations, residual) = last.newton();
+    let how = match why {
+        GiveUp::Cutbacks => format!("increment cut back {} times", params.max_cutbacks),
+        GiveUp::RoundOff => format!(
+            "increment cut back to {:.3e}, below round-off",
+            p.control.size.abs()
+        ),
+    };
+    let hint = match params.control {
+        Control::Load { .. } | Control::Displacement { .. } => {
+            "; if the structure reached a limit point (a snap), arc-length control follows it"
+        }
+        Control::ArcLength { .. } => "",
+    };
+    Error::NotConverged {
+        step: None,
+        t: state.t,
+        iterations,
+        residual,
+        detail: format!("{how}; last failure: {last}{hint}"),
+    }
 }

@@ -104,7 +104,7 @@ pub fn linear_displacements(model: &Model) -> Result<Vec<[f64; 3]>> {
     system.assemble(&state, true, &mut asm);
     let mut solver = LinearSolver::try_new(&system.pattern_ff)?;
     solver.factorize(&asm.k_ff)?;
-    let mut u = asm.f_ext.clone();
+    let mut u = asm.df_ext.clone();
     solver.solve_in_place(&mut u)?;
     let mut disp = vec![[0.0; 3]; model.mesh.n_nodes()];
     for (eq, (node, dof)) in system.dofs.free_dofs.iter().enumerate() {
@@ -262,19 +262,19 @@ pub fn newton_residuals(
 ) -> Result<Vec<f64>> {
     let mut asm = Assembled::default();
     let zero = vec![0.0; system.n_free()];
-    system.update(state, &zero, lambda - state.lambda);
+    system.update(state, &zero, lambda - state.t);
     let mut solver = LinearSolver::try_new(&system.pattern_ff)?;
     let mut norms = Vec::with_capacity(iterations + 1);
     for _ in 0..iterations {
         system.assemble(state, true, &mut asm);
-        norms.push(asm.residual.iter().map(|r| r * r).sum::<f64>().sqrt());
+        norms.push(asm.residual().iter().map(|r| r * r).sum::<f64>().sqrt());
         solver.factorize(&asm.k_ff)?;
-        let mut dq: Vec<f64> = asm.residual.iter().map(|r| -r).collect();
+        let mut dq: Vec<f64> = asm.residual().iter().map(|r| -r).collect();
         solver.solve_in_place(&mut dq)?;
         system.update(state, &dq, 0.0);
     }
     system.assemble(state, false, &mut asm);
-    norms.push(asm.residual.iter().map(|r| r * r).sum::<f64>().sqrt());
+    norms.push(asm.residual().iter().map(|r| r * r).sum::<f64>().sqrt());
     Ok(norms)
 }
 

@@ -1,0 +1,386 @@
+//! Analyses as sequences of steps: [`run`] carries one state (time, positions, rotations) through
+//! the steps of a model, switching its constraints, loads and gravity at the start of each step as
+//! the step says, and records one [`History`].
+//!
+//! Switching, in a static step:
+//! * a constraint switched **on** holds its DOF where it is and moves it by
+//!   `value * (f(t) - f(t_on))` from there;
+//! * a constraint switched **off** is released without a jolt: its last reaction becomes a nodal
+//!   load that decreases linearly to zero over the step (from the step's start to its final load
+//!   factor), so the state stays in equilibrium at the start of the step;
+//! * a load (or gravity) switched **off** decreases linearly to zero over the step in the same way;
+//! * a load (or gravity) switched **on** acts as `value * f(t)` from the start of the step (give it
+//!   a function that starts at zero there, such as a ramp, to apply it gradually).
+//!
+//! The numbering of the unknowns, the sparsity pattern and the symbolic factorisation are rebuilt
+//! only when the set of constrained DOFs changes.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+use crate::assembly::{Assembled, System};
+use crate::constraint::Activity;
+use crate::error::{Error, Result};
+use crate::model::{Load, Model};
+use crate::options::Options;
+use crate::output::{Fields, History, Outputs};
+use crate::solver::{solve_static, Control, StaticParams, StaticStep, Stats};
+use crate::state::State;
+use crate::time_function::TimeFunction;
+
+/// What a step computes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StepKind {
+    /// A static equilibrium path.
+    Static(StaticParams),
+}
+
+/// An analysis step: what it computes and what it switches at its start.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Step {
+    /// Name (in messages and results).
+    pub name: String,
+    /// What the step computes.
+    pub kind: StepKind,
+    /// Ids of constraints, loads or gravity switched on at the start of the step.
+    pub activate: Vec<String>,
+    /// Ids switched off at the start of the step.
+    pub deactivate: Vec<String>,
+}
+
+impl Step {
+    /// A static step with `params`, switching nothing.
+    #[must_use]
+    pub fn new_static(name: &str, params: StaticParams) -> Self {
+        Self {
+            name: name.to_owned(),
+            kind: StepKind::Static(params),
+            activate: Vec::new(),
+            deactivate: Vec::new(),
+        }
+    }
+
+    /// A step from a flat JSON object: `name`, `kind` (`"static"`), `activate` and `deactivate`
+    /// (lists of ids), and the options of its kind (see [`StaticParams::from_options`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming a bad, inapplicable or unknown option.
+    pub fn from_json(value: Value) -> Result<Self> {
+        let mut o = Options::from_value(value, "step")?;
+        let name: String = o.take_or("name", String::new())?;
+        let kind: String = o.take_or("kind", "static".to_owned())?;
+        let activate: Vec<String> = o.take_or("activate", Vec::new())?;
+        let deactivate: Vec<String> = o.take_or("deactivate", Vec::new())?;
+        let kind = match kind.as_str() {
+            "static" => StepKind::Static(
+                StaticParams::from_options(o)
+                    .map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
+            ),
+            other => {
+                return Err(Error::InvalidParameter(format!(
+                    "step '{name}': unknown kind '{other}' (expected 'static')"
+                )))
+            }
+        };
+        Ok(Self {
+            name,
+            kind,
+            activate,
+            deactivate,
+        })
+    }
+
+    /// The step as the flat JSON object [`Step::from_json`] reads (every option explicit).
+    #[must_use]
+    pub fn to_json(&self) -> Value {
+        let StepKind::Static(p) = &self.kind;
+        let mut m: Map<String, Value> = Map::new();
+        m.insert("name".into(), self.name.clone().into());
+        m.insert("kind".into(), "static".into());
+        m.insert("activate".into(), self.activate.clone().into());
+        m.insert("deactivate".into(), self.deactivate.clone().into());
+        m.extend(p.to_options());
+        Value::Object(m)
+    }
+
+    fn params(&self) -> &StaticParams {
+        let StepKind::Static(p) = &self.kind;
+        p
+    }
+}
+
+/// Where a running analysis is, for progress reports.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress<'a> {
+    /// Index of the current step.
+    pub step: usize,
+    /// Its name.
+    pub name: &'a str,
+    /// Number of steps.
+    pub n_steps: usize,
+    /// Time (load factor) of the last converged state.
+    pub t: f64,
+    /// States recorded so far.
+    pub records: usize,
+}
+
+/// The outcome of [`run`].
+#[derive(Debug, Default)]
+pub struct RunResult {
+    /// Everything recorded, up to where the analysis stopped.
+    pub history: History,
+    /// Why the analysis stopped early, if it did (the history so far is kept).
+    pub error: Option<Error>,
+    /// True if the progress callback asked to stop.
+    pub cancelled: bool,
+    /// Counters and timings of each step that ran.
+    pub step_stats: Vec<Stats>,
+    /// Counters and timings of the whole analysis.
+    pub stats: Stats,
+    /// The last converged state.
+    pub state: Option<State>,
+    /// Steps completed.
+    pub steps_completed: usize,
+}
+
+/// Checks a model, its steps and the outputs before anything runs.
+fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
+    model.validate()?;
+    if steps.is_empty() {
+        return Err(Error::InvalidParameter("an analysis needs at least one step".into()));
+    }
+    let mut activity = Activity::initial(model);
+    for (k, step) in steps.iter().enumerate() {
+        let name = &step.name;
+        let context = format!("step {k} '{name}'");
+        step.params().validate().map_err(|e| e.context(&context))?;
+        for id in &step.activate {
+            activity.switch(model, id, true).map_err(|e| e.context(&context))?;
+        }
+        for id in &step.deactivate {
+            activity.switch(model, id, false).map_err(|e| e.context(&context))?;
+        }
+        let releases = !step.deactivate.is_empty() && k > 0;
+        if releases && matches!(step.params().control, Control::Displacement { .. }) {
+            return Err(Error::InvalidParameter(format!(
+                "step {k} '{name}': constraints and loads are released over a step's load-factor range, \
+                 which displacement control does not fix: release them in a load or arc-length step"
+            )));
+        }
+    }
+    outputs.reaction_dofs(model)?;
+    Ok(())
+}
+
+/// The loads that release what step `step` switches off: the reactions of released constraints
+/// and the loads (and gravity) switched off, each decreasing linearly to zero between the
+/// current time `t0` and the step's final load factor.
+fn release_loads(
+    model: &Model,
+    system: &System,
+    before: &Activity,
+    after: &Activity,
+    last_reactions: &[f64],
+    t0: f64,
+    t1: f64,
+) -> Result<(Vec<Load>, Option<TimeFunction>)> {
+    let to_zero = |at_t0: f64| TimeFunction::Table {
+        points: if t1 > t0 {
+            vec![(t0, at_t0), (t1, 0.0)]
+        } else {
+            vec![(t1, 0.0), (t0, at_t0)]
+        },
+    };
+    let mut loads = Vec::new();
+    for (k, c) in model.constraints.iter().enumerate() {
+        if before.constraints[k] && !after.constraints[k] {
+            let i = system
+                .dofs
+                .constraint_index
+                .iter()
+                .position(|&j| j == k)
+                .expect("an active constraint is numbered");
+            loads.push(Load {
+                id: None,
+                node: c.node,
+                dof: c.dof,
+                value: last_reactions[i],
+                function: to_zero(1.0),
+                active: true,
+            });
+        }
+    }
+    for (k, l) in model.loads.iter().enumerate() {
+        if before.loads[k] && !after.loads[k] {
+            loads.push(Load {
+                function: to_zero(l.function.value(t0)),
+                ..l.clone()
+            });
+        }
+    }
+    let gravity = model
+        .gravity
+        .as_ref()
+        .filter(|_| before.gravity && !after.gravity)
+        .map(|g| to_zero(g.function.value(t0)));
+    if (!loads.is_empty() || gravity.is_some()) && t1 == t0 {
+        return Err(Error::InvalidParameter(format!(
+            "a static step that releases constraints or loads must move the load factor (it stays at {t0})"
+        )));
+    }
+    Ok((loads, gravity))
+}
+
+/// The record of a state that was not reached by a solver (the initial state).
+fn initial_record(system: &mut System, state: &State, stability: bool, fields: bool) -> Result<StaticStep> {
+    let mut asm = Assembled::default();
+    system.assemble(state, stability, &mut asm);
+    let negative_eigenvalues = if stability {
+        system.linear.factorize(&asm.k_ff)?;
+        Some(system.linear.negative_eigenvalues()?)
+    } else {
+        None
+    };
+    let r = asm.residual();
+    let n = |v: Vec<nalgebra::Vector3<f64>>| v.iter().map(|x| (*x).into()).collect();
+    let zeros = if fields { vec![[0.0; 3]; state.x.len()] } else { Vec::new() };
+    Ok(StaticStep {
+        lambda: state.t,
+        iterations: 0,
+        residual: r.iter().map(|v| v * v).sum::<f64>().sqrt(),
+        energy: asm.energy,
+        gravity_energy: asm.gravity_energy,
+        reactions: asm.reactions(),
+        negative_eigenvalues,
+        displacements: zeros.clone(),
+        rotations: zeros,
+        markers: n(system.marker_positions(state)),
+        marker_rotations: n(system.marker_rotations(state)),
+        probes: system.probe(&asm),
+        ..StaticStep::default()
+    })
+}
+
+/// Runs `steps` on `model` from its reference configuration, recording what `outputs` asks (and
+/// the time, markers, energies and stability of every state). `progress` is called after each
+/// converged state; returning `false` stops the analysis.
+///
+/// # Errors
+/// An invalid model, step or output request is returned at once; a failure during the analysis is
+/// reported in [`RunResult::error`] (naming the step and where it stopped) with everything
+/// recorded so far.
+pub fn run(
+    model: &Model,
+    steps: &[Step],
+    outputs: &Outputs,
+    progress: &mut dyn FnMut(&Progress) -> bool,
+) -> Result<RunResult> {
+    let start = Instant::now();
+    validate(model, steps, outputs)?;
+    let reaction_dofs = outputs.reaction_dofs(model)?;
+    let interval = outputs.field_interval;
+    let mut activity = Activity::initial(model);
+    for id in &steps[0].activate {
+        activity.switch(model, id, true)?;
+    }
+    for id in &steps[0].deactivate {
+        activity.switch(model, id, false)?;
+    }
+    let mut system = System::try_with(model, &activity)?;
+    system.probes.clone_from(&reaction_dofs);
+    let mut state = system.initial_state();
+    let mut result = RunResult::default();
+    let history = &mut result.history;
+    history.marker_names = model.markers.iter().map(|m| m.name.clone()).collect();
+    history.reaction_dofs.clone_from(&reaction_dofs);
+    let first = initial_record(&mut system, &state, steps[0].params().stability, interval > 0)?;
+    let mut last_reactions = first.reactions.clone();
+    history.push(0, first, interval > 0);
+    let mut symbolic = 1;
+    for (k, step) in steps.iter().enumerate() {
+        let params = step.params();
+        if k > 0 {
+            let before = activity.clone();
+            for id in &step.activate {
+                activity.switch(model, id, true)?;
+            }
+            for id in &step.deactivate {
+                activity.switch(model, id, false)?;
+            }
+            let t1 = match &params.control {
+                Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => *lambda_end,
+                Control::Displacement { .. } => state.t,
+            };
+            let (released, gravity_off) =
+                release_loads(model, &system, &before, &activity, &last_reactions, state.t, t1)
+                    .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?;
+            let gravity = system.gravity.clone();
+            if system
+                .set_activity(model, &activity)
+                .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
+            {
+                symbolic += 1;
+            }
+            system.loads.extend(released);
+            if let (Some(f), Some((g, _))) = (gravity_off, gravity) {
+                system.gravity = Some((g, f));
+            }
+        }
+        history.ndof.push(system.n_free());
+        let n_steps = steps.len();
+        let mut records = history.len();
+        let mut cb = |s: &StaticStep, _: &Stats| {
+            records += 1;
+            progress(&Progress {
+                step: k,
+                name: &step.name,
+                n_steps,
+                t: s.lambda,
+                records,
+            })
+        };
+        let mut params = params.clone();
+        params.record_fields = interval > 0;
+        let path = solve_static(&mut system, &mut state, &params, &mut cb)
+            .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?;
+        let mut stats = path.stats;
+        stats.symbolic_analyses = std::mem::take(&mut symbolic);
+        result.stats.add(&stats);
+        result.step_stats.push(stats);
+        if let Some(last) = path.steps.last() {
+            last_reactions.clone_from(&last.reactions);
+        }
+        for s in path.steps {
+            let keep = interval > 0 && history.len() % interval == 0;
+            history.push(k, s, keep);
+        }
+        if path.cancelled {
+            result.cancelled = true;
+            break;
+        }
+        if let Some(e) = path.error {
+            result.error = Some(e.in_step(&step.name));
+            break;
+        }
+        result.steps_completed += 1;
+    }
+    // The last state's fields, always.
+    let last = history.len() - 1;
+    if interval > 0 && history.fields.last().is_none_or(|f| f.record != last) {
+        let reference = &system.reference;
+        history.fields.push(Fields {
+            record: last,
+            displacements: (0..state.x.len())
+                .map(|i| state.displacement(reference, i).into())
+                .collect(),
+            rotations: (0..state.x.len())
+                .map(|i| state.rotation(reference, i).into())
+                .collect(),
+        });
+    }
+    result.stats.wall_s = start.elapsed().as_secs_f64();
+    result.state = Some(state);
+    Ok(result)
+}

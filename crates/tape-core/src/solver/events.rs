@@ -1,0 +1,298 @@
+//! Events on arc-length paths: limit points of the load factor and extrema of a monitored
+//! reaction are located between converged states, and stretches of the path along which the
+//! monitored reaction changes much are refined, without changing the path itself.
+//!
+//! Every extra equilibrium is found on a hyperplane across a chord between two converged states
+//! `z_a`, `z_b` (`z = (q, lambda)`, in the arc-length metric): predictor `z_a + s (z_b - z_a)`,
+//! corrections orthogonal to the chord (Riks' normal plane), so that `s` is a coordinate along the
+//! path between them. An extremum is searched for in `s` by successive parabolic interpolation
+//! with golden-section safeguards (Brent's minimisation without derivatives); the driver's state
+//! (assembly, factorisation, mixed stresses) is saved before and restored after, so the path
+//! resumes exactly as it would have.
+
+use super::statics::{Driver, Increment};
+use super::{Event, StaticPath, StaticStep};
+use crate::assembly::Assembled;
+use crate::element::shell::ElementStress;
+use crate::error::Result;
+use crate::state::State;
+
+/// A converged state of the path with what the location needs.
+#[derive(Clone, Debug)]
+pub(super) struct Point {
+    pub state: State,
+    /// Arc-length position on the path.
+    pub arc: f64,
+    /// The monitored reaction (0 without a monitor).
+    pub monitor: f64,
+}
+
+/// Most evaluations spent on locating one event.
+const MAX_EVALUATIONS: usize = 12;
+/// Most sub-segments a converged step is split into when refined.
+const MAX_SPLIT: usize = 16;
+/// Golden-section ratio.
+const GOLDEN: f64 = 0.381_966_011_250_105_2;
+
+/// What the driver was holding, restored after the location.
+struct Saved {
+    asm: Assembled,
+    r: Vec<f64>,
+    fresh: bool,
+    factorised: bool,
+    stress: (Vec<ElementStress>, bool),
+}
+
+/// An equilibrium found on a plane, with its position `s` along the chord.
+struct Found {
+    s: f64,
+    state: State,
+    step: StaticStep,
+    monitor: f64,
+}
+
+impl Driver<'_> {
+    fn save(&mut self) -> Saved {
+        Saved {
+            asm: self.asm.clone(),
+            r: self.r.clone(),
+            fresh: self.fresh,
+            factorised: self.factorised,
+            stress: (self.stress.clone(), self.stress_valid),
+        }
+    }
+
+    fn restore(&mut self, saved: Saved) -> Result<()> {
+        self.asm = saved.asm;
+        self.r = saved.r;
+        (self.stress, self.stress_valid) = saved.stress;
+        self.fresh = saved.fresh;
+        self.factorised = false;
+        if saved.factorised {
+            // The same matrix factorised again: the same factors, bit for bit.
+            self.factorise()?;
+        }
+        Ok(())
+    }
+
+    /// Increments `(dq, dlambda)` that take `a` to `b`: translations of the free DOFs, spatial
+    /// rotation vectors `log(R_b R_a^T)` of the free rotations, and the load factor.
+    fn difference(&self, a: &State, b: &State) -> (Vec<f64>, f64) {
+        let dq = self
+            .system
+            .dofs
+            .free_dofs
+            .iter()
+            .map(|&(node, dof)| {
+                let d = dof.index();
+                if d < 3 {
+                    b.x[node][d] - a.x[node][d]
+                } else {
+                    (b.q[node] * a.q[node].inverse()).scaled_axis()[d - 3]
+                }
+            })
+            .collect();
+        (dq, b.t - a.t)
+    }
+
+    /// The equilibrium on the plane at fraction `s` of the chord from `from` (`None` if Newton
+    /// fails there).
+    fn on_plane(&mut self, from: &State, chord: &(Vec<f64>, f64), s: f64, monitor: Option<usize>) -> Option<Found> {
+        let mut state = from.clone();
+        self.invalidate();
+        let inc = Increment::Plane {
+            chord: chord.0.clone(),
+            chord_lambda: chord.1,
+            fraction: s,
+        };
+        let out = self.increment(&mut state, &inc).ok()?;
+        let step = self.record(&state, &out).ok()?;
+        let monitor = monitor.map_or(0.0, |i| step.reactions[i]);
+        Some(Found {
+            s,
+            state,
+            step,
+            monitor,
+        })
+    }
+}
+
+/// Arc position of fraction `s` of the chord from `a` to `c`, through `b` at fraction `sb`.
+fn arc_at(s: f64, (a, b, c): (f64, f64, f64), sb: f64) -> f64 {
+    if s <= sb {
+        a + (b - a) * s / sb.max(1e-300)
+    } else {
+        b + (c - b) * (s - sb) / (1.0 - sb).max(1e-300)
+    }
+}
+
+/// After a converged step: locates the events between the last three converged states of
+/// `history`, and refines the last step, inserting the states found into `path` (sorted by arc
+/// position at the end of the path). `current` is the driver's state, unchanged on return.
+pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPath) -> Result<()> {
+    let monitor = s.monitor_index();
+    let n = history.len();
+    if n >= 3 {
+        let (a, b, c) = (&history[n - 3], &history[n - 2], &history[n - 1]);
+        let mut kinds = Vec::new();
+        if s.params.locate_limit_points {
+            kinds.push((Event::LimitPoint, [a.state.t, b.state.t, c.state.t]));
+        }
+        if monitor.is_some() {
+            kinds.push((Event::MonitorExtremum, [a.monitor, b.monitor, c.monitor]));
+        }
+        for (kind, g) in kinds {
+            let sense = (g[1] - g[0]).signum();
+            if (g[1] - g[0]) * (g[2] - g[1]) < 0.0 {
+                let saved = s.save();
+                let found = search(s, (a, b, c), kind, sense, monitor);
+                s.restore(saved)?;
+                insert(s, path, found, kind, b);
+            }
+        }
+    }
+    if n >= 2 && s.params.refine_change > 0.0 {
+        let saved = s.save();
+        let found = refine(s, &history[n - 2], &history[n - 1], monitor, 0);
+        s.restore(saved)?;
+        s.stats.steps += found.len();
+        path.steps.extend(found.into_iter().map(|f| f.step));
+    }
+    Ok(())
+}
+
+/// Records the located event: the best state found, or the middle state itself if the search
+/// found nothing better.
+fn insert(s: &mut Driver, path: &mut StaticPath, found: Option<Found>, kind: Event, middle: &Point) {
+    match found {
+        Some(mut f) => {
+            f.step.event = Some(kind);
+            s.stats.steps += 1;
+            path.steps.push(f.step);
+        }
+        None => {
+            if let Some(st) = path
+                .steps
+                .iter_mut()
+                .find(|st| st.arc == middle.arc && st.event.is_none())
+            {
+                st.event = Some(kind);
+            }
+        }
+    }
+}
+
+/// Searches the extremum of `sense * g` (g the load factor or the monitored reaction) between
+/// `a` and `c`, where `b` is higher than both; returns the best new state if it beats `b`.
+fn search(s: &mut Driver, (a, b, c): (&Point, &Point, &Point), kind: Event, sense: f64, monitor: Option<usize>) -> Option<Found> {
+    let chord = s.difference(&a.state, &c.state);
+    let c2 = s.arc_dot((&chord.0, chord.1), (&chord.0, chord.1));
+    if !(c2 > 0.0) {
+        return None;
+    }
+    let db = s.difference(&a.state, &b.state);
+    let sb = (s.arc_dot((&db.0, db.1), (&chord.0, chord.1)) / c2).clamp(1e-3, 1.0 - 1e-3);
+    let value = |t: f64, m: f64| {
+        sense
+            * match kind {
+                Event::LimitPoint => t,
+                Event::MonitorExtremum => m,
+            }
+    };
+    // Bracket (s, h, load factor); the middle one is the highest.
+    let mut l = (0.0, value(a.state.t, a.monitor), a.state.t);
+    let mut m = (sb, value(b.state.t, b.monitor), b.state.t);
+    let mut r = (1.0, value(c.state.t, c.monitor), c.state.t);
+    let tol = s.params.event_tolerance;
+    let mut best: Option<Found> = None;
+    for _ in 0..MAX_EVALUATIONS {
+        // Parabola through the bracket: vertex, unless it falls outside or too near the middle.
+        let (d1, d2) = (m.0 - l.0, m.0 - r.0);
+        let (f1, f2) = (m.1 - l.1, m.1 - r.1);
+        let den = d1 * f2 - d2 * f1;
+        let vertex = m.0 - 0.5 * (d1 * d1 * f2 - d2 * d2 * f1) / den;
+        let span = r.0 - l.0;
+        let parabolic = den != 0.0 && vertex > l.0 && vertex < r.0 && (vertex - m.0).abs() > 1e-3 * span;
+        let next = if parabolic {
+            vertex
+        } else if m.0 - l.0 > r.0 - m.0 {
+            // Golden section into the larger side.
+            m.0 - GOLDEN * (m.0 - l.0)
+        } else {
+            m.0 + GOLDEN * (r.0 - m.0)
+        };
+        let Some(f) = s.on_plane(&a.state, &chord, next, monitor) else {
+            break;
+        };
+        let h = value(f.step.lambda, f.monitor);
+        let point = (f.s, h, f.step.lambda);
+        if h > m.1 {
+            if point.0 < m.0 {
+                r = m;
+            } else {
+                l = m;
+            }
+            m = point;
+            best = Some(f);
+        } else if point.0 < m.0 {
+            l = point;
+        } else {
+            r = point;
+        }
+        let done = match kind {
+            // The limit value is known once the points around the highest are within the
+            // tolerance of it (a smooth maximum: they bound it from below, the parabola from above).
+            Event::LimitPoint => m.1 - l.1.max(r.1) < tol,
+            // The position of the extremum is known once the bracket is narrow in load factor.
+            Event::MonitorExtremum => (r.2 - l.2).abs() < tol,
+        };
+        if done {
+            break;
+        }
+    }
+    best.map(|mut f| {
+        f.step.arc = arc_at(f.s, (a.arc, b.arc, c.arc), sb);
+        f
+    })
+}
+
+/// Splits the step from `b` to `c` into equal parts along its chord if it is longer than
+/// `refine_span` in load factor while the monitored reaction changes by more than `refine_change`
+/// of its magnitude, and refines the parts that still are (up to 3 levels). Returns the states
+/// found.
+fn refine(s: &mut Driver, b: &Point, c: &Point, monitor: Option<usize>, depth: usize) -> Vec<Found> {
+    let (span, change) = (s.params.refine_span, s.params.refine_change);
+    let dl = (c.state.t - b.state.t).abs();
+    let dm = (c.monitor - b.monitor).abs();
+    let scale = b.monitor.abs().max(c.monitor.abs());
+    if dl <= span || dm <= change * scale || depth >= 3 {
+        return Vec::new();
+    }
+    let chord = s.difference(&b.state, &c.state);
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let parts = ((dl / span).ceil() as usize).clamp(2, MAX_SPLIT);
+    let mut found: Vec<Found> = Vec::new();
+    for j in 1..parts {
+        #[allow(clippy::cast_precision_loss)]
+        let frac = j as f64 / parts as f64;
+        let Some(mut f) = s.on_plane(&b.state, &chord, frac, monitor) else {
+            break;
+        };
+        f.step.arc = b.arc + frac * (c.arc - b.arc);
+        found.push(f);
+    }
+    // Refine the parts that still change too much.
+    let mut points: Vec<Point> = vec![b.clone()];
+    points.extend(found.iter().map(|f| Point {
+        state: f.state.clone(),
+        arc: f.step.arc,
+        monitor: f.monitor,
+    }));
+    points.push(c.clone());
+    let mut more = Vec::new();
+    for w in points.windows(2) {
+        more.extend(refine(s, &w[0], &w[1], monitor, depth + 1));
+    }
+    found.extend(more);
+    found
+}

@@ -1,0 +1,182 @@
+//! Analysis steps ([`tape_core::run`]): a state carried from step to step, constraints switched
+//! between steps, and the equilibrium path of the paper's tape unchanged by the move of the bending
+//! curve onto the generic runner.
+//!
+//! ```text
+//!   clamped edge |=============== plate / tape ===============| tip section tied to a reference node
+//!   x = 0                                                      x = L
+//! ```
+//!
+//! Reference values: `reference_values/bending_paths.json`, the bending curves (opposite sense,
+//! paper's tape, 4 and 2 mm meshes, with and without unloading) traced before the analysis-step
+//! refactor by the dedicated bending driver; the other tests compare paths with themselves (split
+//! into steps or not) and with the small-deflection beam.
+
+mod common;
+
+use nalgebra::Vector3;
+use tape_core::mesh::generate::flat_plate;
+use tape_core::model::Constraint;
+use tape_core::samples::TapeBending;
+use tape_core::solver::{Control, NewtonParams, StaticParams};
+use tape_core::{run, Dof, Model, Outputs, Result, Step, TimeFunction};
+
+/// The pre-refactor curves are reproduced point by point: same number of equilibria, same angles
+/// and moments to 1e-9 relative (the arithmetic is the same; only the order of a few sums of
+/// zero external loads could differ).
+#[test]
+fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
+    let reference = common::reference("bending_paths.json");
+    for (name, unload) in [("4mm_load", false), ("4mm_unload", true)] {
+        let curve = &reference["curves"][name];
+        let tb = TapeBending {
+            mesh_size: common::num(&curve["mesh_size"]),
+            unload,
+            ..TapeBending::default()
+        };
+        let ours = tb.run(&mut |_| true)?;
+        assert!(ours.error.is_none(), "{name}: {:?}", ours.error);
+        let theta = common::nums(&curve["theta_rad"]);
+        let moment = common::nums(&curve["moment"]);
+        assert_eq!(ours.points.len(), theta.len(), "{name}: number of equilibria");
+        for (i, p) in ours.points.iter().enumerate() {
+            assert!((p.theta - theta[i]).abs() <= 1e-9 * tb.theta_max, "{name} point {i}: theta {} vs {}", p.theta, theta[i]);
+            assert!(
+                (p.moment - moment[i]).abs() <= 1e-9 * moment[i].abs().max(1e-3),
+                "{name} point {i}: moment {} vs {}",
+                p.moment,
+                moment[i]
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A steel strip 200 x 20 x 2 mm, clamped at x = 0, its tip section tied to a reference node.
+fn cantilever(nx: usize) -> Result<(Model, usize)> {
+    let mesh = flat_plate(0.2, 0.02, nx, 2)?;
+    let mut model = Model::try_new(mesh, common::section(2e-3, 2e11, 0.0))?;
+    let x0 = model.mesh.node_set("x0")?.to_vec();
+    let x1 = model.mesh.node_set("x1")?.to_vec();
+    model.fix(&x0, &Dof::ALL)?;
+    let tip = model.add_node(Vector3::new(0.2, 0.01, 0.0))?;
+    model.tie(&x1, tip)?;
+    Ok((model, tip))
+}
+
+fn load_step(name: &str, lambda_end: f64, increments: usize) -> Step {
+    Step::new_static(
+        name,
+        StaticParams {
+            control: Control::Load { lambda_end, increments },
+            newton: NewtonParams {
+                tol_force: 1e-10,
+                ..NewtonParams::default()
+            },
+            ..StaticParams::default()
+        },
+    )
+}
+
+/// A large rotation of the tip (a moment rolling the strip a third of the way into a circle),
+/// followed in one step of 10 increments or in two steps of 5: the same load factors from the same
+/// states, so the same equilibria to the Newton tolerance (1e-10 of the force; a new step starts
+/// its Newton iteration from the true stresses rather than the mixed ones, so the iterates differ);
+/// then unloaded back to zero in a third step: the elastic strip returns to its reference
+/// configuration and passes through the loading equilibria.
+#[test]
+fn steps_carry_the_state_and_unloading_retraces_the_path() -> Result<()> {
+    let (mut model, tip) = cantilever(16)?;
+    let ei = 2e11 * 0.02 * 2e-3_f64.powi(3) / 12.0;
+    model.add_load(tip, Dof::Ry, -ei * 2.0 * std::f64::consts::PI / 0.2 / 3.0)?;
+    let outputs = Outputs {
+        reactions: vec![(tip, Dof::Uz)],
+        field_interval: 1,
+    };
+    let one = run(&model, &[load_step("all", 1.0, 10)], &outputs, &mut |_| true)?;
+    let two = run(
+        &model,
+        &[load_step("first", 0.5, 5), load_step("second", 1.0, 5), load_step("unload", 0.0, 10)],
+        &outputs,
+        &mut |_| true,
+    )?;
+    assert!(one.error.is_none() && two.error.is_none(), "{:?} {:?}", one.error, two.error);
+    let (h1, h2) = (&one.history, &two.history);
+    assert_eq!(h1.len(), 11);
+    assert_eq!(h2.len(), 21);
+    assert_eq!(h2.step[..11], [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1]);
+    let tip_of = |h: &tape_core::History, i: usize| {
+        let f = h.fields.iter().find(|f| f.record == i).expect("fields recorded");
+        Vector3::from(f.displacements[tip])
+    };
+    for i in 0..11 {
+        assert_eq!(h1.t[i], h2.t[i], "record {i}");
+        let (a, b) = (tip_of(h1, i), tip_of(h2, i));
+        assert!((a - b).norm() <= 1e-9 * 0.2, "record {i}: {a:?} vs {b:?}");
+    }
+    // Unloading retraces the loading path (same load factors in reverse), to the Newton tolerance.
+    for i in 11..21 {
+        let j = 20 - i;
+        assert!((h2.t[i] - h1.t[j]).abs() < 1e-12, "record {i}: t {} vs {}", h2.t[i], h1.t[j]);
+        let (a, b) = (tip_of(h2, i), tip_of(h1, j));
+        assert!((a - b).norm() <= 1e-8 * 0.2, "record {i}: unloading {a:?} vs loading {b:?}");
+    }
+    assert!(tip_of(h2, 20).norm() < 1e-9, "not back to the reference: {:?}", tip_of(h2, 20));
+    Ok(())
+}
+
+/// Released without a jolt: a tip pushed 5 mm by a prescribed displacement (id "push") is released
+/// in the next step, whose reaction then decreases linearly to zero over the step; in the
+/// small-deflection range the tip follows the force back linearly, so at a tenth of the release
+/// step it is still at 90 % of the push (a jolt would have sent it back to zero at once), and the
+/// step converges in few iterations from the released state.
+#[test]
+fn released_prescribed_displacement_leaves_the_state_continuous() -> Result<()> {
+    let (mut model, tip) = cantilever(16)?;
+    model.add_constraint(Constraint {
+        id: Some("push".into()),
+        node: tip,
+        dof: Dof::Uz,
+        value: 5e-4,
+        function: TimeFunction::Linear,
+        active: true,
+    })?;
+    let mut release = load_step("release", 2.0, 10);
+    release.deactivate.push("push".into());
+    let outputs = Outputs {
+        reactions: vec![(tip, Dof::Uz)],
+        field_interval: 1,
+    };
+    let result = run(&model, &[load_step("push", 1.0, 4), release], &outputs, &mut |_| true)?;
+    assert!(result.error.is_none(), "{:?}", result.error);
+    let h = &result.history;
+    assert_eq!(h.len(), 15);
+    let uz = |i: usize| h.fields.iter().find(|f| f.record == i).expect("fields").displacements[tip][2];
+    let force = h.reaction(tip, Dof::Uz).expect("recorded");
+    assert!((uz(4) - 5e-4).abs() < 1e-12, "pushed to {}", uz(4));
+    assert!(force[4] > 0.0, "the support pushes the tip up: {}", force[4]);
+    // One increment into the release: 90 % of the push remains (linear to 1e-3 at w/L = 2.5e-3).
+    assert!((uz(5) / 5e-4 - 0.9).abs() < 1e-3, "after the first release increment: {}", uz(5));
+    assert!(h.iterations[5] <= 3, "{} iterations after the release", h.iterations[5]);
+    // Once free, the tip DOF carries no force (a residual at the Newton tolerance).
+    assert!(force[5].abs() < 1e-8 * force[4], "residual at the released DOF {}", force[5]);
+    assert!(uz(14).abs() < 1e-10, "released tip at {}", uz(14));
+    // The numbering changed once: two symbolic analyses.
+    assert_eq!(result.stats.symbolic_analyses, 2);
+    assert_eq!(h.ndof, [h.ndof[0], h.ndof[0] + 1]);
+    Ok(())
+}
+
+/// Switching an id that nothing carries, or releasing in a step whose load-factor range is empty,
+/// is refused before anything runs, with a message naming the step.
+#[test]
+fn bad_steps_are_refused_with_their_name() -> Result<()> {
+    let (model, _) = cantilever(4)?;
+    let mut step = load_step("first", 1.0, 1);
+    step.activate.push("nothing".into());
+    let err = run(&model, &[step], &Outputs::default(), &mut |_| true).unwrap_err();
+    assert!(err.to_string().contains("step 0 'first'") && err.to_string().contains("nothing"), "{err}");
+    let err = run(&model, &[], &Outputs::default(), &mut |_| true).unwrap_err();
+    assert!(err.to_string().contains("at least one step"), "{err}");
+    Ok(())
+}
