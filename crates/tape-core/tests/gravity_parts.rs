@@ -7,7 +7,7 @@
 //!
 //! * Cantilever under its own weight: Euler-Bernoulli tip deflection `w = q L^4 / (8 E I)` within
 //!   1 %; more sharply, Timoshenko's, which adds the shear deflection `4 E I / (k G A L^2)` = 8e-5
-//!   of it, within 1e-6 (the geometric nonlinearity, (w/L)^2 ~ 1e-6, is below that).
+//!   of it, within twice the geometric nonlinearity (w/L)^2 = 1.4e-6.
 //! * A rigid body hung on a tape spring: by global equilibrium the clamp's reaction force is
 //!   `-M g` and its moment `-(x_G - x_clamp) x M g` with the centre of mass `x_G` in the deformed
 //!   configuration (exact: to the Newton tolerance).
@@ -79,9 +79,11 @@ fn cantilever_under_its_own_weight_matches_beam_theory() -> Result<()> {
     eprintln!("own-weight cantilever: w/w_beam - 1 = {errors:?} (8, 16, 32 elements)");
     assert!(errors[2].abs() < 0.01, "{errors:?}");
     // What is left is the shear deflection of a Timoshenko beam, 4 E I / (k G A L^2) = 4 t^2 / (5 L^2)
-    // for nu = 0: the bilinear element is converged already on 8 elements.
+    // for nu = 0, to within the geometric nonlinearity (w/L)^2 = 1.4e-6 (the three meshes agree to
+    // 3e-8: the bilinear element is converged on 8 elements).
     let shear = 4.0 * t * t / (5.0 * l * l);
-    assert!(errors.iter().all(|e| (e - shear).abs() < 1e-6), "{errors:?} vs {shear:e}");
+    let nonlinear = 2.0 * (w_beam / l).powi(2);
+    assert!(errors.iter().all(|e| (e - shear).abs() < nonlinear), "{errors:?} vs {shear:e} +- {nonlinear:e}");
     Ok(())
 }
 
