@@ -75,8 +75,7 @@ impl Step {
         let deactivate: Vec<String> = o.take_or("deactivate", Vec::new())?;
         let kind = match kind.as_str() {
             "static" => StepKind::Static(
-                StaticParams::from_options(o)
-                    .map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
+                StaticParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
             ),
             other => {
                 return Err(Error::InvalidParameter(format!(
@@ -157,10 +156,14 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
         let context = format!("step {k} '{name}'");
         step.params().validate().map_err(|e| e.context(&context))?;
         for id in &step.activate {
-            activity.switch(model, id, true).map_err(|e| e.context(&context))?;
+            activity
+                .switch(model, id, true)
+                .map_err(|e| e.context(&context))?;
         }
         for id in &step.deactivate {
-            activity.switch(model, id, false).map_err(|e| e.context(&context))?;
+            activity
+                .switch(model, id, false)
+                .map_err(|e| e.context(&context))?;
         }
         let releases = !step.deactivate.is_empty() && k > 0;
         if releases && matches!(step.params().control, Control::Displacement { .. }) {
@@ -245,7 +248,11 @@ fn initial_record(system: &mut System, state: &State, stability: bool, fields: b
     };
     let r = asm.residual();
     let n = |v: Vec<nalgebra::Vector3<f64>>| v.iter().map(|x| (*x).into()).collect();
-    let zeros = if fields { vec![[0.0; 3]; state.x.len()] } else { Vec::new() };
+    let zeros = if fields {
+        vec![[0.0; 3]; state.x.len()]
+    } else {
+        Vec::new()
+    };
     Ok(StaticStep {
         lambda: state.t,
         iterations: 0,

@@ -56,12 +56,7 @@ impl Dof {
             .iter()
             .position(|n| n.eq_ignore_ascii_case(name))
             .map(|i| Self::ALL[i])
-            .ok_or_else(|| {
-                Error::InvalidModel(format!(
-                    "unknown DOF '{name}' (expected one of {:?})",
-                    Self::NAMES
-                ))
-            })
+            .ok_or_else(|| Error::InvalidModel(format!("unknown DOF '{name}' (expected one of {:?})", Self::NAMES)))
     }
 
     /// Index 0..6 of the DOF within its node.

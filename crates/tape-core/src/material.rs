@@ -18,8 +18,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{check_positive, Error, Result};
 
-/// Section properties of a homogeneous shell.
+/// Section properties of a homogeneous shell. Serialised with `thickness`, `youngs_modulus` and
+/// `poisson` required and the other fields optional (the defaults of [`ShellSection::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ShellSection {
     /// Thickness t [m], > 0.
     pub thickness: f64,
@@ -27,30 +29,30 @@ pub struct ShellSection {
     pub youngs_modulus: f64,
     /// Poisson's ratio nu, in (-1, 0.5).
     pub poisson: f64,
-    /// Mass density [kg/m^3], >= 0.
+    /// Mass density [kg/m^3], >= 0 (default 0: massless).
+    #[serde(default)]
     pub density: f64,
-    /// Kelvin-Voigt viscosity eta [s], >= 0.
+    /// Kelvin-Voigt viscosity eta [s], >= 0 (default 0).
+    #[serde(default)]
     pub eta: f64,
-    /// Transverse shear correction factor k_s (5/6 by default), > 0.
+    /// Transverse shear correction factor k_s, > 0 (default 5/6).
+    #[serde(default = "default_shear_factor")]
     pub shear_factor: f64,
     /// Drilling stiffness as a fraction of `G t` (Hughes-Brezzi penalty on the difference between
-    /// the nodal drilling rotation and the in-plane rotation of the membrane), > 0.
+    /// the nodal drilling rotation and the in-plane rotation of the membrane), > 0 (default 1e-3).
+    #[serde(default = "default_drilling_factor")]
     pub drilling_factor: f64,
 }
 
-impl Default for ShellSection {
-    /// Steel measuring tape identified in the paper (Table 5): t = 0.138 mm, E = 151.76 GPa, nu = 0.3.
-    fn default() -> Self {
-        Self {
-            thickness: 0.138e-3,
-            youngs_modulus: 151.76e9,
-            poisson: 0.3,
-            density: 7850.0,
-            eta: 0.0,
-            shear_factor: 5.0 / 6.0,
-            drilling_factor: 1e-3,
-        }
-    }
+fn default_shear_factor() -> f64 {
+    5.0 / 6.0
+}
+
+/// The drilling stiffness is a fraction of the shear stiffness small enough not to stiffen the
+/// membrane (checked on the Scordelis-Lo roof and the twisted beam) and large enough to keep the
+/// tangent regular.
+fn default_drilling_factor() -> f64 {
+    1e-3
 }
 
 /// Constitutive matrices of a section, computed once.
@@ -71,6 +73,22 @@ pub struct SectionStiffness {
 }
 
 impl ShellSection {
+    /// A homogeneous elastic section of thickness `thickness` [m], Young's modulus
+    /// `youngs_modulus` [Pa] and Poisson's ratio `poisson`, without mass or damping; shear factor
+    /// 5/6, drilling factor 1e-3.
+    #[must_use]
+    pub fn new(thickness: f64, youngs_modulus: f64, poisson: f64) -> Self {
+        Self {
+            thickness,
+            youngs_modulus,
+            poisson,
+            density: 0.0,
+            eta: 0.0,
+            shear_factor: default_shear_factor(),
+            drilling_factor: default_drilling_factor(),
+        }
+    }
+
     /// Checks every field against its admissible range.
     ///
     /// # Errors

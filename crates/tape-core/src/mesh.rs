@@ -47,7 +47,12 @@ impl Placement {
     /// # Errors
     /// [`Error::InvalidParameter`] for a non-finite component.
     pub fn validate(&self) -> Result<()> {
-        if self.rotation.iter().chain(self.translation.iter()).all(|c| c.is_finite()) {
+        if self
+            .rotation
+            .iter()
+            .chain(self.translation.iter())
+            .all(|c| c.is_finite())
+        {
             Ok(())
         } else {
             Err(Error::InvalidParameter(format!(
@@ -332,10 +337,14 @@ mod tests {
     fn queries_find_nearest_box_corner_and_point_nodes() {
         let m = square(1.0);
         assert_eq!(m.nearest_node(&Vector3::new(1.1, 0.8, 0.3)), Some(4));
-        assert_eq!(m.nodes_in_box(&Vector3::new(0.5, -1.0, -1.0), &Vector3::new(2.0, 0.5, 1.0)), vec![1, 2]);
+        assert_eq!(
+            m.nodes_in_box(&Vector3::new(0.5, -1.0, -1.0), &Vector3::new(2.0, 0.5, 1.0)),
+            vec![1, 2]
+        );
         assert_eq!(m.corner_nodes(), vec![0, 2, 3, 5]);
         assert_eq!(
-            m.nodes_at(&[Vector3::new(2.0, 1.0, 0.0), Vector3::new(0.0, 0.01, 0.0)], 0.05).unwrap(),
+            m.nodes_at(&[Vector3::new(2.0, 1.0, 0.0), Vector3::new(0.0, 0.01, 0.0)], 0.05)
+                .unwrap(),
             vec![5, 0]
         );
         assert!(m.nodes_at(&[Vector3::new(0.5, 0.5, 0.0)], 0.1).is_err());

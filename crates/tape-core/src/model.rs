@@ -534,7 +534,9 @@ impl Model {
         }
         for (name, set) in &self.mesh.node_sets {
             if let Some(&bad) = set.iter().find(|&&n| n >= self.mesh.n_nodes()) {
-                return Err(Error::InvalidModel(format!("node set '{name}' names node {bad}, which does not exist")));
+                return Err(Error::InvalidModel(format!(
+                    "node set '{name}' names node {bad}, which does not exist"
+                )));
             }
         }
         for t in &self.ties {
@@ -546,7 +548,10 @@ impl Model {
         for c in &self.constraints {
             self.check_node(c.node)?;
             if !c.value.is_finite() {
-                return Err(Error::InvalidModel(format!("constraint at node {} is not finite", c.node)));
+                return Err(Error::InvalidModel(format!(
+                    "constraint at node {} is not finite",
+                    c.node
+                )));
             }
             c.function.validate()?;
         }
@@ -572,7 +577,10 @@ impl Model {
         for (i, m) in self.markers.iter().enumerate() {
             self.check_node(m.node)?;
             if m.name.is_empty() || self.markers[..i].iter().any(|o| o.name == m.name) || !finite3(&m.offset) {
-                return Err(Error::InvalidModel(format!("marker '{}' is invalid or repeated", m.name)));
+                return Err(Error::InvalidModel(format!(
+                    "marker '{}' is invalid or repeated",
+                    m.name
+                )));
             }
         }
         Ok(())

@@ -46,9 +46,9 @@ impl Options {
             None | Some(Value::Null) => Ok(None),
             Some(v) => {
                 let shown = v.to_string();
-                serde_json::from_value(v).map(Some).map_err(|e| {
-                    Error::InvalidParameter(format!("{} option {key} = {shown}: {e}", self.what))
-                })
+                serde_json::from_value(v)
+                    .map(Some)
+                    .map_err(|e| Error::InvalidParameter(format!("{} option {key} = {shown}: {e}", self.what)))
             }
         }
     }
@@ -70,8 +70,10 @@ impl Options {
         if self.map.is_empty() {
             return Ok(());
         }
-        let (inapplicable, unknown): (Vec<&String>, Vec<&String>) =
-            self.map.keys().partition(|k| other_keys.contains(&k.as_str()));
+        let (inapplicable, unknown): (Vec<&String>, Vec<&String>) = self
+            .map
+            .keys()
+            .partition(|k| other_keys.contains(&k.as_str()));
         let mut parts = Vec::new();
         if !inapplicable.is_empty() {
             parts.push(format!("{inapplicable:?} do not apply to {context}"));
@@ -79,7 +81,11 @@ impl Options {
         if !unknown.is_empty() {
             parts.push(format!("{unknown:?} are not options of a {}", self.what));
         }
-        Err(Error::InvalidParameter(format!("{} options: {}", self.what, parts.join("; "))))
+        Err(Error::InvalidParameter(format!(
+            "{} options: {}",
+            self.what,
+            parts.join("; ")
+        )))
     }
 }
 
@@ -90,13 +96,18 @@ mod tests {
 
     #[test]
     fn errors_name_the_option() {
-        let Value::Object(map) = json!({"a": 1, "b": "x", "c": 2, "d": 3}) else { unreachable!() };
+        let Value::Object(map) = json!({"a": 1, "b": "x", "c": 2, "d": 3}) else {
+            unreachable!()
+        };
         let mut o = Options::new(map, "test");
         assert_eq!(o.take::<usize>("a").unwrap(), Some(1));
         let err = o.take::<usize>("b").unwrap_err().to_string();
         assert!(err.contains("option b"), "{err}");
         assert_eq!(o.take_or("missing", 7usize).unwrap(), 7);
         let err = o.finish(&["c"], "this control").unwrap_err().to_string();
-        assert!(err.contains("[\"c\"] do not apply to this control") && err.contains("[\"d\"] are not options"), "{err}");
+        assert!(
+            err.contains("[\"c\"] do not apply to this control") && err.contains("[\"d\"] are not options"),
+            "{err}"
+        );
     }
 }

@@ -29,7 +29,11 @@ impl Outputs {
     /// # Errors
     /// [`Error::InvalidModel`] for a node that does not exist.
     pub fn reaction_dofs(&self, model: &Model) -> Result<Vec<(usize, Dof)>> {
-        if let Some(&(n, _)) = self.reactions.iter().find(|(n, _)| *n >= model.mesh.n_nodes()) {
+        if let Some(&(n, _)) = self
+            .reactions
+            .iter()
+            .find(|(n, _)| *n >= model.mesh.n_nodes())
+        {
             return Err(Error::InvalidModel(format!(
                 "a reaction is requested at node {n}, which does not exist (the model has {} nodes)",
                 model.mesh.n_nodes()
@@ -151,6 +155,10 @@ impl History {
     pub fn marker(&self, name: &str) -> Option<Vec<[f64; 3]>> {
         let k = self.marker_names.iter().position(|m| m == name)?;
         let n = self.marker_names.len();
-        Some((0..self.len()).map(|i| self.marker_positions[i * n + k]).collect())
+        Some(
+            (0..self.len())
+                .map(|i| self.marker_positions[i * n + k])
+                .collect(),
+        )
     }
 }

@@ -12,6 +12,16 @@ use crate::model::{Dof, Model};
 use crate::output::Outputs;
 use crate::solver::{Control, NewtonParams, StaticParams, Stats};
 
+/// The section of the paper's tape: Table 5 identified thickness t = 0.138 mm and modulus
+/// E = 151.76 GPa, nu = 0.3 (Sec. 5.1), steel density 7850 kg/m^3.
+#[must_use]
+pub fn paper_tape_section() -> ShellSection {
+    ShellSection {
+        density: 7850.0,
+        ..ShellSection::new(0.138e-3, 151.76e9, 0.3)
+    }
+}
+
 /// Pure bending of one tape spring (paper Sec. 2, Fig. 4).
 ///
 /// Each end section is rigidly tied to a reference node at the centroid of the end cross-section.
@@ -51,7 +61,7 @@ impl Default for TapeBending {
                 radius: 15.55e-3,
                 alpha: 69.85_f64.to_radians(),
             },
-            section: ShellSection::default(),
+            section: paper_tape_section(),
             mesh_size: 2e-3,
             theta_max: std::f64::consts::FRAC_PI_2,
             unload: false,

@@ -167,7 +167,10 @@ impl StaticParams {
         let bad = |s: String| Err(Error::InvalidParameter(s));
         self.newton.validate()?;
         if !(1..=1000).contains(&self.target_iterations) {
-            return bad(format!("target_iterations must lie in [1, 1000] (got {})", self.target_iterations));
+            return bad(format!(
+                "target_iterations must lie in [1, 1000] (got {})",
+                self.target_iterations
+            ));
         }
         if self.max_cutbacks > 60 {
             return bad(format!(
@@ -201,10 +204,14 @@ impl StaticParams {
                     return bad(format!("arc-length needs a finite lambda_end (got {lambda_end})"));
                 }
                 if !(initial_increment.is_finite() && *initial_increment > 0.0) {
-                    return bad(format!("initial_increment must be finite and > 0 (got {initial_increment})"));
+                    return bad(format!(
+                        "initial_increment must be finite and > 0 (got {initial_increment})"
+                    ));
                 }
                 if !(max_increment_factor.is_finite() && *max_increment_factor >= 1.0) {
-                    return bad(format!("max_increment_factor must be finite and >= 1 (got {max_increment_factor})"));
+                    return bad(format!(
+                        "max_increment_factor must be finite and >= 1 (got {max_increment_factor})"
+                    ));
                 }
                 if *max_steps == 0 {
                     return bad("max_steps must be >= 1".into());
@@ -222,10 +229,16 @@ impl StaticParams {
             ));
         }
         if !(self.event_tolerance.is_finite() && self.event_tolerance > 0.0) {
-            return bad(format!("event_tolerance must be finite and > 0 (got {})", self.event_tolerance));
+            return bad(format!(
+                "event_tolerance must be finite and > 0 (got {})",
+                self.event_tolerance
+            ));
         }
         if !(self.refine_change.is_finite() && self.refine_change >= 0.0) {
-            return bad(format!("refine_change must be finite and >= 0 (got {})", self.refine_change));
+            return bad(format!(
+                "refine_change must be finite and >= 0 (got {})",
+                self.refine_change
+            ));
         }
         if !(self.refine_span.is_finite() && self.refine_span > 0.0) {
             return bad(format!("refine_span must be finite and > 0 (got {})", self.refine_span));
@@ -478,7 +491,11 @@ pub struct StaticPath {
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Rejection {
     /// Newton did not converge.
-    NotConverged { iterations: usize, residual: f64, stalled: bool },
+    NotConverged {
+        iterations: usize,
+        residual: f64,
+        stalled: bool,
+    },
     /// The tangent could not be factorised or solved.
     Singular(String),
     /// The residual became NaN or infinite.
@@ -508,10 +525,16 @@ impl std::fmt::Display for Rejection {
                 iterations,
                 residual,
                 stalled: true,
-            } => write!(f, "Newton iterations stalled after {iterations} (residual {residual:.3e} N)"),
+            } => write!(
+                f,
+                "Newton iterations stalled after {iterations} (residual {residual:.3e} N)"
+            ),
             Self::NotConverged {
                 iterations, residual, ..
-            } => write!(f, "Newton did not converge in {iterations} iterations (residual {residual:.3e} N)"),
+            } => write!(
+                f,
+                "Newton did not converge in {iterations} iterations (residual {residual:.3e} N)"
+            ),
             Self::Singular(msg) => write!(f, "singular tangent ({msg})"),
             Self::NonFinite => write!(f, "the residual became non-finite"),
             Self::NoArcRoot => write!(f, "the arc-length constraint has no real root"),

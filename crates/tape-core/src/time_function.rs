@@ -52,7 +52,9 @@ impl TimeFunction {
             Self::Linear | Self::Constant => Ok(()),
             Self::Ramp { start, end } => {
                 if !(start.is_finite() && end.is_finite() && end > start) {
-                    return bad(format!("ramp time function needs finite start < end (got {start}, {end})"));
+                    return bad(format!(
+                        "ramp time function needs finite start < end (got {start}, {end})"
+                    ));
                 }
                 Ok(())
             }
@@ -60,7 +62,10 @@ impl TimeFunction {
                 if points.is_empty() {
                     return bad("table time function needs at least one point".into());
                 }
-                if let Some((t, f)) = points.iter().find(|(t, f)| !(t.is_finite() && f.is_finite())) {
+                if let Some((t, f)) = points
+                    .iter()
+                    .find(|(t, f)| !(t.is_finite() && f.is_finite()))
+                {
                     return bad(format!("table time function has a non-finite point ({t}, {f})"));
                 }
                 if let Some(w) = points.windows(2).find(|w| w[1].0 <= w[0].0) {
@@ -104,7 +109,11 @@ impl TimeFunction {
             Self::Linear => 1.0,
             Self::Constant => 0.0,
             Self::Ramp { start, end } => {
-                let inside = if forward { t >= *start && t < *end } else { t > *start && t <= *end };
+                let inside = if forward {
+                    t >= *start && t < *end
+                } else {
+                    t > *start && t <= *end
+                };
                 if inside {
                     1.0 / (end - start)
                 } else {
@@ -197,8 +206,15 @@ mod tests {
 
     #[test]
     fn invalid_functions_are_refused() {
-        assert!(TimeFunction::Ramp { start: 1.0, end: 1.0 }.validate().is_err());
-        assert!(TimeFunction::Ramp { start: f64::NAN, end: 1.0 }.validate().is_err());
+        assert!(TimeFunction::Ramp { start: 1.0, end: 1.0 }
+            .validate()
+            .is_err());
+        assert!(TimeFunction::Ramp {
+            start: f64::NAN,
+            end: 1.0
+        }
+        .validate()
+        .is_err());
         assert!(TimeFunction::Table { points: vec![] }.validate().is_err());
         assert!(TimeFunction::Table {
             points: vec![(0.0, 0.0), (0.0, 1.0)]

@@ -40,7 +40,12 @@ fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
         let moment = common::nums(&curve["moment"]);
         assert_eq!(ours.points.len(), theta.len(), "{name}: number of equilibria");
         for (i, p) in ours.points.iter().enumerate() {
-            assert!((p.theta - theta[i]).abs() <= 1e-9 * tb.theta_max, "{name} point {i}: theta {} vs {}", p.theta, theta[i]);
+            assert!(
+                (p.theta - theta[i]).abs() <= 1e-9 * tb.theta_max,
+                "{name} point {i}: theta {} vs {}",
+                p.theta,
+                theta[i]
+            );
             assert!(
                 (p.moment - moment[i]).abs() <= 1e-9 * moment[i].abs().max(1e-3),
                 "{name} point {i}: moment {} vs {}",
@@ -96,17 +101,30 @@ fn steps_carry_the_state_and_unloading_retraces_the_path() -> Result<()> {
     let one = run(&model, &[load_step("all", 1.0, 10)], &outputs, &mut |_| true)?;
     let two = run(
         &model,
-        &[load_step("first", 0.5, 5), load_step("second", 1.0, 5), load_step("unload", 0.0, 10)],
+        &[
+            load_step("first", 0.5, 5),
+            load_step("second", 1.0, 5),
+            load_step("unload", 0.0, 10),
+        ],
         &outputs,
         &mut |_| true,
     )?;
-    assert!(one.error.is_none() && two.error.is_none(), "{:?} {:?}", one.error, two.error);
+    assert!(
+        one.error.is_none() && two.error.is_none(),
+        "{:?} {:?}",
+        one.error,
+        two.error
+    );
     let (h1, h2) = (&one.history, &two.history);
     assert_eq!(h1.len(), 11);
     assert_eq!(h2.len(), 21);
     assert_eq!(h2.step[..11], [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1]);
     let tip_of = |h: &tape_core::History, i: usize| {
-        let f = h.fields.iter().find(|f| f.record == i).expect("fields recorded");
+        let f = h
+            .fields
+            .iter()
+            .find(|f| f.record == i)
+            .expect("fields recorded");
         Vector3::from(f.displacements[tip])
     };
     for i in 0..11 {
@@ -117,11 +135,23 @@ fn steps_carry_the_state_and_unloading_retraces_the_path() -> Result<()> {
     // Unloading retraces the loading path (same load factors in reverse), to the Newton tolerance.
     for i in 11..21 {
         let j = 20 - i;
-        assert!((h2.t[i] - h1.t[j]).abs() < 1e-12, "record {i}: t {} vs {}", h2.t[i], h1.t[j]);
+        assert!(
+            (h2.t[i] - h1.t[j]).abs() < 1e-12,
+            "record {i}: t {} vs {}",
+            h2.t[i],
+            h1.t[j]
+        );
         let (a, b) = (tip_of(h2, i), tip_of(h1, j));
-        assert!((a - b).norm() <= 1e-8 * 0.2, "record {i}: unloading {a:?} vs loading {b:?}");
+        assert!(
+            (a - b).norm() <= 1e-8 * 0.2,
+            "record {i}: unloading {a:?} vs loading {b:?}"
+        );
     }
-    assert!(tip_of(h2, 20).norm() < 1e-9, "not back to the reference: {:?}", tip_of(h2, 20));
+    assert!(
+        tip_of(h2, 20).norm() < 1e-9,
+        "not back to the reference: {:?}",
+        tip_of(h2, 20)
+    );
     Ok(())
 }
 
@@ -151,15 +181,29 @@ fn released_prescribed_displacement_leaves_the_state_continuous() -> Result<()> 
     assert!(result.error.is_none(), "{:?}", result.error);
     let h = &result.history;
     assert_eq!(h.len(), 15);
-    let uz = |i: usize| h.fields.iter().find(|f| f.record == i).expect("fields").displacements[tip][2];
+    let uz = |i: usize| {
+        h.fields
+            .iter()
+            .find(|f| f.record == i)
+            .expect("fields")
+            .displacements[tip][2]
+    };
     let force = h.reaction(tip, Dof::Uz).expect("recorded");
     assert!((uz(4) - 5e-4).abs() < 1e-12, "pushed to {}", uz(4));
     assert!(force[4] > 0.0, "the support pushes the tip up: {}", force[4]);
     // One increment into the release: 90 % of the push remains (linear to 1e-3 at w/L = 2.5e-3).
-    assert!((uz(5) / 5e-4 - 0.9).abs() < 1e-3, "after the first release increment: {}", uz(5));
+    assert!(
+        (uz(5) / 5e-4 - 0.9).abs() < 1e-3,
+        "after the first release increment: {}",
+        uz(5)
+    );
     assert!(h.iterations[5] <= 3, "{} iterations after the release", h.iterations[5]);
     // Once free, the tip DOF carries no force (a residual at the Newton tolerance).
-    assert!(force[5].abs() < 1e-8 * force[4], "residual at the released DOF {}", force[5]);
+    assert!(
+        force[5].abs() < 1e-8 * force[4],
+        "residual at the released DOF {}",
+        force[5]
+    );
     assert!(uz(14).abs() < 1e-10, "released tip at {}", uz(14));
     // The numbering changed once: two symbolic analyses.
     assert_eq!(result.stats.symbolic_analyses, 2);
@@ -175,7 +219,10 @@ fn bad_steps_are_refused_with_their_name() -> Result<()> {
     let mut step = load_step("first", 1.0, 1);
     step.activate.push("nothing".into());
     let err = run(&model, &[step], &Outputs::default(), &mut |_| true).unwrap_err();
-    assert!(err.to_string().contains("step 0 'first'") && err.to_string().contains("nothing"), "{err}");
+    assert!(
+        err.to_string().contains("step 0 'first'") && err.to_string().contains("nothing"),
+        "{err}"
+    );
     let err = run(&model, &[], &Outputs::default(), &mut |_| true).unwrap_err();
     assert!(err.to_string().contains("at least one step"), "{err}");
     Ok(())

@@ -12,8 +12,8 @@
 //! paths, so the results must be identical, not merely close: no tolerance.
 
 use tape_core::assembly::Assembled;
-use tape_core::material::ShellSection;
 use tape_core::mesh::generate::{tape_spring, TapeGeometry};
+use tape_core::samples::paper_tape_section;
 use tape_core::{Dof, Model, Result, State, System};
 
 fn model() -> Result<Model> {
@@ -23,7 +23,7 @@ fn model() -> Result<Model> {
         alpha: 69.85_f64.to_radians(),
     };
     let mesh = tape_spring(&g, 2e-3)?;
-    let mut model = Model::try_new(mesh, ShellSection::default())?;
+    let mut model = Model::try_new(mesh, paper_tape_section())?;
     let end0 = model.mesh.node_set("end0")?.to_vec();
     let end1 = model.mesh.node_set("end1")?.to_vec();
     model.fix(&end0, &Dof::ALL)?;

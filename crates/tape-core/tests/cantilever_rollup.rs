@@ -23,12 +23,7 @@ use tape_core::{Dof, Model, Result, System};
 fn max_tip_error(n: usize) -> Result<(f64, f64)> {
     let (l, b, t, e) = (12.0, 1.0, 0.1, 1.2e6);
     let mesh = flat_plate(l, b, n, 1)?;
-    let section = ShellSection {
-        thickness: t,
-        youngs_modulus: e,
-        poisson: 0.0,
-        ..ShellSection::default()
-    };
+    let section = ShellSection::new(t, e, 0.0);
     let mut model = Model::try_new(mesh, section)?;
     let root = model.mesh.node_set("x0")?.to_vec();
     let tip = model.mesh.node_set("x1")?.to_vec();

@@ -63,7 +63,10 @@ fn cantilever_under_its_own_weight_matches_beam_theory() -> Result<()> {
             function: TimeFunction::Linear,
             active: true,
         })?;
-        let tip = model.mesh.nearest_node(&Vector3::new(l, 0.5 * b, 0.0)).expect("nodes");
+        let tip = model
+            .mesh
+            .nearest_node(&Vector3::new(l, 0.5 * b, 0.0))
+            .expect("nodes");
         model.add_marker(Marker {
             name: "tip".into(),
             node: tip,
@@ -83,7 +86,10 @@ fn cantilever_under_its_own_weight_matches_beam_theory() -> Result<()> {
     // 3e-8: the bilinear element is converged on 8 elements).
     let shear = 4.0 * t * t / (5.0 * l * l);
     let nonlinear = 2.0 * (w_beam / l).powi(2);
-    assert!(errors.iter().all(|e| (e - shear).abs() < nonlinear), "{errors:?} vs {shear:e} +- {nonlinear:e}");
+    assert!(
+        errors.iter().all(|e| (e - shear).abs() < nonlinear),
+        "{errors:?} vs {shear:e} +- {nonlinear:e}"
+    );
     Ok(())
 }
 
@@ -127,14 +133,21 @@ fn rigid_body_weight_appears_exactly_in_the_clamp_reaction() -> Result<()> {
     let force = Vector3::new(reaction(Dof::Ux), reaction(Dof::Uy), reaction(Dof::Uz));
     let moment = Vector3::new(reaction(Dof::Rx), reaction(Dof::Ry), reaction(Dof::Rz));
     let expected_moment = -(x_g - x_clamp).cross(&weight);
-    assert!((force + weight).norm() < 1e-8 * weight.norm(), "reaction {force:?}, weight {weight:?}");
+    assert!(
+        (force + weight).norm() < 1e-8 * weight.norm(),
+        "reaction {force:?}, weight {weight:?}"
+    );
     assert!(
         (moment - expected_moment).norm() < 1e-8 * expected_moment.norm(),
         "moment {moment:?}, expected {expected_moment:?}"
     );
     // The tape did bend (the centre of mass moved down), and gravity's potential is -M g . x_G.
     assert!(x_g.z < x_clamp.z + com.z - 1e-4, "x_G = {x_g:?}");
-    assert!((h.gravity_energy[last] + weight.dot(&x_g)).abs() < 1e-12, "{}", h.gravity_energy[last]);
+    assert!(
+        (h.gravity_energy[last] + weight.dot(&x_g)).abs() < 1e-12,
+        "{}",
+        h.gravity_energy[last]
+    );
     Ok(())
 }
 
@@ -148,7 +161,12 @@ fn strip_of_two_thicknesses_matches_beam_theory() -> Result<()> {
     let i = |t: f64| b * t.powi(3) / 12.0;
     let w_beam = p * a.powi(3) * (1.0 / 3.0 + 0.5 + 0.5 + 1.0) / (E * i(t1)) + p * a.powi(3) / (3.0 * E * i(t2));
     let mut model = Model::default();
-    model.add_part("thick", flat_plate(a, b, 32, 2)?, common::section(t1, E, 0.0), &Placement::default())?;
+    model.add_part(
+        "thick",
+        flat_plate(a, b, 32, 2)?,
+        common::section(t1, E, 0.0),
+        &Placement::default(),
+    )?;
     let thin = Placement {
         rotation: Vector3::zeros(),
         translation: Vector3::new(a, 0.0, 0.0),
@@ -211,7 +229,15 @@ fn a_placed_part_gives_the_placed_results_of_the_part_built_in_place() -> Result
     let (u0, r0) = tips[0];
     let (u1, r1) = tips[1];
     assert!(u0.z > 0.05, "the strip did deflect: {u0:?}");
-    assert!((u1 - rot * u0).norm() < 1e-8 * u0.norm(), "placed {u1:?} vs rotated {:?}", rot * u0);
-    assert!((r1 - rot * r0).norm() < 1e-8 * r0.norm(), "placed {r1:?} vs rotated {:?}", rot * r0);
+    assert!(
+        (u1 - rot * u0).norm() < 1e-8 * u0.norm(),
+        "placed {u1:?} vs rotated {:?}",
+        rot * u0
+    );
+    assert!(
+        (r1 - rot * r0).norm() < 1e-8 * r0.norm(),
+        "placed {r1:?} vs rotated {:?}",
+        rot * r0
+    );
     Ok(())
 }

@@ -33,11 +33,7 @@ fn bend(mixed: bool) -> Result<(Vec<f64>, usize, usize)> {
     params.newton.tol_energy = 1e-16;
     let path = solve_static(&mut system, &mut state, &params, &mut |_, _| true)?;
     assert!(path.error.is_none(), "mixed = {mixed}: {:?}", path.error);
-    assert!(
-        (state.t - 1.0).abs() < 1e-12,
-        "mixed = {mixed}: stopped at {}",
-        state.t
-    );
+    assert!((state.t - 1.0).abs() < 1e-12, "mixed = {mixed}: stopped at {}", state.t);
     let moments = path
         .steps
         .iter()

@@ -6,22 +6,16 @@
 
 use std::collections::BTreeMap;
 
+use nalgebra::Vector3;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use serde_json::{Map, Number, Value};
 use tape_core::mesh::Mesh;
-use tape_core::model::Dof;
-use tape_core::solver::{StaticPath, Stats};
-
-/// Lower-case names of the six nodal DOFs, in [`Dof::ALL`] order.
-pub const DOF_NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
-
-/// Name of a DOF as Python sees it.
-pub fn dof_name(dof: Dof) -> &'static str {
-    DOF_NAMES[dof.index()]
-}
+use tape_core::output::History;
+use tape_core::{Dof, TimeFunction};
 
 /// `numpy.asarray(obj, dtype=float64)` as an n-dimensional array.
 fn float_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
@@ -188,7 +182,8 @@ pub fn dofs(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Dof>> {
     }
     let names: Vec<String> = obj.extract().map_err(|_| {
         PyValueError::new_err(format!(
-            "dofs must be 'all' or a list of names among {DOF_NAMES:?} (got {})",
+            "dofs must be 'all' or a list of names among {:?} (got {})",
+            Dof::NAMES,
             obj.repr()
                 .map_or_else(|_| "?".to_owned(), |r| r.to_string())
         ))
@@ -254,97 +249,230 @@ pub fn mesh_to_tuple<'py>(py: Python<'py>, mesh: &Mesh) -> PyResult<Bound<'py, P
     Ok(t.into_pyobject(py)?.into_any())
 }
 
-/// Solver counters and timings as a dict.
-pub fn stats_to_dict<'py>(py: Python<'py>, s: &Stats) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("steps", s.steps)?;
-    d.set_item("iterations", s.iterations)?;
-    d.set_item("cutbacks", s.cutbacks)?;
-    d.set_item("factorisations", s.factorisations)?;
-    d.set_item("refinement_sweeps", s.refinement_sweeps)?;
-    d.set_item("lu_fallbacks", s.lu_fallbacks)?;
-    d.set_item("assembly_s", s.assembly_s)?;
-    d.set_item("solve_s", s.solve_s)?;
-    d.set_item("wall_s", s.wall_s)?;
-    Ok(d)
+/// A Python value as JSON: dicts with string keys, lists and tuples, numbers (numpy scalars and
+/// arrays included), strings, booleans and None. `what` names the value in errors; NaN and
+/// infinities are refused (they have no JSON form and no option takes them).
+pub fn to_json(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
+    if obj.is_none() {
+        return Ok(Value::Null);
+    }
+    if let Ok(b) = obj.cast::<PyBool>() {
+        return Ok(Value::Bool(b.is_true()));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        if let Ok(i) = obj.extract::<i64>() {
+            return Ok(Value::from(i));
+        }
+        return Err(PyValueError::new_err(format!("{what} = {obj} does not fit in 64 bits")));
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        let v: f64 = obj.extract()?;
+        return Number::from_f64(v)
+            .map(Value::Number)
+            .ok_or_else(|| PyValueError::new_err(format!("{what} must be finite (got {v})")));
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(Value::String(s.to_str()?.to_owned()));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut map = Map::new();
+        for (k, v) in d.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| PyValueError::new_err(format!("{what} must have string keys (got {k})")))?;
+            let value = to_json(&v, &format!("{what}['{key}']"))?;
+            map.insert(key, value);
+        }
+        return Ok(Value::Object(map));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        return obj
+            .try_iter()?
+            .enumerate()
+            .map(|(i, v)| to_json(&v?, &format!("{what}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()
+            .map(Value::Array);
+    }
+    // numpy scalars and arrays (and anything else with the same protocol).
+    if obj.hasattr("tolist")? {
+        let plain = obj.call_method0("tolist")?;
+        if !plain.is(obj) {
+            return to_json(&plain, what);
+        }
+    }
+    Err(PyValueError::new_err(format!(
+        "{what} must be a number, a string, a boolean, a list or a dict (got {})",
+        obj.get_type().name()?
+    )))
 }
 
-/// List of `(node, dof_name)` tuples.
-pub fn constrained_to_list<'py>(
-    py: Python<'py>,
-    constrained: impl Iterator<Item = (usize, Dof)>,
-) -> PyResult<Bound<'py, PyList>> {
-    PyList::new(py, constrained.map(|(n, d)| (n, dof_name(d))))
+/// A JSON value as a Python object (dicts, lists, floats, ints, strings, booleans, None).
+pub fn from_json<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match value {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Number(n) => match (n.as_i64(), n.as_f64()) {
+            (Some(i), _) => i.into_pyobject(py)?.into_any(),
+            (None, Some(f)) => f.into_pyobject(py)?.into_any(),
+            (None, None) => py.None().into_bound(py),
+        },
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Array(a) => PyList::new(
+            py,
+            a.iter()
+                .map(|v| from_json(py, v))
+                .collect::<PyResult<Vec<_>>>()?,
+        )?
+        .into_any(),
+        Value::Object(m) => {
+            let d = PyDict::new(py);
+            for (k, v) in m {
+                d.set_item(k, from_json(py, v)?)?;
+            }
+            d.into_any()
+        }
+    })
 }
 
-/// The recorded path as the dict documented on `solve_static` (without `settings`, `ndof`).
-///
-/// `n_nodes` is the number of nodes of the recorded fields (0 when fields are not recorded).
-pub fn path_to_dict<'py>(
-    py: Python<'py>,
-    path: &StaticPath,
-    n_nodes: usize,
-    n_constrained: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    let steps = &path.steps;
-    let n_steps = steps.len();
-    let d = PyDict::new(py);
-    let field = |pick: fn(&tape_core::solver::StaticStep) -> &[[f64; 3]]| {
-        let flat: Vec<f64> = steps
-            .iter()
-            .flat_map(|s| pick(s).iter().flatten().copied())
-            .collect();
-        Array3::from_shape_vec((n_steps, n_nodes, 3), flat)
-            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("inconsistent recorded fields: {e}")))
+/// A serde value as a Python object.
+pub fn to_py_object<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let json = serde_json::to_value(value)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("serialisation failed: {e}")))?;
+    from_json(py, &json)
+}
+
+/// A time function given as a name (`"linear"`, `"constant"`), a dict such as
+/// `{"kind": "ramp", "start": 0, "end": 1}`, or a sequence of `(t, f)` pairs (a table).
+pub fn time_function(obj: Option<&Bound<'_, PyAny>>, default: TimeFunction, what: &str) -> PyResult<TimeFunction> {
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(default);
     };
-    d.set_item(
-        "lambda",
-        steps
-            .iter()
-            .map(|s| s.lambda)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item("displacements", field(|s| &s.displacements)?.into_pyarray(py))?;
-    d.set_item("rotations", field(|s| &s.rotations)?.into_pyarray(py))?;
-    let reactions: Vec<f64> = steps
+    let value = match to_json(obj, what)? {
+        Value::String(kind) => serde_json::json!({ "kind": kind.to_ascii_lowercase() }),
+        Value::Array(points) => serde_json::json!({ "kind": "table", "points": points }),
+        other => other,
+    };
+    let f: TimeFunction = serde_json::from_value(value).map_err(|e| {
+        PyValueError::new_err(format!(
+            "{what}: {e} (a time function is 'linear', 'constant', {{'kind': 'ramp', 'start': t0, 'end': t1}} or a list of (t, f) pairs)"
+        ))
+    })?;
+    crate::error::to_py(f.validate())?;
+    Ok(f)
+}
+
+/// Three finite numbers.
+pub fn vector3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector3<f64>> {
+    let arr = float_array(obj, what)?;
+    let ro = arr.readonly();
+    let v = ro.as_array();
+    if v.len() != 3 || v.ndim() != 1 {
+        return Err(PyValueError::new_err(format!(
+            "{what} must be three numbers, got shape {}",
+            shape_str(v.shape())
+        )));
+    }
+    let x = Vector3::new(v[0], v[1], v[2]);
+    if x.iter().all(|c| c.is_finite()) {
+        Ok(x)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{what} = {:?} is not finite",
+            x.as_slice()
+        )))
+    }
+}
+
+/// One non-negative integral node index.
+pub fn node(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<usize> {
+    let v = index_vec(obj, what)?;
+    let arr_dims = int_array(obj, what)?.ndim();
+    match (v.as_slice(), arr_dims) {
+        ([n], 0) => Ok(*n),
+        _ => Err(PyValueError::new_err(format!(
+            "{what} must be one node index (got {obj})"
+        ))),
+    }
+}
+
+/// A float vector as a 1-D float64 array.
+pub fn vec_to_numpy<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
+    v.into_pyarray(py).into_any()
+}
+
+/// Counts as an int64 array.
+fn counts_to_numpy<'py>(py: Python<'py>, v: impl Iterator<Item = usize>) -> Bound<'py, PyAny> {
+    v.map(|i| i64::try_from(i).unwrap_or(i64::MAX))
+        .collect::<Vec<_>>()
+        .into_pyarray(py)
+        .into_any()
+}
+
+/// A recorded history as a dict of numpy arrays (shapes in the stub of `run`).
+pub fn history_to_dict<'py>(py: Python<'py>, h: &History, n_nodes: usize) -> PyResult<Bound<'py, PyDict>> {
+    let n = h.len();
+    let d = PyDict::new(py);
+    let shape_err =
+        |e: numpy::ndarray::ShapeError| pyo3::exceptions::PyRuntimeError::new_err(format!("inconsistent history: {e}"));
+    d.set_item("step", counts_to_numpy(py, h.step.iter().copied()))?;
+    d.set_item("t", vec_to_numpy(py, h.t.clone()))?;
+    d.set_item("iterations", counts_to_numpy(py, h.iterations.iter().copied()))?;
+    d.set_item("residual", vec_to_numpy(py, h.residual.clone()))?;
+    d.set_item("negative_eigenvalues", h.negative_eigenvalues.clone().into_pyarray(py))?;
+    d.set_item("jump", numpy::PyArray1::from_iter(py, h.jump.iter().copied()))?;
+    let events: Vec<Option<String>> = h
+        .event
         .iter()
-        .flat_map(|s| s.reactions.iter().copied())
-        .collect();
-    let reactions = Array2::from_shape_vec((n_steps, n_constrained), reactions)
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("inconsistent reactions: {e}")))?;
-    d.set_item("reactions", reactions.into_pyarray(py))?;
-    let neg: Vec<i64> = steps
-        .iter()
-        .map(|s| {
-            s.negative_eigenvalues
-                .map_or(-1, |n| i64::try_from(n).unwrap_or(i64::MAX))
+        .map(|e| {
+            e.map(|e| {
+                serde_json::to_value(e)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_owned))
+                    .unwrap_or_default()
+            })
         })
         .collect();
-    d.set_item("negative_eigenvalues", neg.into_pyarray(py))?;
-    let its: Vec<i64> = steps
-        .iter()
-        .map(|s| i64::try_from(s.iterations).unwrap_or(i64::MAX))
-        .collect();
-    d.set_item("iterations", its.into_pyarray(py))?;
+    d.set_item("event", events)?;
+    d.set_item("strain_energy", vec_to_numpy(py, h.strain_energy.clone()))?;
+    d.set_item("gravity_energy", vec_to_numpy(py, h.gravity_energy.clone()))?;
+    let m = h.marker_names.len();
+    d.set_item("marker_names", h.marker_names.clone())?;
+    let flat = |rows: &[[f64; 3]]| rows.iter().flatten().copied().collect::<Vec<f64>>();
     d.set_item(
-        "residual",
-        steps
-            .iter()
-            .map(|s| s.residual)
-            .collect::<Vec<_>>()
+        "marker_positions",
+        Array3::from_shape_vec((n, m, 3), flat(&h.marker_positions))
+            .map_err(shape_err)?
             .into_pyarray(py),
     )?;
     d.set_item(
-        "energy",
-        steps
-            .iter()
-            .map(|s| s.energy)
-            .collect::<Vec<_>>()
+        "marker_rotations",
+        Array3::from_shape_vec((n, m, 3), flat(&h.marker_rotations))
+            .map_err(shape_err)?
             .into_pyarray(py),
     )?;
-    d.set_item("stats", stats_to_dict(py, &path.stats)?)?;
-    d.set_item("error", path.error.as_ref().map(ToString::to_string))?;
-    d.set_item("cancelled", path.cancelled)?;
+    let k = h.reaction_dofs.len();
+    d.set_item(
+        "reaction_dofs",
+        PyList::new(py, h.reaction_dofs.iter().map(|(n, dof)| (*n, dof.name())))?,
+    )?;
+    d.set_item(
+        "reactions",
+        Array2::from_shape_vec((n, k), h.reactions.clone())
+            .map_err(shape_err)?
+            .into_pyarray(py),
+    )?;
+    let nf = h.fields.len();
+    d.set_item("field_records", counts_to_numpy(py, h.fields.iter().map(|f| f.record)))?;
+    let fields = |pick: fn(&tape_core::output::Fields) -> &Vec<[f64; 3]>| {
+        let flat: Vec<f64> = h
+            .fields
+            .iter()
+            .flat_map(|f| pick(f).iter().flatten().copied())
+            .collect();
+        Array3::from_shape_vec((nf, if nf == 0 { 0 } else { n_nodes }, 3), flat).map_err(shape_err)
+    };
+    d.set_item("displacements", fields(|f| &f.displacements)?.into_pyarray(py))?;
+    d.set_item("rotations", fields(|f| &f.rotations)?.into_pyarray(py))?;
+    d.set_item("ndof", counts_to_numpy(py, h.ndof.iter().copied()))?;
     Ok(d)
 }

@@ -3,7 +3,7 @@
 //! | tape-core error                                    | Python exception              |
 //! |----------------------------------------------------|-------------------------------|
 //! | `InvalidParameter`, `InvalidMesh`, `InvalidModel`  | `ValueError`                  |
-//! | `NotConverged`                                     | `ConvergenceError`            |
+//! | `NotConverged`, `StepLimit`                        | `ConvergenceError`            |
 //! | `Factorisation`                                    | `TapeError`                   |
 //! | a panic inside tape-core (a bug)                   | `TapeError`                   |
 
@@ -11,7 +11,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
-use pyo3::PyErr;
+use pyo3::prelude::*;
 use tape_core::Error;
 
 create_exception!(
@@ -42,7 +42,7 @@ impl From<PyTapeError> for PyErr {
             Error::InvalidParameter(_) | Error::InvalidMesh(_) | Error::InvalidModel(_) => {
                 PyValueError::new_err(e.0.to_string())
             }
-            Error::NotConverged { .. } => ConvergenceError::new_err(e.0.to_string()),
+            Error::NotConverged { .. } | Error::StepLimit { .. } => ConvergenceError::new_err(e.0.to_string()),
             Error::Factorisation(_) => TapeError::new_err(e.0.to_string()),
         }
     }
@@ -66,4 +66,55 @@ pub fn guard<T>(f: impl FnOnce() -> Result<T, PyErr>) -> Result<T, PyErr> {
             "internal error in tape-core (please report it): {msg}"
         )))
     })
+}
+
+/// Calls back into Python from a detached computation: Ctrl-C check, then the user's callback.
+pub struct Ticker<'a> {
+    callback: Option<&'a Py<PyAny>>,
+    /// Exception raised by the callback or by a signal handler; stops the run.
+    error: Option<PyErr>,
+}
+
+impl Ticker<'_> {
+    /// Returns `false` to stop the computation. Must be called without the GIL held.
+    pub fn tick(&mut self, call: impl for<'py> FnOnce(Python<'py>, &Py<PyAny>) -> PyResult<Bound<'py, PyAny>>) -> bool {
+        Python::attach(|py| {
+            if let Err(e) = py.check_signals() {
+                self.error = Some(e);
+                return false;
+            }
+            let Some(cb) = self.callback else { return true };
+            match call(py, cb).and_then(|r| Ok(r.is_none() || r.is_truthy()?)) {
+                Ok(keep_going) => keep_going,
+                Err(e) => {
+                    self.error = Some(e);
+                    false
+                }
+            }
+        })
+    }
+}
+
+/// The one way the binding runs tape-core: with the GIL released (other Python threads keep
+/// running), panics turned into `TapeError`, and a [`Ticker`] for progress and Ctrl-C; an
+/// exception raised by the callback or a signal handler is re-raised after `f` returns.
+///
+/// # Errors
+/// The error of `f`, of the callback, or a `ValueError` if `callback` is not callable.
+pub fn run_detached<T: Send>(
+    py: Python<'_>,
+    callback: Option<&Py<PyAny>>,
+    f: impl for<'a> FnOnce(&mut Ticker<'a>) -> PyResult<T> + Send,
+) -> PyResult<T> {
+    if let Some(cb) = callback {
+        if !cb.bind(py).is_callable() {
+            return Err(PyValueError::new_err("progress must be callable or None"));
+        }
+    }
+    let mut ticker = Ticker { callback, error: None };
+    let out = py.detach(|| guard(|| f(&mut ticker)));
+    if let Some(e) = ticker.error {
+        return Err(e);
+    }
+    out
 }

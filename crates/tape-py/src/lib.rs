@@ -3,22 +3,23 @@
 //! This crate only converts, wraps, releases the GIL and maps errors; every loop over elements
 //! or load steps lives in tape-core. Units are SI (m, N, Pa, rad), as in tape-core.
 
+mod analysis;
 mod convert;
 mod error;
+mod mesh;
 mod model;
-mod simulate;
 
-/// Native core of tapespring: the shell model, static solver and tape-spring bending.
+/// Native core of tapespring: the model, the analysis runner and the mesh generators.
 #[pyo3::pymodule]
 mod _core {
     use pyo3::prelude::*;
 
     #[pymodule_export]
-    use super::model::PyModel;
+    use super::analysis::{run, step_defaults};
     #[pymodule_export]
-    use super::simulate::{
-        _panic_for_tests, bend_tape, cylindrical_panel_mesh, flat_plate_mesh, solve_static, tape_spring_mesh,
-    };
+    use super::mesh::{_panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_spring_mesh};
+    #[pymodule_export]
+    use super::model::PyModel;
 
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -26,6 +27,7 @@ mod _core {
         m.add("TapeError", py.get_type::<super::error::TapeError>())?;
         m.add("ConvergenceError", py.get_type::<super::error::ConvergenceError>())?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+        m.add("DOFS", tape_core::Dof::NAMES.to_vec())?;
         Ok(())
     }
 }

@@ -1,67 +1,128 @@
-//! `tapespring._core.Model`: a shell model (mesh, section, constraints, loads).
-
-use std::collections::BTreeMap;
+//! `tapespring.Model`: the native model (tape-core's `Model`) under its domain name.
+//!
+//! Sections, time functions and options cross the boundary as JSON-like Python values read by
+//! serde in tape-core, so a new section parameter costs no binding code.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use serde_json::Value;
 use tape_core::material::ShellSection;
-use tape_core::mesh::Mesh;
-use tape_core::Model;
+use tape_core::mesh::{Mesh, Placement};
+use tape_core::model::{Constraint, Gravity, Load, Marker, RigidBody};
+use tape_core::{Model, TimeFunction};
 
 use crate::convert;
 use crate::error::to_py;
 
-/// A shell model: mesh, homogeneous section, constraints, rigid ties and nodal loads (SI units).
-#[pyclass(name = "Model", module = "tapespring._core")]
+/// A model: shell parts with their sections, reference nodes, rigid bodies, ties, constraints,
+/// loads, gravity and markers (SI units). See the type stub for every method.
+#[pyclass(name = "Model", module = "tapespring._core", skip_from_py_object)]
+#[derive(Clone)]
 pub struct PyModel {
     pub inner: Model,
 }
 
-#[pymethods]
-impl PyModel {
-    #[new]
-    #[pyo3(signature = (
-        nodes, quads, *, thickness, youngs_modulus, poisson, density = 7850.0, eta = 0.0,
-        shear_factor = 5.0 / 6.0, drilling_factor = 1e-3, node_sets = None
-    ))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        nodes: &Bound<'_, PyAny>,
-        quads: &Bound<'_, PyAny>,
-        thickness: f64,
-        youngs_modulus: f64,
-        poisson: f64,
-        density: f64,
-        eta: f64,
-        shear_factor: f64,
-        drilling_factor: f64,
-        node_sets: Option<BTreeMap<String, Bound<'_, PyAny>>>,
-    ) -> PyResult<Self> {
-        let nodes = convert::float_rows::<3>(nodes, "nodes")?;
-        let quads = convert::index_rows::<4>(quads, "quads")?;
-        if quads.is_empty() {
-            return Err(PyValueError::new_err(
-                "quads is empty: the model needs at least one element",
-            ));
-        }
-        let mut mesh = to_py(Mesh::try_new(nodes.into_iter().map(Into::into).collect(), quads))?;
-        for (name, set) in node_sets.unwrap_or_default() {
+/// A section from keyword arguments (the fields of tape-core's `ShellSection`, read by serde:
+/// `thickness`, `youngs_modulus` and `poisson` required, the others optional).
+fn section(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ShellSection> {
+    let value = match kwargs {
+        Some(k) => convert::to_json(k.as_any(), "section")?,
+        None => Value::Object(serde_json::Map::new()),
+    };
+    let s: ShellSection = serde_json::from_value(value).map_err(|e| {
+        PyValueError::new_err(format!(
+            "section: {e} (thickness [m], youngs_modulus [Pa] and poisson are required; density [kg/m^3], eta [s], shear_factor and drilling_factor are optional)"
+        ))
+    })?;
+    to_py(s.validate())?;
+    Ok(s)
+}
+
+/// `(rotation vector, translation)` into a placement.
+fn placement(rotation: Option<&Bound<'_, PyAny>>, translation: Option<&Bound<'_, PyAny>>) -> PyResult<Placement> {
+    let v =
+        |o: Option<&Bound<'_, PyAny>>, what| o.map_or(Ok(nalgebra::Vector3::zeros()), |o| convert::vector3(o, what));
+    Ok(Placement {
+        rotation: v(rotation, "rotation")?,
+        translation: v(translation, "translation")?,
+    })
+}
+
+fn mesh_of(
+    nodes: &Bound<'_, PyAny>,
+    quads: &Bound<'_, PyAny>,
+    node_sets: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Mesh> {
+    let nodes = convert::float_rows::<3>(nodes, "nodes")?;
+    let quads = convert::index_rows::<4>(quads, "quads")?;
+    if quads.is_empty() {
+        return Err(PyValueError::new_err(
+            "quads is empty: a part needs at least one element",
+        ));
+    }
+    let mut mesh = to_py(Mesh::try_new(nodes.into_iter().map(Into::into).collect(), quads))?;
+    if let Some(sets) = node_sets {
+        for (name, set) in sets.iter() {
+            let name: String = name
+                .extract()
+                .map_err(|_| PyValueError::new_err("node_sets must map names (str) to node indices"))?;
             let set = convert::index_vec(&set, &format!("node_sets['{name}']"))?;
             to_py(mesh.add_node_set(&name, set))?;
         }
-        let section = ShellSection {
-            thickness,
-            youngs_modulus,
-            poisson,
-            density,
-            eta,
-            shear_factor,
-            drilling_factor,
+    }
+    Ok(mesh)
+}
+
+#[pymethods]
+impl PyModel {
+    /// An empty model, or a model of one part (named `""`: its node sets keep their names) when
+    /// `nodes`, `quads` and the section are given.
+    #[new]
+    #[pyo3(signature = (nodes = None, quads = None, *, node_sets = None, **section_kwargs))]
+    fn new(
+        nodes: Option<&Bound<'_, PyAny>>,
+        quads: Option<&Bound<'_, PyAny>>,
+        node_sets: Option<&Bound<'_, PyDict>>,
+        section_kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let mut model = Self {
+            inner: Model::default(),
         };
-        Ok(Self {
-            inner: to_py(Model::try_new(mesh, section))?,
-        })
+        match (nodes, quads) {
+            (None, None) => {
+                if section_kwargs.is_some_and(|k| !k.is_empty()) || node_sets.is_some() {
+                    return Err(PyValueError::new_err(
+                        "a section or node sets without nodes and quads: give the mesh, or add parts with add_part",
+                    ));
+                }
+            }
+            (Some(n), Some(q)) => {
+                model.add_part("", n, q, None, None, node_sets, section_kwargs)?;
+            }
+            _ => return Err(PyValueError::new_err("give both nodes and quads, or neither")),
+        }
+        Ok(model)
+    }
+
+    /// Adds a part: the mesh `(nodes, quads)` moved by `rotation` (a rotation vector [rad]) then
+    /// `translation` [m], with the section of the keyword arguments; returns the part's index.
+    #[pyo3(signature = (name, nodes, quads, *, rotation = None, translation = None, node_sets = None, **section_kwargs))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_part(
+        &mut self,
+        name: &str,
+        nodes: &Bound<'_, PyAny>,
+        quads: &Bound<'_, PyAny>,
+        rotation: Option<&Bound<'_, PyAny>>,
+        translation: Option<&Bound<'_, PyAny>>,
+        node_sets: Option<&Bound<'_, PyDict>>,
+        section_kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<usize> {
+        let mesh = mesh_of(nodes, quads, node_sets)?;
+        let section = section(section_kwargs)?;
+        let placement = placement(rotation, translation)?;
+        to_py(self.inner.add_part(name, mesh, section, &placement))
     }
 
     /// Number of nodes (mesh nodes and added reference nodes).
@@ -88,25 +149,33 @@ impl PyModel {
         convert::quads_to_numpy(py, &self.inner.mesh.quads)
     }
 
-    /// Section properties as a dict (thickness [m], youngs_modulus [Pa], poisson, density
-    /// [kg/m^3], eta [s], shear_factor, drilling_factor).
+    /// The parts: list of dicts with `name`, `section` and `elements` (`[first, end)`).
     #[getter]
-    fn section<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        section_to_dict(py, &self.inner.section)
+    fn parts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        convert::to_py_object(py, &self.inner.parts)
+    }
+
+    /// Section of the first part (the section of a one-part model), as a dict.
+    #[getter]
+    fn section<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let part = self
+            .inner
+            .parts
+            .first()
+            .ok_or_else(|| PyValueError::new_err("the model has no part"))?;
+        convert::to_py_object(py, &part.section)
+    }
+
+    /// Total mass [kg]: shells (density x thickness x area) and rigid bodies.
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.inner.total_mass()
     }
 
     /// Adds a node at `xyz` [m] (e.g. the reference node of a rigid tie); returns its index.
     fn add_node(&mut self, xyz: &Bound<'_, PyAny>) -> PyResult<usize> {
-        let xyz: Vec<f64> = xyz
-            .extract()
-            .map_err(|_| PyValueError::new_err("xyz must be a sequence of three numbers"))?;
-        let [x, y, z] = xyz[..] else {
-            return Err(PyValueError::new_err(format!(
-                "xyz must have 3 coordinates (got {})",
-                xyz.len()
-            )));
-        };
-        to_py(self.inner.add_node([x, y, z].into()))
+        let x = convert::vector3(xyz, "xyz")?;
+        to_py(self.inner.add_node(x))
     }
 
     /// Adds (or replaces) a named node set.
@@ -126,41 +195,219 @@ impl PyModel {
         self.inner.mesh.node_sets.keys().cloned().collect()
     }
 
-    /// Fixes `dofs` ("all", a name or a list of names among ux, uy, uz, rx, ry, rz) of `nodes`
-    /// (an index, a sequence of indices or a node-set name).
-    fn fix(&mut self, nodes: &Bound<'_, PyAny>, dofs: &Bound<'_, PyAny>) -> PyResult<()> {
+    /// Index of the node nearest to `point` [m].
+    fn nearest_node(&self, point: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let p = convert::vector3(point, "point")?;
+        self.inner
+            .mesh
+            .nearest_node(&p)
+            .ok_or_else(|| PyValueError::new_err("the model has no node"))
+    }
+
+    /// Nodes inside the axis-aligned box `[lo, hi]` [m], in index order.
+    fn nodes_in_box<'py>(
+        &self,
+        py: Python<'py>,
+        lo: &Bound<'_, PyAny>,
+        hi: &Bound<'_, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (lo, hi) = (convert::vector3(lo, "lo")?, convert::vector3(hi, "hi")?);
+        Ok(convert::indices_to_numpy(py, &self.inner.mesh.nodes_in_box(&lo, &hi)))
+    }
+
+    /// Corner nodes: nodes used by exactly one element (the corners of structured patches).
+    fn corner_nodes<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        convert::indices_to_numpy(py, &self.inner.mesh.corner_nodes())
+    }
+
+    /// The node nearest to each of `points` (shape (n, 3)); `ValueError` if one is farther than
+    /// `tolerance` [m].
+    #[pyo3(signature = (points, tolerance = 1e-6))]
+    fn nodes_at<'py>(&self, py: Python<'py>, points: &Bound<'_, PyAny>, tolerance: f64) -> PyResult<Bound<'py, PyAny>> {
+        let pts: Vec<nalgebra::Vector3<f64>> = convert::float_rows::<3>(points, "points")?
+            .into_iter()
+            .map(Into::into)
+            .collect();
+        Ok(convert::indices_to_numpy(
+            py,
+            &to_py(self.inner.mesh.nodes_at(&pts, tolerance))?,
+        ))
+    }
+
+    /// Holds `dofs` ("all", a name or a list of names among ux, uy, uz, rx, ry, rz) of `nodes` (an
+    /// index, a sequence of indices or a node-set name) where they are when switched on.
+    #[pyo3(signature = (nodes, dofs = None, *, id = None, active = true))]
+    fn fix(
+        &mut self,
+        nodes: &Bound<'_, PyAny>,
+        dofs: Option<&Bound<'_, PyAny>>,
+        id: Option<String>,
+        active: bool,
+    ) -> PyResult<()> {
         let nodes = convert::node_selection(&self.inner.mesh, nodes, "nodes")?;
         if nodes.is_empty() {
             return Err(PyValueError::new_err("nodes is empty: name at least one node to fix"));
         }
-        let dofs = convert::dofs(dofs)?;
-        to_py(self.inner.fix(&nodes, &dofs))
+        let dofs = match dofs {
+            Some(d) => convert::dofs(d)?,
+            None => tape_core::Dof::ALL.to_vec(),
+        };
+        for n in nodes {
+            for &dof in &dofs {
+                to_py(self.inner.add_constraint(Constraint {
+                    id: id.clone(),
+                    node: n,
+                    dof,
+                    value: 0.0,
+                    function: TimeFunction::Linear,
+                    active,
+                }))?;
+            }
+        }
+        Ok(())
     }
 
-    /// Prescribes `dof` of `node` to `lambda * value` [m or rad].
-    fn prescribe(&mut self, node: i64, dof: &str, value: f64) -> PyResult<()> {
-        let node = convert::index(node, "node")?;
-        let dof = convert::dof(dof)?;
-        to_py(self.inner.prescribe(node, dof, value))
+    /// Moves `dof` of `node` by `value * (f(t) - f(t_on))` [m or rad] while active (`function`
+    /// `f` defaults to the load factor itself).
+    #[pyo3(signature = (node, dof, value, *, function = None, id = None, active = true))]
+    fn prescribe(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        dof: &str,
+        value: f64,
+        function: Option<&Bound<'_, PyAny>>,
+        id: Option<String>,
+        active: bool,
+    ) -> PyResult<()> {
+        let node = convert::node(node, "node")?;
+        let c = Constraint {
+            id,
+            node,
+            dof: convert::dof(dof)?,
+            value,
+            function: convert::time_function(function, TimeFunction::Linear, "function")?,
+            active,
+        };
+        to_py(self.inner.add_constraint(c))
     }
 
     /// Ties `nodes` (indices or a node-set name) rigidly to the node `reference`.
-    fn tie(&mut self, nodes: &Bound<'_, PyAny>, reference: i64) -> PyResult<()> {
+    fn tie(&mut self, nodes: &Bound<'_, PyAny>, reference: &Bound<'_, PyAny>) -> PyResult<()> {
         let nodes = convert::node_selection(&self.inner.mesh, nodes, "nodes")?;
-        let reference = convert::index(reference, "reference")?;
+        let reference = convert::node(reference, "reference")?;
         to_py(self.inner.tie(&nodes, reference))
     }
 
-    /// Adds a nodal force [N] (ux, uy, uz) or moment [N m] (rx, ry, rz) at load factor 1.
-    fn add_load(&mut self, node: i64, dof: &str, value: f64) -> PyResult<()> {
-        let node = convert::index(node, "node")?;
-        let dof = convert::dof(dof)?;
-        to_py(self.inner.add_load(node, dof, value))
+    /// Adds a nodal force [N] (ux, uy, uz) or moment [N m] (rx, ry, rz): `value * f(t)` while
+    /// active (`function` defaults to the load factor itself).
+    #[pyo3(signature = (node, dof, value, *, function = None, id = None, active = true))]
+    fn add_load(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        dof: &str,
+        value: f64,
+        function: Option<&Bound<'_, PyAny>>,
+        id: Option<String>,
+        active: bool,
+    ) -> PyResult<()> {
+        let node = convert::node(node, "node")?;
+        to_py(self.inner.add_load_with(Load {
+            id,
+            node,
+            dof: convert::dof(dof)?,
+            value,
+            function: convert::time_function(function, TimeFunction::Linear, "function")?,
+            active,
+        }))
     }
 
-    /// Constrained DOFs as (node, dof) pairs, in the order of the reaction columns.
+    /// Puts a rigid body on `node`: `mass` [kg], `centre_of_mass` relative to the node [m] (in the
+    /// reference configuration; it rotates with the node), `inertia` about the centre of mass
+    /// [kg m^2] (3 x 3, global axes; zero for a point mass).
+    #[pyo3(signature = (node, mass, *, centre_of_mass = None, inertia = None))]
+    fn add_rigid_body(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        mass: f64,
+        centre_of_mass: Option<&Bound<'_, PyAny>>,
+        inertia: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let node = convert::node(node, "node")?;
+        let centre_of_mass = centre_of_mass.map_or(Ok(nalgebra::Vector3::zeros()), |c| {
+            convert::vector3(c, "centre_of_mass")
+        })?;
+        let inertia = match inertia {
+            None => nalgebra::Matrix3::zeros(),
+            Some(j) => {
+                let rows = convert::float_rows::<3>(j, "inertia")?;
+                if rows.len() != 3 {
+                    return Err(PyValueError::new_err(format!(
+                        "inertia must be 3 x 3 (got {} rows)",
+                        rows.len()
+                    )));
+                }
+                nalgebra::Matrix3::from_fn(|r, c| rows[r][c])
+            }
+        };
+        to_py(self.inner.add_rigid_body(RigidBody {
+            node,
+            mass,
+            centre_of_mass,
+            inertia,
+        }))
+    }
+
+    /// Puts a point mass [kg] on `node` (a rigid body without inertia or offset).
+    fn add_point_mass(&mut self, node: &Bound<'_, PyAny>, mass: f64) -> PyResult<()> {
+        self.add_rigid_body(node, mass, None, None)
+    }
+
+    /// Sets gravity: `acceleration` [m/s^2] (e.g. `(0, 0, -9.81)`) times `function` (default: a
+    /// ramp from 0 to 1 over the load factor's first unit, then constant).
+    #[pyo3(signature = (acceleration, *, function = None, id = None, active = true))]
+    fn set_gravity(
+        &mut self,
+        acceleration: &Bound<'_, PyAny>,
+        function: Option<&Bound<'_, PyAny>>,
+        id: Option<String>,
+        active: bool,
+    ) -> PyResult<()> {
+        let ramp = TimeFunction::Ramp { start: 0.0, end: 1.0 };
+        to_py(self.inner.set_gravity(Gravity {
+            id,
+            acceleration: convert::vector3(acceleration, "acceleration")?,
+            function: convert::time_function(function, ramp, "function")?,
+            active,
+        }))
+    }
+
+    /// Adds a marker `name` following `node`, at `offset` [m] from it (rotating with it).
+    #[pyo3(signature = (name, node, *, offset = None))]
+    fn add_marker(&mut self, name: &str, node: &Bound<'_, PyAny>, offset: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        let node = convert::node(node, "node")?;
+        let offset = offset.map_or(Ok(nalgebra::Vector3::zeros()), |o| convert::vector3(o, "offset"))?;
+        to_py(self.inner.add_marker(Marker {
+            name: name.to_owned(),
+            node,
+            offset,
+        }))
+    }
+
+    /// Constrained DOFs as (node, dof) pairs, in model order (the default reaction columns).
     fn constrained<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        convert::constrained_to_list(py, self.inner.constraints.iter().map(|c| (c.node, c.dof)))
+        let mut seen: Vec<(usize, &'static str)> = Vec::new();
+        for c in &self.inner.constraints {
+            let key = (c.node, c.dof.name());
+            if !seen.contains(&key) {
+                seen.push(key);
+            }
+        }
+        PyList::new(py, seen)
+    }
+
+    /// Constraints as dicts (id, node, dof, value, function, active).
+    fn constraints<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        convert::to_py_object(py, &self.inner.constraints)
     }
 
     /// Nodal loads as (node, dof, value) triples.
@@ -168,7 +415,7 @@ impl PyModel {
         self.inner
             .loads
             .iter()
-            .map(|l| (l.node, convert::dof_name(l.dof), l.value))
+            .map(|l| (l.node, l.dof.name(), l.value))
             .collect()
     }
 
@@ -181,33 +428,66 @@ impl PyModel {
             .collect()
     }
 
+    /// Rigid bodies as dicts (node, mass, centre_of_mass, inertia).
+    #[getter]
+    fn rigid_bodies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        convert::to_py_object(py, &self.inner.rigid_bodies)
+    }
+
+    /// Marker names, in model order.
+    #[getter]
+    fn markers(&self) -> Vec<String> {
+        self.inner.markers.iter().map(|m| m.name.clone()).collect()
+    }
+
+    /// The model as a JSON string (everything: parts, sections, constraints ...).
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.inner)
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("serialisation failed: {e}")))
+    }
+
+    /// A model from the JSON of `to_json` (checked as a whole).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        let inner: Model = serde_json::from_str(text).map_err(|e| PyValueError::new_err(format!("model JSON: {e}")))?;
+        to_py(inner.validate())?;
+        Ok(Self { inner })
+    }
+
+    fn __getstate__(&self) -> PyResult<String> {
+        self.to_json()
+    }
+
+    fn __setstate__(&mut self, state: &str) -> PyResult<()> {
+        *self = Self::from_json(state)?;
+        Ok(())
+    }
+
+    fn __getnewargs__(&self) -> (Option<i64>,) {
+        (None,)
+    }
+
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+
     fn __repr__(&self) -> String {
         let m = &self.inner;
         format!(
-            "Model(n_nodes={}, n_elements={}, node_sets={:?}, constraints={}, ties={}, loads={}, thickness={}, \
-             youngs_modulus={}, poisson={})",
+            "Model(n_nodes={}, n_elements={}, parts={:?}, constraints={}, ties={}, loads={}, rigid_bodies={}, markers={}, gravity={})",
             m.mesh.n_nodes(),
             m.mesh.quads.len(),
-            m.mesh.node_sets.keys().collect::<Vec<_>>(),
+            m.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(),
             m.constraints.len(),
             m.ties.len(),
             m.loads.len(),
-            m.section.thickness,
-            m.section.youngs_modulus,
-            m.section.poisson
+            m.rigid_bodies.len(),
+            m.markers.len(),
+            m.gravity.is_some()
         )
     }
-}
-
-/// Section properties as a dict.
-pub fn section_to_dict<'py>(py: Python<'py>, s: &ShellSection) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("thickness", s.thickness)?;
-    d.set_item("youngs_modulus", s.youngs_modulus)?;
-    d.set_item("poisson", s.poisson)?;
-    d.set_item("density", s.density)?;
-    d.set_item("eta", s.eta)?;
-    d.set_item("shear_factor", s.shear_factor)?;
-    d.set_item("drilling_factor", s.drilling_factor)?;
-    Ok(d)
 }

@@ -767,9 +767,8 @@ mod tests {
 
     fn section() -> SectionStiffness {
         ShellSection {
-            thickness: 0.138e-3,
             drilling_factor: 0.1,
-            ..ShellSection::default()
+            ..ShellSection::new(0.138e-3, 151.76e9, 0.3)
         }
         .stiffness()
     }

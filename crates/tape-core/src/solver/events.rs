@@ -184,10 +184,16 @@ fn insert(s: &mut Driver, path: &mut StaticPath, found: Option<Found>, kind: Eve
 
 /// Searches the extremum of `sense * g` (g the load factor or the monitored reaction) between
 /// `a` and `c`, where `b` is higher than both; returns the best new state if it beats `b`.
-fn search(s: &mut Driver, (a, b, c): (&Point, &Point, &Point), kind: Event, sense: f64, monitor: Option<usize>) -> Option<Found> {
+fn search(
+    s: &mut Driver,
+    (a, b, c): (&Point, &Point, &Point),
+    kind: Event,
+    sense: f64,
+    monitor: Option<usize>,
+) -> Option<Found> {
     let chord = s.difference(&a.state, &c.state);
     let c2 = s.arc_dot((&chord.0, chord.1), (&chord.0, chord.1));
-    if !(c2 > 0.0) {
+    if c2.is_nan() || c2 <= 0.0 {
         return None;
     }
     let db = s.difference(&a.state, &b.state);

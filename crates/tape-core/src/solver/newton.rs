@@ -62,7 +62,10 @@ impl NewtonParams {
     pub fn validate(&self) -> Result<()> {
         let bad = |s: String| Err(Error::InvalidParameter(s));
         if !(1..=1000).contains(&self.max_iterations) {
-            return bad(format!("max_iterations must lie in [1, 1000] (got {})", self.max_iterations));
+            return bad(format!(
+                "max_iterations must lie in [1, 1000] (got {})",
+                self.max_iterations
+            ));
         }
         let in_unit = |v: f64| v > 0.0 && v < 1.0;
         if !in_unit(self.tol_force) {
@@ -72,7 +75,10 @@ impl NewtonParams {
             return bad(format!("tol_energy must lie in (0, 1) (got {})", self.tol_energy));
         }
         if self.stall_iterations > 1000 {
-            return bad(format!("stall_iterations must lie in [0, 1000] (got {})", self.stall_iterations));
+            return bad(format!(
+                "stall_iterations must lie in [0, 1000] (got {})",
+                self.stall_iterations
+            ));
         }
         Ok(())
     }

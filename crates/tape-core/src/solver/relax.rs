@@ -17,7 +17,14 @@ impl Driver<'_> {
     ///
     /// # Errors
     /// [`Error::NotConverged`] if no stable equilibrium is found.
-    pub fn jump(&mut self, state: &mut State, saved: &State, travel: f64, last_dlambda: Option<f64>, ds: f64) -> Result<()> {
+    pub fn jump(
+        &mut self,
+        state: &mut State,
+        saved: &State,
+        travel: f64,
+        last_dlambda: Option<f64>,
+        ds: f64,
+    ) -> Result<()> {
         let mut offset = last_dlambda.map_or(1e-3, |dl| 0.25 * dl.abs()).max(1e-6);
         for _ in 0..8 {
             *state = saved.clone();

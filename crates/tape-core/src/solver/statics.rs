@@ -524,7 +524,9 @@ impl Driver<'_> {
         a.x.iter()
             .zip(&b.x)
             .zip(a.q.iter().zip(&b.q))
-            .map(|((xa, xb), (qa, qb))| (xa - xb).norm_squared() + lc2 * (qa * qb.inverse()).scaled_axis().norm_squared())
+            .map(|((xa, xb), (qa, qb))| {
+                (xa - xb).norm_squared() + lc2 * (qa * qb.inverse()).scaled_axis().norm_squared()
+            })
             .sum::<f64>()
             .sqrt()
     }
@@ -622,10 +624,7 @@ pub fn solve_static(
     // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
     #[allow(clippy::cast_precision_loss)]
     let round_off = f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
-    let linear_counts = (
-        system.linear.refinement_sweeps,
-        system.linear.lu_fallbacks,
-    );
+    let linear_counts = (system.linear.refinement_sweeps, system.linear.lu_fallbacks);
     let mut s = Driver {
         system,
         asm: Assembled::default(),
@@ -971,10 +970,7 @@ fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: 
     let (iterations, residual) = last.newton();
     let how = match why {
         GiveUp::Cutbacks => format!("increment cut back {} times", params.max_cutbacks),
-        GiveUp::RoundOff => format!(
-            "increment cut back to {:.3e}, below round-off",
-            p.control.size.abs()
-        ),
+        GiveUp::RoundOff => format!("increment cut back to {:.3e}, below round-off", p.control.size.abs()),
     };
     let hint = match params.control {
         Control::Load { .. } | Control::Displacement { .. } => {

@@ -14,12 +14,7 @@ use tape_core::{Model, Result, System};
 
 /// Homogeneous isotropic section; the other fields (drilling factor, shear factor) keep their defaults.
 pub fn section(thickness: f64, youngs_modulus: f64, poisson: f64) -> ShellSection {
-    ShellSection {
-        thickness,
-        youngs_modulus,
-        poisson,
-        ..ShellSection::default()
-    }
+    ShellSection::new(thickness, youngs_modulus, poisson)
 }
 
 /// Reads `tests/reference_values/<file>`.

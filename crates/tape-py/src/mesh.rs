@@ -1,0 +1,73 @@
+//! Mesh generators of tape-core: `(nodes, quads, node_sets)` tuples of numpy arrays.
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use tape_core::mesh::generate::{self, TapeGeometry};
+
+use crate::convert;
+use crate::error::{guard, to_py};
+
+/// A count (elements ...) that must be `>= min`.
+fn count(name: &str, value: i64, min: usize) -> PyResult<usize> {
+    usize::try_from(value)
+        .ok()
+        .filter(|v| *v >= min)
+        .ok_or_else(|| PyValueError::new_err(format!("{name} must be an integer >= {min} (got {value})")))
+}
+
+/// Runs a mesh generator with the GIL released and returns `(nodes, quads, node_sets)`.
+fn mesh_tuple<'py>(
+    py: Python<'py>,
+    make: impl FnOnce() -> tape_core::Result<tape_core::mesh::Mesh> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mesh = py.detach(|| guard(|| to_py(make())))?;
+    convert::mesh_to_tuple(py, &mesh)
+}
+
+/// Tape-spring mesh: `(nodes, quads, node_sets)` with sets end0, end1, side0, side1, midline, all.
+#[pyfunction]
+#[pyo3(signature = (length, radius, alpha, mesh_size))]
+pub fn tape_spring_mesh(
+    py: Python<'_>,
+    length: f64,
+    radius: f64,
+    alpha: f64,
+    mesh_size: f64,
+) -> PyResult<Bound<'_, PyAny>> {
+    mesh_tuple(py, || {
+        generate::tape_spring(&TapeGeometry { length, radius, alpha }, mesh_size)
+    })
+}
+
+/// Flat plate `[0, lx] x [0, ly]` in the x-y plane: `(nodes, quads, node_sets)` with sets x0, x1,
+/// y0, y1, all.
+#[pyfunction]
+#[pyo3(signature = (lx, ly, nx, ny))]
+pub fn flat_plate_mesh(py: Python<'_>, lx: f64, ly: f64, nx: i64, ny: i64) -> PyResult<Bound<'_, PyAny>> {
+    let (nx, ny) = (count("nx", nx, 1)?, count("ny", ny, 1)?);
+    mesh_tuple(py, || generate::flat_plate(lx, ly, nx, ny))
+}
+
+/// Cylindrical panel about the x axis: `(nodes, quads, node_sets)` with sets x0, x1, phi0, phi1, all.
+#[pyfunction]
+#[pyo3(signature = (radius, length, phi0, phi1, n_axial, n_arc))]
+pub fn cylindrical_panel_mesh(
+    py: Python<'_>,
+    radius: f64,
+    length: f64,
+    phi0: f64,
+    phi1: f64,
+    n_axial: i64,
+    n_arc: i64,
+) -> PyResult<Bound<'_, PyAny>> {
+    let (n_axial, n_arc) = (count("n_axial", n_axial, 1)?, count("n_arc", n_arc, 1)?);
+    mesh_tuple(py, || {
+        generate::cylindrical_panel(radius, length, phi0, phi1, n_axial, n_arc)
+    })
+}
+
+/// Test hook: panics inside the same guard as the solver entry points (must raise `TapeError`).
+#[pyfunction]
+pub fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
+    py.detach(|| guard(|| -> PyResult<()> { panic!("deliberate panic for the test-suite") }))
+}
