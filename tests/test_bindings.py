@@ -1,5 +1,7 @@
 """The native module tapespring._core: argument checking, error mapping, GIL release, callbacks.
 
+Static analyses go through ``core.run`` with one static step (`solve_static` below builds it).
+
 Every invalid input must raise an ordinary Python exception whose message names the problem,
 never a pyo3 PanicException (a BaseException that would escape ``except Exception``).
 """
@@ -24,6 +26,19 @@ def square():
     nodes = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
     quads = np.array([[0, 1, 2, 3]])
     return nodes, quads
+
+
+def solve_static(model, *, record_fields=True, progress=None, **options):
+    """One static step of ``core.run``; `progress(i, t)` sees the i-th converged state."""
+    hook = progress
+    if callable(progress):
+        count = iter(range(1000))
+
+        def hook(step, name, t):
+            return progress(next(count), t)
+
+    outputs = {"field_interval": 1 if record_fields else 0}
+    return core.run(model, [{"name": "static", **options}], outputs=outputs, progress=hook)
 
 
 def cantilever(nx=8, ny=2, load=50.0):
@@ -254,14 +269,14 @@ def test_no_load_is_rejected():
     model = core.Model(*square(), **SECTION)
     model.fix([0, 3], "all")
     with pytest.raises(ValueError, match="no load and no prescribed motion"):
-        core.solve_static(model)
+        solve_static(model)
 
 
 def test_no_constraint_is_rejected():
     model = core.Model(*square(), **SECTION)
     model.add_load(2, "uz", 1.0)
     with pytest.raises(ValueError, match="no constraint"):
-        core.solve_static(model)
+        solve_static(model)
 
 
 @pytest.mark.parametrize(
@@ -270,21 +285,24 @@ def test_no_constraint_is_rejected():
         ({"control": "force"}, "unknown control 'force'"),
         ({"control": "displacement"}, "needs node, dof and delta"),
         ({"control": "displacement", "node": 2, "dof": "uz"}, "needs node, dof and delta"),
-        ({"control": "displacement", "node": 2, "dof": "uw", "delta": 1e-3}, "unknown DOF"),
+        ({"control": "displacement", "node": 2, "dof": "uw", "delta": 1e-3}, "option dof"),
         ({"control": "displacement", "node": 0, "dof": "uz", "delta": 1e-3}, "is not free"),
         ({"control": "displacement", "node": 99, "dof": "uz", "delta": 1e-3}, "does not exist"),
         ({"control": "displacement", "node": 2, "dof": "uz", "delta": 0.0}, "non-zero delta"),
-        ({"node": 2}, "only apply to control='displacement'"),
-        ({"increments": 0}, "increments must be an integer >= 1"),
-        ({"increments": -3}, "increments must be an integer >= 1"),
-        ({"lambda_end": float("nan")}, "finite lambda_end"),
+        ({"node": 2}, r"\[\"node\"\] do not apply to control 'load'"),
+        ({"initial_increment": 0.1}, "do not apply to control 'load'"),
+        ({"tol_forse": 1e-6}, "are not options of a step"),
+        ({"increments": 0}, "increments >= 1"),
+        ({"increments": -3}, "option increments = -3"),
+        ({"lambda_end": float("nan")}, r"\['lambda_end'\] must be finite"),
         ({"control": "arc-length", "direction": 2}, "direction must be \\+1 or -1"),
         ({"control": "arc-length", "max_steps": 0}, "max_steps must be"),
-        ({"control": "arc-length", "initial_increment": 0.0}, "initial_increment > 0"),
-        ({"control": "arc-length", "max_increment_factor": 0.5}, "max_increment_factor >= 1"),
-        ({"tol_force": 0.0}, "tolerances"),
-        ({"max_iterations": 0}, "max_iterations must be"),
-        ({"max_cutbacks": -1}, "max_cutbacks must be"),
+        ({"control": "arc-length", "initial_increment": 0.0}, "initial_increment must be"),
+        ({"control": "arc-length", "max_increment_factor": 0.5}, "max_increment_factor must be"),
+        ({"tol_force": 0.0}, "tol_force must lie in"),
+        ({"max_iterations": 0}, "max_iterations must lie in"),
+        ({"max_cutbacks": -1}, "option max_cutbacks = -1"),
+        ({"max_cutbacks": 2**70}, r"\['max_cutbacks'\] = \d+ does not fit"),
         ({"progress": 3}, "progress must be callable"),
     ],
 )
@@ -293,30 +311,31 @@ def test_bad_control_options_raise_value_error_before_solving(options, match):
     model.fix([0, 3], "all")
     model.add_load(2, "uz", 1.0)
     with pytest.raises(ValueError, match=match):
-        core.solve_static(model, **options)
+        solve_static(model, **options)
 
 
 def test_options_are_keyword_only():
     model = cantilever()
     with pytest.raises(TypeError):
-        core.solve_static(model, "load")
+        core.run(model, [{"name": "static"}], {"field_interval": 1})
 
 
 def test_result_dict_has_every_key_with_consistent_shapes():
     model = cantilever()
-    r = core.solve_static(model, increments=2, stability=True, **TOL)
-    n = r["lambda"].shape[0]
-    assert r["error"] is None and not r["cancelled"] and n == 2
+    r = solve_static(model, increments=2, stability=True, **TOL)
+    n = r["t"].shape[0]
+    # The initial state and two increments.
+    assert r["error"] is None and not r["cancelled"] and n == 3
     assert r["displacements"].shape == (n, model.n_nodes, 3)
     assert r["rotations"].shape == (n, model.n_nodes, 3)
     assert r["reactions"].shape == (n, len(model.constrained()))
-    assert r["constrained"] == model.constrained()
-    for key in ("negative_eigenvalues", "iterations"):
+    assert r["reaction_dofs"] == model.constrained()
+    for key in ("negative_eigenvalues", "iterations", "step"):
         assert r[key].dtype == np.int64 and r[key].shape == (n,)
-    for key in ("residual", "energy"):
+    for key in ("residual", "strain_energy", "gravity_energy"):
         assert r[key].shape == (n,)
     np.testing.assert_array_equal(r["negative_eigenvalues"], 0)
-    assert r["ndof"] == 6 * (model.n_nodes - 3)
+    assert r["ndof"].tolist() == [6 * (model.n_nodes - 3)]
     assert set(r["stats"]) == {
         "steps",
         "iterations",
@@ -324,34 +343,36 @@ def test_result_dict_has_every_key_with_consistent_shapes():
         "factorisations",
         "refinement_sweeps",
         "lu_fallbacks",
+        "symbolic_analyses",
         "assembly_s",
         "solve_s",
         "wall_s",
     }
-    assert r["settings"]["control"] == "load" and r["settings"]["increments"] == 2
-    assert r["settings"]["section"]["thickness"] == PLATE["thickness"]
+    step = r["settings"]["steps"][0]
+    assert step["control"] == "load" and step["increments"] == 2
+    assert r["settings"]["model"]["parts"][0]["section"]["thickness"] == PLATE["thickness"]
 
 
 def test_fields_not_recorded_and_eigenvalues_not_computed():
-    r = core.solve_static(cantilever(), **TOL, increments=2, record_fields=False)
-    assert r["displacements"].shape == (2, 0, 3) and r["rotations"].shape == (2, 0, 3)
+    r = solve_static(cantilever(), **TOL, increments=2, record_fields=False)
+    assert r["displacements"].shape == (0, 0, 3) and r["rotations"].shape == (0, 0, 3)
     np.testing.assert_array_equal(r["negative_eigenvalues"], -1)
 
 
 def test_analysis_failure_is_returned_not_raised():
     # One Newton iteration and no cut-back cannot converge on a nonlinear problem.
-    r = core.solve_static(cantilever(), **TOL, increments=1, max_iterations=1, max_cutbacks=0)
-    assert r["lambda"].shape == (0,)
-    assert r["error"].startswith("no convergence")
-    assert r["displacements"].shape[0] == 0
+    r = solve_static(cantilever(), **TOL, increments=1, max_iterations=1, max_cutbacks=0)
+    assert r["t"].shape == (1,)  # the initial state only
+    assert r["error"].startswith("no convergence in step 'static'")
+    assert r["displacements"].shape[0] == 1
 
 
 def test_mechanism_is_reported_in_error():
     model = core.Model(*square(), **SECTION)
     model.fix(0, ["ux", "uy", "uz"])  # rotations about node 0 are free: a mechanism
     model.add_load(2, "uz", 1.0)
-    r = core.solve_static(model, increments=1, max_cutbacks=1)
-    assert r["error"] is not None and r["lambda"].shape == (0,)
+    r = solve_static(model, increments=1, max_cutbacks=1)
+    assert r["error"] is not None and r["t"].shape == (1,)
 
 
 # ----------------------------------------------------------------------------- callbacks, GIL
@@ -362,18 +383,16 @@ def test_progress_callback_sees_every_step_and_can_cancel():
         seen.append((i, lam))
         return i < 1
 
-    r = core.solve_static(cantilever(), **TOL, increments=5, progress=progress)
+    r = solve_static(cantilever(), **TOL, increments=5, progress=progress)
     assert r["cancelled"] and r["error"] is None
     assert [i for i, _ in seen] == [0, 1]
-    np.testing.assert_allclose(r["lambda"], [lam for _, lam in seen])
+    np.testing.assert_allclose(r["t"][1:], [lam for _, lam in seen])
 
 
 def test_progress_returning_none_continues():
     calls = []
-    r = core.solve_static(
-        cantilever(), **TOL, increments=3, progress=lambda i, lam: calls.append(i)
-    )
-    assert not r["cancelled"] and calls == [0, 1, 2] and r["lambda"][-1] == 1.0
+    r = solve_static(cantilever(), **TOL, increments=3, progress=lambda i, lam: calls.append(i))
+    assert not r["cancelled"] and calls == [0, 1, 2] and r["t"][-1] == 1.0
 
 
 def test_exception_in_progress_callback_propagates():
@@ -381,7 +400,7 @@ def test_exception_in_progress_callback_propagates():
         raise RuntimeError("stop here")
 
     with pytest.raises(RuntimeError, match="stop here"):
-        core.solve_static(cantilever(), **TOL, increments=3, progress=progress)
+        solve_static(cantilever(), **TOL, increments=3, progress=progress)
 
 
 def test_gil_is_released_during_a_solve():
@@ -401,7 +420,7 @@ def test_gil_is_released_during_a_solve():
     try:
         time.sleep(0.01)
         start = time.perf_counter()
-        r = core.solve_static(model, increments=1, **TOL)
+        r = solve_static(model, increments=1, **TOL)
         end = time.perf_counter()
     finally:
         done.set()
@@ -428,7 +447,7 @@ def test_model_is_usable_from_another_thread_during_a_solve():
 
     thread = threading.Thread(target=mutate)
     thread.start()
-    r = core.solve_static(model, increments=1, record_fields=False, **TOL)
+    r = solve_static(model, increments=1, record_fields=False, **TOL)
     thread.join()
     assert errors == [] and r["error"] is None
 
@@ -447,13 +466,12 @@ def test_a_panic_becomes_tape_error():
         lambda: core.cylindrical_panel_mesh(1.0, 1.0, 1.0, 0.5, 2, 2),
         lambda: core.tape_spring_mesh(0.1, 0.01, 7.0, 1e-3),
         lambda: core.tape_spring_mesh(0.1, 0.01, 1.0, 0.0),
-        lambda: core.bend_tape(theta_max=0.0),
-        lambda: core.bend_tape(poisson=0.5),
-        lambda: core.bend_tape(max_steps=0),
-        lambda: core.bend_tape(initial_increment=2.0),
+        lambda: core.tape_spring_mesh(0.1, 0.01, 1.0, 1e-3, twist=float("nan")),
+        lambda: core.tape_section_centroid_z(0.01, 7.0),
+        lambda: core.step_defaults("dynamic"),
     ],
 )
-def test_bad_generator_and_bending_arguments_are_value_errors(call):
+def test_bad_generator_and_step_arguments_are_value_errors(call):
     with pytest.raises(ValueError):
         call()
 
@@ -463,19 +481,3 @@ def test_generators_return_nodes_quads_and_sets():
     assert nodes.shape == (5 * 4, 3) and quads.shape == (12, 4)
     assert sorted(sets) == ["all", "phi0", "phi1", "x0", "x1"]
     np.testing.assert_allclose(np.hypot(nodes[:, 1], nodes[:, 2]), 1.0)
-
-
-def test_bend_tape_progress_can_cancel_and_returns_the_curve():
-    thetas = []
-
-    def progress(theta):
-        thetas.append(theta)
-        return len(thetas) < 3
-
-    r = core.bend_tape(mesh_size=10e-3, theta_max=0.2, progress=progress)
-    assert r["error"] is None
-    assert r["theta"].shape == r["moment"].shape == r["branch"].shape == (3,)
-    np.testing.assert_allclose(r["theta"], thetas)
-    assert np.all(np.diff(r["theta"]) > 0) and np.all(r["moment"] != 0)
-    np.testing.assert_array_equal(r["branch"], 0)
-    assert r["settings"]["theta_max"] == 0.2 and r["ndof"] > 0

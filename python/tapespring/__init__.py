@@ -2,10 +2,15 @@
 
 Sub-modules
 -----------
+analysis
+    The model, analysis steps and `run`: one call to the native solver (also exported here as
+    `Model`, `Step`, `Outputs`, `run`).
+results
+    `Results`: everything an analysis recorded, saved and loaded with its settings.
 shell
-    Build shell models from arrays and follow their static equilibrium paths (native solver).
-bending
-    The tape spring in pure bending (moment-rotation curve, paper Fig. 4).
+    Shell meshes, and static equilibrium paths in one call.
+scenarios
+    The paper's set-up and tests as ready-made simulations (pure bending of a tape spring).
 signals
     Signal analyses on plain arrays, for measured and simulated series alike: bending angle,
     smoothing, peaks, statistics, damping fit, phases, circle fit, pull-test maximum.
@@ -32,20 +37,39 @@ from typing import Any
 __version__ = "0.1.0"
 
 __all__ = [
+    "Model",
+    "Outputs",
+    "Results",
+    "Step",
     "__version__",
-    "bending",
+    "analysis",
     "cli",
     "plot",
     "protocols",
     "report",
+    "results",
+    "run",
+    "scenarios",
     "shell",
     "signals",
     "trials",
 ]
 
 
+_FROM = {
+    "Model": "analysis",
+    "Outputs": "analysis",
+    "Step": "analysis",
+    "run": "analysis",
+    "Results": "results",
+}
+
+
 def __getattr__(name: str) -> Any:
-    # __version__ is a plain attribute, so every name that reaches here is a sub-module's.
+    # __version__ is a plain attribute, so every name that reaches here is a sub-module's or one
+    # of the names the package re-exports from them.
+    if name in _FROM:
+        return getattr(importlib.import_module(f"tapespring.{_FROM[name]}"), name)
     if name in __all__:
         return importlib.import_module(f"tapespring.{name}")
     raise AttributeError(f"module 'tapespring' has no attribute {name!r}")

@@ -93,7 +93,8 @@ pub struct StaticParams {
     pub target_iterations: usize,
     /// Count the negative eigenvalues of the tangent at each converged state.
     pub stability: bool,
-    /// Record nodal displacements and rotations at each converged state.
+    /// Record nodal displacements and rotations at each converged state (not an option of the
+    /// flat option maps: [`crate::analysis::run`] sets it from its outputs).
     pub record_fields: bool,
     /// Arc-length only: where the load factor reaches a limit and the path turns back, jump to the
     /// stable equilibrium beyond the limit instead of following the unstable branch, as a test
@@ -107,6 +108,10 @@ pub struct StaticParams {
     pub monitor: Option<Monitor>,
     /// Tolerance of located limit points and extrema, in load factor (> 0).
     pub event_tolerance: f64,
+    /// An extremum of the monitored reaction is located only if the reaction changes by more than
+    /// this fraction of its magnitude on both sides of it, over the converged steps that bracket it
+    /// (in [0, 1)): the extrema of a plateau are not events.
+    pub monitor_prominence: f64,
     /// With a monitor: a converged step longer than `refine_span` in load factor over which the
     /// monitored reaction changes by more than this fraction of its magnitude is refined by extra
     /// equilibria in between (0: no refinement).
@@ -131,6 +136,7 @@ impl Default for StaticParams {
             locate_limit_points: false,
             monitor: None,
             event_tolerance: 1e-4,
+            monitor_prominence: 0.01,
             refine_change: 0.0,
             refine_span: 1e-2,
         }
@@ -148,12 +154,13 @@ const ARC_OPTIONS: [&str; 5] = [
     "direction",
 ];
 /// Options that apply to arc-length control only (beside those of the control itself).
-const ARC_ONLY: [&str; 7] = [
+const ARC_ONLY: [&str; 8] = [
     "jump",
     "locate_limit_points",
     "monitor_node",
     "monitor_dof",
     "event_tolerance",
+    "monitor_prominence",
     "refine_change",
     "refine_span",
 ];
@@ -234,6 +241,12 @@ impl StaticParams {
                 self.event_tolerance
             ));
         }
+        if !(self.monitor_prominence >= 0.0 && self.monitor_prominence < 1.0) {
+            return bad(format!(
+                "monitor_prominence must lie in [0, 1) (got {})",
+                self.monitor_prominence
+            ));
+        }
         if !(self.refine_change.is_finite() && self.refine_change >= 0.0) {
             return bad(format!(
                 "refine_change must be finite and >= 0 (got {})",
@@ -298,7 +311,6 @@ impl StaticParams {
             max_cutbacks: o.take_or("max_cutbacks", d.max_cutbacks)?,
             target_iterations: o.take_or("target_iterations", d.target_iterations)?,
             stability: o.take_or("stability", d.stability)?,
-            record_fields: o.take_or("record_fields", d.record_fields)?,
             control,
             ..d
         };
@@ -315,6 +327,7 @@ impl StaticParams {
                 }
             };
             p.event_tolerance = o.take_or("event_tolerance", d.event_tolerance)?;
+            p.monitor_prominence = o.take_or("monitor_prominence", d.monitor_prominence)?;
             p.refine_change = o.take_or("refine_change", d.refine_change)?;
             p.refine_span = o.take_or("refine_span", d.refine_span)?;
         }
@@ -371,6 +384,7 @@ impl StaticParams {
                     m.insert("monitor_dof".into(), mon.dof.name().into());
                 }
                 m.insert("event_tolerance".into(), self.event_tolerance.into());
+                m.insert("monitor_prominence".into(), self.monitor_prominence.into());
                 m.insert("refine_change".into(), self.refine_change.into());
                 m.insert("refine_span".into(), self.refine_span.into());
             }
@@ -379,7 +393,6 @@ impl StaticParams {
         m.insert("max_cutbacks".into(), self.max_cutbacks.into());
         m.insert("target_iterations".into(), self.target_iterations.into());
         m.insert("stability".into(), self.stability.into());
-        m.insert("record_fields".into(), self.record_fields.into());
         m
     }
 }
@@ -433,6 +446,8 @@ pub enum Event {
     LimitPoint,
     /// An extremum of the monitored reaction.
     MonitorExtremum,
+    /// An equilibrium added between two converged states to refine the path.
+    Refinement,
 }
 
 /// One converged equilibrium state.

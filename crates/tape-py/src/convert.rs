@@ -368,7 +368,7 @@ pub fn vector3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector3<f64>> {
     let v = ro.as_array();
     if v.len() != 3 || v.ndim() != 1 {
         return Err(PyValueError::new_err(format!(
-            "{what} must be three numbers, got shape {}",
+            "{what} must have 3 coordinates (got shape {})",
             shape_str(v.shape())
         )));
     }
@@ -383,16 +383,17 @@ pub fn vector3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector3<f64>> {
     }
 }
 
-/// One non-negative integral node index.
+/// One non-negative node index: an integer (a float only if integral).
 pub fn node(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<usize> {
-    let v = index_vec(obj, what)?;
-    let arr_dims = int_array(obj, what)?.ndim();
-    match (v.as_slice(), arr_dims) {
-        ([n], 0) => Ok(*n),
-        _ => Err(PyValueError::new_err(format!(
+    let arr = int_array(obj, what)?;
+    let ro = arr.readonly();
+    let view = ro.as_array();
+    if view.ndim() != 0 {
+        return Err(PyValueError::new_err(format!(
             "{what} must be one node index (got {obj})"
-        ))),
+        )));
     }
+    index(view[[]], what)
 }
 
 /// A float vector as a 1-D float64 array.

@@ -17,7 +17,9 @@ mod _core {
     #[pymodule_export]
     use super::analysis::{run, step_defaults};
     #[pymodule_export]
-    use super::mesh::{_panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_spring_mesh};
+    use super::mesh::{
+        _panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_section_centroid_z, tape_spring_mesh,
+    };
     #[pymodule_export]
     use super::model::PyModel;
 

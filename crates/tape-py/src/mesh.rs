@@ -24,18 +24,27 @@ fn mesh_tuple<'py>(
     convert::mesh_to_tuple(py, &mesh)
 }
 
-/// Tape-spring mesh: `(nodes, quads, node_sets)` with sets end0, end1, side0, side1, midline, all.
+/// Tape-spring mesh: `(nodes, quads, node_sets)` with sets end0, end1, side0, side1, midline, all;
+/// `twist` [rad] rotates the sections about x by `twist sin(pi x / L)` (an imperfection).
 #[pyfunction]
-#[pyo3(signature = (length, radius, alpha, mesh_size))]
+#[pyo3(signature = (length, radius, alpha, mesh_size, *, twist = 0.0))]
 pub fn tape_spring_mesh(
     py: Python<'_>,
     length: f64,
     radius: f64,
     alpha: f64,
     mesh_size: f64,
+    twist: f64,
 ) -> PyResult<Bound<'_, PyAny>> {
+    if !twist.is_finite() {
+        return Err(PyValueError::new_err(format!("twist must be finite (got {twist})")));
+    }
     mesh_tuple(py, || {
-        generate::tape_spring(&TapeGeometry { length, radius, alpha }, mesh_size)
+        let mut mesh = generate::tape_spring(&TapeGeometry { length, radius, alpha }, mesh_size)?;
+        if twist != 0.0 {
+            generate::apply_twist_imperfection(&mut mesh, length, twist);
+        }
+        Ok(mesh)
     })
 }
 
@@ -70,4 +79,17 @@ pub fn cylindrical_panel_mesh(
 #[pyfunction]
 pub fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
     py.detach(|| guard(|| -> PyResult<()> { panic!("deliberate panic for the test-suite") }))
+}
+
+/// Height of the centroid of a tape spring's cross-section arc above the arc's middle point [m]:
+/// `R (1 - sin(alpha/2) / (alpha/2))`.
+#[pyfunction]
+pub fn tape_section_centroid_z(radius: f64, alpha: f64) -> PyResult<f64> {
+    let g = TapeGeometry {
+        length: 1.0,
+        radius,
+        alpha,
+    };
+    to_py(g.validate())?;
+    Ok(g.section_centroid_z())
 }

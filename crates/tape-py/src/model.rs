@@ -26,6 +26,13 @@ pub struct PyModel {
 /// A section from keyword arguments (the fields of tape-core's `ShellSection`, read by serde:
 /// `thickness`, `youngs_modulus` and `poisson` required, the others optional).
 fn section(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ShellSection> {
+    for key in ["thickness", "youngs_modulus", "poisson"] {
+        if !kwargs.is_some_and(|k| k.contains(key).unwrap_or(false)) {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "missing required keyword argument of the section: '{key}' (thickness [m], youngs_modulus [Pa] and poisson are required)"
+            )));
+        }
+    }
     let value = match kwargs {
         Some(k) => convert::to_json(k.as_any(), "section")?,
         None => Value::Object(serde_json::Map::new()),

@@ -1,9 +1,9 @@
 """Command line: ``tapespring bend``.
 
 Moment-rotation curve of one tape spring in pure bending (paper Fig. 4), with a summary,
-optional CSV, PNG and JSON outputs. The solver (`tapespring.bending.bend`) and matplotlib are
-imported by `run`; building the parser imports only `tapespring.bending.BendingSetup` for its
-defaults (numpy).
+optional CSV, PNG and JSON outputs. The scenario (`tapespring.scenarios.bending.bend`) and
+matplotlib are imported by `run`; building the parser imports only
+`tapespring.scenarios.bending.BendingSetup` for its defaults (numpy).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The ``bend`` parser.
     """
-    from tapespring.bending import BendingSetup
+    from tapespring.scenarios.bending import BendingSetup
 
     d = BendingSetup()
     p = sub.add_parser(
@@ -98,7 +98,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "equilibrium beyond (default in equal sense, whose path branches)"
         ),
     )
-    p.add_argument("--csv", help="write theta_deg, moment_Nm, stable to this CSV file")
+    p.add_argument(
+        "--csv", help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file"
+    )
     p.add_argument("--plot", help="write the curve as a PNG (paper Fig. 4)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -115,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
         0 on success, 1 if no equilibrium converged or the path stopped early (error or Ctrl-C),
         2 on bad input (the message is printed on stderr).
     """
-    from tapespring.bending import BendingSetup, bend, plot_bending, summarize, write_csv
+    from tapespring.scenarios.bending import BendingSetup, bend, summarize, write_csv
 
     if not math.isfinite(args.theta_max) or args.theta_max == 0.0:
         print("error: --theta-max must be a non-zero angle in degrees", file=sys.stderr)
@@ -142,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    if result.theta_deg.size == 0:
+    if result.theta_deg.size <= 1:
         print(f"error: no equilibrium converged: {result.error}", file=sys.stderr)
         return 1
     s = summarize(result)
@@ -153,6 +155,8 @@ def run(args: argparse.Namespace) -> int:
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+
+        from tapespring.plot.bending import plot_bending
 
         ax = plot_bending(result)
         ax.figure.savefig(args.plot, dpi=150)

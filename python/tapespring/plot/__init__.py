@@ -10,13 +10,15 @@ trials
     coefficients of the peaks, tip trajectory, force and angle, pull test, free decay, damping
     series, two-series comparison and peak differences.
 
-The moment-rotation curve of pure bending is `tapespring.bending.plot_bending`.
+bending
+    The moment-rotation curve of a tape spring in pure bending (paper Fig. 4).
 """
 
 from tapespring._lazy import lazy_exports
 
 __all__ = [
     "plot_angle_histories",
+    "plot_bending",
     "plot_damping_series",
     "plot_force_and_angle",
     "plot_free_decay",
@@ -27,4 +29,8 @@ __all__ = [
     "plot_variation_coefficients",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, __all__, {"trials": __all__})
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    __all__,
+    {"trials": [n for n in __all__ if n != "plot_bending"], "bending": ["plot_bending"]},
+)

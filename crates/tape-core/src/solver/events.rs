@@ -143,7 +143,16 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
         }
         for (kind, g) in kinds {
             let sense = (g[1] - g[0]).signum();
-            if (g[1] - g[0]) * (g[2] - g[1]) < 0.0 {
+            // An extremum of the monitor on a plateau (a change on either side below
+            // `monitor_prominence` of its magnitude) is noise, not an event: not located.
+            let prominent = match kind {
+                Event::MonitorExtremum => {
+                    let scale = g[1].abs() * s.params.monitor_prominence;
+                    (g[1] - g[0]).abs() > scale && (g[1] - g[2]).abs() > scale
+                }
+                _ => true,
+            };
+            if prominent && (g[1] - g[0]) * (g[2] - g[1]) < 0.0 {
                 let saved = s.save();
                 let found = search(s, (a, b, c), kind, sense, monitor);
                 s.restore(saved)?;
@@ -151,7 +160,7 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
             }
         }
     }
-    if n >= 2 && s.params.refine_change > 0.0 {
+    if n >= 2 && needs_refinement(s, &history[n - 2], &history[n - 1]) {
         let saved = s.save();
         let found = refine(s, &history[n - 2], &history[n - 1], monitor, 0);
         s.restore(saved)?;
@@ -161,24 +170,16 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
     Ok(())
 }
 
-/// Records the located event: the best state found, or the middle state itself if the search
-/// found nothing better.
+/// Records the located event: the best state found. If the search found nothing better than the
+/// converged state in the middle, that state is the best estimate; it stays a plain step of the
+/// path (the path's states are never relabelled) and the event is not recorded.
 fn insert(s: &mut Driver, path: &mut StaticPath, found: Option<Found>, kind: Event, middle: &Point) {
-    match found {
-        Some(mut f) => {
-            f.step.event = Some(kind);
-            s.stats.steps += 1;
-            path.steps.push(f.step);
-        }
-        None => {
-            if let Some(st) = path
-                .steps
-                .iter_mut()
-                .find(|st| st.arc == middle.arc && st.event.is_none())
-            {
-                st.event = Some(kind);
-            }
-        }
+    if let Some(mut f) = found {
+        f.step.event = Some(kind);
+        s.stats.steps += 1;
+        path.steps.push(f.step);
+    } else {
+        log::debug!("{kind:?} near t = {} not improved on by the search", middle.state.t);
     }
 }
 
@@ -202,7 +203,7 @@ fn search(
         sense
             * match kind {
                 Event::LimitPoint => t,
-                Event::MonitorExtremum => m,
+                Event::MonitorExtremum | Event::Refinement => m,
             }
     };
     // Bracket (s, h, load factor); the middle one is the highest.
@@ -250,7 +251,7 @@ fn search(
             // tolerance of it (a smooth maximum: they bound it from below, the parabola from above).
             Event::LimitPoint => m.1 - l.1.max(r.1) < tol,
             // The position of the extremum is known once the bracket is narrow in load factor.
-            Event::MonitorExtremum => (r.2 - l.2).abs() < tol,
+            Event::MonitorExtremum | Event::Refinement => (r.2 - l.2).abs() < tol,
         };
         if done {
             break;
@@ -262,21 +263,27 @@ fn search(
     })
 }
 
-/// Splits the step from `b` to `c` into equal parts along its chord if it is longer than
-/// `refine_span` in load factor while the monitored reaction changes by more than `refine_change`
-/// of its magnitude, and refines the parts that still are (up to 3 levels). Returns the states
-/// found.
-fn refine(s: &mut Driver, b: &Point, c: &Point, monitor: Option<usize>, depth: usize) -> Vec<Found> {
+/// Whether the step from `b` to `c` is longer than `refine_span` in load factor while the
+/// monitored reaction changes by more than `refine_change` of its magnitude.
+fn needs_refinement(s: &Driver, b: &Point, c: &Point) -> bool {
     let (span, change) = (s.params.refine_span, s.params.refine_change);
     let dl = (c.state.t - b.state.t).abs();
     let dm = (c.monitor - b.monitor).abs();
-    let scale = b.monitor.abs().max(c.monitor.abs());
-    if dl <= span || dm <= change * scale || depth >= 3 {
+    change > 0.0 && dl > span && dm > change * b.monitor.abs().max(c.monitor.abs())
+}
+
+/// Splits the step from `b` to `c` into equal parts along its chord if it needs refinement (see
+/// [`needs_refinement`]), and refines the parts that still need it (up to 3 levels). Returns the
+/// states found.
+fn refine(s: &mut Driver, b: &Point, c: &Point, monitor: Option<usize>, depth: usize) -> Vec<Found> {
+    if depth >= 3 || !needs_refinement(s, b, c) {
         return Vec::new();
     }
+    let dl = (c.state.t - b.state.t).abs();
     let chord = s.difference(&b.state, &c.state);
+    // A margin over the span: the load factor is not exactly uniform along the chord.
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let parts = ((dl / span).ceil() as usize).clamp(2, MAX_SPLIT);
+    let parts = ((1.05 * dl / s.params.refine_span).ceil() as usize).clamp(2, MAX_SPLIT);
     let mut found: Vec<Found> = Vec::new();
     for j in 1..parts {
         #[allow(clippy::cast_precision_loss)]
@@ -285,6 +292,7 @@ fn refine(s: &mut Driver, b: &Point, c: &Point, monitor: Option<usize>, depth: u
             break;
         };
         f.step.arc = b.arc + frac * (c.arc - b.arc);
+        f.step.event = Some(Event::Refinement);
         found.push(f);
     }
     // Refine the parts that still change too much.

@@ -1,4 +1,5 @@
-"""Physics of a tape spring in pure bending (`tapespring.bending`; the paper's Section 2, Fig. 4).
+"""Physics of a tape spring in pure bending (`tapespring.scenarios.bending`; the paper's Section 2,
+Fig. 4).
 
 The paper's tape (Table 1 geometry, Table 5 t and E, nu = 0.3) is bent by rotating one end
 section. Numbers quoted in the comments were measured with this build (2 cores, release):
@@ -26,7 +27,7 @@ from dataclasses import asdict
 
 import numpy as np
 import pytest
-from tapespring.bending import (
+from tapespring.scenarios.bending import (
     BendingResult,
     BendingSetup,
     analytical_residual_moment,
@@ -156,22 +157,24 @@ def test_initial_stiffness_lies_between_beam_and_plate_bending_stiffness(small_a
     i_section = t * r**3 * (a / 2 + math.sin(a) / 2 - 4 * math.sin(a / 2) ** 2 / a)
     k_beam = st.youngs_modulus * i_section / st.length
     k_plate = k_beam / (1.0 - st.poisson**2)
-    k = small_angle.moment / np.radians(small_angle.theta_deg)
+    # (Point 0 is the initial state, at the origin.)
+    k = small_angle.moment[1:] / np.radians(small_angle.theta_deg[1:])
     assert k_beam < k[0] < k_plate
     # And it is linear: over 0.01-0.5 deg the secant stiffness changes by 0.08 %.
     np.testing.assert_allclose(k, k[0], rtol=2e-3)
 
 
 def test_first_loading_points_are_linear_then_soften(opposite, small_angle):
-    k0 = small_angle.moment[0] / math.radians(small_angle.theta_deg[0])
+    k0 = small_angle.moment[1] / math.radians(small_angle.theta_deg[1])
     th, m, _ = _loading(opposite)
     i_turn = _first_turn(th, +1.0)
-    k = m[: i_turn + 1] / np.radians(th[: i_turn + 1])
+    # (Point 0 is the initial state, at the origin.)
+    k = m[1 : i_turn + 1] / np.radians(th[1 : i_turn + 1])
     assert (k > 0.0).all()
     # The first arc-length step is 2 % of theta_max (1.8 deg). There the secant stiffness is
     # 1.4 % below k0: the softening is quadratic in theta (6 % at 3.7 deg, i.e. 1.4 % x (3.7 /
     # 1.8)^2) and comes from the flattening of the section. 3 % bounds the first point.
-    assert th[0] < 2.0
+    assert th[1] < 2.0
     assert k[0] == pytest.approx(k0, rel=0.03)
     # The section keeps flattening up to the snap: the secant stiffness decreases monotonically.
     assert (np.diff(k) < 0.0).all()
@@ -328,9 +331,9 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
     assert lines[1].startswith("# settings: ")
     settings = json.loads(lines[1][len("# settings: ") :])
     assert settings["mesh_size"] == pytest.approx(2e-3)
-    assert lines[2] == "theta_deg,moment_Nm,stable,branch,jump"
+    assert lines[2] == "theta_deg,moment_Nm,stable,branch,jump,event"
     assert len(lines) == 3 + opposite.theta_deg.size
-    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=3, ndmin=2)
+    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=3, ndmin=2, usecols=range(5))
     assert data.shape == (opposite.theta_deg.size, 5)
     # Written with 6 decimals (deg) and 10 significant digits (N m).
     np.testing.assert_allclose(data[:, 0], opposite.theta_deg, rtol=0, atol=5e-7)

@@ -1,0 +1,264 @@
+"""The results of an analysis: one history for every kind of step, saved with its settings.
+
+Row ``i`` of every per-record array belongs to the same recorded state; row 0 is the initial
+state (time 0, before the first step). Units are SI (m, N, N m, J, rad).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Results"]
+
+_FORMAT = "tapespring.Results"
+_VERSION = 1
+
+# Per-record arrays and their dtypes, in the order of the native dict and of the saved file.
+_ARRAYS: dict[str, Any] = {
+    "t": float,
+    "step": np.int64,
+    "iterations": np.int64,
+    "residual": float,
+    "negative_eigenvalues": np.int64,
+    "jump": bool,
+    "strain_energy": float,
+    "gravity_energy": float,
+    "marker_positions": float,
+    "marker_rotations": float,
+    "reactions": float,
+    "field_records": np.int64,
+    "displacements": float,
+    "rotations": float,
+    "ndof": np.int64,
+}
+
+
+@dataclass(frozen=True, eq=False)
+class Results:
+    """Everything an analysis recorded, with the settings that produced it.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time [s]; the load factor in static steps.
+    step : ndarray of int, shape (n,)
+        Index of the analysis step of each record (0 for the initial state).
+    iterations : ndarray of int, shape (n,)
+        Newton iterations spent on each state.
+    residual : ndarray, shape (n,)
+        Weighted residual norm of each state [N].
+    negative_eigenvalues : ndarray of int, shape (n,)
+        Negative eigenvalues of the tangent (-1 where not computed).
+    jump : ndarray of bool, shape (n,)
+        Reached by a jump past a limit point.
+    event : tuple of (str or None)
+        ``"limit_point"`` or ``"monitor_extremum"`` where a state was located as one.
+    strain_energy, gravity_energy : ndarray, shape (n,)
+        Strain energy and potential energy of gravity [J].
+    marker_names : tuple of str
+        Marker names.
+    marker_positions, marker_rotations : ndarray, shape (n, n_markers, 3)
+        Marker positions [m] and rotation vectors [rad].
+    reaction_dofs : tuple of (int, str)
+        ``(node, dof)`` of each reaction column.
+    reactions : ndarray, shape (n, n_reactions)
+        Nodal forces ``f_int - f_ext`` [N or N m]: reactions at constrained DOFs.
+    field_records : ndarray of int, shape (n_fields,)
+        The records whose nodal fields were kept.
+    displacements, rotations : ndarray, shape (n_fields, n_nodes, 3)
+        Nodal displacements [m] and rotation vectors [rad] at `field_records`.
+    ndof : ndarray of int, shape (n_steps_run,)
+        Free DOFs of each step's numbering.
+    stats : dict
+        Counters and timings of the whole analysis; `step_stats` per step.
+    error : str or None
+        Why the analysis stopped early, if it did.
+    cancelled : bool
+        True if the progress callback stopped the run.
+    steps_completed : int
+        Steps that ran to their end.
+    settings : dict
+        The model (JSON form), the steps with every option, and the outputs asked for.
+    """
+
+    t: NDArray[np.float64]
+    step: NDArray[np.int64]
+    iterations: NDArray[np.int64]
+    residual: NDArray[np.float64]
+    negative_eigenvalues: NDArray[np.int64]
+    jump: NDArray[np.bool_]
+    event: tuple[str | None, ...]
+    strain_energy: NDArray[np.float64]
+    gravity_energy: NDArray[np.float64]
+    marker_names: tuple[str, ...]
+    marker_positions: NDArray[np.float64]
+    marker_rotations: NDArray[np.float64]
+    reaction_dofs: tuple[tuple[int, str], ...]
+    reactions: NDArray[np.float64]
+    field_records: NDArray[np.int64]
+    displacements: NDArray[np.float64]
+    rotations: NDArray[np.float64]
+    ndof: NDArray[np.int64]
+    stats: dict[str, Any] = field(default_factory=dict)
+    step_stats: tuple[dict[str, Any], ...] = ()
+    error: str | None = None
+    cancelled: bool = False
+    steps_completed: int = 0
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Results:
+        """Build from the dict returned by :func:`tapespring._core.run`."""
+        arrays = {k: np.asarray(d[k], dtype=dt) for k, dt in _ARRAYS.items()}
+        return cls(
+            **arrays,
+            event=tuple(d["event"]),
+            marker_names=tuple(d["marker_names"]),
+            reaction_dofs=tuple((int(n), str(k)) for n, k in d["reaction_dofs"]),
+            stats=dict(d["stats"]),
+            step_stats=tuple(dict(s) for s in d["step_stats"]),
+            error=d["error"],
+            cancelled=bool(d["cancelled"]),
+            steps_completed=int(d["steps_completed"]),
+            settings=dict(d["settings"]),
+        )
+
+    @property
+    def n_records(self) -> int:
+        """Number of recorded states (the initial one included)."""
+        return int(self.t.shape[0])
+
+    @property
+    def completed(self) -> bool:
+        """True if every step ran to its end (no error, not cancelled)."""
+        return self.error is None and not self.cancelled
+
+    @property
+    def stable(self) -> NDArray[np.bool_]:
+        """Whether each state is stable (positive definite tangent).
+
+        Raises
+        ------
+        ValueError
+            If the eigenvalue count was not computed (steps with ``stability=True``).
+        """
+        if np.any(self.negative_eigenvalues < 0):
+            raise ValueError("stability was not computed: run the steps with stability=True")
+        return self.negative_eigenvalues == 0
+
+    def reaction(self, node: int, dof: str) -> NDArray[np.float64]:
+        """History of the recorded force at `dof` of `node` [N or N m], shape (n,).
+
+        Raises
+        ------
+        KeyError
+            If that (node, dof) was not recorded.
+        """
+        key = (int(node), dof.lower())
+        try:
+            column = self.reaction_dofs.index(key)
+        except ValueError:
+            raise KeyError(f"the reaction at {dof!r} of node {node} was not recorded") from None
+        return self.reactions[:, column]
+
+    def total_reaction(self, dof: str) -> NDArray[np.float64]:
+        """Sum of the recorded forces at `dof` over their nodes, shape (n,).
+
+        Raises
+        ------
+        KeyError
+            If no force at that DOF was recorded (or the name is not a DOF).
+        """
+        columns = [i for i, (_, d) in enumerate(self.reaction_dofs) if d == dof.lower()]
+        if not columns:
+            raise KeyError(f"no reaction at {dof!r} was recorded (recorded: {self.reaction_dofs})")
+        return self.reactions[:, columns].sum(axis=1)
+
+    def marker(self, name: str) -> NDArray[np.float64]:
+        """Position history of marker `name` [m], shape (n, 3).
+
+        Raises
+        ------
+        KeyError
+            If there is no such marker.
+        """
+        try:
+            k = self.marker_names.index(name)
+        except ValueError:
+            raise KeyError(f"no marker {name!r} (markers: {self.marker_names})") from None
+        return self.marker_positions[:, k, :]
+
+    def field(self, record: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Nodal displacements and rotations at `record` (negative counts from the end).
+
+        Raises
+        ------
+        KeyError
+            If the fields of that record were not kept.
+        """
+        r = int(record) % self.n_records
+        hits = np.nonzero(self.field_records == r)[0]
+        if hits.size == 0:
+            raise KeyError(f"the fields of record {r} were not kept (kept: {self.field_records})")
+        return self.displacements[hits[0]], self.rotations[hits[0]]
+
+    def in_step(self, step: int) -> NDArray[np.int64]:
+        """Indices of the records of analysis step `step` (the initial state belongs to none)."""
+        idx = np.nonzero(self.step == step)[0]
+        return idx[idx > 0]
+
+    def save(self, path: str | Path) -> Path:
+        """Write to a NumPy ``.npz`` file; stats and settings are stored as JSON.
+
+        Read it back with :meth:`load`.
+        """
+        path = Path(path)
+        meta = {
+            "format": _FORMAT,
+            "version": _VERSION,
+            "event": list(self.event),
+            "marker_names": list(self.marker_names),
+            "reaction_dofs": [list(rd) for rd in self.reaction_dofs],
+            "stats": self.stats,
+            "step_stats": list(self.step_stats),
+            "error": self.error,
+            "cancelled": self.cancelled,
+            "steps_completed": self.steps_completed,
+            "settings": self.settings,
+        }
+        np.savez(
+            path,
+            **{k: getattr(self, k) for k in _ARRAYS},
+            meta=np.array(json.dumps(meta)),
+        )
+        return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
+
+    @classmethod
+    def load(cls, path: str | Path) -> Results:
+        """Read results written by :meth:`save`.
+
+        Raises
+        ------
+        ValueError
+            If the file is not a saved `Results`, or is of a newer format.
+        """
+        with np.load(Path(path), allow_pickle=False) as f:
+            if "meta" not in f:
+                raise ValueError(f"{path} is not a saved tapespring Results")
+            meta = json.loads(str(f["meta"]))
+            if meta.get("format") != _FORMAT:
+                raise ValueError(f"{path} is not a saved tapespring Results")
+            if meta.get("version", 0) > _VERSION:
+                raise ValueError(
+                    f"{path} was written by a newer tapespring (format {meta['version']})"
+                )
+            d = {k: f[k] for k in _ARRAYS}
+        d.update(meta)
+        return cls.from_dict(d)
