@@ -11,8 +11,7 @@ import time
 
 import numpy as np
 import pytest
-
-core = pytest.importorskip("tapespring._core")
+import tapespring._core as core
 
 SECTION = {"thickness": 1e-3, "youngs_modulus": 2e11, "poisson": 0.3}
 # The cantilever below is 1 m x 0.1 m x 10 mm. The residual of tape-core's total-Lagrangian shell

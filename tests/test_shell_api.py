@@ -17,8 +17,7 @@ import json
 
 import numpy as np
 import pytest
-
-shell = pytest.importorskip("tapespring.shell")
+from tapespring import shell
 
 L, B, T, E = 0.2, 0.02, 2e-3, 2e11
 I = B * T**3 / 12  # noqa: E741 - second moment of area, as in the textbooks

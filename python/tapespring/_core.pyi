@@ -1,12 +1,30 @@
-"""Type stub of the native module ``tapespring._core`` (Rust crate ``tape-py``)."""
+"""Type stub of the native module ``tapespring._core`` (Rust crate ``tape-py``).
+
+Checked against the compiled module with ``python -m mypy.stubtest tapespring._core``.
+"""
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Literal, TypedDict
+from typing import Any, Self, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+__all__ = [
+    "DOFS",
+    "ConvergenceError",
+    "Model",
+    "TapeError",
+    "__version__",
+    "_panic_for_tests",
+    "cylindrical_panel_mesh",
+    "flat_plate_mesh",
+    "run",
+    "step_defaults",
+    "tape_section_centroid_z",
+    "tape_spring_mesh",
+]
 __version__: str
+DOFS: list[str]
 
 class TapeError(Exception):
     """Base class of the errors raised by the tapespring solver."""
@@ -14,27 +32,35 @@ class TapeError(Exception):
 class ConvergenceError(TapeError):
     """The nonlinear solver did not converge (the equilibrium path stopped early)."""
 
-DofName = Literal["ux", "uy", "uz", "rx", "ry", "rz"]
-NodeSelection = int | str | Sequence[int] | NDArray[np.integer[Any]]
-MeshTuple = tuple[NDArray[np.float64], NDArray[np.int64], dict[str, NDArray[np.int64]]]
+_NodeSelection = int | str | Sequence[int] | NDArray[np.integer[Any]]
+_Node = int | np.integer[Any]
+_MeshTuple = tuple[NDArray[np.float64], NDArray[np.int64], dict[str, NDArray[np.int64]]]
+_TimeFunction = str | Mapping[str, Any] | Sequence[tuple[float, float]]
 
+@final
 class Model:
-    """A shell model: mesh, section, constraints, rigid ties and nodal loads (SI units)."""
+    """A model: shell parts with their sections, reference nodes, rigid bodies, ties,
+    constraints, loads, gravity and markers (SI units)."""
 
-    def __init__(
+    def __new__(
+        cls,
+        nodes: ArrayLike | None = None,
+        quads: ArrayLike | None = None,
+        *,
+        node_sets: Mapping[str, ArrayLike] | None = None,
+        **section_kwargs: float,
+    ) -> Self: ...
+    def add_part(
         self,
+        name: str,
         nodes: ArrayLike,
         quads: ArrayLike,
         *,
-        thickness: float,
-        youngs_modulus: float,
-        poisson: float,
-        density: float = 7850.0,
-        eta: float = 0.0,
-        shear_factor: float = ...,
-        drilling_factor: float = 1e-3,
+        rotation: ArrayLike | None = None,
+        translation: ArrayLike | None = None,
         node_sets: Mapping[str, ArrayLike] | None = None,
-    ) -> None: ...
+        **section_kwargs: float,
+    ) -> int: ...
     @property
     def n_nodes(self) -> int: ...
     @property
@@ -44,80 +70,104 @@ class Model:
     @property
     def quads(self) -> NDArray[np.int64]: ...
     @property
+    def parts(self) -> list[dict[str, Any]]: ...
+    @property
     def section(self) -> dict[str, float]: ...
-    def add_node(self, xyz: Sequence[float]) -> int: ...
+    @property
+    def total_mass(self) -> float: ...
+    @property
+    def rigid_bodies(self) -> list[dict[str, Any]]: ...
+    @property
+    def markers(self) -> list[str]: ...
+    def add_node(self, xyz: ArrayLike) -> int: ...
     def add_node_set(self, name: str, nodes: ArrayLike) -> None: ...
     def node_set(self, name: str) -> NDArray[np.int64]: ...
     def node_set_names(self) -> list[str]: ...
-    def fix(self, nodes: NodeSelection, dofs: str | Sequence[str]) -> None: ...
-    def prescribe(self, node: int, dof: str, value: float) -> None: ...
-    def tie(self, nodes: NodeSelection, reference: int) -> None: ...
-    def add_load(self, node: int, dof: str, value: float) -> None: ...
+    def nearest_node(self, point: ArrayLike) -> int: ...
+    def nodes_in_box(self, lo: ArrayLike, hi: ArrayLike) -> NDArray[np.int64]: ...
+    def corner_nodes(self) -> NDArray[np.int64]: ...
+    def nodes_at(self, points: ArrayLike, tolerance: float = 1e-6) -> NDArray[np.int64]: ...
+    def fix(
+        self,
+        nodes: _NodeSelection,
+        dofs: str | Sequence[str] | None = None,
+        *,
+        id: str | None = None,
+        active: bool = True,
+    ) -> None: ...
+    def prescribe(
+        self,
+        node: _Node,
+        dof: str,
+        value: float,
+        *,
+        function: _TimeFunction | None = None,
+        id: str | None = None,
+        active: bool = True,
+    ) -> None: ...
+    def tie(self, nodes: _NodeSelection, reference: _Node) -> None: ...
+    def add_load(
+        self,
+        node: _Node,
+        dof: str,
+        value: float,
+        *,
+        function: _TimeFunction | None = None,
+        id: str | None = None,
+        active: bool = True,
+    ) -> None: ...
+    def add_rigid_body(
+        self,
+        node: _Node,
+        mass: float,
+        *,
+        centre_of_mass: ArrayLike | None = None,
+        inertia: ArrayLike | None = None,
+    ) -> None: ...
+    def add_point_mass(self, node: _Node, mass: float) -> None: ...
+    def set_gravity(
+        self,
+        acceleration: ArrayLike,
+        *,
+        function: _TimeFunction | None = None,
+        id: str | None = None,
+        active: bool = True,
+    ) -> None: ...
+    def add_marker(self, name: str, node: _Node, *, offset: ArrayLike | None = None) -> None: ...
     def constrained(self) -> list[tuple[int, str]]: ...
+    def constraints(self) -> list[dict[str, Any]]: ...
     def loads(self) -> list[tuple[int, str, float]]: ...
     def ties(self) -> list[tuple[int, NDArray[np.int64]]]: ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> Model: ...
+    def __getstate__(self) -> str: ...
+    def __setstate__(self, state: str) -> None: ...
+    def __getnewargs__(self) -> tuple[int | None]: ...
+    def __copy__(self) -> Model: ...
+    def __deepcopy__(self, memo: Any) -> Model: ...
 
-class Stats(TypedDict):
-    steps: int
-    iterations: int
-    cutbacks: int
-    factorisations: int
-    assembly_s: float
-    solve_s: float
-    wall_s: float
-
-def solve_static(
+def run(
     model: Model,
+    steps: Sequence[Mapping[str, Any]],
     /,
     *,
-    control: Literal["load", "displacement", "arc-length"] | str = "load",
-    lambda_end: float = 1.0,
-    increments: int = 10,
-    node: int | None = None,
-    dof: str | None = None,
-    delta: float | None = None,
-    initial_increment: float = 0.01,
-    max_increment_factor: float = 10.0,
-    max_steps: int = 500,
-    direction: int = 1,
-    stability: bool = False,
-    record_fields: bool = True,
-    jump: bool = False,
-    tol_force: float = 1e-8,
-    mixed_stress: bool = True,
-    max_iterations: int = 20,
-    max_cutbacks: int = 10,
-    target_iterations: int = 5,
-    progress: Callable[[int, float], bool | None] | None = None,
+    outputs: Mapping[str, Any] | None = None,
+    progress: Callable[[int, str, float], bool | None] | None = None,
 ) -> dict[str, Any]:
-    """Follow the static equilibrium path; keys: lambda, displacements, rotations, reactions,
-    negative_eigenvalues, iterations, residual, energy, constrained, ndof, stats, error,
-    cancelled, settings."""
+    """Run the steps; keys: step, t, iterations, residual, negative_eigenvalues, jump, event,
+    strain_energy, gravity_energy, marker_names, marker_positions, marker_rotations,
+    reaction_dofs, reactions, field_records, displacements, rotations, ndof, stats, step_stats,
+    error, cancelled, steps_completed, settings."""
 
-def bend_tape(
-    *,
-    length: float = 0.1,
-    radius: float = 15.55e-3,
-    alpha: float = 1.21911,
-    thickness: float = 0.138e-3,
-    youngs_modulus: float = 151.76e9,
-    poisson: float = 0.3,
-    mesh_size: float = 2e-3,
-    theta_max: float = ...,
-    unload: bool = False,
-    imperfection: float = 0.0,
-    initial_increment: float = 0.02,
-    max_steps: int = 1000,
-    jump: bool = False,
-    progress: Callable[[float], bool | None] | None = None,
-) -> dict[str, Any]:
-    """Pure bending of a tape spring; keys: theta, moment, negative_eigenvalues, branch, ndof,
-    stats, error, settings."""
-
-def tape_spring_mesh(length: float, radius: float, alpha: float, mesh_size: float) -> MeshTuple: ...
-def flat_plate_mesh(lx: float, ly: float, nx: int, ny: int) -> MeshTuple: ...
+def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]: ...
+def tape_spring_mesh(
+    length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0
+) -> _MeshTuple: ...
+def tape_section_centroid_z(radius: float, alpha: float) -> float: ...
+def flat_plate_mesh(lx: float, ly: float, nx: int, ny: int) -> _MeshTuple: ...
 def cylindrical_panel_mesh(
     radius: float, length: float, phi0: float, phi1: float, n_axial: int, n_arc: int
-) -> MeshTuple: ...
+) -> _MeshTuple: ...
 def _panic_for_tests() -> None:
     """Test hook: panics inside the solver guard; raises TapeError."""
