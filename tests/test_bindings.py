@@ -288,7 +288,7 @@ def test_no_constraint_is_rejected():
         ({"control": "displacement", "node": 0, "dof": "uz", "delta": 1e-3}, "is not free"),
         ({"control": "displacement", "node": 99, "dof": "uz", "delta": 1e-3}, "does not exist"),
         ({"control": "displacement", "node": 2, "dof": "uz", "delta": 0.0}, "non-zero delta"),
-        ({"node": 2}, r"\[\"node\"\] do not apply to control 'load'"),
+        ({"node": 2}, r"\['node'\] do not apply to control 'load'"),
         ({"initial_increment": 0.1}, "do not apply to control 'load'"),
         ({"tol_forse": 1e-6}, "are not options of a step"),
         ({"increments": 0}, "increments >= 1"),

@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -364,3 +365,51 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
 def test_bad_input_raises_value_error_naming_the_problem(change, message):
     with pytest.raises(ValueError, match=message):
         bend(BendingSetup(**change))
+
+
+# ---------------------------------------------------------------------------------------------
+# The curve as a user sees it: origin, located limit points, resolution, unchanged path
+# ---------------------------------------------------------------------------------------------
+REFERENCE = Path(__file__).parents[2] / "crates/tape-core/tests/reference_values/bending_paths.json"
+
+
+def test_default_job_reproduces_the_pre_refactor_path(opposite):
+    # The converged steps of the path (not the located or refining states inserted between them)
+    # are those the dedicated bending driver traced before the move onto the generic runner.
+    reference = json.loads(REFERENCE.read_text())["curves"]["2mm_load"]
+    path = [i for i, e in enumerate(opposite.event) if e is None and i > 0]
+    np.testing.assert_allclose(
+        np.radians(opposite.theta_deg[path]), reference["theta_rad"], rtol=1e-9, atol=1e-12
+    )
+    np.testing.assert_allclose(opposite.moment[path], reference["moment"], rtol=1e-9)
+
+
+def test_curve_starts_at_the_origin(opposite, hysteresis):
+    for result in (opposite, hysteresis):
+        assert result.theta_deg[0] == 0.0 and result.moment[0] == 0.0 and result.stable[0]
+
+
+def test_limit_points_and_peak_are_located_to_a_hundredth_of_a_degree(hysteresis):
+    # Located to 0.005 deg by default; relocated to 0.0005 deg, they move by less than 0.01 deg
+    # (the location converges), and each is the extreme value among all the path's states.
+    fine = bend(BendingSetup(unload=True, locate_tolerance_deg=5e-4))
+    coarse_s, fine_s = summarize(hysteresis), summarize(fine)
+    for name in ("theta_snap_deg", "theta_heel_deg", "theta_at_m_max_deg"):
+        assert getattr(coarse_s, name) == pytest.approx(getattr(fine_s, name), abs=0.01), name
+    th, m, _ = _loading(hysteresis)
+    i_turn = _first_turn(th, +1.0)
+    assert coarse_s.theta_snap_deg == th[: i_turn + 1].max()
+    assert coarse_s.m_max == m[: i_turn + 1].max()
+    events = [e for e, b in zip(hysteresis.event, hysteresis.branch, strict=True) if b == 0]
+    assert events.count("limit_point") == 2  # the snap and the minimum angle of the snap-back
+    assert "monitor_extremum" in events
+
+
+def test_no_plotted_segment_spans_more_than_a_degree_where_the_moment_changes_by_5_percent(
+    hysteresis,
+):
+    th, m, jump = hysteresis.theta_deg, hysteresis.moment, hysteresis.jump
+    wide = np.abs(np.diff(th)) > 1.0
+    change = np.abs(np.diff(m)) / np.maximum(np.abs(m[:-1]), np.abs(m[1:]))
+    bad = np.nonzero(wide & (change > 0.05) & ~jump[1:])[0]
+    assert bad.size == 0, [(th[i], th[i + 1], m[i], m[i + 1]) for i in bad]

@@ -74,12 +74,13 @@ impl Options {
             .map
             .keys()
             .partition(|k| other_keys.contains(&k.as_str()));
+        let list = |keys: &[&String]| keys.iter().map(|k| format!("'{k}'")).collect::<Vec<_>>().join(", ");
         let mut parts = Vec::new();
         if !inapplicable.is_empty() {
-            parts.push(format!("{inapplicable:?} do not apply to {context}"));
+            parts.push(format!("[{}] do not apply to {context}", list(&inapplicable)));
         }
         if !unknown.is_empty() {
-            parts.push(format!("{unknown:?} are not options of a {}", self.what));
+            parts.push(format!("[{}] are not options of a {}", list(&unknown), self.what));
         }
         Err(Error::InvalidParameter(format!(
             "{} options: {}",

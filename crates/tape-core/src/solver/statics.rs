@@ -883,8 +883,19 @@ pub fn solve_static(
                     p.arc += s.arc_norm(&o2.dq, o2.dlambda);
                     step.arc = p.arc;
                     s.stats.steps += 1;
+                    let _ = progress(&step, &s.stats);
+                    let monitored = monitor.map_or(0.0, |i| step.reactions[i]);
                     path.steps.push(step);
-                    let _ = progress(path.steps.last().expect("pushed"), &s.stats);
+                    if locate {
+                        p.history.push(Point {
+                            state: state.clone(),
+                            arc: p.arc,
+                            monitor: monitored,
+                        });
+                        if let Err(e) = after_step(&mut s, &p.history, &mut path) {
+                            path.error = Some(e);
+                        }
+                    }
                     break;
                 }
                 // The final load step failed: retry the crossing with a shorter arc.
