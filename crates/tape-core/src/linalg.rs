@@ -550,6 +550,27 @@ impl LinearSolver {
         }
     }
 
+    /// Solves `S x = b` in place with the LDL^T of the symmetric part `S = (K + K^T)/2` only (the
+    /// operator of inverse iterations for the eigenvector of the smallest eigenvalue).
+    ///
+    /// # Errors
+    /// [`Error::Factorisation`] before a factorisation, for a wrong length or a singular `S`.
+    pub fn solve_symmetric_part_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
+        if !self.factorised || rhs.len() != self.permuted.len() {
+            return Err(Error::Factorisation(
+                "symmetric solve without a factorisation of this size".into(),
+            ));
+        }
+        self.solve_sym(rhs);
+        if rhs.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err(Error::Factorisation(
+                "the symmetric part of the tangent is singular".into(),
+            ))
+        }
+    }
+
     /// Solves `K x = rhs` in place with the last factorisation.
     ///
     /// # Errors

@@ -74,7 +74,12 @@ impl Options {
             .map
             .keys()
             .partition(|k| other_keys.contains(&k.as_str()));
-        let list = |keys: &[&String]| keys.iter().map(|k| format!("'{k}'")).collect::<Vec<_>>().join(", ");
+        let list = |keys: &[&String]| {
+            keys.iter()
+                .map(|k| format!("'{k}'"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         let mut parts = Vec::new();
         if !inapplicable.is_empty() {
             parts.push(format!("[{}] do not apply to {context}", list(&inapplicable)));
@@ -107,7 +112,7 @@ mod tests {
         assert_eq!(o.take_or("missing", 7usize).unwrap(), 7);
         let err = o.finish(&["c"], "this control").unwrap_err().to_string();
         assert!(
-            err.contains("[\"c\"] do not apply to this control") && err.contains("[\"d\"] are not options"),
+            err.contains("['c'] do not apply to this control") && err.contains("['d'] are not options"),
             "{err}"
         );
     }

@@ -96,10 +96,15 @@ pub struct StaticParams {
     /// Record nodal displacements and rotations at each converged state (not an option of the
     /// flat option maps: [`crate::analysis::run`] sets it from its outputs).
     pub record_fields: bool,
-    /// Arc-length only: where the load factor reaches a limit and the path turns back, jump to the
-    /// stable equilibrium beyond the limit instead of following the unstable branch, as a test
-    /// driven slowly by the same loads or prescribed motions does (see [`statics`]).
+    /// Arc-length only: follow the path that a test driven slowly by the same loads or
+    /// prescribed motions follows: where the load factor reaches a limit and the path turns back,
+    /// jump to the stable equilibrium beyond the limit instead of following the unstable branch
+    /// (see [`statics`]).
     pub jump_at_limit_points: bool,
+    /// With `jump_at_limit_points` and `stability`: where the tangent loses its positive
+    /// definiteness while the load factor keeps going (a bifurcation), locate it and switch to the
+    /// stable branch along the critical mode instead of following the unstable one.
+    pub switch_branches: bool,
     /// Arc-length only: locate the limit points of the load factor (where the path turns back in
     /// load factor) to within `event_tolerance` and record them on the path.
     pub locate_limit_points: bool,
@@ -133,6 +138,7 @@ impl Default for StaticParams {
             stability: false,
             record_fields: true,
             jump_at_limit_points: false,
+            switch_branches: false,
             locate_limit_points: false,
             monitor: None,
             event_tolerance: 1e-4,
@@ -154,8 +160,9 @@ const ARC_OPTIONS: [&str; 5] = [
     "direction",
 ];
 /// Options that apply to arc-length control only (beside those of the control itself).
-const ARC_ONLY: [&str; 8] = [
+const ARC_ONLY: [&str; 9] = [
     "jump",
+    "switch_branches",
     "locate_limit_points",
     "monitor_node",
     "monitor_dof",
@@ -229,6 +236,9 @@ impl StaticParams {
             }
         }
         let arc = matches!(self.control, Control::ArcLength { .. });
+        if self.switch_branches && !(self.jump_at_limit_points && self.stability) {
+            return bad("switch_branches needs jump and stability".into());
+        }
         if !arc && (self.jump_at_limit_points || self.locate_limit_points || self.monitor.is_some()) {
             return bad(format!(
                 "jump, locate_limit_points and a monitor apply to arc-length control only (control is '{}')",
@@ -316,6 +326,7 @@ impl StaticParams {
         };
         if arc {
             p.jump_at_limit_points = o.take_or("jump", d.jump_at_limit_points)?;
+            p.switch_branches = o.take_or("switch_branches", d.switch_branches)?;
             p.locate_limit_points = o.take_or("locate_limit_points", d.locate_limit_points)?;
             p.monitor = match (o.take("monitor_node")?, o.take("monitor_dof")?) {
                 (Some(node), Some(dof)) => Some(Monitor { node, dof }),
@@ -378,6 +389,7 @@ impl StaticParams {
                 m.insert("max_steps".into(), (*max_steps).into());
                 m.insert("direction".into(), (*direction).into());
                 m.insert("jump".into(), self.jump_at_limit_points.into());
+                m.insert("switch_branches".into(), self.switch_branches.into());
                 m.insert("locate_limit_points".into(), self.locate_limit_points.into());
                 if let Some(mon) = &self.monitor {
                     m.insert("monitor_node".into(), mon.node.into());
@@ -448,6 +460,11 @@ pub enum Event {
     MonitorExtremum,
     /// An equilibrium added between two converged states to refine the path.
     Refinement,
+    /// The last stable state before a bifurcation (the tangent loses its positive definiteness
+    /// while the load factor keeps going), located on the path.
+    Bifurcation,
+    /// The stable state reached on the branch chosen at a bifurcation.
+    BranchSwitch,
 }
 
 /// One converged equilibrium state.

@@ -99,6 +99,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         ),
     )
     p.add_argument(
+        "--switch-branches",
+        action="store_true",
+        help=(
+            "with --path jump: at a bifurcation (the path loses stability while the angle keeps "
+            "growing, as the perfect tape in equal sense), follow the stable branch leaving it"
+        ),
+    )
+    p.add_argument(
         "--csv", help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file"
     )
     p.add_argument("--plot", help="write the curve as a PNG (paper Fig. 4)")
@@ -138,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
         unload=args.unload,
         imperfection_deg=imperfection,
         jump=(args.path or ("jump" if args.theta_max < 0 else "full")) == "jump",
+        switch_branches=args.switch_branches,
     )
     try:
         result = bend(setup, progress=not (args.no_progress or args.json))

@@ -86,6 +86,10 @@ class BendingSetup:
         Follow the path of a slow rotation-controlled test: where the angle reaches a limit, jump
         to the stable equilibrium beyond it instead of tracing the unstable branch back. Off: the
         whole equilibrium path (stable and unstable) is traced.
+    switch_branches : bool
+        With `jump`: where the path loses its stability while the angle keeps growing (a
+        bifurcation, as that of the perfect tape in equal sense, where it twists), locate it and
+        follow the stable branch leaving it instead of the unstable one.
     locate_tolerance_deg : float
         Limit points of the angle and extrema of the moment are located to this [deg], > 0.
     """
@@ -101,6 +105,7 @@ class BendingSetup:
     unload: bool = False
     imperfection_deg: float = 0.0
     jump: bool = False
+    switch_branches: bool = False
     locate_tolerance_deg: float = 0.005
 
     @property
@@ -217,6 +222,7 @@ def bending_steps(setup: BendingSetup, driven: int) -> list[Any]:
                 max_steps=1000,
                 stability=True,
                 jump=setup.jump,
+                switch_branches=setup.switch_branches and setup.jump,
                 target_iterations=8 if careful else 5,
                 tol_force=1e-6 if careful else 1e-5,
                 tol_energy=1e-12 if careful else 1e-10,

@@ -44,10 +44,10 @@ struct Saved {
 }
 
 /// An equilibrium found on a plane, with its position `s` along the chord.
-struct Found {
-    s: f64,
-    state: State,
-    step: StaticStep,
+pub(super) struct Found {
+    pub s: f64,
+    pub state: State,
+    pub step: StaticStep,
     monitor: f64,
 }
 
@@ -77,7 +77,7 @@ impl Driver<'_> {
 
     /// Increments `(dq, dlambda)` that take `a` to `b`: translations of the free DOFs, spatial
     /// rotation vectors `log(R_b R_a^T)` of the free rotations, and the load factor.
-    fn difference(&self, a: &State, b: &State) -> (Vec<f64>, f64) {
+    pub(super) fn difference(&self, a: &State, b: &State) -> (Vec<f64>, f64) {
         let dq = self
             .system
             .dofs
@@ -97,7 +97,13 @@ impl Driver<'_> {
 
     /// The equilibrium on the plane at fraction `s` of the chord from `from` (`None` if Newton
     /// fails there).
-    fn on_plane(&mut self, from: &State, chord: &(Vec<f64>, f64), s: f64, monitor: Option<usize>) -> Option<Found> {
+    pub(super) fn on_plane(
+        &mut self,
+        from: &State,
+        chord: &(Vec<f64>, f64),
+        s: f64,
+        monitor: Option<usize>,
+    ) -> Option<Found> {
         let mut state = from.clone();
         self.invalidate();
         let inc = Increment::Plane {
@@ -203,7 +209,7 @@ fn search(
         sense
             * match kind {
                 Event::LimitPoint => t,
-                Event::MonitorExtremum | Event::Refinement => m,
+                _ => m,
             }
     };
     // Bracket (s, h, load factor); the middle one is the highest.
@@ -251,7 +257,7 @@ fn search(
             // tolerance of it (a smooth maximum: they bound it from below, the parabola from above).
             Event::LimitPoint => m.1 - l.1.max(r.1) < tol,
             // The position of the extremum is known once the bracket is narrow in load factor.
-            Event::MonitorExtremum | Event::Refinement => (r.2 - l.2).abs() < tol,
+            _ => (r.2 - l.2).abs() < tol,
         };
         if done {
             break;

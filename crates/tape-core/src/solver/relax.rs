@@ -1,13 +1,42 @@
-//! Jumps at limit points: where a path driven by a load factor reaches a limit and turns back, a
-//! slow test driven by the same loads or motions snaps to a stable equilibrium beyond the limit.
-//! That equilibrium is found by pseudo-transient continuation: each pseudo-time step solves
-//! `r(q) + C (q - q_k) = 0` with `C = beta diag|K|`, `beta` large enough that `K + C` is positive
-//! definite, so every step descends the potential (an implicit gradient flow); `beta` shrinks as
-//! steps succeed, ending in plain Newton at a stable equilibrium.
+//! The stable path of a slowly driven test: jumps at limit points and branch switches at
+//! bifurcations.
+//!
+//! Where a path driven by a load factor reaches a limit and turns back, a slow test driven by the
+//! same loads or motions snaps to a stable equilibrium beyond the limit. Where the tangent loses
+//! its positive definiteness while the load factor keeps going (a bifurcation: a pivot of the
+//! LDL^T changes sign without a limit point), the test leaves the now unstable path along the
+//! critical mode. Both stable equilibria are found by pseudo-transient continuation: each
+//! pseudo-time step solves `r(q) + C (q - q_k) = 0` with `C = beta diag|K|`, `beta` large enough
+//! that `K + C` is positive definite, so every step descends the potential (an implicit gradient
+//! flow); `beta` shrinks as steps succeed, ending in plain Newton at a stable equilibrium.
+//!
+//! At a bifurcation, the last stable state before it is located by bisection along the path (on
+//! hyperplanes across the chord, as in [`super::events`]), the critical mode is the eigenvector of
+//! the tangent's eigenvalue nearest zero there (inverse iteration with the LDL^T of the symmetric
+//! part), and the state just past the bifurcation, pushed both ways along the mode, is relaxed: of
+//! the stable equilibria reached, the one of lowest potential energy is the branch followed (the
+//! two are mirror images when the bifurcation is symmetric; the sign of the mode then decides).
 
+use super::events::Found;
 use super::statics::Driver;
+use super::{Event, StaticStep};
 use crate::error::{Error, Result};
 use crate::state::State;
+
+/// An eigenvalue above `-NEUTRAL` times the largest diagonal entry of the tangent is zero to
+/// round-off: a hundred ulps (the instabilities met past the equal-sense bifurcations of the tape
+/// measure -4e-14 and beyond, its neutral sliding modes -7e-16).
+const NEUTRAL: f64 = 100.0 * f64::EPSILON;
+
+/// The outcome of a branch switch at a bifurcation.
+pub(super) struct Switch {
+    /// The last stable state located before the bifurcation, recorded with its event.
+    pub critical: Option<(State, StaticStep)>,
+    /// The stable state reached on the chosen branch (the driver's state on return).
+    pub stable: State,
+    /// Its potential energy [J].
+    pub energy: f64,
+}
 
 impl Driver<'_> {
     /// From the converged `saved` state before a limit point, finds a stable equilibrium a little
@@ -47,6 +76,190 @@ impl Driver<'_> {
         })
     }
 
+    /// Between the stable converged state `stable` and the unstable one `unstable` reached from it
+    /// without a limit point, locates the bifurcation, and moves `state` to a stable equilibrium
+    /// on the branch leaving it (see the module notes). `None` if the unstable state's instability
+    /// is not one a push along the critical mode leaves (both pushes relax back onto the path
+    /// itself, within `ds / 10`): the path is then kept.
+    ///
+    /// # Errors
+    /// A failure of the linear algebra, or no stable equilibrium found either way.
+    pub fn switch_branch(
+        &mut self,
+        state: &mut State,
+        stable: &State,
+        unstable: &State,
+        ds: f64,
+    ) -> Result<Option<Switch>> {
+        // Is the instability real? Pushed along the critical mode, the unstable state must relax
+        // away from the path.
+        let mode = self.critical_mode(unstable)?;
+        let mut trial = unstable.clone();
+        self.push_along(&mut trial, &mode, 0.2 * ds);
+        let away = self.relax(&mut trial, unstable.t).is_ok() && self.distance(&trial, unstable) >= 0.1 * ds;
+        if !away {
+            // Back where it started: the path's own state is stable after all (a pivot at
+            // round-off level, not an instability).
+            self.invalidate();
+            return Ok(None);
+        }
+        // The bifurcation, by bisection along the path between the stable and unstable states.
+        // Near it the tangent is nearly singular along the critical mode, which the hyperplane
+        // does not fix: a solve that fails there counts as past it.
+        let chord = self.difference(stable, unstable);
+        let (mut lo, mut hi) = (0.0, 1.0);
+        let mut last_stable: Option<Found> = None;
+        let t_at = |s: f64| stable.t + s * chord.1;
+        // Load factor at `hi`: that of the state found there (the path bends near the
+        // bifurcation, so it differs from the chord's), else the chord's.
+        let mut t_hi = unstable.t;
+        for _ in 0..16 {
+            if (t_hi - t_at(lo)).abs() < self.params.event_tolerance {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            match self.on_plane(stable, &chord, mid, None) {
+                Some(found) if found.step.negative_eigenvalues == Some(0) => {
+                    lo = mid;
+                    last_stable = Some(found);
+                }
+                found => {
+                    hi = mid;
+                    t_hi = found.map_or_else(|| t_at(mid), |f| f.state.t);
+                }
+            }
+        }
+        // From the last stable state, both ways along the mode, just past the bifurcation: the
+        // stable equilibrium of lowest potential energy is the branch followed. Failed solves may
+        // have put `hi` before the bifurcation: if both ways relax back onto the path, go further
+        // (beyond the unstable state too, when the stable branch lies past a snap).
+        let start = last_stable
+            .as_ref()
+            .map_or_else(|| stable.clone(), |f| f.state.clone());
+        let mode = self.critical_mode(&start)?;
+        let mut best: Option<(State, f64)> = None;
+        // Past a limit point the path comes back in load factor: the switch is never behind the
+        // last stable state (it is then the jump of a limit point).
+        let t_lo = last_stable.as_ref().map_or(stable.t, |f| f.state.t);
+        let t_hi = if chord.1 >= 0.0 { t_hi.max(t_lo) } else { t_hi.min(t_lo) };
+        let mut t_switch = t_hi;
+        for s_switch in [hi, 0.5 * (hi + 1.0), 1.0, 2.0, 4.0, 8.0] {
+            if s_switch > hi {
+                // Further along, never behind the state found past the bifurcation.
+                let t = t_at(s_switch);
+                t_switch = if chord.1 >= 0.0 { t.max(t_hi) } else { t.min(t_hi) };
+            }
+            for sign in [1.0, -1.0] {
+                let mut trial = start.clone();
+                self.push_along(&mut trial, &mode, sign * 0.2 * ds);
+                if self.relax(&mut trial, t_switch).is_err() || self.distance(&trial, &start) < 0.1 * ds {
+                    continue;
+                }
+                let energy = self.asm.energy + self.asm.gravity_energy;
+                if best.as_ref().is_none_or(|(_, e)| energy < *e) {
+                    best = Some((trial, energy));
+                }
+            }
+            if best.is_some() {
+                break;
+            }
+        }
+        let Some((switched, energy)) = best else {
+            return Err(Error::NotConverged {
+                step: None,
+                t: t_switch,
+                iterations: 0,
+                residual: f64::NAN,
+                detail: "no stable equilibrium found along the critical mode of a bifurcation".into(),
+            });
+        };
+        let critical = last_stable.map(|mut f| {
+            f.step.event = Some(Event::Bifurcation);
+            (f.state, f.step)
+        });
+        *state = switched.clone();
+        self.invalidate();
+        self.assemble(state);
+        Ok(Some(Switch {
+            critical,
+            stable: switched,
+            energy,
+        }))
+    }
+
+    /// The eigenvector of the tangent's eigenvalue nearest zero at `at` (inverse iteration with
+    /// the LDL^T of the symmetric part), of unit weighted norm.
+    fn critical_mode(&mut self, at: &State) -> Result<Vec<f64>> {
+        self.invalidate();
+        self.assemble(at);
+        self.factorise()?;
+        self.inverse_iteration()
+    }
+
+    /// Inverse iteration with the factorised tangent's symmetric part.
+    fn inverse_iteration(&mut self) -> Result<Vec<f64>> {
+        let n = self.system.n_free();
+        // A deterministic start with components along every DOF.
+        #[allow(clippy::cast_precision_loss)]
+        let mut mode: Vec<f64> = (0..n)
+            .map(|i| ((i as f64) * 0.618_033_988_749_895).fract() - 0.5)
+            .collect();
+        for _ in 0..30 {
+            self.system
+                .linear
+                .solve_symmetric_part_in_place(&mut mode)?;
+            let norm = self.dot_w(&mode, &mode).sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(Error::Factorisation(
+                    "inverse iteration for the critical mode failed".into(),
+                ));
+            }
+            for v in &mut mode {
+                *v /= norm;
+            }
+        }
+        Ok(mode)
+    }
+
+    /// Negative eigenvalues of the factorised tangent of the current state, not counting one at
+    /// round-off level (a neutral mode, see [`NEUTRAL`]). Used to tell instabilities a state can
+    /// leave from neutral modes; the stability recorded on paths is the plain count (the
+    /// eigenvalues of bending-dominated unstable branches of thin shells are themselves a few
+    /// ulps of the membrane stiffness, so no such threshold separates them from neutral modes).
+    ///
+    /// # Errors
+    /// No factorisation, or a failed solve.
+    pub fn negative_eigenvalues(&mut self) -> Result<usize> {
+        self.factorise()?;
+        let count = self.system.linear.negative_eigenvalues()?;
+        if count != 1 {
+            return Ok(count);
+        }
+        let mode = self.inverse_iteration()?;
+        Ok(usize::from(self.relative_rayleigh(&mode) <= -NEUTRAL))
+    }
+
+    /// Rayleigh quotient of the current tangent for `mode`, relative to the largest diagonal entry.
+    fn relative_rayleigh(&self, mode: &[f64]) -> f64 {
+        let mut km = vec![0.0; mode.len()];
+        self.system
+            .pattern_ff
+            .mul_add(&self.asm.k_ff, mode, &mut km);
+        let num: f64 = mode.iter().zip(&km).map(|(a, b)| a * b).sum();
+        let den: f64 = mode.iter().map(|a| a * a).sum();
+        let diag = (0..mode.len())
+            .filter_map(|i| self.system.pattern_ff.find(i, i))
+            .map(|p| self.asm.k_ff[p].abs())
+            .fold(0.0, f64::max);
+        num / den / diag
+    }
+
+    /// Moves `state` by `amount` (weighted norm) along the unit `mode`, at fixed load factor.
+    fn push_along(&self, state: &mut State, mode: &[f64], amount: f64) {
+        let push: Vec<f64> = mode.iter().map(|v| amount * v).collect();
+        self.system.update(state, &push, 0.0);
+    }
+
     /// Moves the load factor to `lambda` and relaxes `state` to a stable equilibrium there.
     /// Returns the pseudo-steps used.
     fn relax(&mut self, state: &mut State, lambda: f64) -> Result<usize> {
@@ -70,8 +283,10 @@ impl Driver<'_> {
             let (ok, rr) = self.converged(None);
             log::trace!("relaxation step {step}: beta {beta:.1e}, residual {rr:.3e}");
             if ok && beta <= 1e-6 {
-                self.factorise()?;
-                if self.system.linear.negative_eigenvalues()? == 0 {
+                // A negative eigenvalue at round-off level is a neutral mode (a fold free to slide
+                // along a uniform tape: measured -7e-16 of the largest diagonal entry), not an
+                // instability the flow can leave: the state is as stable as it gets.
+                if self.negative_eigenvalues()? == 0 {
                     return Ok(step);
                 }
                 beta = beta.max(1e-3);

@@ -37,7 +37,7 @@ use std::time::Instant;
 use super::control::{GiveUp, StepController};
 use super::events::{after_step, Point};
 use super::newton::{Convergence, Stall};
-use super::{Control, Rejection, StaticParams, StaticPath, StaticStep, Stats};
+use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
@@ -557,6 +557,10 @@ struct PathState {
     arc: f64,
     /// Converged states kept for the location of events and refinement (cleared at jumps).
     history: Vec<Point>,
+    /// Negative eigenvalues of the last recorded state (if counted).
+    last_negative: Option<usize>,
+    /// After a jump or a branch switch: the load-factor increment of the restarting step.
+    restart: Option<f64>,
 }
 
 /// Follows the static equilibrium path of `system` from `state` as `params` says, calling
@@ -703,6 +707,8 @@ pub fn solve_static(
         travelled: 0.0,
         arc: 0.0,
         history: Vec::new(),
+        last_negative: None,
+        restart: None,
     };
     let locate = arc_control && (params.locate_limit_points || params.monitor.is_some());
     let monitor = s.monitor_index();
@@ -788,9 +794,16 @@ pub fn solve_static(
                 }
                 // Without a previous increment (first step, or after a jump) head for lambda_end.
                 let towards = (lambda_end - state.t).signum();
-                Increment::Arc {
-                    ds: p.control.size.abs(),
-                    direction: if towards == 0.0 { *direction } else { towards },
+                let towards = if towards == 0.0 { *direction } else { towards };
+                match p.restart {
+                    // After a jump or a branch switch the state may carry a neutral mode (a fold
+                    // free to slide) that makes the tangent direction of the path undefined: the
+                    // path restarts with a load increment, which fixes the direction of travel.
+                    Some(dl) => Increment::Load(towards * dl),
+                    None => Increment::Arc {
+                        ds: p.control.size.abs(),
+                        direction: towards,
+                    },
                 }
             }
         };
@@ -806,26 +819,86 @@ pub fn solve_static(
                 s.stats.cutbacks += 1;
                 log::debug!("increment rejected at t = {}: {rejection}; cutting back", state.t);
                 if let Err(why) = p.control.reject() {
-                    path.error = Some(give_up(&p, why, &rejection, state, params));
-                    break;
+                    // On the stable path of a slowly driven test, a state whose tangent does not
+                    // define the path (a neutral mode: a fold free to slide) can still be left by
+                    // relaxing at a larger load factor.
+                    let relaxed = match (params.jump_at_limit_points && arc_control, lambda_end, p.arc_ds) {
+                        (true, Some(end), Some(ds)) => {
+                            let from = state.clone();
+                            let travel = (end - from.t).signum();
+                            match s.jump(state, &from, travel, p.last_dlambda, ds) {
+                                Ok(()) => true,
+                                Err(e) => {
+                                    log::debug!("no relaxation past t = {}: {e}", from.t);
+                                    *state = from;
+                                    false
+                                }
+                            }
+                        }
+                        _ => false,
+                    };
+                    if !relaxed {
+                        path.error = Some(give_up(&p, why, &rejection, state, params));
+                        break;
+                    }
+                    let outcome = Outcome {
+                        iterations: 0,
+                        residual: 0.0,
+                        dq: Vec::new(),
+                        dlambda: 0.0,
+                    };
+                    match s.record(state, &outcome) {
+                        Ok(mut st) => {
+                            p.arc += p.arc_ds.unwrap_or(0.0);
+                            st.arc = p.arc;
+                            s.stats.steps += 1;
+                            p.last_negative = st.negative_eigenvalues;
+                            let keep_going = progress(&st, &s.stats);
+                            path.steps.push(st);
+                            if !keep_going {
+                                path.cancelled = true;
+                                break;
+                            }
+                        }
+                        Err(e) => {
+                            path.error = Some(e);
+                            break;
+                        }
+                    }
+                    s.previous = None;
+                    p.history.clear();
+                    p.control.cutbacks = 0;
+                    p.control.size = p.arc_ds.unwrap_or(p.control.size);
+                    continue;
                 }
                 s.strict_turns = p.control.cutbacks < params.max_cutbacks / 2;
                 s.tangent_predictor = false;
+                // A restarting load increment that fails (the branch ends in a snap): back to the
+                // arc length, which turns at the limit.
+                p.restart = None;
                 continue;
             }
         };
         // A limit point of the load factor: jump to the stable equilibrium beyond it.
         if let (true, Some(end)) = (params.jump_at_limit_points && arc_control, lambda_end) {
             let travel = (end - saved.t).signum();
-            if (state.t - saved.t) * travel < 0.0 && p.last_dlambda.is_some() {
-                match s.jump(state, &saved, travel, p.last_dlambda, p.control.size.abs()) {
-                    Ok(()) => {}
+            let turned = state.clone();
+            let jumped = (state.t - saved.t) * travel < 0.0
+                && p.last_dlambda.is_some()
+                && match s.jump(state, &saved, travel, p.last_dlambda, p.control.size.abs()) {
+                    Ok(()) => true,
                     Err(e) => {
-                        *state = saved;
-                        path.error = Some(e);
-                        break 'steps;
+                        // No stable equilibrium beyond this limit point (a neutral mode, such as
+                        // a fold free to slide, makes the gradient flow stall): the path itself is
+                        // followed through it, its states recorded with their stability.
+                        log::debug!("no jump at t = {}: {e}; following the path", saved.t);
+                        *state = turned;
+                        s.invalidate();
+                        s.assemble(state);
+                        false
                     }
-                }
+                };
+            if jumped {
                 let relaxed = Outcome {
                     iterations: 0,
                     residual: 0.0,
@@ -835,6 +908,7 @@ pub fn solve_static(
                 match s.record(state, &relaxed) {
                     Ok(mut st) => {
                         st.jump = true;
+                        p.last_negative = st.negative_eigenvalues;
                         p.arc += s.distance(state, &saved);
                         st.arc = p.arc;
                         s.stats.steps += 1;
@@ -851,6 +925,7 @@ pub fn solve_static(
                     }
                 }
                 s.previous = None;
+                p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
                 p.history.clear();
                 if locate {
                     let reactions = s.asm.reactions();
@@ -862,6 +937,87 @@ pub fn solve_static(
                 }
                 p.control.cutbacks = 0;
                 continue 'steps;
+            }
+        }
+        // A bifurcation on the stable path: the tangent lost its positive definiteness while the
+        // load factor kept going. Switch to the stable branch leaving it.
+        let forward = lambda_end.is_some_and(|end| (state.t - saved.t) * (end - saved.t) > 0.0);
+        if params.switch_branches && arc_control && forward && p.last_negative == Some(0) {
+            let unstable = match s
+                .factorise()
+                .and_then(|()| s.system.linear.negative_eigenvalues())
+            {
+                Ok(n) => n > 0,
+                Err(e) => {
+                    path.error = Some(e);
+                    break 'steps;
+                }
+            };
+            if unstable {
+                let reached = state.clone();
+                let ds = p.control.size.abs();
+                match s.switch_branch(state, &saved, &reached, ds) {
+                    Ok(Some(switch)) => {
+                        if let Some((critical, mut step)) = switch.critical {
+                            step.arc = p.arc + s.distance(&critical, &saved);
+                            p.arc = step.arc;
+                            s.stats.steps += 1;
+                            path.steps.push(step);
+                        }
+                        let relaxed = Outcome {
+                            iterations: 0,
+                            residual: 0.0,
+                            dq: Vec::new(),
+                            dlambda: 0.0,
+                        };
+                        match s.record(state, &relaxed) {
+                            Ok(mut st) => {
+                                st.event = Some(Event::BranchSwitch);
+                                // A branch that leaves the bifurcation continuously is reached
+                                // nearby; a far one was reached by a snap.
+                                st.jump = s.distance(&switch.stable, &reached) > 0.5 * ds;
+                                p.arc += s.distance(state, &saved);
+                                st.arc = p.arc;
+                                s.stats.steps += 1;
+                                log::debug!(
+                                    "branch switch at t = {}: potential energy {:.6e} J",
+                                    state.t,
+                                    switch.energy
+                                );
+                                let keep_going = progress(&st, &s.stats);
+                                p.last_negative = st.negative_eigenvalues;
+                                path.steps.push(st);
+                                if !keep_going {
+                                    path.cancelled = true;
+                                    break 'steps;
+                                }
+                            }
+                            Err(e) => {
+                                path.error = Some(e);
+                                break 'steps;
+                            }
+                        }
+                        s.previous = None;
+                        p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
+                        p.history.clear();
+                        p.control.cutbacks = 0;
+                        continue 'steps;
+                    }
+                    Ok(None) => {
+                        // A round-off pivot: keep the converged state (its pieces, changed by the
+                        // trial relaxations, are assembled again).
+                        *state = reached;
+                        s.assemble(state);
+                    }
+                    Err(e) => {
+                        // No stable branch found: the path itself is followed, its states
+                        // recorded with their stability.
+                        log::debug!("no branch switch at t = {}: {e}; following the path", reached.t);
+                        *state = reached;
+                        s.invalidate();
+                        s.assemble(state);
+                    }
+                }
             }
         }
         // Arc-length: do not overshoot the final load factor; finish with a load step.
@@ -910,6 +1066,7 @@ pub fn solve_static(
             }
         }
         // Accept.
+        p.restart = None;
         s.strict_turns = true;
         s.tangent_predictor = true;
         let mut step = match s.record(state, &out) {
@@ -923,6 +1080,7 @@ pub fn solve_static(
         step.arc = p.arc;
         s.stats.steps += 1;
         let keep_going = progress(&step, &s.stats);
+        p.last_negative = step.negative_eigenvalues;
         path.steps.push(step);
         if let Control::Displacement { .. } = &params.control {
             p.travelled += p.control.size;
