@@ -841,33 +841,22 @@ pub fn solve_static(
                         path.error = Some(give_up(&p, why, &rejection, state, params));
                         break;
                     }
-                    let outcome = Outcome {
-                        iterations: 0,
-                        residual: 0.0,
-                        dq: Vec::new(),
-                        dlambda: 0.0,
+                    let relaxed = Relaxed {
+                        distance: p.arc_ds.unwrap_or(0.0),
+                        jump: false,
+                        event: None,
                     };
-                    match s.record(state, &outcome) {
-                        Ok(mut st) => {
-                            p.arc += p.arc_ds.unwrap_or(0.0);
-                            st.arc = p.arc;
-                            s.stats.steps += 1;
-                            p.last_negative = st.negative_eigenvalues;
-                            let keep_going = progress(&st, &s.stats);
-                            path.steps.push(st);
-                            if !keep_going {
-                                path.cancelled = true;
-                                break;
-                            }
-                        }
-                        Err(e) => {
-                            path.error = Some(e);
-                            break;
-                        }
+                    if !push_relaxed(
+                        &mut s,
+                        &mut p,
+                        &mut path,
+                        state,
+                        relaxed,
+                        progress,
+                        locate.then_some(monitor),
+                    ) {
+                        break;
                     }
-                    s.previous = None;
-                    p.history.clear();
-                    p.control.cutbacks = 0;
                     p.control.size = p.arc_ds.unwrap_or(p.control.size);
                     continue;
                 }
@@ -899,43 +888,22 @@ pub fn solve_static(
                     }
                 };
             if jumped {
-                let relaxed = Outcome {
-                    iterations: 0,
-                    residual: 0.0,
-                    dq: Vec::new(),
-                    dlambda: 0.0,
+                let relaxed = Relaxed {
+                    distance: s.distance(state, &saved),
+                    jump: true,
+                    event: None,
                 };
-                match s.record(state, &relaxed) {
-                    Ok(mut st) => {
-                        st.jump = true;
-                        p.last_negative = st.negative_eigenvalues;
-                        p.arc += s.distance(state, &saved);
-                        st.arc = p.arc;
-                        s.stats.steps += 1;
-                        let keep_going = progress(&st, &s.stats);
-                        path.steps.push(st);
-                        if !keep_going {
-                            path.cancelled = true;
-                            break 'steps;
-                        }
-                    }
-                    Err(e) => {
-                        path.error = Some(e);
-                        break 'steps;
-                    }
+                if !push_relaxed(
+                    &mut s,
+                    &mut p,
+                    &mut path,
+                    state,
+                    relaxed,
+                    progress,
+                    locate.then_some(monitor),
+                ) {
+                    break 'steps;
                 }
-                s.previous = None;
-                p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
-                p.history.clear();
-                if locate {
-                    let reactions = s.asm.reactions();
-                    p.history.push(Point {
-                        state: state.clone(),
-                        arc: p.arc,
-                        monitor: monitor.map_or(0.0, |i| reactions[i]),
-                    });
-                }
-                p.control.cutbacks = 0;
                 continue 'steps;
             }
         }
@@ -964,43 +932,29 @@ pub fn solve_static(
                             s.stats.steps += 1;
                             path.steps.push(step);
                         }
-                        let relaxed = Outcome {
-                            iterations: 0,
-                            residual: 0.0,
-                            dq: Vec::new(),
-                            dlambda: 0.0,
+                        log::debug!(
+                            "branch switch at t = {}: potential energy {:.6e} J",
+                            state.t,
+                            switch.energy
+                        );
+                        // A branch that leaves the bifurcation continuously is reached nearby; a
+                        // far one was reached by a snap.
+                        let relaxed = Relaxed {
+                            distance: s.distance(state, &saved),
+                            jump: s.distance(&switch.stable, &reached) > 0.5 * ds,
+                            event: Some(Event::BranchSwitch),
                         };
-                        match s.record(state, &relaxed) {
-                            Ok(mut st) => {
-                                st.event = Some(Event::BranchSwitch);
-                                // A branch that leaves the bifurcation continuously is reached
-                                // nearby; a far one was reached by a snap.
-                                st.jump = s.distance(&switch.stable, &reached) > 0.5 * ds;
-                                p.arc += s.distance(state, &saved);
-                                st.arc = p.arc;
-                                s.stats.steps += 1;
-                                log::debug!(
-                                    "branch switch at t = {}: potential energy {:.6e} J",
-                                    state.t,
-                                    switch.energy
-                                );
-                                let keep_going = progress(&st, &s.stats);
-                                p.last_negative = st.negative_eigenvalues;
-                                path.steps.push(st);
-                                if !keep_going {
-                                    path.cancelled = true;
-                                    break 'steps;
-                                }
-                            }
-                            Err(e) => {
-                                path.error = Some(e);
-                                break 'steps;
-                            }
+                        if !push_relaxed(
+                            &mut s,
+                            &mut p,
+                            &mut path,
+                            state,
+                            relaxed,
+                            progress,
+                            locate.then_some(monitor),
+                        ) {
+                            break 'steps;
                         }
-                        s.previous = None;
-                        p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
-                        p.history.clear();
-                        p.control.cutbacks = 0;
                         continue 'steps;
                     }
                     Ok(None) => {
@@ -1132,6 +1086,69 @@ pub fn solve_static(
     s.stats.wall_s = start.elapsed().as_secs_f64();
     path.stats = s.stats;
     Ok(path)
+}
+
+/// A state reached by relaxation rather than along the path: a jump past a limit point, a branch
+/// switch at a bifurcation, or a relaxation past a neutral mode.
+struct Relaxed {
+    /// How far from the last recorded state, for the arc position.
+    distance: f64,
+    /// Reached by a snap.
+    jump: bool,
+    /// What it marks.
+    event: Option<Event>,
+}
+
+/// Records `state`, reached by relaxation, and restarts the path from it (no previous increment,
+/// a restarting load increment, a new location history holding it when events are located, with
+/// the reaction at index `monitor` if any); `false` if the analysis must stop (a failed record, or
+/// the progress callback's wish).
+fn push_relaxed(
+    s: &mut Driver,
+    p: &mut PathState,
+    path: &mut StaticPath,
+    state: &State,
+    relaxed: Relaxed,
+    progress: &mut dyn FnMut(&StaticStep, &Stats) -> bool,
+    location: Option<Option<usize>>,
+) -> bool {
+    let outcome = Outcome {
+        iterations: 0,
+        residual: 0.0,
+        dq: Vec::new(),
+        dlambda: 0.0,
+    };
+    let mut st = match s.record(state, &outcome) {
+        Ok(st) => st,
+        Err(e) => {
+            path.error = Some(e);
+            return false;
+        }
+    };
+    st.jump = relaxed.jump;
+    st.event = relaxed.event;
+    p.arc += relaxed.distance;
+    st.arc = p.arc;
+    p.last_negative = st.negative_eigenvalues;
+    s.stats.steps += 1;
+    let keep_going = progress(&st, &s.stats);
+    let monitored = location.map(|monitor| monitor.map_or(0.0, |i| st.reactions[i]));
+    path.steps.push(st);
+    s.previous = None;
+    p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
+    p.control.cutbacks = 0;
+    p.history.clear();
+    if let Some(value) = monitored {
+        p.history.push(Point {
+            state: state.clone(),
+            arc: p.arc,
+            monitor: value,
+        });
+    }
+    if !keep_going {
+        path.cancelled = true;
+    }
+    keep_going
 }
 
 /// The error that ends a path whose increment could not be made to converge.
