@@ -317,6 +317,33 @@ def test_equal_sense_peak_is_lower_than_opposite_and_residual_moment_matches(to_
     assert result.stable[result.jump].all()
 
 
+def test_perfect_tape_bifurcates_in_equal_sense_and_follows_the_stable_branch():
+    # The perfect tape's symmetric path loses its stability at a bifurcation (measured on 2 mm:
+    # -3.33 deg, M = -0.152 N m) while the angle keeps growing, and goes on unstable (the peak of
+    # the unstable symmetric path is -0.166 N m at -3.87 deg). With branch switching the
+    # bifurcation is located (the last stable state, within 0.005 deg) and the path leaves it along
+    # the critical mode to a stable branch, by a snap: the bifurcation is subcritical, the new
+    # branch carries a smaller moment. The twist-imperfect tape has a limit point before it
+    # instead (-3.22 deg on a fine path), where the jump takes the path to the same branch.
+    result = bend(
+        BendingSetup(theta_max_deg=-6.0, imperfection_deg=0.0, jump=True, switch_branches=True)
+    )
+    assert result.error is None
+    events = list(result.event)
+    assert "bifurcation" in events and "branch_switch" in events
+    i_bif, i_switch = events.index("bifurcation"), events.index("branch_switch")
+    assert i_switch == i_bif + 1
+    # Everything before the bifurcation is stable and on the symmetric path (linear-ish rise).
+    assert result.stable[: i_bif + 1].all()
+    assert -3.6 < result.theta_deg[i_bif] < -3.0
+    assert result.moment[i_bif] == summarize(result).m_max
+    # The switch is a snap to a stable state of smaller moment at (almost) the same angle.
+    assert result.stable[i_switch] and result.jump[i_switch]
+    assert abs(result.moment[i_switch]) < 0.9 * abs(result.moment[i_bif])
+    # The rest of the path, on the twisted branch, is stable to -6 deg.
+    assert result.stable[i_switch:].all() and result.theta_deg[-1] == pytest.approx(-6.0)
+
+
 # ---------------------------------------------------------------------------------------------
 # CSV output
 # ---------------------------------------------------------------------------------------------
