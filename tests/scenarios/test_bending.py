@@ -387,6 +387,10 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
         ({"theta_max_deg": 0.0}, "theta_max"),
         ({"mesh_size": 0.0}, "mesh_size"),
         ({"mesh_size": -1e-3}, "mesh_size"),
+        # Coarser than a quarter of the width (18.96 mm): the section cannot bend into a fold.
+        ({"mesh_size": 38e-3}, "too coarse for a tape 18.96 mm wide"),
+        ({"mesh_size": 1000.0}, "too coarse"),
+        ({"mesh_size": float("nan")}, "mesh_size must be finite"),
     ],
 )
 def test_bad_input_raises_value_error_naming_the_problem(change, message):

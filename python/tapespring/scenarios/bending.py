@@ -53,6 +53,10 @@ __all__ = [
 ]
 
 
+#: Fewest elements across the width (and along the length) of a tape that a bending run accepts.
+MIN_ELEMENTS = 4
+
+
 @dataclass(frozen=True)
 class BendingSetup:
     """Geometry, material and loading of a pure-bending run (SI units).
@@ -134,6 +138,17 @@ class BendingSetup:
             )
         if self.mesh_size <= 0.0:
             raise ValueError(f"mesh_size [m] must be finite and > 0 (got {self.mesh_size})")
+        # A coarser mesh does not represent the curved section, and the fold that forms in it, at
+        # all (38 mm elements on this tape gave M_max = 1.45 N m instead of 0.30).
+        width = self.radius * math.radians(self.alpha_deg)
+        coarsest = min(width, self.length) / MIN_ELEMENTS
+        if self.mesh_size > coarsest:
+            raise ValueError(
+                f"mesh_size = {self.mesh_size} m is too coarse for a tape "
+                f"{width * 1e3:.2f} mm wide and {self.length * 1e3:.1f} mm long: at least "
+                f"{MIN_ELEMENTS} elements are needed across and along it "
+                f"(mesh_size <= {coarsest:.3e} m)"
+            )
         if self.locate_tolerance_deg <= 0.0:
             raise ValueError(f"locate_tolerance_deg must be > 0 (got {self.locate_tolerance_deg})")
 
