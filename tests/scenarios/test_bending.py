@@ -391,6 +391,8 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
         ({"mesh_size": 38e-3}, "too coarse for a tape 18.96 mm wide"),
         ({"mesh_size": 1000.0}, "too coarse"),
         ({"mesh_size": float("nan")}, "mesh_size must be finite"),
+        ({"alpha_deg": [1.0]}, r"alpha_deg must be a number \(got \[1.0\]\)"),
+        ({"theta_max_deg": None}, r"theta_max_deg must be a number \(got None\)"),
     ],
 )
 def test_bad_input_raises_value_error_naming_the_problem(change, message):

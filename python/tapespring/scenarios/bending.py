@@ -125,7 +125,19 @@ class BendingSetup:
         ValueError
             Naming the bad value.
         """
-        for name in ("theta_max_deg", "mesh_size", "imperfection_deg", "locate_tolerance_deg"):
+        numbers = (
+            "length",
+            "radius",
+            "alpha_deg",
+            "thickness",
+            "youngs_modulus",
+            "poisson",
+            "theta_max_deg",
+            "mesh_size",
+            "imperfection_deg",
+            "locate_tolerance_deg",
+        )
+        for name in numbers:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError(f"{name} must be a number (got {value!r})")
