@@ -6,6 +6,7 @@ Every invalid input must raise an ordinary Python exception whose message names 
 never a pyo3 PanicException (a BaseException that would escape ``except Exception``).
 """
 
+import itertools
 import threading
 import time
 
@@ -31,7 +32,7 @@ def solve_static(model, *, record_fields=True, progress=None, **options):
     """One static step of ``core.run``; `progress(i, t)` sees the i-th converged state."""
     hook = progress
     if callable(progress):
-        count = iter(range(1000))
+        count = itertools.count()
 
         def hook(step, name, t):
             return progress(next(count), t)

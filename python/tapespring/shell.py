@@ -22,6 +22,7 @@ Example
 
 from __future__ import annotations
 
+import itertools
 import sys
 from collections.abc import Callable
 from typing import Any, NamedTuple
@@ -221,7 +222,7 @@ def solve_static(
     hook = None
     if callable(progress):
         user = progress
-        count = iter(range(1 << 62))
+        count = itertools.count()
 
         def hook(_step: int, _name: str, t: float) -> bool | None:
             return user(next(count), t)

@@ -256,7 +256,7 @@ fn initial_record(system: &mut System, state: &State, stability: bool, fields: b
     Ok(StaticStep {
         lambda: state.t,
         iterations: 0,
-        residual: r.iter().map(|v| v * v).sum::<f64>().sqrt(),
+        residual: System::force_norm(&r, &system.free_weights()),
         energy: asm.energy,
         gravity_energy: asm.gravity_energy,
         reactions: asm.reactions(),

@@ -182,22 +182,8 @@ fn numbering(elements: &[ShellElement], dofs: &DofMap) -> Numbering {
             }
         }
     }
-    // The rotation block of every independent node: lever-arm terms of rigid bodies whose node
-    // carries no element of its own.
-    for i in 0..dofs.slots.len() {
-        if dofs.master[i].is_some() {
-            continue;
-        }
-        for dr in 3..6 {
-            let Slot::Free(row) = slot_of(i, dr) else { continue };
-            for dc in 3..6 {
-                match slot_of(i, dc) {
-                    Slot::Free(col) => cols_ff[col].push(row),
-                    Slot::Constrained(col) => cols_fc[col].push(row),
-                }
-            }
-        }
-    }
+    // (Every node with free DOFs owns an element's DOFs, its own or its tied nodes'; see
+    // `DofMap::try_with`: so the rotation blocks of the lever-arm terms are in the pattern.)
     let pattern_ff = Pattern::from_columns(dofs.n_free, cols_ff);
     let pattern_fc = Pattern::from_columns(dofs.n_free, cols_fc);
     let nnz_ff = pattern_ff.nnz();
@@ -448,6 +434,17 @@ impl System {
             .collect()
     }
 
+    /// Norm of a force vector at the free equations in the metric dual to [`Self::free_weights`]
+    /// (moments divided by `L_c`) [N]: the residual norm of the convergence tests.
+    #[must_use]
+    pub fn force_norm(f: &[f64], weights: &[f64]) -> f64 {
+        f.iter()
+            .zip(weights)
+            .map(|(v, w)| v * v / w)
+            .sum::<f64>()
+            .sqrt()
+    }
+
     /// Increment `(delta x, theta)` of independent node `i` for the free increments `dq` and the
     /// constrained increments `dc`.
     fn node_increment(&self, i: usize, dq: &[f64], dc: &[f64]) -> [Vector3<f64>; 2] {
@@ -634,7 +631,7 @@ impl System {
         let mut df_ext = vec![[0.0; 6]; n_nodes];
         // External forces applied at tied nodes (before condensation), for the lever terms.
         let mut f_ext_node = vec![Vector3::zeros(); n_nodes];
-        let mut apply = |node: usize, force: [f64; 6], rate: [f64; 6], f_ext_node: &mut Vec<Vector3<f64>>| {
+        let mut apply = |node: usize, force: [f64; 6], rate: [f64; 6]| {
             let owner = self.dofs.owner(node);
             for d in 0..6 {
                 f_ext[owner][d] += force[d];
@@ -657,7 +654,7 @@ impl System {
             let (mut force, mut rate) = ([0.0; 6], [0.0; 6]);
             force[load.dof.index()] = load.value * load.function.value(t);
             rate[load.dof.index()] = load.value * load.function.derivative(t, dir);
-            apply(load.node, force, rate, &mut f_ext_node);
+            apply(load.node, force, rate);
         }
         out.gravity_energy = 0.0;
         let mut body_terms = Vec::new();
@@ -669,7 +666,7 @@ impl System {
                 }
                 let force = [m * gt.x, m * gt.y, m * gt.z, 0.0, 0.0, 0.0];
                 let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
-                apply(n, force, rate, &mut f_ext_node);
+                apply(n, force, rate);
                 out.gravity_energy -= m * gt.dot(&state.x[n]);
             }
             for body in &self.bodies {

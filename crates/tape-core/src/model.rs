@@ -96,9 +96,6 @@ pub struct Constraint {
     pub active: bool,
 }
 
-/// The previous name of [`Constraint`].
-pub type Prescribed = Constraint;
-
 /// A nodal force or moment of fixed direction, `value * f(t)` while active.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -119,9 +116,6 @@ pub struct Load {
     #[serde(default = "yes")]
     pub active: bool,
 }
-
-/// The previous name of [`Load`].
-pub type NodalLoad = Load;
 
 /// Gravity: a uniform acceleration field `acceleration * f(t)` acting on all mass.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -146,12 +146,6 @@ impl TimeFunction {
             _ => self.value(t + dt) - self.value(t),
         }
     }
-
-    /// Whether `f` is affine in `t` everywhere (so that a linearisation in `t` is exact).
-    #[must_use]
-    pub fn is_affine(&self) -> bool {
-        matches!(self, Self::Linear | Self::Constant)
-    }
 }
 
 #[cfg(test)]

@@ -55,7 +55,10 @@ fn normalised_deflection(n: usize) -> Result<f64> {
     model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
     model.fix(&plane_y0, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
     model.fix(&plane_z0, &[Dof::Uz, Dof::Rx, Dof::Ry])?;
-    let a = common::nearest_node(&model.mesh, Vector3::new(l / 2.0, 0.0, r));
+    let a = model
+        .mesh
+        .nearest_node(&Vector3::new(l / 2.0, 0.0, r))
+        .expect("the mesh has nodes");
     model.add_load(a, Dof::Uz, -force / 4.0)?;
     let u = common::linear_displacements(&model)?;
     Ok(-u[a][2] / w_ref)

@@ -47,8 +47,14 @@ fn load_point_displacements(n: usize) -> Result<(f64, f64)> {
     model.fix(&plane_y0, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
     let hole_node = model.mesh.node_set("hole")?[0];
     model.fix(&[hole_node], &[Dof::Uz])?;
-    let a = common::nearest_node(&model.mesh, Vector3::new(r, 0.0, 0.0));
-    let b = common::nearest_node(&model.mesh, Vector3::new(0.0, r, 0.0));
+    let a = model
+        .mesh
+        .nearest_node(&Vector3::new(r, 0.0, 0.0))
+        .expect("the mesh has nodes");
+    let b = model
+        .mesh
+        .nearest_node(&Vector3::new(0.0, r, 0.0))
+        .expect("the mesh has nodes");
     model.add_load(a, Dof::Ux, force)?;
     model.add_load(b, Dof::Uy, -force)?;
     let u = common::linear_displacements(&model)?;

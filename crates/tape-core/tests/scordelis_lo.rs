@@ -60,7 +60,10 @@ fn roof(n: usize) -> Result<(Model, usize)> {
     for (node, a) in areas.iter().enumerate() {
         model.add_load(node, Dof::Uz, -q * a)?;
     }
-    let a = common::nearest_node(&model.mesh, Vector3::new(L / 2.0, R * phi.sin(), R * phi.cos()));
+    let a = model
+        .mesh
+        .nearest_node(&Vector3::new(L / 2.0, R * phi.sin(), R * phi.cos()))
+        .expect("the mesh has nodes");
     Ok((model, a))
 }
 

@@ -197,8 +197,14 @@ fn hemisphere_alternating_forces_follows_sze_within_2_percent() -> Result<()> {
     model.fix(&plane_y0, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
     let hole_node = model.mesh.node_set("hole")?[0];
     model.fix(&[hole_node], &[Dof::Uz])?;
-    let a = common::nearest_node(&model.mesh, Vector3::new(r, 0.0, 0.0));
-    let b = common::nearest_node(&model.mesh, Vector3::new(0.0, r, 0.0));
+    let a = model
+        .mesh
+        .nearest_node(&Vector3::new(r, 0.0, 0.0))
+        .expect("the mesh has nodes");
+    let b = model
+        .mesh
+        .nearest_node(&Vector3::new(0.0, r, 0.0))
+        .expect("the mesh has nodes");
     model.add_load(a, Dof::Ux, p_max / 2.0)?;
     model.add_load(b, Dof::Uy, -p_max / 2.0)?;
     let mut system = System::try_new(&model)?;
@@ -266,9 +272,18 @@ fn open_cylinder_pull_out_follows_sze_within_2_percent_away_from_the_snap() -> R
     model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
     model.fix(&plane_y0, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
     model.fix(&plane_z0, &[Dof::Uz, Dof::Rx, Dof::Ry])?;
-    let a = common::nearest_node(&model.mesh, Vector3::new(l / 2.0, 0.0, r));
-    let b = common::nearest_node(&model.mesh, Vector3::new(l / 2.0, r, 0.0));
-    let c = common::nearest_node(&model.mesh, Vector3::new(0.0, r, 0.0));
+    let a = model
+        .mesh
+        .nearest_node(&Vector3::new(l / 2.0, 0.0, r))
+        .expect("the mesh has nodes");
+    let b = model
+        .mesh
+        .nearest_node(&Vector3::new(l / 2.0, r, 0.0))
+        .expect("the mesh has nodes");
+    let c = model
+        .mesh
+        .nearest_node(&Vector3::new(0.0, r, 0.0))
+        .expect("the mesh has nodes");
     model.add_load(a, Dof::Uz, p_max / 4.0)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
@@ -371,7 +386,10 @@ fn hinged_roof_snaps_through_along_sze_curve() -> Result<()> {
     model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
     model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
     model.fix(&hinged, &Dof::TRANSLATIONS)?;
-    let c = common::nearest_node(&model.mesh, Vector3::new(half_length, 0.0, r));
+    let c = model
+        .mesh
+        .nearest_node(&Vector3::new(half_length, 0.0, r))
+        .expect("the mesh has nodes");
     model.add_load(c, Dof::Uz, -p_max / 4.0)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();

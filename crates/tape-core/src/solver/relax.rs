@@ -32,9 +32,8 @@ const NEUTRAL: f64 = 100.0 * f64::EPSILON;
 pub(super) struct Switch {
     /// The last stable state located before the bifurcation, recorded with its event.
     pub critical: Option<(State, StaticStep)>,
-    /// The stable state reached on the chosen branch (the driver's state on return).
-    pub stable: State,
-    /// Its potential energy [J].
+    /// Potential energy of the stable state reached on the chosen branch (the driver's state on
+    /// return) [J].
     pub energy: f64,
 }
 
@@ -177,14 +176,10 @@ impl Driver<'_> {
             f.step.event = Some(Event::Bifurcation);
             (f.state, f.step)
         });
-        *state = switched.clone();
+        *state = switched;
         self.invalidate();
         self.assemble(state);
-        Ok(Some(Switch {
-            critical,
-            stable: switched,
-            energy,
-        }))
+        Ok(Some(Switch { critical, energy }))
     }
 
     /// The eigenvector of the tangent's eigenvalue nearest zero at `at` (inverse iteration with
@@ -229,7 +224,7 @@ impl Driver<'_> {
     ///
     /// # Errors
     /// No factorisation, or a failed solve.
-    pub fn negative_eigenvalues(&mut self) -> Result<usize> {
+    fn negative_eigenvalues(&mut self) -> Result<usize> {
         self.factorise()?;
         let count = self.system.linear.negative_eigenvalues()?;
         if count != 1 {

@@ -148,11 +148,7 @@ impl Driver<'_> {
     }
 
     pub fn force_norm(&self, f: &[f64]) -> f64 {
-        f.iter()
-            .zip(&self.weights)
-            .map(|(v, w)| v * v / w)
-            .sum::<f64>()
-            .sqrt()
+        System::force_norm(f, &self.weights)
     }
 
     fn reaction_norm(&self) -> f64 {
@@ -563,14 +559,53 @@ struct PathState {
     restart: Option<f64>,
 }
 
+/// What the driver does after a stage of an increment.
+enum Flow {
+    /// Propose the next increment.
+    Next,
+    /// The path ends (completed, failed or cancelled: see the path).
+    Stop,
+}
+
+/// A state reached by relaxation rather than along the path: a jump past a limit point, a branch
+/// switch at a bifurcation, or a relaxation past a neutral mode.
+struct Relaxed {
+    /// How far from the last recorded state, for the arc position.
+    distance: f64,
+    /// Reached by a snap.
+    jump: bool,
+    /// What it marks.
+    event: Option<Event>,
+}
+
+/// One static path being followed: the driver, its bookkeeping and what is recorded.
+struct Walk<'a, 'b> {
+    s: Driver<'a>,
+    p: PathState,
+    path: StaticPath,
+    progress: &'b mut dyn FnMut(&StaticStep, &Stats) -> bool,
+    lambda_end: Option<f64>,
+    arc_control: bool,
+    /// Events are located (limit points or extrema of the monitor).
+    locate: bool,
+    /// Index of the monitored reaction among the constrained DOFs.
+    monitor: Option<usize>,
+    /// Load-factor scale of round-off.
+    scale: f64,
+}
+
 /// Follows the static equilibrium path of `system` from `state` as `params` says, calling
 /// `progress` after each converged step (return `false` to stop). `state` ends at the last
 /// converged configuration.
 ///
+/// Each increment is proposed (`Walk::propose`), attempted (`Driver::increment`), then rejected
+/// (`Walk::reject`), or accepted (`Walk::accept`) unless it reaches a limit point to jump from
+/// (`Walk::jump_at_limit`), a bifurcation to leave (`Walk::switch_at_bifurcation`), or the final
+/// load factor to land on (`Walk::land`).
+///
 /// # Errors
 /// Invalid parameters or a model with nothing to solve are returned at once; failures during the
 /// analysis are reported in [`StaticPath::error`] with the converged steps kept.
-#[allow(clippy::too_many_lines)]
 pub fn solve_static(
     system: &mut System,
     state: &mut State,
@@ -579,163 +614,212 @@ pub fn solve_static(
 ) -> Result<StaticPath> {
     params.validate()?;
     let start = Instant::now();
-    let arc_control = matches!(params.control, Control::ArcLength { .. });
-    let lambda_end = match &params.control {
-        Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => Some(*lambda_end),
-        Control::Displacement { .. } => None,
-    };
-    system.time_direction = match (lambda_end, &params.control) {
-        (Some(end), Control::ArcLength { direction, .. }) if end == state.t => *direction,
-        (Some(end), _) if end < state.t => -1.0,
-        _ => 1.0,
-    };
-    let rates = system.constrained_rates(state.t);
-    let has_motion = rates.iter().any(|v| *v != 0.0) || system.dofs.constrained.iter().any(|c| c.value != 0.0);
-    let has_load = system.loads.iter().any(|l| l.value != 0.0)
-        || system
-            .gravity
-            .as_ref()
-            .is_some_and(|(g, _)| *g != nalgebra::Vector3::zeros() && system.total_mass() > 0.0);
-    if !has_load && !has_motion {
-        return Err(Error::InvalidModel(
-            "the analysis has no load and no prescribed motion".into(),
-        ));
-    }
-    if system.dofs.constrained.is_empty() {
-        return Err(Error::InvalidModel(
-            "the model has no constraint against rigid-body motion".into(),
-        ));
-    }
-    let lc2 = system.char_length.powi(2);
-    let c_lambda: f64 = system
-        .dofs
-        .constrained
-        .iter()
-        .zip(&rates)
-        .map(|(c, v)| if c.dof.is_rotation() { lc2 * v * v } else { v * v })
-        .sum();
-    let weights = system.free_weights();
-    let membrane = system.membrane_stiffness();
-    let force_floor = 1e-13 * membrane * system.char_length;
-    // Element forces are sums of terms of size E t |x| that cancel: the residual cannot go below a
-    // few ulps of them (measured: about eps E t |x| per node).
-    let x_max = system
-        .reference
-        .x
-        .iter()
-        .map(|x| x.norm())
-        .fold(0.0, f64::max);
-    // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
-    #[allow(clippy::cast_precision_loss)]
-    let round_off = f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
     let linear_counts = (system.linear.refinement_sweeps, system.linear.lu_fallbacks);
-    let mut s = Driver {
-        system,
-        asm: Assembled::default(),
-        r: Vec::new(),
-        fresh: false,
-        factorised: false,
-        stress: Vec::new(),
-        stress_valid: false,
-        conv: Convergence {
-            tol_force: params.newton.tol_force,
-            tol_energy: params.newton.tol_energy,
-            round_off,
-        },
-        force_floor,
-        strict_turns: true,
-        tangent_predictor: true,
-        previous: None,
-        weights,
-        rates,
-        c_lambda,
-        params,
-        stats: Stats::default(),
-    };
-    let mut path = StaticPath::default();
+    let mut w = Walk::new(system, state, params, progress)?;
+    while w.p.steps_left > 0 {
+        let Some(inc) = w.propose(state)? else { break };
+        let saved = state.clone();
+        let out = match w.s.increment(state, &inc) {
+            Ok(out) => out,
+            Err(rejection) => match w.reject(state, saved, &rejection) {
+                Flow::Next => continue,
+                Flow::Stop => break,
+            },
+        };
+        let flow = match w.jump_at_limit(state, &saved) {
+            Some(flow) => flow,
+            None => match w.switch_at_bifurcation(state, &saved) {
+                Some(flow) => flow,
+                None => match w.land(state, saved.clone()) {
+                    Some(flow) => flow,
+                    None => w.accept(state, &saved, out),
+                },
+            },
+        };
+        if let Flow::Stop = flow {
+            break;
+        }
+    }
+    w.finish(state, start, linear_counts)
+}
 
-    // Smallest increment worth trying: below it, the increment is lost in the load factor's or
-    // the controlled DOF's round-off.
-    let scale = state.t.abs().max(lambda_end.map_or(0.0, f64::abs)).max(1.0);
-    let (size, steps_left, max_size) = match &params.control {
-        Control::Load { lambda_end, increments } => {
-            #[allow(clippy::cast_precision_loss)]
-            let size = (lambda_end - state.t) / *increments as f64;
-            (size, usize::MAX, size.abs())
+impl<'a, 'b> Walk<'a, 'b> {
+    /// Checks that the model has something to solve, and sets the driver and the step control up.
+    #[allow(clippy::too_many_lines)]
+    fn new(
+        system: &'a mut System,
+        state: &State,
+        params: &'a StaticParams,
+        progress: &'b mut dyn FnMut(&StaticStep, &Stats) -> bool,
+    ) -> Result<Self> {
+        let arc_control = matches!(params.control, Control::ArcLength { .. });
+        let lambda_end = match &params.control {
+            Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => Some(*lambda_end),
+            Control::Displacement { .. } => None,
+        };
+        system.time_direction = match (lambda_end, &params.control) {
+            (Some(end), Control::ArcLength { direction, .. }) if end == state.t => *direction,
+            (Some(end), _) if end < state.t => -1.0,
+            _ => 1.0,
+        };
+        let rates = system.constrained_rates(state.t);
+        let has_motion = rates.iter().any(|v| *v != 0.0) || system.dofs.constrained.iter().any(|c| c.value != 0.0);
+        let has_load = system.loads.iter().any(|l| l.value != 0.0)
+            || system
+                .gravity
+                .as_ref()
+                .is_some_and(|(g, _)| *g != nalgebra::Vector3::zeros() && system.total_mass() > 0.0);
+        if !has_load && !has_motion {
+            return Err(Error::InvalidModel(
+                "the analysis has no load and no prescribed motion".into(),
+            ));
         }
-        Control::Displacement {
-            node,
-            dof,
-            delta,
-            increments,
-        } => {
-            let node = *node;
-            if node >= s.system.dofs.slots.len() {
-                return Err(Error::InvalidModel(format!("controlled node {node} does not exist")));
-            }
-            if s.system.dofs.master[node].is_some() {
-                return Err(Error::InvalidModel(format!(
-                    "controlled node {node} is rigidly tied; control its reference node"
-                )));
-            }
-            let Slot::Free(_) = s.system.dofs.slots[node][dof.index()] else {
-                return Err(Error::InvalidModel(format!(
-                    "controlled DOF {} of node {node} is not free",
-                    dof.name()
-                )));
-            };
-            #[allow(clippy::cast_precision_loss)]
-            let size = delta / *increments as f64;
-            (size, usize::MAX, size.abs())
+        if system.dofs.constrained.is_empty() {
+            return Err(Error::InvalidModel(
+                "the model has no constraint against rigid-body motion".into(),
+            ));
         }
-        Control::ArcLength {
-            initial_increment,
-            direction,
-            max_steps,
-            ..
-        } => (initial_increment * direction, *max_steps, f64::INFINITY),
-    };
-    let min_size = match &params.control {
-        Control::Displacement { delta, .. } => 1e-14 * delta.abs(),
-        _ => 1e-14 * scale,
-    };
-    let mut p = PathState {
-        control: StepController::new(size, max_size, min_size, params.target_iterations, params.max_cutbacks),
-        last_dlambda: None,
-        steps_left,
-        arc_ds: None,
-        travelled: 0.0,
-        arc: 0.0,
-        history: Vec::new(),
-        last_negative: None,
-        restart: None,
-    };
-    let locate = arc_control && (params.locate_limit_points || params.monitor.is_some());
-    let monitor = s.monitor_index();
-    if let (Some(m), None) = (params.monitor, monitor) {
-        return Err(Error::InvalidModel(format!(
-            "the monitored reaction ({} of node {}) is not a constrained DOF",
-            m.dof.name(),
-            m.node
-        )));
+        let lc2 = system.char_length.powi(2);
+        let c_lambda: f64 = system
+            .dofs
+            .constrained
+            .iter()
+            .zip(&rates)
+            .map(|(c, v)| if c.dof.is_rotation() { lc2 * v * v } else { v * v })
+            .sum();
+        let weights = system.free_weights();
+        let membrane = system.membrane_stiffness();
+        let force_floor = 1e-13 * membrane * system.char_length;
+        // Element forces are sums of terms of size E t |x| that cancel: the residual cannot go
+        // below a few ulps of them (measured: about eps E t |x| per node).
+        let x_max = system
+            .reference
+            .x
+            .iter()
+            .map(|x| x.norm())
+            .fold(0.0, f64::max);
+        // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
+        #[allow(clippy::cast_precision_loss)]
+        let round_off =
+            f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
+        // Smallest increment worth trying: below it, the increment is lost in the load factor's
+        // or the controlled DOF's round-off.
+        let scale = state.t.abs().max(lambda_end.map_or(0.0, f64::abs)).max(1.0);
+        let (size, steps_left, max_size) = match &params.control {
+            Control::Load { lambda_end, increments } => {
+                #[allow(clippy::cast_precision_loss)]
+                let size = (lambda_end - state.t) / *increments as f64;
+                (size, usize::MAX, size.abs())
+            }
+            Control::Displacement {
+                node,
+                dof,
+                delta,
+                increments,
+            } => {
+                let node = *node;
+                if node >= system.dofs.slots.len() {
+                    return Err(Error::InvalidModel(format!("controlled node {node} does not exist")));
+                }
+                if system.dofs.master[node].is_some() {
+                    return Err(Error::InvalidModel(format!(
+                        "controlled node {node} is rigidly tied; control its reference node"
+                    )));
+                }
+                let Slot::Free(_) = system.dofs.slots[node][dof.index()] else {
+                    return Err(Error::InvalidModel(format!(
+                        "controlled DOF {} of node {node} is not free",
+                        dof.name()
+                    )));
+                };
+                #[allow(clippy::cast_precision_loss)]
+                let size = delta / *increments as f64;
+                (size, usize::MAX, size.abs())
+            }
+            Control::ArcLength {
+                initial_increment,
+                direction,
+                max_steps,
+                ..
+            } => (initial_increment * direction, *max_steps, f64::INFINITY),
+        };
+        let min_size = match &params.control {
+            Control::Displacement { delta, .. } => 1e-14 * delta.abs(),
+            _ => 1e-14 * scale,
+        };
+        let s = Driver {
+            system,
+            asm: Assembled::default(),
+            r: Vec::new(),
+            fresh: false,
+            factorised: false,
+            stress: Vec::new(),
+            stress_valid: false,
+            conv: Convergence {
+                tol_force: params.newton.tol_force,
+                tol_energy: params.newton.tol_energy,
+                round_off,
+            },
+            force_floor,
+            strict_turns: true,
+            tangent_predictor: true,
+            previous: None,
+            weights,
+            rates,
+            c_lambda,
+            params,
+            stats: Stats::default(),
+        };
+        let monitor = s.monitor_index();
+        if let (Some(m), None) = (params.monitor, monitor) {
+            return Err(Error::InvalidModel(format!(
+                "the monitored reaction ({} of node {}) is not a constrained DOF",
+                m.dof.name(),
+                m.node
+            )));
+        }
+        let mut w = Self {
+            s,
+            p: PathState {
+                control: StepController::new(size, max_size, min_size, params.target_iterations, params.max_cutbacks),
+                last_dlambda: None,
+                steps_left,
+                arc_ds: None,
+                travelled: 0.0,
+                arc: 0.0,
+                history: Vec::new(),
+                last_negative: None,
+                restart: None,
+            },
+            path: StaticPath::default(),
+            progress,
+            lambda_end,
+            arc_control,
+            locate: arc_control && (params.locate_limit_points || params.monitor.is_some()),
+            monitor,
+            scale,
+        };
+        if w.locate {
+            // The start of the path is the first point of the location history (the assembly is
+            // the one the first increment needs anyway).
+            w.s.assemble(state);
+            w.push_history(state);
+        }
+        Ok(w)
     }
-    if locate {
-        // The start of the path is the first point of the location history (the assembly is the
-        // one the first increment needs anyway).
-        s.assemble(state);
-        let reactions = s.asm.reactions();
-        p.history.push(Point {
-            state: state.clone(),
-            arc: 0.0,
-            monitor: monitor.map_or(0.0, |i| reactions[i]),
-        });
-    }
-    'steps: while p.steps_left > 0 {
-        // Propose.
-        if let (Some(end), false) = (lambda_end, arc_control) {
+
+    /// The next increment; `None` once the path is at its end (or the first arc-length step
+    /// could not be sized, an error recorded on the path).
+    ///
+    /// # Errors
+    /// Arc-length control on a model whose loads and motions do not act on the free DOFs.
+    fn propose(&mut self, state: &mut State) -> Result<Option<Increment>> {
+        let (s, p) = (&mut self.s, &mut self.p);
+        let params = s.params;
+        if let (Some(end), false) = (self.lambda_end, self.arc_control) {
             let remaining = end - state.t;
             if remaining.abs() <= 1e-12 * end.abs().max(1.0) {
-                break;
+                return Ok(None);
             }
             if p.control.size.abs() > remaining.abs() {
                 p.control.size = remaining;
@@ -744,17 +828,17 @@ pub fn solve_static(
         if let Control::Displacement { delta, .. } = &params.control {
             let remaining = delta - p.travelled;
             if remaining.abs() <= 1e-12 * delta.abs() {
-                break;
+                return Ok(None);
             }
             if p.control.size.abs() > remaining.abs() {
                 p.control.size = remaining;
             }
         }
-        let inc = match &params.control {
+        Ok(Some(match &params.control {
             Control::Load { .. } => Increment::Load(p.control.size),
             Control::Displacement { node, dof, .. } => {
                 let Slot::Free(eq) = s.system.dofs.slots[*node][dof.index()] else {
-                    unreachable!("checked above")
+                    unreachable!("checked by Walk::new")
                 };
                 Increment::Displacement {
                     eq,
@@ -776,8 +860,8 @@ pub fn solve_static(
                     let dq_b = match s.solve_pair() {
                         Ok((_, b)) => b,
                         Err(e) => {
-                            path.error = Some(e);
-                            break 'steps;
+                            self.path.error = Some(e);
+                            return Ok(None);
                         }
                     };
                     let ds = initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt();
@@ -790,7 +874,7 @@ pub fn solve_static(
                     p.arc_ds = Some(ds);
                     p.control.size = ds;
                     p.control.max_size = ds * max_increment_factor;
-                    p.control.min_size = 1e-14 * ds / initial_increment * scale;
+                    p.control.min_size = 1e-14 * ds / initial_increment * self.scale;
                 }
                 // Without a previous increment (first step, or after a jump) head for lambda_end.
                 let towards = (lambda_end - state.t).signum();
@@ -806,349 +890,336 @@ pub fn solve_static(
                     },
                 }
             }
-        };
-        // Attempt.
-        let saved = state.clone();
-        let outcome = s.increment(state, &inc);
-        let out = match outcome {
-            Ok(out) => out,
-            Err(rejection) => {
-                // Reject.
-                *state = saved;
-                s.invalidate();
-                s.stats.cutbacks += 1;
-                log::debug!("increment rejected at t = {}: {rejection}; cutting back", state.t);
-                if let Err(why) = p.control.reject() {
-                    // On the stable path of a slowly driven test, a state whose tangent does not
-                    // define the path (a neutral mode: a fold free to slide) can still be left by
-                    // relaxing at a larger load factor.
-                    let relaxed = match (params.jump_at_limit_points && arc_control, lambda_end, p.arc_ds) {
-                        (true, Some(end), Some(ds)) => {
-                            let from = state.clone();
-                            let travel = (end - from.t).signum();
-                            match s.jump(state, &from, travel, p.last_dlambda, ds) {
-                                Ok(()) => true,
-                                Err(e) => {
-                                    log::debug!("no relaxation past t = {}: {e}", from.t);
-                                    *state = from;
-                                    false
-                                }
-                            }
-                        }
-                        _ => false,
-                    };
-                    if !relaxed {
-                        path.error = Some(give_up(&p, why, &rejection, state, params));
-                        break;
-                    }
-                    let relaxed = Relaxed {
-                        distance: p.arc_ds.unwrap_or(0.0),
-                        jump: false,
-                        event: None,
-                    };
-                    if !push_relaxed(
-                        &mut s,
-                        &mut p,
-                        &mut path,
-                        state,
-                        relaxed,
-                        progress,
-                        locate.then_some(monitor),
-                    ) {
-                        break;
-                    }
-                    p.control.size = p.arc_ds.unwrap_or(p.control.size);
-                    continue;
-                }
-                s.strict_turns = p.control.cutbacks < params.max_cutbacks / 2;
-                s.tangent_predictor = false;
-                // A restarting load increment that fails (the branch ends in a snap): back to the
-                // arc length, which turns at the limit.
-                p.restart = None;
-                continue;
-            }
-        };
-        // A limit point of the load factor: jump to the stable equilibrium beyond it.
-        if let (true, Some(end)) = (params.jump_at_limit_points && arc_control, lambda_end) {
-            let travel = (end - saved.t).signum();
-            let turned = state.clone();
-            let jumped = (state.t - saved.t) * travel < 0.0
-                && p.last_dlambda.is_some()
-                && match s.jump(state, &saved, travel, p.last_dlambda, p.control.size.abs()) {
-                    Ok(()) => true,
-                    Err(e) => {
-                        // No stable equilibrium beyond this limit point (a neutral mode, such as
-                        // a fold free to slide, makes the gradient flow stall): the path itself is
-                        // followed through it, its states recorded with their stability.
-                        log::debug!("no jump at t = {}: {e}; following the path", saved.t);
-                        *state = turned;
-                        s.invalidate();
-                        s.assemble(state);
-                        false
-                    }
-                };
-            if jumped {
-                let relaxed = Relaxed {
-                    distance: s.distance(state, &saved),
-                    jump: true,
-                    event: None,
-                };
-                if !push_relaxed(
-                    &mut s,
-                    &mut p,
-                    &mut path,
-                    state,
-                    relaxed,
-                    progress,
-                    locate.then_some(monitor),
-                ) {
-                    break 'steps;
-                }
-                continue 'steps;
-            }
-        }
-        // A bifurcation on the stable path: the tangent lost its positive definiteness while the
-        // load factor kept going. Switch to the stable branch leaving it.
-        let forward = lambda_end.is_some_and(|end| (state.t - saved.t) * (end - saved.t) > 0.0);
-        if params.switch_branches && arc_control && forward && p.last_negative == Some(0) {
-            let unstable = match s
-                .factorise()
-                .and_then(|()| s.system.linear.negative_eigenvalues())
-            {
-                Ok(n) => n > 0,
-                Err(e) => {
-                    path.error = Some(e);
-                    break 'steps;
-                }
-            };
-            if unstable {
-                let reached = state.clone();
-                let ds = p.control.size.abs();
-                match s.switch_branch(state, &saved, &reached, ds) {
-                    Ok(Some(switch)) => {
-                        if let Some((critical, mut step)) = switch.critical {
-                            step.arc = p.arc + s.distance(&critical, &saved);
-                            p.arc = step.arc;
-                            s.stats.steps += 1;
-                            path.steps.push(step);
-                        }
-                        log::debug!(
-                            "branch switch at t = {}: potential energy {:.6e} J",
-                            state.t,
-                            switch.energy
-                        );
-                        // A branch that leaves the bifurcation continuously is reached nearby; a
-                        // far one was reached by a snap.
-                        let relaxed = Relaxed {
-                            distance: s.distance(state, &saved),
-                            jump: s.distance(&switch.stable, &reached) > 0.5 * ds,
-                            event: Some(Event::BranchSwitch),
-                        };
-                        if !push_relaxed(
-                            &mut s,
-                            &mut p,
-                            &mut path,
-                            state,
-                            relaxed,
-                            progress,
-                            locate.then_some(monitor),
-                        ) {
-                            break 'steps;
-                        }
-                        continue 'steps;
-                    }
-                    Ok(None) => {
-                        // A round-off pivot: keep the converged state (its pieces, changed by the
-                        // trial relaxations, are assembled again).
-                        *state = reached;
-                        s.assemble(state);
-                    }
-                    Err(e) => {
-                        // No stable branch found: the path itself is followed, its states
-                        // recorded with their stability.
-                        log::debug!("no branch switch at t = {}: {e}; following the path", reached.t);
-                        *state = reached;
-                        s.invalidate();
-                        s.assemble(state);
-                    }
-                }
-            }
-        }
-        // Arc-length: do not overshoot the final load factor; finish with a load step.
-        if let (true, Some(end)) = (arc_control, lambda_end) {
-            let start_l = saved.t;
-            let crossed = (start_l - end) * (state.t - end) < 0.0 && p.last_dlambda.is_some();
-            if crossed {
-                let mut trial = saved.clone();
-                s.invalidate();
-                if let Ok(o2) = s.increment(&mut trial, &Increment::Load(end - start_l)) {
-                    *state = trial;
-                    let mut step = match s.record(state, &o2) {
-                        Ok(st) => st,
+        }))
+    }
+
+    /// A failed increment: back to the converged `saved` state with half the increment; once the
+    /// halvings run out, on the stable path of a slowly driven test, a relaxation at a larger load
+    /// factor, else the end of the path.
+    fn reject(&mut self, state: &mut State, saved: State, rejection: &Rejection) -> Flow {
+        *state = saved;
+        self.s.invalidate();
+        self.s.stats.cutbacks += 1;
+        log::debug!("increment rejected at t = {}: {rejection}; cutting back", state.t);
+        let params = self.s.params;
+        if let Err(why) = self.p.control.reject() {
+            // On the stable path of a slowly driven test, a state whose tangent does not define
+            // the path (a neutral mode: a fold free to slide) can still be left by relaxing at a
+            // larger load factor.
+            let relaxed = match (
+                params.jump_at_limit_points && self.arc_control,
+                self.lambda_end,
+                self.p.arc_ds,
+            ) {
+                (true, Some(end), Some(ds)) => {
+                    let from = state.clone();
+                    let travel = (end - from.t).signum();
+                    match self.s.jump(state, &from, travel, self.p.last_dlambda, ds) {
+                        Ok(()) => true,
                         Err(e) => {
-                            path.error = Some(e);
-                            break;
-                        }
-                    };
-                    p.arc += s.arc_norm(&o2.dq, o2.dlambda);
-                    step.arc = p.arc;
-                    s.stats.steps += 1;
-                    let _ = progress(&step, &s.stats);
-                    let monitored = monitor.map_or(0.0, |i| step.reactions[i]);
-                    path.steps.push(step);
-                    if locate {
-                        p.history.push(Point {
-                            state: state.clone(),
-                            arc: p.arc,
-                            monitor: monitored,
-                        });
-                        if let Err(e) = after_step(&mut s, &p.history, &mut path) {
-                            path.error = Some(e);
+                            log::debug!("no relaxation past t = {}: {e}", from.t);
+                            *state = from;
+                            false
                         }
                     }
-                    break;
                 }
-                // The final load step failed: retry the crossing with a shorter arc.
-                *state = saved;
-                s.invalidate();
-                s.stats.cutbacks += 1;
-                if let Err(why) = p.control.reject() {
-                    path.error = Some(give_up(&p, why, &Rejection::Landing, state, params));
-                    break;
-                }
-                continue 'steps;
+                _ => false,
+            };
+            if !relaxed {
+                self.path.error = Some(give_up(&self.p, why, rejection, state, params));
+                return Flow::Stop;
+            }
+            let relaxed = Relaxed {
+                distance: self.p.arc_ds.unwrap_or(0.0),
+                jump: false,
+                event: None,
+            };
+            if !self.push_relaxed(state, relaxed) {
+                return Flow::Stop;
+            }
+            self.p.control.size = self.p.arc_ds.unwrap_or(self.p.control.size);
+            return Flow::Next;
+        }
+        self.s.strict_turns = self.p.control.cutbacks < params.max_cutbacks / 2;
+        self.s.tangent_predictor = false;
+        // A restarting load increment that fails (the branch ends in a snap): back to the arc
+        // length, which turns at the limit.
+        self.p.restart = None;
+        Flow::Next
+    }
+
+    /// A converged arc-length increment that went back in load factor, on the path of a slowly
+    /// driven test: jump to the stable equilibrium beyond the limit point. `None` if there is
+    /// nothing to jump from (or no stable equilibrium: the path is then followed through it).
+    fn jump_at_limit(&mut self, state: &mut State, saved: &State) -> Option<Flow> {
+        let (true, Some(end)) = (self.s.params.jump_at_limit_points && self.arc_control, self.lambda_end) else {
+            return None;
+        };
+        let travel = (end - saved.t).signum();
+        if (state.t - saved.t) * travel >= 0.0 || self.p.last_dlambda.is_none() {
+            return None;
+        }
+        let turned = state.clone();
+        if let Err(e) = self
+            .s
+            .jump(state, saved, travel, self.p.last_dlambda, self.p.control.size.abs())
+        {
+            // No stable equilibrium beyond this limit point (a neutral mode, such as a fold free to
+            // slide, makes the gradient flow stall): the path itself is followed through it, its
+            // states recorded with their stability.
+            log::debug!("no jump at t = {}: {e}; following the path", saved.t);
+            *state = turned;
+            self.s.invalidate();
+            self.s.assemble(state);
+            return None;
+        }
+        let relaxed = Relaxed {
+            distance: self.s.distance(state, saved),
+            jump: true,
+            event: None,
+        };
+        Some(if self.push_relaxed(state, relaxed) {
+            Flow::Next
+        } else {
+            Flow::Stop
+        })
+    }
+
+    /// A converged increment that went on in load factor from a stable state to an unstable one
+    /// (a bifurcation), when branches are switched: leave it for the stable branch. `None` if it
+    /// is not the case, or the instability is not one the state leaves (the path goes on).
+    fn switch_at_bifurcation(&mut self, state: &mut State, saved: &State) -> Option<Flow> {
+        let forward = self
+            .lambda_end
+            .is_some_and(|end| (state.t - saved.t) * (end - saved.t) > 0.0);
+        if !(self.s.params.switch_branches && self.arc_control && forward && self.p.last_negative == Some(0)) {
+            return None;
+        }
+        match self
+            .s
+            .factorise()
+            .and_then(|()| self.s.system.linear.negative_eigenvalues())
+        {
+            Ok(0) => return None,
+            Ok(_) => {}
+            Err(e) => {
+                self.path.error = Some(e);
+                return Some(Flow::Stop);
             }
         }
-        // Accept.
-        p.restart = None;
-        s.strict_turns = true;
-        s.tangent_predictor = true;
-        let mut step = match s.record(state, &out) {
+        let reached = state.clone();
+        let ds = self.p.control.size.abs();
+        let switch = match self.s.switch_branch(state, saved, &reached, ds) {
+            Ok(Some(switch)) => switch,
+            Ok(None) => {
+                // A round-off pivot: keep the converged state (its pieces, changed by the trial
+                // relaxations, are assembled again).
+                *state = reached;
+                self.s.assemble(state);
+                return None;
+            }
+            Err(e) => {
+                // No stable branch found: the path itself is followed, its states recorded with
+                // their stability.
+                log::debug!("no branch switch at t = {}: {e}; following the path", reached.t);
+                *state = reached;
+                self.s.invalidate();
+                self.s.assemble(state);
+                return None;
+            }
+        };
+        // Arc positions run from the last converged state, through the located bifurcation, to
+        // the state on the new branch.
+        let mut from = saved;
+        if let Some((critical, step)) = &switch.critical {
+            let mut step = step.clone();
+            step.arc = self.p.arc + self.s.distance(critical, saved);
+            self.p.arc = step.arc;
+            self.s.stats.steps += 1;
+            self.path.steps.push(step);
+            from = critical;
+        }
+        log::debug!(
+            "branch switch at t = {}: potential energy {:.6e} J",
+            state.t,
+            switch.energy
+        );
+        // A branch that leaves the bifurcation continuously is reached nearby; a far one was
+        // reached by a snap.
+        let relaxed = Relaxed {
+            distance: self.s.distance(state, from),
+            jump: self.s.distance(state, &reached) > 0.5 * ds,
+            event: Some(Event::BranchSwitch),
+        };
+        Some(if self.push_relaxed(state, relaxed) {
+            Flow::Next
+        } else {
+            Flow::Stop
+        })
+    }
+
+    /// A converged arc-length increment that crossed the final load factor: the path ends with a
+    /// load increment onto it from `saved` (or, if that fails, the crossing is retried shorter).
+    /// `None` if it did not cross.
+    fn land(&mut self, state: &mut State, saved: State) -> Option<Flow> {
+        let (true, Some(end)) = (self.arc_control, self.lambda_end) else {
+            return None;
+        };
+        let start = saved.t;
+        if (start - end) * (state.t - end) >= 0.0 || self.p.last_dlambda.is_none() {
+            return None;
+        }
+        let mut trial = saved.clone();
+        self.s.invalidate();
+        if let Ok(out) = self.s.increment(&mut trial, &Increment::Load(end - start)) {
+            *state = trial;
+            // The path ends here, whatever the progress callback says.
+            let _ = self.record_step(state, &out);
+            return Some(Flow::Stop);
+        }
+        // The final load step failed: retry the crossing with a shorter arc.
+        *state = saved;
+        self.s.invalidate();
+        self.s.stats.cutbacks += 1;
+        if let Err(why) = self.p.control.reject() {
+            self.path.error = Some(give_up(&self.p, why, &Rejection::Landing, state, self.s.params));
+            return Some(Flow::Stop);
+        }
+        Some(Flow::Next)
+    }
+
+    /// A converged increment along the path: record it, adapt the next increment.
+    fn accept(&mut self, state: &State, saved: &State, out: Outcome) -> Flow {
+        self.p.restart = None;
+        self.s.strict_turns = true;
+        self.s.tangent_predictor = true;
+        let Some(keep_going) = self.record_step(state, &out) else {
+            return Flow::Stop;
+        };
+        // Adapt the increment to the Newton effort.
+        self.p.control.accept(out.iterations);
+        if let (true, Some(end)) = (self.arc_control, self.lambda_end) {
+            let reached = (state.t - end) * (saved.t - end) <= 0.0;
+            if reached && self.p.last_dlambda.is_some() {
+                return Flow::Stop;
+            }
+        }
+        self.p.last_dlambda = Some(out.dlambda);
+        self.s.previous = Some((out.dq, out.dlambda));
+        if !keep_going {
+            self.path.cancelled = true;
+            return Flow::Stop;
+        }
+        self.p.steps_left = self.p.steps_left.saturating_sub(1);
+        Flow::Next
+    }
+
+    /// Records the converged `state` reached by the increment `out` (and what is located or
+    /// refined after it); `Some(keep_going)` as the progress callback says, `None` on an error
+    /// (recorded on the path).
+    fn record_step(&mut self, state: &State, out: &Outcome) -> Option<bool> {
+        let mut step = match self.s.record(state, out) {
             Ok(st) => st,
             Err(e) => {
-                path.error = Some(e);
-                break;
+                self.path.error = Some(e);
+                return None;
             }
         };
-        p.arc += s.arc_norm(&out.dq, out.dlambda);
-        step.arc = p.arc;
-        s.stats.steps += 1;
-        let keep_going = progress(&step, &s.stats);
-        p.last_negative = step.negative_eigenvalues;
-        path.steps.push(step);
-        if let Control::Displacement { .. } = &params.control {
-            p.travelled += p.control.size;
+        self.p.arc += self.s.arc_norm(&out.dq, out.dlambda);
+        step.arc = self.p.arc;
+        self.s.stats.steps += 1;
+        let keep_going = (self.progress)(&step, &self.s.stats);
+        self.p.last_negative = step.negative_eigenvalues;
+        self.path.steps.push(step);
+        if let Control::Displacement { .. } = &self.s.params.control {
+            self.p.travelled += self.p.control.size;
         }
-        if locate {
-            let monitor = monitor.map_or(0.0, |i| path.steps.last().expect("pushed").reactions[i]);
-            p.history.push(Point {
-                state: state.clone(),
-                arc: p.arc,
-                monitor,
-            });
-            if let Err(e) = after_step(&mut s, &p.history, &mut path) {
-                path.error = Some(e);
-                break;
+        if self.locate {
+            self.push_history(state);
+            if let Err(e) = after_step(&mut self.s, &self.p.history, &mut self.path) {
+                self.path.error = Some(e);
+                return None;
             }
         }
-        // Adapt the increment to the Newton effort.
-        p.control.accept(out.iterations);
-        if let (true, Some(end)) = (arc_control, lambda_end) {
-            let reached = (state.t - end) * (saved.t - end) <= 0.0;
-            if reached && p.last_dlambda.is_some() {
-                break;
-            }
-        }
-        p.last_dlambda = Some(out.dlambda);
-        s.previous = Some((out.dq, out.dlambda));
-        if !keep_going {
-            path.cancelled = true;
-            break;
-        }
-        p.steps_left = p.steps_left.saturating_sub(1);
+        Some(keep_going)
     }
-    if let (true, Some(end), Control::ArcLength { max_steps, .. }) = (arc_control, lambda_end, &params.control) {
-        let short = (state.t - end).abs() > 1e-9 * end.abs().max(1.0);
-        if path.error.is_none() && !path.cancelled && short {
-            path.error = Some(Error::StepLimit {
-                step: None,
-                t: state.t,
-                steps: *max_steps,
-                target: end,
-            });
-        }
-    }
-    if locate {
-        path.steps.sort_by(|a, b| a.arc.total_cmp(&b.arc));
-    }
-    s.stats.refinement_sweeps = s.system.linear.refinement_sweeps - linear_counts.0;
-    s.stats.lu_fallbacks = s.system.linear.lu_fallbacks - linear_counts.1;
-    s.stats.wall_s = start.elapsed().as_secs_f64();
-    path.stats = s.stats;
-    Ok(path)
-}
 
-/// A state reached by relaxation rather than along the path: a jump past a limit point, a branch
-/// switch at a bifurcation, or a relaxation past a neutral mode.
-struct Relaxed {
-    /// How far from the last recorded state, for the arc position.
-    distance: f64,
-    /// Reached by a snap.
-    jump: bool,
-    /// What it marks.
-    event: Option<Event>,
-}
-
-/// Records `state`, reached by relaxation, and restarts the path from it (no previous increment,
-/// a restarting load increment, a new location history holding it when events are located, with
-/// the reaction at index `monitor` if any); `false` if the analysis must stop (a failed record, or
-/// the progress callback's wish).
-fn push_relaxed(
-    s: &mut Driver,
-    p: &mut PathState,
-    path: &mut StaticPath,
-    state: &State,
-    relaxed: Relaxed,
-    progress: &mut dyn FnMut(&StaticStep, &Stats) -> bool,
-    location: Option<Option<usize>>,
-) -> bool {
-    let outcome = Outcome {
-        iterations: 0,
-        residual: 0.0,
-        dq: Vec::new(),
-        dlambda: 0.0,
-    };
-    let mut st = match s.record(state, &outcome) {
-        Ok(st) => st,
-        Err(e) => {
-            path.error = Some(e);
-            return false;
-        }
-    };
-    st.jump = relaxed.jump;
-    st.event = relaxed.event;
-    p.arc += relaxed.distance;
-    st.arc = p.arc;
-    p.last_negative = st.negative_eigenvalues;
-    s.stats.steps += 1;
-    let keep_going = progress(&st, &s.stats);
-    let monitored = location.map(|monitor| monitor.map_or(0.0, |i| st.reactions[i]));
-    path.steps.push(st);
-    s.previous = None;
-    p.restart = p.last_dlambda.map(|dl| 0.5 * dl.abs());
-    p.control.cutbacks = 0;
-    p.history.clear();
-    if let Some(value) = monitored {
-        p.history.push(Point {
+    /// Appends `state` (with the monitored reaction of the last assembly) to the history of the
+    /// location of events.
+    fn push_history(&mut self, state: &State) {
+        let monitor = self
+            .monitor
+            .map_or(0.0, |i| self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i]);
+        self.p.history.push(Point {
             state: state.clone(),
-            arc: p.arc,
-            monitor: value,
+            arc: self.p.arc,
+            monitor,
         });
     }
-    if !keep_going {
-        path.cancelled = true;
+
+    /// Records `state`, reached by relaxation, and restarts the path from it (no previous
+    /// increment, a restarting load increment, a new location history holding it); `false` if the
+    /// analysis must stop (a failed record, or the progress callback's wish).
+    fn push_relaxed(&mut self, state: &State, relaxed: Relaxed) -> bool {
+        let outcome = Outcome {
+            iterations: 0,
+            residual: 0.0,
+            dq: Vec::new(),
+            dlambda: 0.0,
+        };
+        let mut st = match self.s.record(state, &outcome) {
+            Ok(st) => st,
+            Err(e) => {
+                self.path.error = Some(e);
+                return false;
+            }
+        };
+        st.jump = relaxed.jump;
+        st.event = relaxed.event;
+        self.p.arc += relaxed.distance;
+        st.arc = self.p.arc;
+        self.p.last_negative = st.negative_eigenvalues;
+        self.s.stats.steps += 1;
+        let keep_going = (self.progress)(&st, &self.s.stats);
+        self.path.steps.push(st);
+        self.s.previous = None;
+        self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
+        self.p.control.cutbacks = 0;
+        self.p.history.clear();
+        if self.locate {
+            self.push_history(state);
+        }
+        if !keep_going {
+            self.path.cancelled = true;
+        }
+        keep_going
     }
-    keep_going
+
+    /// The path as it ends: the step limit reported, located states in path order, statistics.
+    fn finish(mut self, state: &State, start: Instant, linear_counts: (usize, usize)) -> Result<StaticPath> {
+        if let (true, Some(end), Control::ArcLength { max_steps, .. }) =
+            (self.arc_control, self.lambda_end, &self.s.params.control)
+        {
+            let short = (state.t - end).abs() > 1e-9 * end.abs().max(1.0);
+            if self.path.error.is_none() && !self.path.cancelled && short {
+                self.path.error = Some(Error::StepLimit {
+                    step: None,
+                    t: state.t,
+                    steps: *max_steps,
+                    target: end,
+                });
+            }
+        }
+        if self.locate {
+            self.path.steps.sort_by(|a, b| a.arc.total_cmp(&b.arc));
+        }
+        let s = &mut self.s;
+        s.stats.refinement_sweeps = s.system.linear.refinement_sweeps - linear_counts.0;
+        s.stats.lu_fallbacks = s.system.linear.lu_fallbacks - linear_counts.1;
+        s.stats.wall_s = start.elapsed().as_secs_f64();
+        self.path.stats = s.stats;
+        Ok(self.path)
+    }
 }
 
 /// The error that ends a path whose increment could not be made to converge.

@@ -73,17 +73,6 @@ pub fn nodal_areas(mesh: &Mesh) -> Vec<f64> {
     area
 }
 
-/// Index of the node nearest to `p`.
-pub fn nearest_node(mesh: &Mesh, p: Vector3<f64>) -> usize {
-    (0..mesh.n_nodes())
-        .min_by(|&a, &b| {
-            (mesh.nodes[a] - p)
-                .norm()
-                .total_cmp(&(mesh.nodes[b] - p).norm())
-        })
-        .expect("the mesh has nodes")
-}
-
 /// Linear (small-displacement) nodal displacements of `model` under its loads at load factor 1:
 /// the tangent at the stress-free reference configuration is the linear stiffness, so
 /// `K u = f_ext` is solved once. This avoids the cancellation that evaluating the nonlinear
