@@ -1,6 +1,7 @@
 //! Nonlinear solvers: settings, statistics, recorded results, and the pieces the static and
 //! dynamic drivers share ([`newton`], [`control`]).
 
+pub mod alpha;
 pub mod control;
 mod events;
 pub mod newton;
