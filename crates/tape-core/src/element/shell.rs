@@ -90,6 +90,38 @@ pub struct ElementStress {
     pub drilling: [f64; 4],
 }
 
+/// Nodal rates of an element for Kelvin-Voigt damping: the stresses become
+/// `C (strain + eta d(strain)/dt)`, with the strain rates `B v` of the same assumed strains as the
+/// elastic ones (so a rigid motion has none).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Viscous {
+    /// Nodal velocities [m/s].
+    pub v: [Vector3<f64>; 4],
+    /// Nodal angular velocities, spatial [rad/s].
+    pub w: [Vector3<f64>; 4],
+    /// Viscosity eta [s].
+    pub eta: f64,
+    /// `d(velocity)/d(displacement)` of the time integrator [1/s]: the damping matrix
+    /// `eta K_material` enters the tangent times this factor.
+    pub gamma_prime: f64,
+}
+
+impl Viscous {
+    fn velocity(&self) -> [f64; DOFS_PER_ELEMENT] {
+        let mut out = [0.0; DOFS_PER_ELEMENT];
+        for a in 0..4 {
+            out[6 * a..6 * a + 3].copy_from_slice(self.v[a].as_slice());
+            out[6 * a + 3..6 * a + 6].copy_from_slice(self.w[a].as_slice());
+        }
+        out
+    }
+}
+
+#[inline]
+fn dot24(a: &[f64; DOFS_PER_ELEMENT], b: &[f64; DOFS_PER_ELEMENT]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 /// A 4-node shell element with its reference geometry precomputed.
 #[derive(Clone, Debug)]
 pub struct ShellElement {
@@ -422,7 +454,7 @@ impl ShellElement {
     /// iteration, whose stresses are extrapolated linearly from the previous iterate (see
     /// [`Self::linearised_stress`]). `f` is always the true internal force. If `f_geo` is given it
     /// receives the force of the geometric stresses (`B^T stress`; `f` when `stress` is `None`).
-    #[allow(clippy::too_many_lines, clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)]
     pub fn compute_mixed_into(
         &self,
         x: &[Vector3<f64>; 4],
@@ -433,6 +465,43 @@ impl ShellElement {
         k: Option<&mut ElementMatrix>,
         f_geo: Option<&mut ElementVector>,
     ) -> f64 {
+        self.kernel(x, q, sec, stress, None, f, k, f_geo).0
+    }
+
+    /// Internal force of the Kelvin-Voigt material, elastic plus viscous stresses
+    /// `C (eps + eta B v)`, and, if `k` is given, its tangent for a time integrator: the material
+    /// part scaled by `1 + eta gamma'` (stiffness plus damping matrix) and the geometric part of
+    /// the total stresses. (The derivative of the strain-rate operator `B` with respect to the
+    /// configuration at fixed velocity is left out: it is of relative order `eta |v| / L` and
+    /// only slows Newton's convergence.) Returns the strain energy [J] and the dissipated power
+    /// `eta rate . C rate` [W].
+    pub fn compute_viscous_into(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        viscous: &Viscous,
+        f: &mut ElementVector,
+        k: Option<&mut ElementMatrix>,
+    ) -> (f64, f64) {
+        self.kernel(x, q, sec, None, Some(viscous), f, k, None)
+    }
+
+    #[allow(clippy::too_many_lines, clippy::too_many_arguments)]
+    fn kernel(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        stress: Option<&ElementStress>,
+        viscous: Option<&Viscous>,
+        f: &mut ElementVector,
+        k: Option<&mut ElementMatrix>,
+        f_geo: Option<&mut ElementVector>,
+    ) -> (f64, f64) {
+        let vel = viscous.map(Viscous::velocity);
+        let eta = viscous.map_or(0.0, |v| v.eta);
+        let mut power = 0.0;
         let (mut t1, mut t2, mut d) = ([Vector3::zeros(); 4], [Vector3::zeros(); 4], [Vector3::zeros(); 4]);
         for a in 0..4 {
             (t1[a], t2[a], d[a]) = columns(&q[a]);
@@ -472,9 +541,18 @@ impl ShellElement {
                 xs[1].dot(&ds[1]) - g.kap0[1],
                 xs[0].dot(&ds[1]) + xs[1].dot(&ds[0]) - g.kap0[2],
             );
-            let n = sec.membrane * eps * g.w;
-            let m = sec.bending * kap * g.w;
+            let mut n = sec.membrane * eps * g.w;
+            let mut m = sec.bending * kap * g.w;
             energy += 0.5 * (n.dot(&eps) + m.dot(&kap));
+            let rows = (tangent || vel.is_some()).then(|| gauss_rows(&g.dn, &xs, &ds, &d));
+            if let (Some(vel), Some(rows)) = (&vel, &rows) {
+                let rate = |i: usize| Vector3::new(dot24(&rows[i], vel), dot24(&rows[i + 1], vel), dot24(&rows[i + 2], vel));
+                let (de, dk) = (rate(0), rate(3));
+                let (nv, mv) = (sec.membrane * de * (eta * g.w), sec.bending * dk * (eta * g.w));
+                power += nv.dot(&de) + mv.dot(&dk);
+                n += nv;
+                m += mv;
+            }
             add_gauss_forces(&g.dn, &xs, &ds, &n, &m, &mut f_x, &mut f_d);
             let (n, m) = match mixed {
                 Some(st) => {
@@ -487,31 +565,8 @@ impl ShellElement {
                 }
                 None => (n, m),
             };
-            if tangent {
-                // Rows of B (6 x 24) at this point, premultiplied by sqrt(w) L^T.
-                let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
-                for a in 0..4 {
-                    let [p, r] = g.dn[a];
-                    let c = 6 * a;
-                    let bx = [
-                        p * xs[0],
-                        r * xs[1],
-                        p * xs[1] + r * xs[0],
-                        p * ds[0],
-                        r * ds[1],
-                        p * ds[1] + r * ds[0],
-                    ];
-                    let bt = [
-                        d[a].cross(&(p * xs[0])),
-                        d[a].cross(&(r * xs[1])),
-                        d[a].cross(&(p * xs[1] + r * xs[0])),
-                    ];
-                    for i in 0..3 {
-                        rows[i][c..c + 3].copy_from_slice(bx[i].as_slice());
-                        rows[3 + i][c..c + 3].copy_from_slice(bx[3 + i].as_slice());
-                        rows[3 + i][c + 3..c + 6].copy_from_slice(bt[i].as_slice());
-                    }
-                }
+            if let (true, Some(rows)) = (tangent, &rows) {
+                // Rows of B premultiplied by sqrt(w) L^T.
                 let sw = g.w.sqrt();
                 for (block, factor) in [(0, &sec.membrane_factor), (3, &sec.bending_factor)] {
                     for i in 0..3 {
@@ -545,8 +600,25 @@ impl ShellElement {
             (gt[t], dt[t]) = self.tying_vectors(t, x, &d);
             gam[t] = gt[t].dot(&dt[t]) - self.gamma0[t];
         }
-        let qv = self.shear_metric * gam * sec.shear;
+        let mut qv = self.shear_metric * gam * sec.shear;
         energy += 0.5 * gam.dot(&qv);
+        let shear_rows = (tangent || vel.is_some()).then(|| {
+            let mut rows = [[0.0; DOFS_PER_ELEMENT]; 4];
+            for t in 0..4 {
+                for a in 0..4 {
+                    let c = 6 * a;
+                    rows[t][c..c + 3].copy_from_slice((self.cg[t][a] * dt[t]).as_slice());
+                    rows[t][c + 3..c + 6].copy_from_slice(d[a].cross(&(self.cd[t][a] * gt[t])).as_slice());
+                }
+            }
+            rows
+        });
+        if let (Some(vel), Some(rows)) = (&vel, &shear_rows) {
+            let rate = Vector4::from_fn(|t, _| dot24(&rows[t], vel));
+            let qd = self.shear_metric * rate * (sec.shear * eta);
+            power += qd.dot(&rate);
+            qv += qd;
+        }
         self.add_shear_forces(&qv, &gt, &dt, &mut f_x, &mut f_d);
         let qv = match mixed {
             Some(st) => {
@@ -556,13 +628,9 @@ impl ShellElement {
             }
             None => qv,
         };
-        if tangent {
-            let mut rows = [[0.0; DOFS_PER_ELEMENT]; 4];
+        if let (true, Some(rows)) = (tangent, &shear_rows) {
             for t in 0..4 {
                 for a in 0..4 {
-                    let c = 6 * a;
-                    rows[t][c..c + 3].copy_from_slice((self.cg[t][a] * dt[t]).as_slice());
-                    rows[t][c + 3..c + 6].copy_from_slice(d[a].cross(&(self.cd[t][a] * gt[t])).as_slice());
                     for bb in 0..4 {
                         sxd[a][bb] += qv[t] * self.cg[t][a] * self.cd[t][bb];
                     }
@@ -588,8 +656,22 @@ impl ShellElement {
             let (c0, s0) = self.drill_ref[a];
             let (u, v) = self.drill_vectors(a, &xc);
             let psi = 0.5 * (t1[a].dot(&u) - t2[a].dot(&v)) - self.psi0[a];
-            let big_psi = kd * psi;
+            let mut big_psi = kd * psi;
             energy += 0.5 * kd * psi * psi;
+            let mut row = [0.0; DOFS_PER_ELEMENT];
+            let mut coef = [(0.0, 0.0); 4];
+            for bb in 0..4 {
+                let [p, r] = self.dn_centre[bb];
+                coef[bb] = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
+                let gx = coef[bb].0 * t1[a] + coef[bb].1 * t2[a];
+                row[6 * bb..6 * bb + 3].copy_from_slice(gx.as_slice());
+            }
+            row[6 * a + 3..6 * a + 6].copy_from_slice((0.5 * (t1[a].cross(&u) - t2[a].cross(&v))).as_slice());
+            if let Some(vel) = &vel {
+                let rate = dot24(&row, vel);
+                power += kd * eta * rate * rate;
+                big_psi += kd * eta * rate;
+            }
             f_t1[a] += 0.5 * big_psi * u;
             f_t2[a] -= 0.5 * big_psi * v;
             let geo_psi = mixed.map_or(big_psi, |st| st.drilling[a]);
@@ -597,21 +679,17 @@ impl ShellElement {
                 gf_t1[a] += 0.5 * geo_psi * u;
                 gf_t2[a] -= 0.5 * geo_psi * v;
             }
-            let mut row = [0.0; DOFS_PER_ELEMENT];
             for bb in 0..4 {
-                let [p, r] = self.dn_centre[bb];
-                let (al, be) = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
+                let (al, be) = coef[bb];
                 let gx = al * t1[a] + be * t2[a];
                 f_x[bb] += big_psi * gx;
                 if mixed.is_some() {
                     gf_x[bb] += geo_psi * gx;
                 }
-                row[6 * bb..6 * bb + 3].copy_from_slice(gx.as_slice());
                 sxt1[bb][a] += geo_psi * al;
                 sxt2[bb][a] += geo_psi * be;
             }
             if tangent {
-                row[6 * a + 3..6 * a + 6].copy_from_slice((0.5 * (t1[a].cross(&u) - t2[a].cross(&v))).as_slice());
                 let sk = kd.sqrt();
                 for j in 0..DOFS_PER_ELEMENT {
                     btil[j * N_ROWS + n_rows] = sk * row[j];
@@ -643,6 +721,7 @@ impl ShellElement {
 
         // Geometric stiffness and the rotational terms.
         if let Some(k) = k {
+            let material_scale = viscous.map_or(1.0, |v| 1.0 + v.eta * v.gamma_prime);
             // Material part: K = Bt^T Bt, upper triangle by contiguous dot products, then mirrored.
             debug_assert_eq!(n_rows, N_ROWS);
             for j in 0..DOFS_PER_ELEMENT {
@@ -656,7 +735,7 @@ impl ShellElement {
                             acc[l] += ci[l] * cj[l];
                         }
                     }
-                    let v = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+                    let v = material_scale * (((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])));
                     k[(i, j)] = v;
                     k[(j, i)] = v;
                 }
@@ -681,8 +760,43 @@ impl ShellElement {
                 blk += h;
             }
         }
-        energy
+        (energy, power)
     }
+}
+
+/// Rows of `B` (6 x 24: membrane then bending strains) at a Gauss point: derivatives of the
+/// strains with respect to the nodal translations and spatial rotation increments.
+#[inline]
+fn gauss_rows(
+    dn: &[[f64; 2]; 4],
+    xs: &[Vector3<f64>; 2],
+    ds: &[Vector3<f64>; 2],
+    d: &[Vector3<f64>; 4],
+) -> [[f64; DOFS_PER_ELEMENT]; 6] {
+    let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
+    for a in 0..4 {
+        let [p, r] = dn[a];
+        let c = 6 * a;
+        let bx = [
+            p * xs[0],
+            r * xs[1],
+            p * xs[1] + r * xs[0],
+            p * ds[0],
+            r * ds[1],
+            p * ds[1] + r * ds[0],
+        ];
+        let bt = [
+            d[a].cross(&(p * xs[0])),
+            d[a].cross(&(r * xs[1])),
+            d[a].cross(&(p * xs[1] + r * xs[0])),
+        ];
+        for i in 0..3 {
+            rows[i][c..c + 3].copy_from_slice(bx[i].as_slice());
+            rows[3 + i][c..c + 3].copy_from_slice(bx[3 + i].as_slice());
+            rows[3 + i][c + 3..c + 6].copy_from_slice(bt[i].as_slice());
+        }
+    }
+    rows
 }
 
 #[inline]
@@ -1051,5 +1165,73 @@ mod tests {
             f.amax(),
             f_scale.amax()
         );
+    }
+
+    /// Kelvin-Voigt: a rigid velocity field (translation plus spin about any point) has no strain
+    /// rate, so it dissipates nothing and adds no force; for a deforming one the dissipated power
+    /// is the viscous force's power, and it is positive.
+    #[test]
+    fn viscous_stresses_see_only_strain_rates() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let mut f_el = ElementVector::zeros();
+        e.compute_into(&x, &mats(&q), &sec, &mut f_el, None);
+        let spin = Vector3::new(3.0, -2.0, 5.0);
+        let rigid = Viscous {
+            v: std::array::from_fn(|a| Vector3::new(0.1, 0.2, -0.3) + spin.cross(&(x[a] - Vector3::new(1.0, 2.0, 0.5)))),
+            w: [spin; 4],
+            eta: 0.01,
+            gamma_prime: 0.0,
+        };
+        let mut f = ElementVector::zeros();
+        let (_, power) = e.compute_viscous_into(&x, &mats(&q), &sec, &rigid, &mut f, None);
+        let scale = f_el.norm() * 0.01 * spin.norm();
+        assert!(power.abs() < 1e-12 * scale, "rigid motion dissipates {power:e} W");
+        assert!((f - f_el).norm() < 1e-10 * scale, "rigid motion adds viscous forces");
+        let mut deforming = rigid;
+        deforming.v[2] += Vector3::new(0.0, 0.0, 0.4);
+        deforming.w[1] += Vector3::new(0.0, 7.0, 0.0);
+        let (_, power) = e.compute_viscous_into(&x, &mats(&q), &sec, &deforming, &mut f, None);
+        let vel = ElementVector::from_column_slice(&deforming.velocity());
+        let viscous_power = (f - f_el).dot(&vel);
+        assert!(power > 0.0 && (viscous_power - power).abs() < 1e-9 * power, "{viscous_power} vs {power}");
+    }
+
+    /// At rest, the tangent of the Kelvin-Voigt force with velocities `gamma' delta` is the
+    /// elastic tangent plus `eta gamma'` times its material part (finite differences).
+    #[test]
+    fn viscous_tangent_at_rest_matches_finite_differences() {
+        let (x0, q0, e) = sample();
+        let (x, q) = deformed(&x0, &q0);
+        let sec = section();
+        let (eta, gamma_prime) = (2e-3, 800.0);
+        let at_rest = Viscous {
+            eta,
+            gamma_prime,
+            ..Viscous::default()
+        };
+        let mut f = ElementVector::zeros();
+        let mut k = ElementMatrix::zeros();
+        e.compute_viscous_into(&x, &mats(&q), &sec, &at_rest, &mut f, Some(&mut k));
+        let h = 1e-7;
+        for j in 0..DOFS_PER_ELEMENT {
+            let force = |sign: f64| {
+                let (xp, qp) = perturb(&x, &q, j, sign * h);
+                let mut v = at_rest;
+                let rate = sign * h * gamma_prime;
+                if j % 6 < 3 {
+                    v.v[j / 6][j % 6] = rate;
+                } else {
+                    v.w[j / 6][j % 6 - 3] = rate;
+                }
+                let mut fp = ElementVector::zeros();
+                e.compute_viscous_into(&xp, &mats(&qp), &sec, &v, &mut fp, None);
+                fp
+            };
+            let fd = (force(1.0) - force(-1.0)) / (2.0 * h);
+            let err = (fd - k.column(j)).norm() / k.column(j).norm();
+            assert!(err < 1e-5, "column {j}: relative error {err:e}");
+        }
     }
 }
