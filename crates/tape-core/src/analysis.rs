@@ -26,7 +26,9 @@ use crate::error::{Error, Result};
 use crate::model::{Load, Model};
 use crate::options::Options;
 use crate::output::{Fields, History, Outputs};
-use crate::solver::{solve_static, Control, StaticParams, StaticStep, Stats};
+use crate::solver::{
+    solve_dynamic, solve_static, Control, DynamicParams, EnergyBalance, StaticParams, StaticStep, Stats,
+};
 use crate::state::State;
 use crate::time_function::TimeFunction;
 
@@ -35,6 +37,8 @@ use crate::time_function::TimeFunction;
 pub enum StepKind {
     /// A static equilibrium path.
     Static(StaticParams),
+    /// A transient dynamic analysis over a duration.
+    Dynamic(DynamicParams),
 }
 
 /// An analysis step: what it computes and what it switches at its start.
@@ -62,8 +66,20 @@ impl Step {
         }
     }
 
-    /// A step from a flat JSON object: `name`, `kind` (`"static"`), `activate` and `deactivate`
-    /// (lists of ids), and the options of its kind (see [`StaticParams::from_options`]).
+    /// A dynamic step with `params`, switching nothing.
+    #[must_use]
+    pub fn new_dynamic(name: &str, params: DynamicParams) -> Self {
+        Self {
+            name: name.to_owned(),
+            kind: StepKind::Dynamic(params),
+            activate: Vec::new(),
+            deactivate: Vec::new(),
+        }
+    }
+
+    /// A step from a flat JSON object: `name`, `kind` (`"static"` or `"dynamic"`), `activate` and
+    /// `deactivate` (lists of ids), and the options of its kind (see
+    /// [`StaticParams::from_options`] and [`DynamicParams::from_options`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming a bad, inapplicable or unknown option.
@@ -77,9 +93,12 @@ impl Step {
             "static" => StepKind::Static(
                 StaticParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
             ),
+            "dynamic" => StepKind::Dynamic(
+                DynamicParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
+            ),
             other => {
                 return Err(Error::InvalidParameter(format!(
-                    "step '{name}': unknown kind '{other}' (expected 'static')"
+                    "step '{name}': unknown kind '{other}' (expected 'static' or 'dynamic')"
                 )))
             }
         };
@@ -94,19 +113,24 @@ impl Step {
     /// The step as the flat JSON object [`Step::from_json`] reads (every option explicit).
     #[must_use]
     pub fn to_json(&self) -> Value {
-        let StepKind::Static(p) = &self.kind;
         let mut m: Map<String, Value> = Map::new();
         m.insert("name".into(), self.name.clone().into());
-        m.insert("kind".into(), "static".into());
+        let (kind, options) = match &self.kind {
+            StepKind::Static(p) => ("static", p.to_options()),
+            StepKind::Dynamic(p) => ("dynamic", p.to_options()),
+        };
+        m.insert("kind".into(), kind.into());
         m.insert("activate".into(), self.activate.clone().into());
         m.insert("deactivate".into(), self.deactivate.clone().into());
-        m.extend(p.to_options());
+        m.extend(options);
         Value::Object(m)
     }
 
-    fn params(&self) -> &StaticParams {
-        let StepKind::Static(p) = &self.kind;
-        p
+    fn static_params(&self) -> Option<&StaticParams> {
+        match &self.kind {
+            StepKind::Static(p) => Some(p),
+            StepKind::Dynamic(_) => None,
+        }
     }
 }
 
@@ -144,6 +168,13 @@ pub struct RunResult {
     pub steps_completed: usize,
 }
 
+/// What the runner keeps of a step's path.
+struct PathOut {
+    steps: Vec<StaticStep>,
+    cancelled: bool,
+    error: Option<Error>,
+}
+
 /// Checks a model, its steps and the outputs before anything runs.
 fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
     model.validate()?;
@@ -154,7 +185,11 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
     for (k, step) in steps.iter().enumerate() {
         let name = &step.name;
         let context = format!("step {k} '{name}'");
-        step.params().validate().map_err(|e| e.context(&context))?;
+        match &step.kind {
+            StepKind::Static(p) => p.validate(),
+            StepKind::Dynamic(p) => p.validate(),
+        }
+        .map_err(|e| e.context(&context))?;
         for id in &step.activate {
             activity
                 .switch(model, id, true)
@@ -166,7 +201,7 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                 .map_err(|e| e.context(&context))?;
         }
         let releases = !step.deactivate.is_empty() && k > 0;
-        if releases && matches!(step.params().control, Control::Displacement { .. }) {
+        if releases && step.static_params().is_some_and(|p| matches!(p.control, Control::Displacement { .. })) {
             return Err(Error::InvalidParameter(format!(
                 "step {k} '{name}': constraints and loads are released over a step's load-factor range, \
                  which displacement control does not fix: release them in a load or arc-length step"
@@ -266,6 +301,10 @@ fn initial_record(system: &mut System, state: &State, stability: bool, fields: b
         markers: n(system.marker_positions(state)),
         marker_rotations: n(system.marker_rotations(state)),
         probes: system.probe(&asm),
+        balance: Some(EnergyBalance {
+            kinetic: system.kinetic_energy(state),
+            ..EnergyBalance::default()
+        }),
         ..StaticStep::default()
     })
 }
@@ -298,16 +337,20 @@ pub fn run(
     let mut system = System::try_with(model, &activity)?;
     system.probes.clone_from(&reaction_dofs);
     let mut state = system.initial_state();
+    for iv in &model.initial_velocities {
+        state.v[iv.node] = iv.velocity;
+        state.w[iv.node] = iv.angular_velocity;
+    }
     let mut result = RunResult::default();
     let history = &mut result.history;
     history.marker_names = model.markers.iter().map(|m| m.name.clone()).collect();
     history.reaction_dofs.clone_from(&reaction_dofs);
-    let first = initial_record(&mut system, &state, steps[0].params().stability, interval > 0)?;
+    let stability = steps[0].static_params().is_some_and(|p| p.stability);
+    let first = initial_record(&mut system, &state, stability, interval > 0)?;
     let mut last_reactions = first.reactions.clone();
     history.push(0, first, interval > 0);
     let mut symbolic = 1;
     for (k, step) in steps.iter().enumerate() {
-        let params = step.params();
         if k > 0 {
             let before = activity.clone();
             for id in &step.activate {
@@ -316,13 +359,18 @@ pub fn run(
             for id in &step.deactivate {
                 activity.switch(model, id, false)?;
             }
-            let t1 = match &params.control {
-                Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => *lambda_end,
-                Control::Displacement { .. } => state.t,
+            // A static step releases over its load-factor range; a dynamic one at once.
+            let (released, gravity_off) = match step.static_params().map(|p| &p.control) {
+                Some(Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. }) => {
+                    release_loads(model, &system, &before, &activity, &last_reactions, state.t, *lambda_end)
+                        .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
+                }
+                Some(Control::Displacement { .. }) => {
+                    release_loads(model, &system, &before, &activity, &last_reactions, state.t, state.t)
+                        .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
+                }
+                None => (Vec::new(), None),
             };
-            let (released, gravity_off) =
-                release_loads(model, &system, &before, &activity, &last_reactions, state.t, t1)
-                    .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?;
             let gravity = system.gravity.clone();
             if system
                 .set_activity(model, &activity)
@@ -348,11 +396,28 @@ pub fn run(
                 records,
             })
         };
-        let mut params = params.clone();
-        params.record_fields = interval > 0;
-        let path = solve_static(&mut system, &mut state, &params, &mut cb)
-            .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?;
-        let mut stats = path.stats;
+        let context = format!("step {k} '{}'", step.name);
+        let (steps_done, path_stats, cancelled, error) = match &step.kind {
+            StepKind::Static(p) => {
+                let mut params = p.clone();
+                params.record_fields = interval > 0;
+                state.stop();
+                let path = solve_static(&mut system, &mut state, &params, &mut cb).map_err(|e| e.context(&context))?;
+                (path.steps, path.stats, path.cancelled, path.error)
+            }
+            StepKind::Dynamic(p) => {
+                let mut params = p.clone();
+                params.record_fields = interval > 0;
+                let path = solve_dynamic(&mut system, &mut state, &params, &mut cb).map_err(|e| e.context(&context))?;
+                (path.steps, path.stats, path.cancelled, path.error)
+            }
+        };
+        let path = PathOut {
+            steps: steps_done,
+            cancelled,
+            error,
+        };
+        let mut stats = path_stats;
         stats.symbolic_analyses = std::mem::take(&mut symbolic);
         result.stats.add(&stats);
         result.step_stats.push(stats);

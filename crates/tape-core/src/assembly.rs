@@ -30,9 +30,10 @@ use rayon::prelude::*;
 
 use crate::constraint::{Activity, DofMap, Slot};
 use crate::dof::Dof;
-use crate::element::shell::{ElementMatrix, ElementStress, ElementVector};
+use crate::element::shell::{ElementMatrix, ElementStress, ElementVector, Viscous};
 use crate::element::ShellElement;
 use crate::error::{Error, Result};
+use crate::inertia::NodeInertia;
 use crate::linalg::LinearSolver;
 pub use crate::linalg::Pattern;
 use crate::material::SectionStiffness;
@@ -64,6 +65,19 @@ pub struct Assembled {
     pub energy: f64,
     /// Potential energy of gravity `-sum m g(t) . x` [J].
     pub gravity_energy: f64,
+    /// Power dissipated by Kelvin-Voigt damping [W] (dynamic assemblies).
+    pub dissipation: f64,
+}
+
+/// Nodal velocities of every node (tied nodes included), spatial, for the viscous stresses.
+#[derive(Clone, Debug, Default)]
+pub struct Rates {
+    /// Velocities [m/s].
+    pub v: Vec<Vector3<f64>>,
+    /// Angular velocities, spatial [rad/s].
+    pub w: Vec<Vector3<f64>>,
+    /// `d(velocity)/d(displacement)` of the time integrator [1/s].
+    pub gamma_prime: f64,
 }
 
 impl Assembled {
@@ -114,6 +128,11 @@ pub struct System {
     pub node_mass: Vec<f64>,
     /// Rigid bodies and point masses.
     pub bodies: Vec<RigidBody>,
+    /// Inertia carried by each independent node: its own lumped shell mass and rotary inertia,
+    /// its tied nodes' and its rigid bodies' (zero for tied nodes); see [`crate::inertia`].
+    pub inertia: Vec<NodeInertia>,
+    /// Kelvin-Voigt viscosity of each part [s].
+    eta: Vec<f64>,
     /// Markers.
     pub markers: Vec<Marker>,
     /// Nodal DOFs whose force `f_int - f_ext` is recorded with each converged state (see
@@ -138,7 +157,8 @@ pub struct System {
     /// Element forces of the geometric stresses (mixed iteration), for the tie terms.
     fg_buf: Vec<ElementVector>,
     k_buf: Vec<ElementMatrix>,
-    e_buf: Vec<f64>,
+    /// Strain energy and dissipated power of each element.
+    e_buf: Vec<(f64, f64)>,
     k_scratch_ff: Vec<f64>,
     k_scratch_fc: Vec<f64>,
     /// Use rayon for the element loop.
@@ -182,8 +202,22 @@ fn numbering(elements: &[ShellElement], dofs: &DofMap) -> Numbering {
             }
         }
     }
-    // (Every node with free DOFs owns an element's DOFs, its own or its tied nodes'; see
-    // `DofMap::try_with`: so the rotation blocks of the lever-arm terms are in the pattern.)
+    // Every independent node's own 6 x 6 block (the lever-arm terms and the nodal inertia of a
+    // node that carries only a rigid body).
+    for i in 0..dofs.slots.len() {
+        if dofs.master[i].is_some() {
+            continue;
+        }
+        for dr in 0..6 {
+            let Slot::Free(row) = slot_of(i, dr) else { continue };
+            for dc in 0..6 {
+                match slot_of(i, dc) {
+                    Slot::Free(col) => cols_ff[col].push(row),
+                    Slot::Constrained(col) => cols_fc[col].push(row),
+                }
+            }
+        }
+    }
     let pattern_ff = Pattern::from_columns(dofs.n_free, cols_ff);
     let pattern_fc = Pattern::from_columns(dofs.n_free, cols_fc);
     let nnz_ff = pattern_ff.nnz();
@@ -259,14 +293,26 @@ impl System {
                 ShellElement::try_new(*quad, &x, &q).map_err(|err| Error::InvalidMesh(format!("element {e}: {err}")))
             })
             .collect::<Result<Vec<_>>>()?;
-        let mut node_mass = vec![0.0; model.mesh.n_nodes()];
+        let n_nodes = model.mesh.n_nodes();
+        let mut node_mass = vec![0.0; n_nodes];
+        let mut rotary = vec![0.0; n_nodes];
         for (e, el) in elements.iter().enumerate() {
             let s = &model.parts[element_part[e]].section;
             for (a, w) in el.nodal_areas().iter().enumerate() {
                 node_mass[el.nodes[a]] += s.density * s.thickness * w;
+                rotary[el.nodes[a]] += s.density * s.thickness.powi(3) / 12.0 * w;
             }
         }
         let dofs = DofMap::try_with(model, activity)?;
+        let mut inertia = vec![NodeInertia::default(); n_nodes];
+        for i in 0..n_nodes {
+            let r = dofs.owner(i);
+            let offset = model.mesh.nodes[i] - model.mesh.nodes[r];
+            inertia[r].add(node_mass[i], &offset, &(Matrix3::identity() * rotary[i]));
+        }
+        for b in &model.rigid_bodies {
+            inertia[b.node].add(b.mass, &b.centre_of_mass, &b.inertia);
+        }
         let num = numbering(&elements, &dofs);
         let linear = LinearSolver::try_new(&num.pattern_ff)?;
         let reference = State::at_rest(model.mesh.nodes.clone(), triads);
@@ -282,6 +328,8 @@ impl System {
             gravity,
             node_mass,
             bodies: model.rigid_bodies.clone(),
+            inertia,
+            eta: model.parts.iter().map(|p| p.section.eta).collect(),
             markers: model.markers.clone(),
             probes: Vec::new(),
             pattern_ff: num.pattern_ff,
@@ -295,7 +343,7 @@ impl System {
             f_buf: vec![ElementVector::zeros(); n_el],
             fg_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
-            e_buf: vec![0.0; n_el],
+            e_buf: vec![(0.0, 0.0); n_el],
             k_scratch_ff: Vec::new(),
             k_scratch_fc: Vec::new(),
             parallel: true,
@@ -353,7 +401,8 @@ impl System {
     }
 
     /// Rigid rotation of node `r` from its reference orientation.
-    fn node_rotation(&self, state: &State, r: usize) -> UnitQuaternion<f64> {
+    #[must_use]
+    pub fn node_rotation(&self, state: &State, r: usize) -> UnitQuaternion<f64> {
         state.q[r] * self.reference.q[r].inverse()
     }
 
@@ -521,12 +570,45 @@ impl System {
     ///
     /// # Panics
     /// If `stress` does not have one entry per element.
-    #[allow(clippy::too_many_lines)]
     pub fn assemble_mixed(
         &mut self,
         state: &State,
         tangent: bool,
         stress: Option<&[ElementStress]>,
+        out: &mut Assembled,
+    ) {
+        self.assemble_with(state, tangent, stress, None, out);
+    }
+
+    /// Assembles the pieces and the tangent of a dynamic step at `state` with the nodal `rates`:
+    /// `f_int` includes the Kelvin-Voigt viscous forces and the tangent their damping matrix times
+    /// `rates.gamma_prime` (inertia is the integrator's: see [`crate::inertia`]).
+    pub fn assemble_dynamic(&mut self, state: &State, rates: &Rates, out: &mut Assembled) {
+        self.assemble_with(state, true, None, Some(rates), out);
+    }
+
+    /// Nodal rates of every node from the velocities of the independent nodes in `state` (tied
+    /// nodes move rigidly with their reference node).
+    #[must_use]
+    pub fn rates(&self, state: &State, gamma_prime: f64) -> Rates {
+        let mut w = state.w.clone();
+        let mut v = state.v.clone();
+        for (s, m) in self.dofs.master.iter().enumerate() {
+            if let Some(r) = *m {
+                w[s] = w[r];
+                v[s] = v[r] + w[r].cross(&(state.x[s] - state.x[r]));
+            }
+        }
+        Rates { v, w, gamma_prime }
+    }
+
+    #[allow(clippy::too_many_lines)]
+    fn assemble_with(
+        &mut self,
+        state: &State,
+        tangent: bool,
+        stress: Option<&[ElementStress]>,
+        rates: Option<&Rates>,
         out: &mut Assembled,
     ) {
         if let Some(st) = stress {
@@ -551,21 +633,34 @@ impl System {
             out.k_fc.resize(self.pattern_fc.nnz(), 0.0);
         }
 
-        let (sections, element_part) = (&self.sections, &self.element_part);
+        let (sections, element_part, etas) = (&self.sections, &self.element_part, &self.eta);
         let kernel = |i: usize,
                       e: &ShellElement,
                       f: &mut ElementVector,
                       fg: &mut ElementVector,
                       k: &mut ElementMatrix,
-                      en: &mut f64| {
+                      en: &mut (f64, f64)| {
             let x = e.nodes.map(|n| state.x[n]);
             let q = e
                 .nodes
                 .map(|n| state.q[n].to_rotation_matrix().into_inner());
             let section = &sections[element_part[i]];
-            *en = match stress {
-                Some(st) => e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
-                None => e.compute_into(&x, &q, section, f, tangent.then_some(k)),
+            let eta = etas[element_part[i]];
+            *en = match (stress, rates) {
+                (Some(st), _) => (
+                    e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
+                    0.0,
+                ),
+                (None, Some(r)) if eta > 0.0 => {
+                    let viscous = Viscous {
+                        v: e.nodes.map(|n| r.v[n]),
+                        w: e.nodes.map(|n| r.w[n]),
+                        eta,
+                        gamma_prime: r.gamma_prime,
+                    };
+                    e.compute_viscous_into(&x, &q, section, &viscous, f, tangent.then_some(k))
+                }
+                (None, _) => (e.compute_into(&x, &q, section, f, tangent.then_some(k)), 0.0),
             };
         };
         if self.parallel {
@@ -598,7 +693,8 @@ impl System {
         let mut f_node = vec![Vector3::zeros(); n_nodes];
         // Condensed nodal internal forces of independent nodes.
         let mut f_cond = vec![[0.0; 6]; n_nodes];
-        out.energy = self.e_buf.iter().sum();
+        out.energy = self.e_buf.iter().map(|e| e.0).sum();
+        out.dissipation = self.e_buf.iter().map(|e| e.1).sum();
         for (e, el) in self.elements.iter().enumerate() {
             let f = &mut self.f_buf[e];
             let k = &mut self.k_buf[e];
@@ -796,6 +892,27 @@ impl System {
         }
     }
 
+    /// The nodal loads (not gravity) at `state`'s time, condensed onto each independent node as
+    /// `[force, moment]` (a load on a tied node adds its moment about the reference node).
+    #[must_use]
+    pub fn nodal_loads(&self, state: &State) -> Vec<[f64; 6]> {
+        let mut out = vec![[0.0; 6]; state.x.len()];
+        for load in &self.loads {
+            let owner = self.dofs.owner(load.node);
+            let value = load.value * load.function.value(state.t);
+            let d = load.dof.index();
+            out[owner][d] += value;
+            if owner != load.node && d < 3 {
+                let lever = state.x[load.node] - state.x[owner];
+                let m = lever.cross(&Vector3::ith(d, value));
+                for i in 0..3 {
+                    out[owner][3 + i] += m[i];
+                }
+            }
+        }
+        out
+    }
+
     /// Positions [m] of the markers in `state`.
     #[must_use]
     pub fn marker_positions(&self, state: &State) -> Vec<Vector3<f64>> {
@@ -831,6 +948,18 @@ impl System {
                 }
             })
             .collect()
+    }
+
+    /// Kinetic energy [J] of `state` (every independent node carries its tied nodes' inertia).
+    #[must_use]
+    pub fn kinetic_energy(&self, state: &State) -> f64 {
+        (0..state.x.len())
+            .filter(|&i| self.dofs.master[i].is_none() && !self.inertia[i].is_empty())
+            .map(|i| {
+                let r = self.node_rotation(state, i).to_rotation_matrix().into_inner();
+                self.inertia[i].kinetic_energy(&r, &state.v[i], &state.w[i])
+            })
+            .sum()
     }
 
     /// Total mass [kg] carried by the system (lumped shell mass and rigid bodies).

@@ -143,6 +143,11 @@ impl DofMap {
                 attached[tie.reference] = true;
             }
         }
+        // A rigid body gives its node inertia (dynamics); in statics it may still be a mechanism,
+        // which the factorisation reports.
+        for body in &model.rigid_bodies {
+            attached[body.node] = true;
+        }
         let mut constrained_of = vec![[None; 6]; n];
         let mut constrained = Vec::new();
         let mut constraint_index = Vec::new();

@@ -3,15 +3,20 @@
 //! arms) and the rigid bodies of the model, all summed once in the reference configuration.
 //!
 //! A node's body frame is the reference frame carried by the node's rotation from the reference
-//! configuration, `R = Q Q_0^T`; in it the static moment and the inertia tensor are constant. With
-//! the node's translational velocity `v` (spatial) and angular velocity `W` in the body frame
-//! (`dR/dt = R [W]x`), the kinetic energy and the inertia forces at the node are
+//! configuration, `R = Q Q_0^T`; in it the static moment `s` and the inertia tensor `J` are
+//! constant, and in space they are `s_R = R s`, `J_R = R J R^T`. With the node's velocity `v`
+//! and angular velocity `w` (both spatial, `dR/dt = [w]x R`), the kinetic energy and the inertia
+//! forces at the node are
 //!
 //! ```text
-//! T     = m |v|^2 / 2 + v . R (W x s) + W . J W / 2
-//! f_u   = m a + R (dW/dt x s + W x (W x s))                       (spatial force)
-//! f_th  = R (J dW/dt + W x J W + s x R^T a)                       (spatial moment about the node)
+//! T     = m |v|^2 / 2 + v . (w x s_R) + w . J_R w / 2
+//! f_u   = m a + dw/dt x s_R + w x (w x s_R)                        (force)
+//! f_th  = J_R dw/dt + w x J_R w + s_R x a                          (moment about the node)
 //! ```
+//!
+//! Spatial velocities are used (rather than body ones) because in a fast spin the body-frame
+//! angular velocity of a nutating body turns at the spin rate while the spatial one moves only
+//! with the slow precession and nutation: the time integrator's error is that of the slow motion.
 //!
 //! with `m` the mass, `s = sum m_i c_i` the static moment and `J = sum (J_i + m_i (|c_i|^2 I -
 //! c_i c_i^T))` the inertia tensor about the node (parallel axes), `c_i` the offsets of the masses
@@ -37,16 +42,16 @@ pub struct NodeInertia {
     pub inertia: Matrix3<f64>,
 }
 
-/// Inertia forces at a node and the GA quantities they depend on.
+/// The motion of a node at an instant.
 #[derive(Clone, Copy, Debug)]
 pub struct Motion<'a> {
     /// Rotation of the node from its reference orientation.
     pub r: &'a Matrix3<f64>,
-    /// Translational acceleration (spatial) [m/s^2].
+    /// Acceleration [m/s^2].
     pub a: &'a Vector3<f64>,
-    /// Angular velocity in the body frame [rad/s].
+    /// Angular velocity, spatial [rad/s].
     pub w: &'a Vector3<f64>,
-    /// Angular acceleration in the body frame [rad/s^2].
+    /// Angular acceleration, spatial [rad/s^2].
     pub dw: &'a Vector3<f64>,
 }
 
@@ -65,56 +70,58 @@ impl NodeInertia {
         self.mass == 0.0 && self.inertia == Matrix3::zeros()
     }
 
-    /// Kinetic energy [J] at translational velocity `v` (spatial) and angular velocity `w` (body).
+    /// Static moment and inertia tensor in space for the rotation `r`.
+    #[must_use]
+    pub fn spatial(&self, r: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+        (r * self.moment, r * self.inertia * r.transpose())
+    }
+
+    /// Kinetic energy [J] at velocity `v` and angular velocity `w` (spatial).
     #[must_use]
     pub fn kinetic_energy(&self, r: &Matrix3<f64>, v: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
-        0.5 * self.mass * v.norm_squared() + v.dot(&(r * w.cross(&self.moment))) + 0.5 * w.dot(&(self.inertia * w))
+        let (s, j) = self.spatial(r);
+        0.5 * self.mass * v.norm_squared() + v.dot(&w.cross(&s)) + 0.5 * w.dot(&(j * w))
     }
 
-    /// Linear momentum [kg m/s] (spatial) and angular momentum about the node [kg m^2/s] (body).
+    /// Linear momentum [kg m/s] and angular momentum about the node [kg m^2/s], spatial.
     #[must_use]
     pub fn momentum(&self, r: &Matrix3<f64>, v: &Vector3<f64>, w: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-        let p = v * self.mass + r * w.cross(&self.moment);
-        let h = self.inertia * w + self.moment.cross(&(r.transpose() * v));
-        (p, h)
+        let (s, j) = self.spatial(r);
+        (v * self.mass + w.cross(&s), j * w + s.cross(v))
     }
 
-    /// Inertia force (spatial) and moment about the node (spatial) [N, N m].
+    /// Inertia force and moment about the node [N, N m].
     #[must_use]
     pub fn forces(&self, m: &Motion) -> (Vector3<f64>, Vector3<f64>) {
-        let s = &self.moment;
-        let u = m.dw.cross(s) + m.w.cross(&m.w.cross(s));
-        let f = m.a * self.mass + m.r * u;
-        let p = self.inertia * m.dw + m.w.cross(&(self.inertia * m.w)) + s.cross(&(m.r.transpose() * m.a));
-        (f, m.r * p)
+        let (s, j) = self.spatial(m.r);
+        let f = m.a * self.mass + m.dw.cross(&s) + m.w.cross(&m.w.cross(&s));
+        let moment = j * m.dw + m.w.cross(&(j * m.w)) + s.cross(m.a);
+        (f, moment)
     }
 
     /// Derivative of [`Self::forces`] with respect to the node's translation and spatial rotation
-    /// increments `(delta x, delta theta)`, when the accelerations and velocities follow them as
-    /// `d a = beta' delta x`, `d W/dt = beta' P delta theta`, `d W = gamma' P delta theta` (the
-    /// generalised-alpha relations, `P = T^-1(theta_step) R^T` mapping a spatial rotation
-    /// increment to the step's body rotation vector).
+    /// increments `(delta x, delta theta)` (`R <- exp(delta theta^) R`), when the accelerations
+    /// and velocities follow them as `d a = beta' delta x`, `d dw/dt = beta' P delta theta`,
+    /// `d w = gamma' P delta theta` (the generalised-alpha relations; `P = T^-T(D)` maps a rotation
+    /// increment to the change of the step's rotation vector `D`).
     #[must_use]
     pub fn jacobian(&self, m: &Motion, beta_p: f64, gamma_p: f64, p: &Matrix3<f64>) -> Matrix6<f64> {
-        let s = &self.moment;
-        let (r, w) = (m.r, m.w);
-        let u = m.dw.cross(s) + w.cross(&w.cross(s));
-        let jw = self.inertia * w;
-        let pm = self.inertia * m.dw + w.cross(&jw) + s.cross(&(r.transpose() * m.a));
-        // d(W x (W x s))/dW.
-        let centripetal = w * s.transpose() + Matrix3::identity() * w.dot(s) - s * w.transpose() * 2.0;
-        let gyroscopic = skew(w) * self.inertia - skew(&jw);
-        let ss = skew(s);
+        let (s, j) = self.spatial(m.r);
+        let (w, dw, a) = (m.w, m.dw, m.a);
+        let (ss, sw, sdw) = (skew(&s), skew(w), skew(dw));
+        // d(w x (w x s))/dw.
+        let centripetal = w * s.transpose() + Matrix3::identity() * w.dot(&s) - s * w.transpose() * 2.0;
+        let jw = j * w;
         let mut jac = Matrix6::zeros();
         jac.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&(Matrix3::identity() * (self.mass * beta_p)));
         jac.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(-skew(&(r * u)) + r * (-ss * beta_p + centripetal * gamma_p) * p));
-        jac.fixed_view_mut::<3, 3>(3, 0)
-            .copy_from(&(r * ss * r.transpose() * beta_p));
+            .copy_from(&((-ss * beta_p + centripetal * gamma_p) * p - sdw * ss - sw * sw * ss));
+        jac.fixed_view_mut::<3, 3>(3, 0).copy_from(&(ss * beta_p));
         jac.fixed_view_mut::<3, 3>(3, 3).copy_from(
-            &(-skew(&(r * pm))
-                + r * ((self.inertia * beta_p + gyroscopic * gamma_p) * p + ss * r.transpose() * skew(m.a))),
+            &((j * beta_p + (sw * j - skew(&jw)) * gamma_p) * p - skew(&(j * dw)) + j * sdw - sw * skew(&jw)
+                + sw * j * sw
+                + skew(a) * ss),
         );
         jac
     }
@@ -136,33 +143,33 @@ mod tests {
         body.add(2.0, &Vector3::new(0.1, -0.3, 0.2), &j);
         body.add(0.5, &Vector3::new(-0.2, 0.1, 0.05), &Matrix3::zeros());
         let q0 = UnitQuaternion::from_scaled_axis(Vector3::new(0.4, -0.2, 0.9));
-        let theta_step = Vector3::new(0.05, 0.02, -0.04);
-        let q1 = q0 * UnitQuaternion::from_scaled_axis(theta_step);
+        let d0 = Vector3::new(0.05, 0.02, -0.04);
+        let q1 = UnitQuaternion::from_scaled_axis(d0) * q0;
         let (a, w, dw) = (Vector3::new(1.0, -2.0, 0.5), Vector3::new(3.0, -1.0, 2.0), Vector3::new(-4.0, 5.0, 1.0));
         let (beta_p, gamma_p) = (7.0, 3.0);
         let forces = |q: &UnitQuaternion<f64>, dx: &Vector3<f64>| {
-            // The step's body rotation vector and the velocities that follow from it.
-            let th = (q0.inverse() * q).scaled_axis() - theta_step;
+            // The step's rotation vector and the velocities that follow from it.
+            let th = (q * q0.inverse()).scaled_axis() - d0;
             let r = q.to_rotation_matrix().into_inner();
             let (a, w, dw) = (a + dx * beta_p, w + th * gamma_p, dw + th * beta_p);
             let (f, m) = body.forces(&Motion { r: &r, a: &a, w: &w, dw: &dw });
             Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
         };
         let r1 = q1.to_rotation_matrix().into_inner();
-        let p = tangent_inverse(&theta_step) * r1.transpose();
+        let p = tangent_inverse(&-d0);
         let jac = body.jacobian(&Motion { r: &r1, a: &a, w: &w, dw: &dw }, beta_p, gamma_p, &p);
         let eps = 1e-6;
         for k in 0..6 {
-            let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
-            let fd = |sign: f64, dx: &mut Vector3<f64>, dth: &mut Vector3<f64>| {
+            let fd = |sign: f64| {
+                let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
                 if k < 3 {
                     dx[k] = sign * eps;
                 } else {
                     dth[k - 3] = sign * eps;
                 }
-                forces(&rotate(&q1, dth), dx)
+                forces(&rotate(&q1, &dth), &dx)
             };
-            let col = (fd(1.0, &mut dx, &mut dth) - fd(-1.0, &mut dx, &mut dth)) / (2.0 * eps);
+            let col = (fd(1.0) - fd(-1.0)) / (2.0 * eps);
             let err = (col - jac.column(k)).norm() / jac.column(k).norm().max(1.0);
             assert!(err < 1e-6, "column {k}: fd {col:?} vs {:?}", jac.column(k));
         }
@@ -183,16 +190,17 @@ mod tests {
             Vector3::new(0.2, -3.0, 1.0),
         );
         let (f, m) = body.forces(&Motion { r: &r, a: &a, w: &w, dw: &dw });
-        // dT/dt = f . v + m . (R W) for any motion.
+        // dT/dt = f . v + m . w for any motion (w, dw spatial).
         let h = 1e-6;
         let energy = |dt: f64| {
-            let r = r * UnitQuaternion::from_scaled_axis(w * dt + dw * dt * dt / 2.0)
+            let r = UnitQuaternion::from_scaled_axis(w * dt + dw * dt * dt / 2.0)
                 .to_rotation_matrix()
-                .into_inner();
+                .into_inner()
+                * r;
             body.kinetic_energy(&r, &(v + a * dt), &(w + dw * dt))
         };
         let rate = (energy(h) - energy(-h)) / (2.0 * h);
-        let power = f.dot(&v) + m.dot(&(r * w));
+        let power = f.dot(&v) + m.dot(&w);
         assert!((rate - power).abs() < 1e-7 * power.abs().max(1.0), "dT/dt {rate} vs power {power}");
     }
 }

@@ -151,6 +151,20 @@ fn yes() -> bool {
     true
 }
 
+/// Initial velocity of a node (an initial condition of the first dynamic step).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialVelocity {
+    /// The node (an independent node: tied nodes follow their reference node).
+    pub node: usize,
+    /// Velocity [m/s].
+    #[serde(default = "Vector3::zeros")]
+    pub velocity: Vector3<f64>,
+    /// Angular velocity, global axes [rad/s].
+    #[serde(default = "Vector3::zeros")]
+    pub angular_velocity: Vector3<f64>,
+}
+
 /// A model: parts, rigid bodies, ties, constraints, loads, gravity and markers.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -178,6 +192,9 @@ pub struct Model {
     /// Markers.
     #[serde(default)]
     pub markers: Vec<Marker>,
+    /// Initial velocities (nodes not listed start at rest).
+    #[serde(default)]
+    pub initial_velocities: Vec<InitialVelocity>,
 }
 
 fn finite3(v: &Vector3<f64>) -> bool {
@@ -449,6 +466,37 @@ impl Model {
         Ok(())
     }
 
+    /// Gives node `node` an initial velocity [m/s] and angular velocity [rad/s] (global axes).
+    ///
+    /// # Errors
+    /// [`Error::InvalidModel`] for an unknown or tied node, a node given two initial velocities or
+    /// a non-finite value.
+    pub fn set_initial_velocity(&mut self, v: InitialVelocity) -> Result<()> {
+        self.check_initial_velocity(&v)?;
+        if self.initial_velocities.iter().any(|o| o.node == v.node) {
+            return Err(Error::InvalidModel(format!("node {} already has an initial velocity", v.node)));
+        }
+        self.initial_velocities.push(v);
+        Ok(())
+    }
+
+    fn check_initial_velocity(&self, v: &InitialVelocity) -> Result<()> {
+        self.check_node(v.node)?;
+        if !finite3(&v.velocity) || !finite3(&v.angular_velocity) {
+            return Err(Error::InvalidModel(format!(
+                "the initial velocity of node {} is not finite",
+                v.node
+            )));
+        }
+        if let Some(t) = self.ties.iter().find(|t| t.nodes.contains(&v.node)) {
+            return Err(Error::InvalidModel(format!(
+                "node {} is tied to node {}: give the initial velocity to the reference node",
+                v.node, t.reference
+            )));
+        }
+        Ok(())
+    }
+
     /// Sets gravity.
     ///
     /// # Errors
@@ -567,6 +615,12 @@ impl Model {
                 return Err(Error::InvalidParameter("gravity acceleration must be finite".into()));
             }
             g.function.validate()?;
+        }
+        for (i, v) in self.initial_velocities.iter().enumerate() {
+            self.check_initial_velocity(v)?;
+            if self.initial_velocities[..i].iter().any(|o| o.node == v.node) {
+                return Err(Error::InvalidModel(format!("node {} has two initial velocities", v.node)));
+            }
         }
         for (i, m) in self.markers.iter().enumerate() {
             self.check_node(m.node)?;

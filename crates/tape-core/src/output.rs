@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::dof::Dof;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::solver::{Event, StaticStep};
+use crate::solver::{EnergyBalance, Event, StaticStep};
 
 /// What to record besides the time, the markers and the energies.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -86,6 +86,19 @@ pub struct History {
     pub strain_energy: Vec<f64>,
     /// Potential energy of gravity `-sum m g . x` [J].
     pub gravity_energy: Vec<f64>,
+    /// Kinetic energy [J] (0 in static steps).
+    pub kinetic_energy: Vec<f64>,
+    /// Work of the nodal loads since the start of the record's dynamic step [J] (NaN in static
+    /// steps).
+    pub work_loads: Vec<f64>,
+    /// Work of the prescribed motions since the start of the dynamic step [J] (NaN in static steps).
+    pub work_prescribed: Vec<f64>,
+    /// Energy dissipated by Kelvin-Voigt damping since the start of the dynamic step [J] (NaN in
+    /// static steps).
+    pub viscous_dissipation: Vec<f64>,
+    /// Energy dissipated by the time integrator since the start of the dynamic step: the remainder
+    /// of the balance [J] (NaN in static steps).
+    pub numerical_dissipation: Vec<f64>,
     /// Marker names, in model order.
     pub marker_names: Vec<String>,
     /// Marker positions [m], `record x marker` rows of 3.
@@ -130,6 +143,18 @@ impl History {
         self.event.push(s.event);
         self.strain_energy.push(s.energy);
         self.gravity_energy.push(s.gravity_energy);
+        let b = s.balance.unwrap_or(EnergyBalance {
+            kinetic: 0.0,
+            work_loads: f64::NAN,
+            work_prescribed: f64::NAN,
+            viscous: f64::NAN,
+            numerical: f64::NAN,
+        });
+        self.kinetic_energy.push(b.kinetic);
+        self.work_loads.push(b.work_loads);
+        self.work_prescribed.push(b.work_prescribed);
+        self.viscous_dissipation.push(b.viscous);
+        self.numerical_dissipation.push(b.numerical);
         self.marker_positions.extend(s.markers);
         self.marker_rotations.extend(s.marker_rotations);
         self.reactions.extend(s.probes);

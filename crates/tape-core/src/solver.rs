@@ -3,6 +3,7 @@
 
 pub mod alpha;
 pub mod control;
+pub mod dynamics;
 mod events;
 pub mod newton;
 mod relax;
@@ -16,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::options::Options;
 
 pub use control::StepController;
+pub use dynamics::{solve_dynamic, DynamicParams, DynamicPath, EnergyBalance};
 pub use newton::NewtonParams;
 pub use statics::solve_static;
 
@@ -172,6 +174,20 @@ const ARC_ONLY: [&str; 9] = [
     "refine_change",
     "refine_span",
 ];
+
+/// Names of every option of a static step (refused, as not applying, by dynamic steps).
+pub(crate) fn static_option_names() -> Vec<&'static str> {
+    let mut v: Vec<&str> = ["control", "target_iterations", "stability", "line_search", "mixed_stress"]
+        .iter()
+        .chain(&LOAD_OPTIONS)
+        .chain(&DISPLACEMENT_OPTIONS)
+        .chain(&ARC_OPTIONS)
+        .chain(&ARC_ONLY)
+        .copied()
+        .collect();
+    v.dedup();
+    v
+}
 
 impl StaticParams {
     /// Checks every setting.
@@ -504,6 +520,8 @@ pub struct StaticStep {
     /// Arc-length position of the state from the step's start (path order: states inserted by
     /// location or refinement fall between their neighbours).
     pub arc: f64,
+    /// Energy balance of a dynamic step's state (`None` in static steps).
+    pub balance: Option<dynamics::EnergyBalance>,
 }
 
 /// The equilibrium path followed by a static analysis.

@@ -1,10 +1,14 @@
-//! The state of a model: time (the load factor in static steps), nodal positions and triads.
+//! The state of a model: time (the load factor in static steps), nodal positions and triads, and
+//! in dynamic analyses their velocities and accelerations.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Current configuration, per node so that it survives a renumbering (an analysis step that
 /// switches constraints). Owned by the caller of the solvers; copied to keep converged states.
+///
+/// Velocities and accelerations are spatial (global axes), angular ones included:
+/// `dQ/dt = [w]x Q`. Static steps leave them at zero.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct State {
     /// Time [s] in dynamic steps; the load factor in static steps.
@@ -13,13 +17,43 @@ pub struct State {
     pub x: Vec<Vector3<f64>>,
     /// Nodal triads (orientation of `[t1, t2, d]`), updated multiplicatively `Q <- exp(theta^) Q`.
     pub q: Vec<UnitQuaternion<f64>>,
+    /// Nodal velocities [m/s].
+    #[serde(default)]
+    pub v: Vec<Vector3<f64>>,
+    /// Nodal angular velocities [rad/s].
+    #[serde(default)]
+    pub w: Vec<Vector3<f64>>,
+    /// Nodal accelerations [m/s^2].
+    #[serde(default)]
+    pub acc: Vec<Vector3<f64>>,
+    /// Nodal angular accelerations [rad/s^2].
+    #[serde(default)]
+    pub dw: Vec<Vector3<f64>>,
 }
 
 impl State {
-    /// A state at time 0 with the given positions and triads.
+    /// A state at time 0, at rest, with the given positions and triads.
     #[must_use]
     pub fn at_rest(x: Vec<Vector3<f64>>, q: Vec<UnitQuaternion<f64>>) -> Self {
-        Self { t: 0.0, x, q }
+        let zeros = vec![Vector3::zeros(); x.len()];
+        Self {
+            t: 0.0,
+            v: zeros.clone(),
+            w: zeros.clone(),
+            acc: zeros.clone(),
+            dw: zeros,
+            x,
+            q,
+        }
+    }
+
+    /// Sets every velocity and acceleration to zero (the state a static step leaves).
+    pub fn stop(&mut self) {
+        let n = self.x.len();
+        for v in [&mut self.v, &mut self.w, &mut self.acc, &mut self.dw] {
+            v.clear();
+            v.resize(n, Vector3::zeros());
+        }
     }
 
     /// Displacement of node `i` from `reference` [m].

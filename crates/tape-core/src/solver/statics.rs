@@ -511,6 +511,7 @@ impl Driver<'_> {
             jump: false,
             event: None,
             arc: 0.0,
+            balance: None,
         })
     }
 

@@ -1,0 +1,812 @@
+//! Transient dynamics: the Lie-group generalised-alpha scheme ([`super::alpha`]) on the nodal
+//! configuration space (translations times rotations), Newton's method per step with the
+//! consistent iteration matrix, and adaptive time steps.
+//!
+//! Each Newton iteration works on the spatial increments of the statics (`Q <- exp(theta^) Q`);
+//! the step's rotation vector `D = log(R R_n^T)` of each node (spatial, the right-invariant form of
+//! the Lie-group scheme) and, from it, the velocities and accelerations follow exactly, so
+//! rotations of any size are exact and the only linearised map is `d D = T^-T(D) d theta` (the
+//! tangent operator, in the inertia Jacobian). The
+//! iteration matrix is `K + gamma' C + beta' M` assembled as:
+//!
+//! * the elements' tangent, their Kelvin-Voigt material part scaled by `1 + eta gamma'`;
+//! * each node's 6 x 6 inertia Jacobian (mass, rotary inertia, gyroscopic and centripetal terms,
+//!   see [`crate::inertia`]).
+//!
+//! The inertia forces are added to the internal forces, so the residual is `f_int + f_inertia -
+//! f_ext` and the reactions at constrained DOFs are the forces the supports feel (inertia
+//! included).
+//!
+//! Step control: the local error of the displacements is estimated as `|beta - 1/6| h^2
+//! |dv_{n+1} - dv_n|` per node (rotations times the characteristic length) and kept below the
+//! user's tolerance; a step that fails to converge is cut back by 4, one whose error is too large
+//! is shrunk to the size the estimate asks for. The step never skips an output time.
+
+use std::time::Instant;
+
+use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+use super::alpha::{advance3, Alpha};
+use super::newton::{Convergence, NewtonParams, NEWTON_OPTIONS};
+use super::{StaticStep, Stats};
+use crate::assembly::{Assembled, System};
+use crate::constraint::Slot;
+use crate::error::{check_positive, Error, Result};
+use crate::inertia::Motion;
+use crate::options::Options;
+use crate::rotation::tangent_inverse;
+use crate::state::State;
+
+/// Settings of a dynamic step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DynamicParams {
+    /// Duration of the step [s], > 0.
+    pub duration: f64,
+    /// Spectral radius at infinite frequency of the generalised-alpha scheme, in [0, 1]: 1 has no
+    /// numerical dissipation, smaller values damp high frequencies more (default 0.7, the paper's).
+    pub rho_inf: f64,
+    /// First time step [s] (0: `duration / 1000`).
+    pub initial_step: f64,
+    /// Largest time step [s] (0: `duration / 20`).
+    pub max_step: f64,
+    /// Smallest time step [s] before the step gives up (0: `1e-12 duration`).
+    pub min_step: f64,
+    /// Adapt the time step to the local error estimate (false: fixed steps, cut back only when
+    /// Newton fails).
+    pub adaptive: bool,
+    /// Local error tolerance of the displacements per step [m] (0: `1e-5` times the model's
+    /// characteristic length, half its bounding-box diagonal).
+    pub tolerance: f64,
+    /// Steps land exactly on every multiple of this interval from the step's start [s] (0: none).
+    pub output_interval: f64,
+    /// Largest number of accepted steps.
+    pub max_steps: usize,
+    /// Successive cut-backs allowed before the step gives up.
+    pub max_cutbacks: usize,
+    /// Newton settings (`line_search` and `mixed_stress` do not apply).
+    pub newton: NewtonParams,
+    /// Record nodal fields (set by the analysis runner).
+    #[serde(skip)]
+    pub record_fields: bool,
+}
+
+impl Default for DynamicParams {
+    fn default() -> Self {
+        Self {
+            duration: 1.0,
+            rho_inf: 0.7,
+            initial_step: 0.0,
+            max_step: 0.0,
+            min_step: 0.0,
+            adaptive: true,
+            tolerance: 0.0,
+            output_interval: 0.0,
+            max_steps: 100_000,
+            max_cutbacks: 12,
+            newton: NewtonParams {
+                mixed_stress: false,
+                line_search: false,
+                ..NewtonParams::default()
+            },
+            record_fields: false,
+        }
+    }
+}
+
+const DYNAMIC_OPTIONS: [&str; 10] = [
+    "duration",
+    "rho_inf",
+    "initial_step",
+    "max_step",
+    "min_step",
+    "adaptive",
+    "tolerance",
+    "output_interval",
+    "max_steps",
+    "max_cutbacks",
+];
+
+impl DynamicParams {
+    /// Checks every setting.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the bad setting.
+    pub fn validate(&self) -> Result<()> {
+        check_positive("duration [s]", self.duration)?;
+        Alpha::new(self.rho_inf)?;
+        for (name, v) in [
+            ("initial_step [s]", self.initial_step),
+            ("max_step [s]", self.max_step),
+            ("min_step [s]", self.min_step),
+            ("tolerance [m]", self.tolerance),
+            ("output_interval [s]", self.output_interval),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidParameter(format!(
+                    "{name} must be finite and >= 0 (0: default) (got {v})"
+                )));
+            }
+        }
+        if self.max_steps == 0 {
+            return Err(Error::InvalidParameter("max_steps must be >= 1".into()));
+        }
+        if self.max_cutbacks > 1000 {
+            return Err(Error::InvalidParameter(format!(
+                "max_cutbacks must lie in [0, 1000] (got {})",
+                self.max_cutbacks
+            )));
+        }
+        self.newton.validate()
+    }
+
+    /// Reads a flat option map (defaults for the options absent).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a bad value or an option that is not a dynamic step's.
+    pub fn from_options(mut o: Options) -> Result<Self> {
+        let d = Self::default();
+        let mut newton = NewtonParams::read(&mut o)?;
+        newton.mixed_stress = false;
+        newton.line_search = false;
+        let p = Self {
+            duration: o.take_or("duration", d.duration)?,
+            rho_inf: o.take_or("rho_inf", d.rho_inf)?,
+            initial_step: o.take_or("initial_step", d.initial_step)?,
+            max_step: o.take_or("max_step", d.max_step)?,
+            min_step: o.take_or("min_step", d.min_step)?,
+            adaptive: o.take_or("adaptive", d.adaptive)?,
+            tolerance: o.take_or("tolerance", d.tolerance)?,
+            output_interval: o.take_or("output_interval", d.output_interval)?,
+            max_steps: o.take_or("max_steps", d.max_steps)?,
+            max_cutbacks: o.take_or("max_cutbacks", d.max_cutbacks)?,
+            newton,
+            record_fields: false,
+        };
+        let statics = super::static_option_names();
+        o.finish(&statics, "a dynamic step")?;
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The settings as the flat option map [`Self::from_options`] reads.
+    #[must_use]
+    pub fn to_options(&self) -> Map<String, Value> {
+        let mut m = Map::new();
+        m.insert("duration".into(), self.duration.into());
+        m.insert("rho_inf".into(), self.rho_inf.into());
+        m.insert("initial_step".into(), self.initial_step.into());
+        m.insert("max_step".into(), self.max_step.into());
+        m.insert("min_step".into(), self.min_step.into());
+        m.insert("adaptive".into(), self.adaptive.into());
+        m.insert("tolerance".into(), self.tolerance.into());
+        m.insert("output_interval".into(), self.output_interval.into());
+        m.insert("max_steps".into(), self.max_steps.into());
+        m.insert("max_cutbacks".into(), self.max_cutbacks.into());
+        self.newton.write(&mut m);
+        m.remove("mixed_stress");
+        m.remove("line_search");
+        m
+    }
+
+    /// Names of the options of a dynamic step.
+    #[must_use]
+    pub fn option_names() -> Vec<&'static str> {
+        DYNAMIC_OPTIONS
+            .iter()
+            .chain(NEWTON_OPTIONS.iter().filter(|n| !matches!(**n, "mixed_stress" | "line_search")))
+            .copied()
+            .collect()
+    }
+}
+
+/// Energy terms of a dynamic record, cumulated from the start of its step [J].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyBalance {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Work of the nodal loads since the step's start.
+    pub work_loads: f64,
+    /// Work of the prescribed motions (the supports' reactions) since the step's start.
+    pub work_prescribed: f64,
+    /// Energy dissipated by Kelvin-Voigt damping since the step's start.
+    pub viscous: f64,
+    /// The remainder: work in, minus the change of kinetic, strain and gravity energy, minus the
+    /// viscous dissipation: the energy the time integrator dissipated (or, if negative, created).
+    pub numerical: f64,
+}
+
+/// The trajectory computed by [`solve_dynamic`].
+#[derive(Debug, Default)]
+pub struct DynamicPath {
+    /// Accepted steps, in time order.
+    pub steps: Vec<StaticStep>,
+    /// Why the step stopped early, if it did (the accepted steps are kept).
+    pub error: Option<Error>,
+    /// Counters and timings.
+    pub stats: Stats,
+    /// True if the progress callback asked to stop.
+    pub cancelled: bool,
+}
+
+/// Per-node GA quantities: translation and body rotation.
+type Pair = [Vector3<f64>; 2];
+
+struct Integrator<'a> {
+    system: &'a mut System,
+    alpha: Alpha,
+    asm: Assembled,
+    weights: Vec<f64>,
+    conv: Convergence,
+    force_floor: f64,
+    /// Algorithmic accelerations at the start of the step, and the step that produced them.
+    a_gen: Vec<Pair>,
+    h_gen: f64,
+    stats: Stats,
+}
+
+/// Outcome of one attempted time step.
+enum Attempt {
+    Converged { iterations: usize, error: f64, a_gen: Vec<Pair> },
+    Failed { iterations: usize, residual: f64, why: String },
+}
+
+impl Integrator<'_> {
+    /// The step's increment `(x - x_n, log(R R_n^T))` of independent node `i` (spatial).
+    fn increment(&self, start: &State, state: &State, i: usize) -> Pair {
+        let rel: UnitQuaternion<f64> = state.q[i] * start.q[i].inverse();
+        [state.x[i] - start.x[i], rel.scaled_axis()]
+    }
+
+    /// Velocities and accelerations of `state` from its increment over the step `h` from
+    /// `start` (whose algorithmic accelerations are `a`); returns the new algorithmic ones.
+    fn kinematics(&self, start: &State, state: &mut State, h: f64, a: &[Pair]) -> Vec<Pair> {
+        let mut a_new = vec![[Vector3::zeros(); 2]; state.x.len()];
+        for i in 0..state.x.len() {
+            if self.system.dofs.master[i].is_some() {
+                continue;
+            }
+            let d = self.increment(start, state, i);
+            let [a1, v1, dv1] = advance3(&self.alpha, h, &d[0], &start.v[i], &start.acc[i], &a[i][0]);
+            let [b1, w1, dw1] = advance3(&self.alpha, h, &d[1], &start.w[i], &start.dw[i], &a[i][1]);
+            (state.v[i], state.acc[i], state.w[i], state.dw[i]) = (v1, dv1, w1, dw1);
+            a_new[i] = [a1, b1];
+        }
+        a_new
+    }
+
+    /// Adds the inertia forces of every independent node to `asm.f_int` (free and constrained)
+    /// and, with `jacobian`, their Jacobian to `asm.k_ff`. Returns the weighted norm of the
+    /// inertia forces at the free equations.
+    fn add_inertia(&mut self, start: &State, state: &State, h: f64, jacobian: bool) -> f64 {
+        let (beta_p, gamma_p) = (self.alpha.beta_prime(h), self.alpha.gamma_prime(h));
+        let mut norm2 = 0.0;
+        let lc2 = self.system.char_length.powi(2);
+        for i in 0..state.x.len() {
+            let body = self.system.inertia[i];
+            if self.system.dofs.master[i].is_some() || body.is_empty() {
+                continue;
+            }
+            let r = self.system.node_rotation(state, i).to_rotation_matrix().into_inner();
+            let motion = Motion {
+                r: &r,
+                a: &state.acc[i],
+                w: &state.w[i],
+                dw: &state.dw[i],
+            };
+            let (f, m) = body.forces(&motion);
+            let fm = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+            for d in 0..6 {
+                match self.system.dofs.slots[i][d] {
+                    Slot::Free(eq) => {
+                        self.asm.f_int[eq] += fm[d];
+                        norm2 += fm[d] * fm[d] / if d < 3 { 1.0 } else { lc2 };
+                    }
+                    Slot::Constrained(c) => self.asm.f_int_c[c] += fm[d],
+                }
+            }
+            if jacobian {
+                let d = self.increment(start, state, i);
+                let p = tangent_inverse(&-d[1]);
+                let jac = body.jacobian(&motion, beta_p, gamma_p, &p);
+                self.add_node_matrix(i, &jac);
+            }
+        }
+        norm2.sqrt()
+    }
+
+    fn add_node_matrix(&mut self, i: usize, jac: &Matrix6<f64>) {
+        let slots = &self.system.dofs.slots[i];
+        for r in 0..6 {
+            let Slot::Free(row) = slots[r] else { continue };
+            for c in 0..6 {
+                if let Slot::Free(col) = slots[c] {
+                    let p = self
+                        .system
+                        .pattern_ff
+                        .find(row, col)
+                        .expect("node blocks are in the pattern");
+                    self.asm.k_ff[p] += jac[(r, c)];
+                }
+            }
+        }
+    }
+
+    /// Assembles residual and iteration matrix at `state`; returns (residual norm, reference).
+    fn assemble(&mut self, start: &State, state: &State, h: f64, r: &mut Vec<f64>) -> (f64, f64) {
+        let t = Instant::now();
+        let rates = self.system.rates(state, self.alpha.gamma_prime(h));
+        self.system.assemble_dynamic(state, &rates, &mut self.asm);
+        let f_int = System::force_norm(&self.asm.f_int, &self.weights);
+        let inertia = self.add_inertia(start, state, h, true);
+        self.asm.residual_into(r);
+        self.stats.assembly_s += t.elapsed().as_secs_f64();
+        let reference = System::force_norm(&self.asm.f_ext, &self.weights)
+            .max(inertia)
+            .max(f_int)
+            .max(self.force_floor);
+        (System::force_norm(r, &self.weights), reference)
+    }
+
+    /// One time step of size `h` from `start` (velocities, accelerations and the algorithmic
+    /// accelerations `a`): predictor, then Newton.
+    fn attempt(&mut self, start: &State, state: &mut State, h: f64, a: &[Pair], params: &DynamicParams) -> Attempt {
+        let n_free = self.system.n_free();
+        // Predictor: the true accelerations held over the step.
+        let mut dq = vec![0.0; n_free];
+        for i in 0..state.x.len() {
+            if self.system.dofs.master[i].is_some() {
+                continue;
+            }
+            let mut d = [Vector3::zeros(); 2];
+            for k in 0..3 {
+                d[0][k] = self.alpha.predict(h, start.v[i][k], start.acc[i][k], a[i][0][k]);
+                d[1][k] = self.alpha.predict(h, start.w[i][k], start.dw[i][k], a[i][1][k]);
+            }
+            for (k, slot) in self.system.dofs.slots[i].iter().enumerate() {
+                if let Slot::Free(eq) = slot {
+                    dq[*eq] = d[k / 3][k % 3];
+                }
+            }
+        }
+        let dc = self.system.constrained_increments(start.t, h);
+        state.clone_from(start);
+        self.system.update_with(state, &dq, &dc);
+        state.t = start.t + h;
+        let mut r = Vec::with_capacity(n_free);
+        let mut residual = f64::NAN;
+        let mut a_new = self.kinematics(start, state, h, a);
+        for it in 0..=params.newton.max_iterations {
+            let (res, reference) = self.assemble(start, state, h, &mut r);
+            residual = res;
+            if !res.is_finite() {
+                return Attempt::Failed {
+                    iterations: it,
+                    residual,
+                    why: "the residual is not finite".into(),
+                };
+            }
+            if it > 0 && self.conv.test(res, reference, None) {
+                let error = self.error_estimate(start, state, h, params);
+                return Attempt::Converged {
+                    iterations: it,
+                    error,
+                    a_gen: a_new,
+                };
+            }
+            if it == params.newton.max_iterations {
+                break;
+            }
+            let t = Instant::now();
+            if let Err(e) = self.system.linear.factorize(&self.asm.k_ff) {
+                return Attempt::Failed {
+                    iterations: it,
+                    residual,
+                    why: e.to_string(),
+                };
+            }
+            self.stats.factorisations += 1;
+            let mut delta: Vec<f64> = r.iter().map(|v| -v).collect();
+            if let Err(e) = self.system.linear.solve_in_place(&mut delta) {
+                return Attempt::Failed {
+                    iterations: it,
+                    residual,
+                    why: e.to_string(),
+                };
+            }
+            self.stats.solve_s += t.elapsed().as_secs_f64();
+            self.stats.iterations += 1;
+            let zeros = vec![0.0; self.system.dofs.constrained.len()];
+            self.system.update_with(state, &delta, &zeros);
+            a_new = self.kinematics(start, state, h, a);
+        }
+        Attempt::Failed {
+            iterations: params.newton.max_iterations,
+            residual,
+            why: format!("Newton did not converge in {} iterations", params.newton.max_iterations),
+        }
+    }
+
+    /// Local error estimate of the step over its tolerance (<= 1 is acceptable).
+    fn error_estimate(&self, start: &State, state: &State, h: f64, params: &DynamicParams) -> f64 {
+        let c = self.alpha.error_coefficient() * h * h;
+        let lc = self.system.char_length;
+        let tol = if params.tolerance > 0.0 {
+            params.tolerance
+        } else {
+            1e-5 * lc
+        };
+        let mut worst: f64 = 0.0;
+        for i in 0..state.x.len() {
+            if self.system.dofs.master[i].is_some() || self.system.inertia[i].is_empty() {
+                continue;
+            }
+            let eu = (state.acc[i] - start.acc[i]).norm() * c;
+            let et = (state.dw[i] - start.dw[i]).norm() * c * lc;
+            worst = worst.max(eu).max(et);
+        }
+        worst / tol
+    }
+
+    /// Consistent accelerations of `state` (velocities given): `M dv = f_ext - f_int - g(v)` node
+    /// by node (the mass matrix is block diagonal), constrained DOFs held at zero acceleration.
+    fn initial_accelerations(&mut self, state: &mut State) -> Result<()> {
+        let rates = self.system.rates(state, 0.0);
+        self.system.assemble_dynamic(state, &rates, &mut self.asm);
+        for i in 0..state.x.len() {
+            state.acc[i] = Vector3::zeros();
+            state.dw[i] = Vector3::zeros();
+        }
+        for i in 0..state.x.len() {
+            let body = self.system.inertia[i];
+            if self.system.dofs.master[i].is_some() || body.is_empty() {
+                continue;
+            }
+            let r = self.system.node_rotation(state, i).to_rotation_matrix().into_inner();
+            // Velocity-dependent inertia forces at zero acceleration.
+            let zero = Vector3::zeros();
+            let (g_f, g_m) = body.forces(&Motion {
+                r: &r,
+                a: &zero,
+                w: &state.w[i],
+                dw: &zero,
+            });
+            let g = Vector6::new(g_f.x, g_f.y, g_f.z, g_m.x, g_m.y, g_m.z);
+            // Mass matrix on (acceleration, angular acceleration).
+            let (s, j) = body.spatial(&r);
+            let s = crate::rotation::skew(&s);
+            let mut m = Matrix6::zeros();
+            m.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(Matrix3::identity() * body.mass));
+            m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
+            m.fixed_view_mut::<3, 3>(3, 0).copy_from(&s);
+            m.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
+            let free: Vec<(usize, usize)> = self.system.dofs.slots[i]
+                .iter()
+                .enumerate()
+                .filter_map(|(d, s)| match s {
+                    Slot::Free(eq) => Some((d, *eq)),
+                    Slot::Constrained(_) => None,
+                })
+                .collect();
+            if free.is_empty() {
+                continue;
+            }
+            let n = free.len();
+            let mut mf = nalgebra::DMatrix::zeros(n, n);
+            let mut rhs = nalgebra::DVector::zeros(n);
+            for (a, &(da, eq)) in free.iter().enumerate() {
+                rhs[a] = self.asm.f_ext[eq] - self.asm.f_int[eq] - g[da];
+                for (b, &(db, _)) in free.iter().enumerate() {
+                    mf[(a, b)] = m[(da, db)];
+                }
+            }
+            let sol = mf.clone().cholesky().map(|c| c.solve(&rhs)).ok_or_else(|| {
+                let names: Vec<&str> = free
+                    .iter()
+                    .map(|(d, _)| crate::dof::Dof::ALL[*d].name())
+                    .collect();
+                Error::InvalidModel(format!(
+                    "node {i} has free DOFs {names:?} without mass or rotary inertia: a dynamic step needs \
+                     mass on every free DOF (give its part a density, or attach a rigid body)"
+                ))
+            })?;
+            let mut acc = Vector6::zeros();
+            for (a, &(d, _)) in free.iter().enumerate() {
+                acc[d] = sol[a];
+            }
+            state.acc[i] = acc.fixed_rows::<3>(0).into_owned();
+            state.dw[i] = acc.fixed_rows::<3>(3).into_owned();
+        }
+        Ok(())
+    }
+
+}
+
+/// Integrates the equations of motion of `system` from `state` (positions, rotations, velocities
+/// at `state.t`) over `params.duration`, recording every accepted step. `progress` is called after
+/// each one; returning `false` stops the step.
+///
+/// The accelerations of `state` are recomputed at the start (consistent with the current
+/// constraints and loads, so releasing a constraint does not jolt the state) and the algorithmic
+/// accelerations start from them.
+///
+/// # Errors
+/// Invalid settings, or a model with a free DOF that has no mass. A failure during the step (a
+/// time step cut back `max_cutbacks` times or below `min_step`, the step limit) is reported in
+/// [`DynamicPath::error`] with the accepted steps.
+#[allow(clippy::too_many_lines)]
+pub fn solve_dynamic(
+    system: &mut System,
+    state: &mut State,
+    params: &DynamicParams,
+    progress: &mut dyn FnMut(&StaticStep, &Stats) -> bool,
+) -> Result<DynamicPath> {
+    let start_time = Instant::now();
+    params.validate()?;
+    let alpha = Alpha::new(params.rho_inf)?;
+    let membrane = system.membrane_stiffness();
+    let x_max = system.reference.x.iter().map(|x| x.norm()).fold(0.0, f64::max);
+    #[allow(clippy::cast_precision_loss)]
+    let round_off =
+        f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
+    let weights = system.free_weights();
+    let n_nodes = state.x.len();
+    let mut integ = Integrator {
+        force_floor: 1e-13 * membrane * system.char_length,
+        system,
+        alpha,
+        asm: Assembled::default(),
+        weights,
+        conv: Convergence {
+            tol_force: params.newton.tol_force,
+            tol_energy: params.newton.tol_energy,
+            round_off,
+        },
+        a_gen: Vec::new(),
+        h_gen: 0.0,
+        stats: Stats::default(),
+    };
+    for v in [&mut state.v, &mut state.w, &mut state.acc, &mut state.dw] {
+        v.resize(n_nodes, Vector3::zeros());
+    }
+    integ.initial_accelerations(state)?;
+    integ.a_gen = (0..n_nodes).map(|i| [state.acc[i], state.dw[i]]).collect();
+
+    let t0 = state.t;
+    let t_end = t0 + params.duration;
+    let default_or = |v: f64, d: f64| if v > 0.0 { v } else { d };
+    let max_step = default_or(params.max_step, params.duration / 20.0);
+    let min_step = default_or(params.min_step, 1e-12 * params.duration.max(t_end.abs()));
+    let mut h = default_or(params.initial_step, params.duration / 1000.0).min(max_step);
+    integ.h_gen = h;
+
+    // Energy bookkeeping from the step's start.
+    let mut path = DynamicPath::default();
+    let mut balance = EnergyBalance::default();
+    let rates = integ.system.rates(state, 0.0);
+    integ.system.assemble_dynamic(state, &rates, &mut integ.asm);
+    integ.add_inertia(state, state, h, false);
+    let mut last = Energies::of(&integ, state);
+    let mech0 = last.kinetic + last.strain + last.gravity;
+
+    let eps_t = 1e-12 * params.duration.max(t_end.abs());
+    let mut cutbacks = 0;
+    let mut scratch = state.clone();
+    while state.t < t_end - eps_t {
+        if path.steps.len() >= params.max_steps {
+            path.error = Some(Error::StepLimit {
+                step: None,
+                t: state.t,
+                steps: path.steps.len(),
+                target: t_end,
+            });
+            break;
+        }
+        // Land on the end and on output times.
+        let mut target = t_end;
+        if params.output_interval > 0.0 {
+            let k = ((state.t - t0) / params.output_interval + 1e-9).floor() + 1.0;
+            target = target.min(t0 + k * params.output_interval);
+        }
+        let mut step_h = h.min(target - state.t);
+        if target - state.t - step_h < 0.25 * step_h {
+            // Avoid a sliver before the target.
+            step_h = target - state.t;
+        } else if target - state.t < 2.0 * step_h {
+            step_h = 0.5 * (target - state.t);
+        }
+        // The algorithmic accelerations for this step size.
+        let a: Vec<Pair> = integ
+            .a_gen
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let mut out = *p;
+                for k in 0..3 {
+                    out[0][k] = Alpha::rescale(p[0][k], state.acc[i][k], step_h, integ.h_gen);
+                    out[1][k] = Alpha::rescale(p[1][k], state.dw[i][k], step_h, integ.h_gen);
+                }
+                out
+            })
+            .collect();
+        let attempt = integ.attempt(state, &mut scratch, step_h, &a, params);
+        let (iterations, accepted) = match attempt {
+            Attempt::Converged {
+                iterations,
+                error,
+                a_gen,
+            } => {
+                let ok = !params.adaptive || error <= 1.0;
+                // Next size from the error estimate (third-order local error in h).
+                let factor = if params.adaptive {
+                    (0.9 * error.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 2.0)
+                } else {
+                    2.0
+                };
+                if ok {
+                    integ.a_gen = a_gen;
+                    integ.h_gen = step_h;
+                    h = (step_h.max(h.min(step_h * 4.0)) * factor).clamp(min_step, max_step);
+                    if !params.adaptive {
+                        h = h.min(default_or(params.initial_step, params.duration / 1000.0));
+                    }
+                    (iterations, true)
+                } else {
+                    integ.stats.cutbacks += 1;
+                    h = step_h * factor.min(0.9);
+                    (iterations, false)
+                }
+            }
+            Attempt::Failed {
+                iterations,
+                residual,
+                why,
+            } => {
+                integ.stats.cutbacks += 1;
+                cutbacks += 1;
+                h = step_h * 0.25;
+                if cutbacks > params.max_cutbacks || h < min_step {
+                    path.error = Some(Error::NotConverged {
+                        step: None,
+                        t: state.t,
+                        iterations,
+                        residual,
+                        detail: format!(
+                            "time step cut back {cutbacks} times down to {step_h:.3e} s ({why}); \
+                             lower min_step or raise max_cutbacks if the motion is that fast"
+                        ),
+                    });
+                    break;
+                }
+                (iterations, false)
+            }
+        };
+        if !accepted {
+            if h < min_step {
+                path.error = Some(Error::NotConverged {
+                    step: None,
+                    t: state.t,
+                    iterations,
+                    residual: f64::NAN,
+                    detail: format!(
+                        "the error estimate asks for a time step below min_step = {min_step:.3e} s; \
+                         raise the tolerance or lower min_step"
+                    ),
+                });
+                break;
+            }
+            continue;
+        }
+        cutbacks = 0;
+        // Energy terms: trapezoidal work of loads and supports, viscous dissipation.
+        let asm = &integ.asm;
+        let now = Energies::of(&integ, &scratch);
+        let mut w_loads = 0.0;
+        for i in 0..n_nodes {
+            if integ.system.dofs.master[i].is_some() {
+                continue;
+            }
+            let inc = integ.increment(state, &scratch, i);
+            for k in 0..6 {
+                w_loads += 0.5 * (last.loads[i][k] + now.loads[i][k]) * inc[k / 3][k % 3];
+            }
+        }
+        let dc = integ.system.constrained_increments(state.t, step_h);
+        let w_presc: f64 = dc
+            .iter()
+            .zip(last.reactions.iter().zip(&now.reactions))
+            .map(|(d, (r0, r1))| 0.5 * (r0 + r1) * d)
+            .sum();
+        balance.work_loads += w_loads;
+        balance.work_prescribed += w_presc;
+        balance.viscous += 0.5 * (last.dissipation + now.dissipation) * step_h;
+        balance.kinetic = now.kinetic;
+        balance.numerical = balance.work_loads + balance.work_prescribed
+            - balance.viscous
+            - (now.kinetic + now.strain + now.gravity - mech0);
+        std::mem::swap(state, &mut scratch);
+        integ.stats.steps += 1;
+        let record = record(&integ, state, asm, iterations, balance, params.record_fields);
+        last = now;
+        let go_on = progress(&record, &integ.stats);
+        path.steps.push(record);
+        if !go_on {
+            path.cancelled = true;
+            break;
+        }
+    }
+    integ.stats.wall_s = start_time.elapsed().as_secs_f64();
+    path.stats = integ.stats;
+    Ok(path)
+}
+
+/// What the energy balance needs of a state.
+struct Energies {
+    kinetic: f64,
+    strain: f64,
+    gravity: f64,
+    dissipation: f64,
+    /// Nodal loads (without gravity) per independent node, `[force, moment]`.
+    loads: Vec<[f64; 6]>,
+    /// Reactions at the constrained DOFs.
+    reactions: Vec<f64>,
+}
+
+impl Energies {
+    fn of(integ: &Integrator, state: &State) -> Self {
+        let asm = &integ.asm;
+        Self {
+            kinetic: integ.system.kinetic_energy(state),
+            strain: asm.energy,
+            gravity: asm.gravity_energy,
+            dissipation: asm.dissipation,
+            loads: integ.system.nodal_loads(state),
+            reactions: asm.reactions(),
+        }
+    }
+}
+
+fn record(
+    integ: &Integrator,
+    state: &State,
+    asm: &Assembled,
+    iterations: usize,
+    balance: EnergyBalance,
+    fields: bool,
+) -> StaticStep {
+    let system = &integ.system;
+    let n = |v: Vec<Vector3<f64>>| v.iter().map(|x| (*x).into()).collect();
+    let r = asm.residual();
+    let reference = &system.reference;
+    let (displacements, rotations) = if fields {
+        (
+            (0..state.x.len())
+                .map(|i| state.displacement(reference, i).into())
+                .collect(),
+            (0..state.x.len())
+                .map(|i| state.rotation(reference, i).into())
+                .collect(),
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    StaticStep {
+        lambda: state.t,
+        iterations,
+        residual: System::force_norm(&r, &integ.weights),
+        energy: asm.energy,
+        gravity_energy: asm.gravity_energy,
+        reactions: asm.reactions(),
+        negative_eigenvalues: None,
+        displacements,
+        rotations,
+        markers: n(system.marker_positions(state)),
+        marker_rotations: n(system.marker_rotations(state)),
+        probes: system.probe(asm),
+        balance: Some(balance),
+        ..StaticStep::default()
+    }
+}
+
