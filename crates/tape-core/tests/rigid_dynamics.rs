@@ -152,7 +152,7 @@ fn heavy_top_matches_the_reference_solution() -> Result<()> {
 
 /// Spin about the intermediate axis with a small perturbation: the body flips by pi about that
 /// axis and back; with rho_inf = 1 kinetic energy and angular momentum are kept to 1e-6 over
-/// several flips (no numerical dissipation), and with 0.7 the energy decays.
+/// several flips with rho_inf = 1 and 0.7 alike.
 #[test]
 fn torque_free_body_flips_about_its_intermediate_axis() -> Result<()> {
     let inertia = Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0));
@@ -179,18 +179,16 @@ fn torque_free_body_flips_about_its_intermediate_axis() -> Result<()> {
         let top = state.x.len() - 1;
         let r = r.to_rotation_matrix().into_inner();
         let h = r * inertia * r.transpose() * state.w[top];
-        if rho == 1.0 {
-            assert!((last - t0).abs() < 1e-6 * t0, "kinetic energy {last} vs {t0}");
-            assert!((h.norm() - h0).abs() < 1e-6 * h0, "|L| = {} vs {h0}", h.norm());
-        } else {
-            // The scheme dissipates on average, not step by step on a nonlinear problem: the
-            // energy may rise by a round-off-sized wiggle (measured 4e-8 of it) but ends lower.
-            let growth = kinetic.windows(2).map(|w| w[1] - w[0]).fold(f64::MIN, f64::max);
-            assert!(growth <= 1e-7 * t0, "kinetic energy grew by {growth:e} J in a step");
-            assert!(last < t0, "kinetic energy {last} J ended above its start {t0} J");
-        }
-        // Spatial angular momentum: direction too.
-        assert!((h - inertia * omega0).norm() < 1e-3 * h0 || rho < 1.0, "L drifted to {h:?}");
+        // The flip's frequencies are low (omega h ~ 0.01), where the scheme's algorithmic
+        // damping is ~1e-8 even at rho_inf = 0.7: energy and momentum are kept in both cases.
+        assert!((last - t0).abs() < 1e-6 * t0, "kinetic energy {last} vs {t0}");
+        assert!((h.norm() - h0).abs() < 1e-6 * h0, "|L| = {} vs {h0}", h.norm());
+        let growth = kinetic.windows(2).map(|w| w[1] - w[0]).fold(f64::MIN, f64::max);
+        assert!(growth <= 1e-7 * t0, "kinetic energy grew by {growth:e} J in a step");
+        // Its direction: generalised-alpha does not conserve angular momentum exactly (it is
+        // not a variational integrator); the drift is second order in h (measured 4e-5 of |L|
+        // over 10 s at h = 2e-3 s, omega h = 0.01).
+        assert!((h - inertia * omega0).norm() < 1e-4 * h0, "L drifted to {h:?}");
     }
     Ok(())
 }
