@@ -133,6 +133,13 @@ class Model:
         id: str | None = None,
         active: bool = True,
     ) -> None: ...
+    def set_initial_velocity(
+        self,
+        node: _Node,
+        *,
+        velocity: ArrayLike | None = None,
+        angular_velocity: ArrayLike | None = None,
+    ) -> None: ...
     def add_marker(self, name: str, node: _Node, *, offset: ArrayLike | None = None) -> None: ...
     def constrained(self) -> list[tuple[int, str]]: ...
     def constraints(self) -> list[dict[str, Any]]: ...
@@ -156,7 +163,8 @@ def run(
     progress: Callable[[int, str, float], bool | None] | None = None,
 ) -> dict[str, Any]:
     """Run the steps; keys: step, t, iterations, residual, negative_eigenvalues, jump, event,
-    strain_energy, gravity_energy, marker_names, marker_positions, marker_rotations,
+    strain_energy, gravity_energy, kinetic_energy, work_loads, work_prescribed,
+    viscous_dissipation, numerical_dissipation, marker_names, marker_positions, marker_rotations,
     reaction_dofs, reactions, field_records, displacements, rotations, ndof, stats, step_stats,
     error, cancelled, steps_completed, settings."""
 

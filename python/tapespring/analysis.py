@@ -43,6 +43,7 @@ from tapespring.results import Results
 __all__ = [
     "DOFS",
     "ConvergenceError",
+    "dynamic_step_options",
     "Model",
     "Outputs",
     "Step",
@@ -91,6 +92,21 @@ def step_options(control: str = "load") -> dict[str, Any]:
     return options
 
 
+def dynamic_step_options() -> dict[str, Any]:
+    """Every option of a dynamic step, with its default value.
+
+    ``duration`` [s]; ``rho_inf`` (spectral radius at infinite frequency, 0.7); ``initial_step``,
+    ``max_step``, ``min_step`` [s] (0: ``duration/1000``, ``duration/20``, ``1e-12 duration``);
+    ``adaptive`` (time steps from the local error estimate); ``tolerance`` [m] (local error per
+    step; 0: 1e-5 times the model's characteristic length); ``output_interval`` [s] (steps land on
+    its multiples; 0: none); ``max_steps``; ``max_cutbacks``; and the Newton options.
+    """
+    options = dict(_core.step_defaults("dynamic"))
+    for key in ("name", "kind", "activate", "deactivate"):
+        options.pop(key)
+    return options
+
+
 @dataclass(frozen=True)
 class Step:
     """An analysis step: what it computes, and what it switches on and off at its start.
@@ -100,7 +116,7 @@ class Step:
     name : str
         Name, in messages and results.
     kind : str
-        ``"static"``: an equilibrium path.
+        ``"static"``: an equilibrium path; ``"dynamic"``: a transient over a duration.
     activate, deactivate : tuple of str
         Ids of constraints, loads or gravity switched on and off at the start of the step.
     options : mapping
@@ -125,6 +141,26 @@ class Step:
     ) -> Step:
         """A static step; `options` are those of :func:`step_options` (``control`` included)."""
         return cls(name, "static", tuple(activate), tuple(deactivate), dict(options))
+
+    @classmethod
+    def dynamic(
+        cls,
+        name: str = "dynamic",
+        *,
+        duration: float,
+        activate: Sequence[str] = (),
+        deactivate: Sequence[str] = (),
+        **options: Any,
+    ) -> Step:
+        """A dynamic step of `duration` [s]; `options` are those of :func:`dynamic_step_options`.
+
+        The step starts from the state the previous one left (a static step leaves it at rest);
+        constraints and loads switched off at its start are released at once, with accelerations
+        consistent with what is left.
+        """
+        return cls(
+            name, "dynamic", tuple(activate), tuple(deactivate), {"duration": duration, **options}
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """The flat dict the native runner reads."""

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 __all__ = ["Results"]
 
 _FORMAT = "tapespring.Results"
-_VERSION = 1
+_VERSION = 2
 
 # Per-record arrays and their dtypes, in the order of the native dict and of the saved file.
 _ARRAYS: dict[str, Any] = {
@@ -30,6 +30,11 @@ _ARRAYS: dict[str, Any] = {
     "jump": bool,
     "strain_energy": float,
     "gravity_energy": float,
+    "kinetic_energy": float,
+    "work_loads": float,
+    "work_prescribed": float,
+    "viscous_dissipation": float,
+    "numerical_dissipation": float,
     "marker_positions": float,
     "marker_rotations": float,
     "reactions": float,
@@ -62,6 +67,13 @@ class Results:
         ``"limit_point"`` or ``"monitor_extremum"`` where a state was located as one.
     strain_energy, gravity_energy : ndarray, shape (n,)
         Strain energy and potential energy of gravity [J].
+    kinetic_energy : ndarray, shape (n,)
+        Kinetic energy [J] (0 in static steps).
+    work_loads, work_prescribed, viscous_dissipation, numerical_dissipation : ndarray, shape (n,)
+        Energy balance of dynamic steps, cumulated from the start of each dynamic step [J]: work
+        of the nodal loads, work of the prescribed motions (the supports), energy dissipated by
+        Kelvin-Voigt damping, and the remainder dissipated by the time integrator (NaN in static
+        steps).
     marker_names : tuple of str
         Marker names.
     marker_positions, marker_rotations : ndarray, shape (n, n_markers, 3)
@@ -97,6 +109,11 @@ class Results:
     event: tuple[str | None, ...]
     strain_energy: NDArray[np.float64]
     gravity_energy: NDArray[np.float64]
+    kinetic_energy: NDArray[np.float64]
+    work_loads: NDArray[np.float64]
+    work_prescribed: NDArray[np.float64]
+    viscous_dissipation: NDArray[np.float64]
+    numerical_dissipation: NDArray[np.float64]
     marker_names: tuple[str, ...]
     marker_positions: NDArray[np.float64]
     marker_rotations: NDArray[np.float64]
@@ -259,6 +276,8 @@ class Results:
                 raise ValueError(
                     f"{path} was written by a newer tapespring (format {meta['version']})"
                 )
-            d = {k: f[k] for k in _ARRAYS}
+            n = f["t"].shape[0]
+            # Files of format 1 have no energy balance.
+            d = {k: f[k] if k in f else np.full(n, np.nan) for k in _ARRAYS}
         d.update(meta)
         return cls.from_dict(d)

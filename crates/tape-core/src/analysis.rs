@@ -201,7 +201,11 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                 .map_err(|e| e.context(&context))?;
         }
         let releases = !step.deactivate.is_empty() && k > 0;
-        if releases && step.static_params().is_some_and(|p| matches!(p.control, Control::Displacement { .. })) {
+        if releases
+            && step
+                .static_params()
+                .is_some_and(|p| matches!(p.control, Control::Displacement { .. }))
+        {
             return Err(Error::InvalidParameter(format!(
                 "step {k} '{name}': constraints and loads are released over a step's load-factor range, \
                  which displacement control does not fix: release them in a load or arc-length step"
@@ -361,10 +365,16 @@ pub fn run(
             }
             // A static step releases over its load-factor range; a dynamic one at once.
             let (released, gravity_off) = match step.static_params().map(|p| &p.control) {
-                Some(Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. }) => {
-                    release_loads(model, &system, &before, &activity, &last_reactions, state.t, *lambda_end)
-                        .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
-                }
+                Some(Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. }) => release_loads(
+                    model,
+                    &system,
+                    &before,
+                    &activity,
+                    &last_reactions,
+                    state.t,
+                    *lambda_end,
+                )
+                .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?,
                 Some(Control::Displacement { .. }) => {
                     release_loads(model, &system, &before, &activity, &last_reactions, state.t, state.t)
                         .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?

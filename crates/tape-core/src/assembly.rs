@@ -956,7 +956,10 @@ impl System {
         (0..state.x.len())
             .filter(|&i| self.dofs.master[i].is_none() && !self.inertia[i].is_empty())
             .map(|i| {
-                let r = self.node_rotation(state, i).to_rotation_matrix().into_inner();
+                let r = self
+                    .node_rotation(state, i)
+                    .to_rotation_matrix()
+                    .into_inner();
                 self.inertia[i].kinetic_energy(&r, &state.v[i], &state.w[i])
             })
             .sum()

@@ -132,7 +132,7 @@ mod tests {
     use nalgebra::{UnitQuaternion, Vector6};
 
     use super::*;
-    use crate::rotation::{tangent_inverse, rotate};
+    use crate::rotation::{rotate, tangent_inverse};
 
     /// The Jacobian against finite differences of the forces, with the accelerations and
     /// velocities moved by the generalised-alpha relations.
@@ -145,19 +145,38 @@ mod tests {
         let q0 = UnitQuaternion::from_scaled_axis(Vector3::new(0.4, -0.2, 0.9));
         let d0 = Vector3::new(0.05, 0.02, -0.04);
         let q1 = UnitQuaternion::from_scaled_axis(d0) * q0;
-        let (a, w, dw) = (Vector3::new(1.0, -2.0, 0.5), Vector3::new(3.0, -1.0, 2.0), Vector3::new(-4.0, 5.0, 1.0));
+        let (a, w, dw) = (
+            Vector3::new(1.0, -2.0, 0.5),
+            Vector3::new(3.0, -1.0, 2.0),
+            Vector3::new(-4.0, 5.0, 1.0),
+        );
         let (beta_p, gamma_p) = (7.0, 3.0);
         let forces = |q: &UnitQuaternion<f64>, dx: &Vector3<f64>| {
             // The step's rotation vector and the velocities that follow from it.
             let th = (q * q0.inverse()).scaled_axis() - d0;
             let r = q.to_rotation_matrix().into_inner();
             let (a, w, dw) = (a + dx * beta_p, w + th * gamma_p, dw + th * beta_p);
-            let (f, m) = body.forces(&Motion { r: &r, a: &a, w: &w, dw: &dw });
+            let (f, m) = body.forces(&Motion {
+                r: &r,
+                a: &a,
+                w: &w,
+                dw: &dw,
+            });
             Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
         };
         let r1 = q1.to_rotation_matrix().into_inner();
         let p = tangent_inverse(&-d0);
-        let jac = body.jacobian(&Motion { r: &r1, a: &a, w: &w, dw: &dw }, beta_p, gamma_p, &p);
+        let jac = body.jacobian(
+            &Motion {
+                r: &r1,
+                a: &a,
+                w: &w,
+                dw: &dw,
+            },
+            beta_p,
+            gamma_p,
+            &p,
+        );
         let eps = 1e-6;
         for k in 0..6 {
             let fd = |sign: f64| {
@@ -179,7 +198,11 @@ mod tests {
     #[test]
     fn inertia_forces_are_the_rate_of_momentum() {
         let mut body = NodeInertia::default();
-        body.add(1.5, &Vector3::new(0.2, 0.0, -0.1), &Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3)));
+        body.add(
+            1.5,
+            &Vector3::new(0.2, 0.0, -0.1),
+            &Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3)),
+        );
         let r = UnitQuaternion::from_scaled_axis(Vector3::new(0.3, 0.1, -0.5))
             .to_rotation_matrix()
             .into_inner();
@@ -189,7 +212,12 @@ mod tests {
             Vector3::new(-1.0, 0.4, 2.0),
             Vector3::new(0.2, -3.0, 1.0),
         );
-        let (f, m) = body.forces(&Motion { r: &r, a: &a, w: &w, dw: &dw });
+        let (f, m) = body.forces(&Motion {
+            r: &r,
+            a: &a,
+            w: &w,
+            dw: &dw,
+        });
         // dT/dt = f . v + m . w for any motion (w, dw spatial).
         let h = 1e-6;
         let energy = |dt: f64| {
@@ -201,6 +229,9 @@ mod tests {
         };
         let rate = (energy(h) - energy(-h)) / (2.0 * h);
         let power = f.dot(&v) + m.dot(&w);
-        assert!((rate - power).abs() < 1e-7 * power.abs().max(1.0), "dT/dt {rate} vs power {power}");
+        assert!(
+            (rate - power).abs() < 1e-7 * power.abs().max(1.0),
+            "dT/dt {rate} vs power {power}"
+        );
     }
 }

@@ -474,7 +474,10 @@ impl Model {
     pub fn set_initial_velocity(&mut self, v: InitialVelocity) -> Result<()> {
         self.check_initial_velocity(&v)?;
         if self.initial_velocities.iter().any(|o| o.node == v.node) {
-            return Err(Error::InvalidModel(format!("node {} already has an initial velocity", v.node)));
+            return Err(Error::InvalidModel(format!(
+                "node {} already has an initial velocity",
+                v.node
+            )));
         }
         self.initial_velocities.push(v);
         Ok(())
@@ -618,8 +621,14 @@ impl Model {
         }
         for (i, v) in self.initial_velocities.iter().enumerate() {
             self.check_initial_velocity(v)?;
-            if self.initial_velocities[..i].iter().any(|o| o.node == v.node) {
-                return Err(Error::InvalidModel(format!("node {} has two initial velocities", v.node)));
+            if self.initial_velocities[..i]
+                .iter()
+                .any(|o| o.node == v.node)
+            {
+                return Err(Error::InvalidModel(format!(
+                    "node {} has two initial velocities",
+                    v.node
+                )));
             }
         }
         for (i, m) in self.markers.iter().enumerate() {

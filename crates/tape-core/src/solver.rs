@@ -177,14 +177,20 @@ const ARC_ONLY: [&str; 9] = [
 
 /// Names of every option of a static step (refused, as not applying, by dynamic steps).
 pub(crate) fn static_option_names() -> Vec<&'static str> {
-    let mut v: Vec<&str> = ["control", "target_iterations", "stability", "line_search", "mixed_stress"]
-        .iter()
-        .chain(&LOAD_OPTIONS)
-        .chain(&DISPLACEMENT_OPTIONS)
-        .chain(&ARC_OPTIONS)
-        .chain(&ARC_ONLY)
-        .copied()
-        .collect();
+    let mut v: Vec<&str> = [
+        "control",
+        "target_iterations",
+        "stability",
+        "line_search",
+        "mixed_stress",
+    ]
+    .iter()
+    .chain(&LOAD_OPTIONS)
+    .chain(&DISPLACEMENT_OPTIONS)
+    .chain(&ARC_OPTIONS)
+    .chain(&ARC_ONLY)
+    .copied()
+    .collect();
     v.dedup();
     v
 }

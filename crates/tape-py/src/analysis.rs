@@ -75,8 +75,11 @@ pub fn run<'py>(
 #[pyfunction]
 #[pyo3(signature = (kind = "static", control = "load"))]
 pub fn step_defaults<'py>(py: Python<'py>, kind: &str, control: &str) -> PyResult<Bound<'py, PyAny>> {
-    let mut value = serde_json::json!({ "kind": kind, "control": control });
-    if control == "displacement" {
+    let mut value = serde_json::json!({ "kind": kind });
+    if kind == "static" {
+        value["control"] = control.into();
+    }
+    if kind == "static" && control == "displacement" {
         value["node"] = 0.into();
         value["dof"] = "ux".into();
         value["delta"] = 1.0.into();

@@ -436,6 +436,14 @@ pub fn history_to_dict<'py>(py: Python<'py>, h: &History, n_nodes: usize) -> PyR
     d.set_item("event", events)?;
     d.set_item("strain_energy", vec_to_numpy(py, h.strain_energy.clone()))?;
     d.set_item("gravity_energy", vec_to_numpy(py, h.gravity_energy.clone()))?;
+    d.set_item("kinetic_energy", vec_to_numpy(py, h.kinetic_energy.clone()))?;
+    d.set_item("work_loads", vec_to_numpy(py, h.work_loads.clone()))?;
+    d.set_item("work_prescribed", vec_to_numpy(py, h.work_prescribed.clone()))?;
+    d.set_item("viscous_dissipation", vec_to_numpy(py, h.viscous_dissipation.clone()))?;
+    d.set_item(
+        "numerical_dissipation",
+        vec_to_numpy(py, h.numerical_dissipation.clone()),
+    )?;
     let m = h.marker_names.len();
     d.set_item("marker_names", h.marker_names.clone())?;
     let flat = |rows: &[[f64; 3]]| rows.iter().flatten().copied().collect::<Vec<f64>>();

@@ -9,7 +9,7 @@ use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 use tape_core::material::ShellSection;
 use tape_core::mesh::{Mesh, Placement};
-use tape_core::model::{Constraint, Gravity, Load, Marker, RigidBody};
+use tape_core::model::{Constraint, Gravity, InitialVelocity, Load, Marker, RigidBody};
 use tape_core::{Model, TimeFunction};
 
 use crate::convert;
@@ -385,6 +385,26 @@ impl PyModel {
             acceleration: convert::vector3(acceleration, "acceleration")?,
             function: convert::time_function(function, ramp, "function")?,
             active,
+        }))
+    }
+
+    /// Gives `node` an initial velocity [m/s] and angular velocity [rad/s] (global axes), the
+    /// initial condition of the first dynamic step.
+    #[pyo3(signature = (node, *, velocity = None, angular_velocity = None))]
+    fn set_initial_velocity(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let node = convert::node(node, "node")?;
+        let zero = nalgebra::Vector3::zeros();
+        let velocity = velocity.map_or(Ok(zero), |v| convert::vector3(v, "velocity"))?;
+        let angular_velocity = angular_velocity.map_or(Ok(zero), |v| convert::vector3(v, "angular_velocity"))?;
+        to_py(self.inner.set_initial_velocity(InitialVelocity {
+            node,
+            velocity,
+            angular_velocity,
         }))
     }
 

@@ -180,14 +180,24 @@ def analytical_residual_moment(setup: BendingSetup, sense: int) -> float:
     return (1.0 + setup.poisson) * d * alpha if sense > 0 else -(1.0 - setup.poisson) * d * alpha
 
 
-def bending_model(setup: BendingSetup) -> tuple[Any, int, int]:
+def bending_model(
+    setup: BendingSetup, *, density: float = 0.0, eta: float = 0.0
+) -> tuple[Any, int, int]:
     """The model of a bending run: the tape, its end sections tied to two reference nodes.
+
+    Parameters
+    ----------
+    setup : BendingSetup
+        The tape and its mesh.
+    density, eta : float, optional
+        Density [kg/m^3] and Kelvin-Voigt viscosity [s] of the tape (for dynamic steps).
 
     Returns
     -------
     model : tapespring.Model
-        The clamped reference node is held; the driven one is held in y and about x and z, and
-        its rotation about y is prescribed as ``t * theta_max`` (``t`` the load factor).
+        The clamped reference node is held; the driven one is held in y and about x and z (id
+        ``"guide"``), and its rotation about y is prescribed as ``t * theta_max`` (``t`` the load
+        factor; id ``"fold"``).
     clamped, driven : int
         The reference nodes at x = 0 and x = L.
     """
@@ -210,6 +220,8 @@ def bending_model(setup: BendingSetup) -> tuple[Any, int, int]:
         thickness=setup.thickness,
         youngs_modulus=setup.youngs_modulus,
         poisson=setup.poisson,
+        density=density,
+        eta=eta,
     )
     zc = _core.tape_section_centroid_z(setup.radius, math.radians(setup.alpha_deg))
     clamped = model.add_node([0.0, 0.0, zc])
@@ -217,8 +229,8 @@ def bending_model(setup: BendingSetup) -> tuple[Any, int, int]:
     model.tie("end0", clamped)
     model.tie("end1", driven)
     model.fix(clamped, "all")
-    model.fix(driven, ["uy", "rx", "rz"])
-    model.prescribe(driven, "ry", math.radians(setup.theta_max_deg))
+    model.fix(driven, ["uy", "rx", "rz"], id="guide")
+    model.prescribe(driven, "ry", math.radians(setup.theta_max_deg), id="fold")
     return model, clamped, driven
 
 

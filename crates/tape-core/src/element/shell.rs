@@ -546,7 +546,8 @@ impl ShellElement {
             energy += 0.5 * (n.dot(&eps) + m.dot(&kap));
             let rows = (tangent || vel.is_some()).then(|| gauss_rows(&g.dn, &xs, &ds, &d));
             if let (Some(vel), Some(rows)) = (&vel, &rows) {
-                let rate = |i: usize| Vector3::new(dot24(&rows[i], vel), dot24(&rows[i + 1], vel), dot24(&rows[i + 2], vel));
+                let rate =
+                    |i: usize| Vector3::new(dot24(&rows[i], vel), dot24(&rows[i + 1], vel), dot24(&rows[i + 2], vel));
                 let (de, dk) = (rate(0), rate(3));
                 let (nv, mv) = (sec.membrane * de * (eta * g.w), sec.bending * dk * (eta * g.w));
                 power += nv.dot(&de) + mv.dot(&dk);
@@ -735,7 +736,8 @@ impl ShellElement {
                             acc[l] += ci[l] * cj[l];
                         }
                     }
-                    let v = material_scale * (((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])));
+                    let v = material_scale
+                        * (((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])));
                     k[(i, j)] = v;
                     k[(j, i)] = v;
                 }
@@ -1179,7 +1181,9 @@ mod tests {
         e.compute_into(&x, &mats(&q), &sec, &mut f_el, None);
         let spin = Vector3::new(3.0, -2.0, 5.0);
         let rigid = Viscous {
-            v: std::array::from_fn(|a| Vector3::new(0.1, 0.2, -0.3) + spin.cross(&(x[a] - Vector3::new(1.0, 2.0, 0.5)))),
+            v: std::array::from_fn(|a| {
+                Vector3::new(0.1, 0.2, -0.3) + spin.cross(&(x[a] - Vector3::new(1.0, 2.0, 0.5)))
+            }),
             w: [spin; 4],
             eta: 0.01,
             gamma_prime: 0.0,
@@ -1195,7 +1199,10 @@ mod tests {
         let (_, power) = e.compute_viscous_into(&x, &mats(&q), &sec, &deforming, &mut f, None);
         let vel = ElementVector::from_column_slice(&deforming.velocity());
         let viscous_power = (f - f_el).dot(&vel);
-        assert!(power > 0.0 && (viscous_power - power).abs() < 1e-9 * power, "{viscous_power} vs {power}");
+        assert!(
+            power > 0.0 && (viscous_power - power).abs() < 1e-9 * power,
+            "{viscous_power} vs {power}"
+        );
     }
 
     /// At rest, the tangent of the Kelvin-Voigt force with velocities `gamma' delta` is the

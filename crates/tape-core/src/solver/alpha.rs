@@ -116,13 +116,16 @@ impl Alpha {
     pub fn spectral_properties(&self, omega_h: f64) -> (f64, f64) {
         let eig = self.amplification(omega_h).complex_eigenvalues();
         let radius = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
-        let principal = eig.iter().copied().fold(Complex::new(0.0, 0.0), |best: Complex<f64>, l| {
-            if l.im > best.im {
-                l
-            } else {
-                best
-            }
-        });
+        let principal = eig.iter().copied().fold(
+            Complex::new(0.0, 0.0),
+            |best: Complex<f64>, l| {
+                if l.im > best.im {
+                    l
+                } else {
+                    best
+                }
+            },
+        );
         let damping = if principal.im > 0.0 {
             -principal.norm().ln() / principal.arg()
         } else {
@@ -160,7 +163,12 @@ mod tests {
     #[test]
     fn coefficients_at_0_7() {
         let s = Alpha::new(0.7).unwrap();
-        for (got, want) in [(s.alpha_m, 0.23529), (s.alpha_f, 0.41176), (s.gamma, 0.67647), (s.beta, 0.34602)] {
+        for (got, want) in [
+            (s.alpha_m, 0.23529),
+            (s.alpha_f, 0.41176),
+            (s.gamma, 0.67647),
+            (s.beta, 0.34602),
+        ] {
             assert!((got - want).abs() < 1e-5, "{got} vs {want}");
         }
         assert!(Alpha::new(1.2).is_err() && Alpha::new(f64::NAN).is_err());
@@ -218,16 +226,24 @@ mod tests {
         let uniform = |n: usize| vec![t_end / n as f64; n];
         // Steps from the map t = t_end (tau + 0.3 sin(2 pi tau) / (2 pi)) on a uniform tau grid.
         let graded = |n: usize| {
-            let map = |tau: f64| t_end * (tau + 0.3 * (2.0 * std::f64::consts::PI * tau).sin() / (2.0 * std::f64::consts::PI));
+            let map = |tau: f64| {
+                t_end * (tau + 0.3 * (2.0 * std::f64::consts::PI * tau).sin() / (2.0 * std::f64::consts::PI))
+            };
             (0..n)
                 .map(|k| map((k + 1) as f64 / n as f64) - map(k as f64 / n as f64))
                 .collect::<Vec<_>>()
         };
-        for (name, seq) in [("uniform", &uniform as &dyn Fn(usize) -> Vec<f64>), ("variable", &graded)] {
+        for (name, seq) in [
+            ("uniform", &uniform as &dyn Fn(usize) -> Vec<f64>),
+            ("variable", &graded),
+        ] {
             let e1 = oscillator_error(&s, &seq(200), true);
             let e2 = oscillator_error(&s, &seq(400), true);
             let ratio = e1 / e2;
-            assert!((ratio - 4.0).abs() < 0.3, "{name}: error ratio {ratio} ({e1:e} -> {e2:e})");
+            assert!(
+                (ratio - 4.0).abs() < 0.3,
+                "{name}: error ratio {ratio} ({e1:e} -> {e2:e})"
+            );
         }
     }
 }
