@@ -168,13 +168,6 @@ pub struct RunResult {
     pub steps_completed: usize,
 }
 
-/// What the runner keeps of a step's path.
-struct PathOut {
-    steps: Vec<StaticStep>,
-    cancelled: bool,
-    error: Option<Error>,
-}
-
 /// Checks a model, its steps and the outputs before anything runs.
 fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
     model.validate()?;
@@ -364,21 +357,13 @@ pub fn run(
                 activity.switch(model, id, false)?;
             }
             // A static step releases over its load-factor range; a dynamic one at once.
-            let (released, gravity_off) = match step.static_params().map(|p| &p.control) {
-                Some(Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. }) => release_loads(
-                    model,
-                    &system,
-                    &before,
-                    &activity,
-                    &last_reactions,
-                    state.t,
-                    *lambda_end,
-                )
-                .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?,
-                Some(Control::Displacement { .. }) => {
-                    release_loads(model, &system, &before, &activity, &last_reactions, state.t, state.t)
-                        .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
-                }
+            let t1 = step.static_params().map(|p| match p.control {
+                Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => lambda_end,
+                Control::Displacement { .. } => state.t,
+            });
+            let (released, gravity_off) = match t1 {
+                Some(t1) => release_loads(model, &system, &before, &activity, &last_reactions, state.t, t1)
+                    .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?,
                 None => (Vec::new(), None),
             };
             let gravity = system.gravity.clone();
@@ -407,7 +392,7 @@ pub fn run(
             })
         };
         let context = format!("step {k} '{}'", step.name);
-        let (steps_done, path_stats, cancelled, error) = match &step.kind {
+        let (records, mut stats, cancelled, error) = match &step.kind {
             StepKind::Static(p) => {
                 let mut params = p.clone();
                 params.record_fields = interval > 0;
@@ -422,27 +407,21 @@ pub fn run(
                 (path.steps, path.stats, path.cancelled, path.error)
             }
         };
-        let path = PathOut {
-            steps: steps_done,
-            cancelled,
-            error,
-        };
-        let mut stats = path_stats;
         stats.symbolic_analyses = std::mem::take(&mut symbolic);
         result.stats.add(&stats);
         result.step_stats.push(stats);
-        if let Some(last) = path.steps.last() {
+        if let Some(last) = records.last() {
             last_reactions.clone_from(&last.reactions);
         }
-        for s in path.steps {
+        for s in records {
             let keep = interval > 0 && history.len() % interval == 0;
             history.push(k, s, keep);
         }
-        if path.cancelled {
+        if cancelled {
             result.cancelled = true;
             break;
         }
-        if let Some(e) = path.error {
+        if let Some(e) = error {
             result.error = Some(e.in_step(&step.name));
             break;
         }
@@ -451,15 +430,11 @@ pub fn run(
     // The last state's fields, always.
     let last = history.len() - 1;
     if interval > 0 && history.fields.last().is_none_or(|f| f.record != last) {
-        let reference = &system.reference;
+        let (displacements, rotations) = system.fields(&state);
         history.fields.push(Fields {
             record: last,
-            displacements: (0..state.x.len())
-                .map(|i| state.displacement(reference, i).into())
-                .collect(),
-            rotations: (0..state.x.len())
-                .map(|i| state.rotation(reference, i).into())
-                .collect(),
+            displacements,
+            rotations,
         });
     }
     result.stats.wall_s = start.elapsed().as_secs_f64();

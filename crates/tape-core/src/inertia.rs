@@ -76,6 +76,21 @@ impl NodeInertia {
         (r * self.moment, r * self.inertia * r.transpose())
     }
 
+    /// Mass matrix on (acceleration, angular acceleration) for the rotation `r`:
+    /// `[[m I, -[s_R]x], [[s_R]x, J_R]]`, the part of [`Self::forces`] linear in them.
+    #[must_use]
+    pub fn mass_matrix(&self, r: &Matrix3<f64>) -> Matrix6<f64> {
+        let (s, j) = self.spatial(r);
+        let s = skew(&s);
+        let mut m = Matrix6::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(Matrix3::identity() * self.mass));
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
+        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&s);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
+        m
+    }
+
     /// Kinetic energy [J] at velocity `v` and angular velocity `w` (spatial).
     #[must_use]
     pub fn kinetic_energy(&self, r: &Matrix3<f64>, v: &Vector3<f64>, w: &Vector3<f64>) -> f64 {

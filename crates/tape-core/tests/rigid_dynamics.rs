@@ -116,12 +116,11 @@ fn heavy_top_matches_the_reference_solution() -> Result<()> {
         let hist = &result.history;
         let com = hist.marker("com").expect("marker");
         let mut u = Vec::new();
-        for (t, u_ref) in &references {
+        for (t, _) in &references {
             let x = Vector3::from(com[at(hist, *t)]);
             u.push(x - Vector3::new(0.0, 1.0, 0.0));
             // The centre of mass stays on the unit sphere about the fixed point.
             assert!((x.norm() - 1.0).abs() < 1e-10, "|x_G| = {}", x.norm());
-            let _ = u_ref;
         }
         let worst = u
             .iter()
@@ -175,7 +174,7 @@ fn torque_free_body_flips_about_its_intermediate_axis() -> Result<()> {
         )?;
         assert!(result.error.is_none(), "{:?}", result.error);
         let hist = &result.history;
-        // The body's y axis turns over: min of its z... track y axis direction through rotations.
+        // The body's y axis turns over: its direction reverses at some record.
         let n_markers = hist.marker_names.len();
         let mut min_dot: f64 = 1.0;
         for k in 0..hist.len() {

@@ -12,7 +12,7 @@
 //! * the energy balance closes: without damping and with rho_inf = 1 the integrator dissipates
 //!   less than 1e-3 of the energy released, and with damping the viscous dissipation accounts for
 //!   the lost energy;
-//! * serial and parallel assembly give the same history bit for bit.
+//! * runs on one and on two threads give the same history bit for bit.
 
 mod common;
 

@@ -64,6 +64,11 @@ class ReleaseSetup:
     planar: bool = False
     tolerance: float = 0.0
 
+    @property
+    def folding_tape(self) -> BendingSetup:
+        """The tape's bending set-up for the fold: to `fold_deg`, jumping at the snap."""
+        return replace(self.tape, theta_max_deg=self.fold_deg, jump=True)
+
     def validate(self) -> None:
         """Check the values (the tape's are checked by :meth:`BendingSetup.validate`).
 
@@ -102,8 +107,7 @@ def release_model(setup: ReleaseSetup) -> tuple[Any, int, int]:
         The model and the reference nodes of the clamped and the free end.
     """
     setup.validate()
-    tape = replace(setup.tape, theta_max_deg=setup.fold_deg, jump=True)
-    model, clamped, tip = bending_model(tape, density=setup.density, eta=setup.eta)
+    model, clamped, tip = bending_model(setup.folding_tape, density=setup.density, eta=setup.eta)
     inertia = np.eye(3) * setup.tip_inertia
     model.add_rigid_body(tip, setup.tip_mass, inertia=inertia)
     if setup.gravity != 0.0:
@@ -116,8 +120,7 @@ def release_steps(setup: ReleaseSetup, tip: int) -> list[Any]:
     """The fold (the bending scenario's loading step, jumping at the snap) and the release."""
     from tapespring.analysis import Step
 
-    tape = replace(setup.tape, theta_max_deg=setup.fold_deg, jump=True)
-    fold = bending_steps(tape, tip)[0]
+    fold = bending_steps(setup.folding_tape, tip)[0]
     released = ["fold"] if setup.planar else ["fold", "guide"]
     options: dict[str, Any] = {"rho_inf": setup.rho_inf}
     if setup.tolerance > 0.0:

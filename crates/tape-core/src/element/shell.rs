@@ -660,12 +660,15 @@ impl ShellElement {
             let mut big_psi = kd * psi;
             energy += 0.5 * kd * psi * psi;
             let mut row = [0.0; DOFS_PER_ELEMENT];
+            // d(psi)/dx_b = al t1 + be t2: the drilling row's translational blocks.
             let mut coef = [(0.0, 0.0); 4];
+            let mut gx = [Vector3::zeros(); 4];
             for bb in 0..4 {
                 let [p, r] = self.dn_centre[bb];
-                coef[bb] = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
-                let gx = coef[bb].0 * t1[a] + coef[bb].1 * t2[a];
-                row[6 * bb..6 * bb + 3].copy_from_slice(gx.as_slice());
+                let (al, be) = (0.5 * (c0 * r - s0 * p), -0.5 * (c0 * p + s0 * r));
+                coef[bb] = (al, be);
+                gx[bb] = al * t1[a] + be * t2[a];
+                row[6 * bb..6 * bb + 3].copy_from_slice(gx[bb].as_slice());
             }
             row[6 * a + 3..6 * a + 6].copy_from_slice((0.5 * (t1[a].cross(&u) - t2[a].cross(&v))).as_slice());
             if let Some(vel) = &vel {
@@ -682,10 +685,9 @@ impl ShellElement {
             }
             for bb in 0..4 {
                 let (al, be) = coef[bb];
-                let gx = al * t1[a] + be * t2[a];
-                f_x[bb] += big_psi * gx;
+                f_x[bb] += big_psi * gx[bb];
                 if mixed.is_some() {
-                    gf_x[bb] += geo_psi * gx;
+                    gf_x[bb] += geo_psi * gx[bb];
                 }
                 sxt1[bb][a] += geo_psi * al;
                 sxt2[bb][a] += geo_psi * be;

@@ -24,12 +24,12 @@
 
 use std::time::Instant;
 
-use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{Matrix6, UnitQuaternion, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use super::alpha::{advance3, Alpha};
-use super::newton::{Convergence, NewtonParams, NEWTON_OPTIONS};
+use super::newton::{Convergence, NewtonParams};
 use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
@@ -94,19 +94,6 @@ impl Default for DynamicParams {
         }
     }
 }
-
-const DYNAMIC_OPTIONS: [&str; 10] = [
-    "duration",
-    "rho_inf",
-    "initial_step",
-    "max_step",
-    "min_step",
-    "adaptive",
-    "tolerance",
-    "output_interval",
-    "max_steps",
-    "max_cutbacks",
-];
 
 impl DynamicParams {
     /// Checks every setting.
@@ -188,20 +175,6 @@ impl DynamicParams {
         m.remove("mixed_stress");
         m.remove("line_search");
         m
-    }
-
-    /// Names of the options of a dynamic step.
-    #[must_use]
-    pub fn option_names() -> Vec<&'static str> {
-        DYNAMIC_OPTIONS
-            .iter()
-            .chain(
-                NEWTON_OPTIONS
-                    .iter()
-                    .filter(|n| !matches!(**n, "mixed_stress" | "line_search")),
-            )
-            .copied()
-            .collect()
     }
 }
 
@@ -398,6 +371,8 @@ impl Integrator<'_> {
         self.system.update_with(state, &dq, &dc);
         state.t = start.t + h;
         let mut r = Vec::with_capacity(n_free);
+        // Newton corrections leave the constrained DOFs where the step put them.
+        let held = vec![0.0; dc.len()];
         let mut residual = f64::NAN;
         let mut a_new = self.kinematics(start, state, h, a);
         for it in 0..=params.newton.max_iterations {
@@ -446,8 +421,7 @@ impl Integrator<'_> {
             }
             self.stats.solve_s += t.elapsed().as_secs_f64();
             self.stats.iterations += 1;
-            let zeros = vec![0.0; self.system.dofs.constrained.len()];
-            self.system.update_with(state, &delta, &zeros);
+            self.system.update_with(state, &delta, &held);
             a_new = self.kinematics(start, state, h, a);
         }
         Attempt::Failed {
@@ -506,15 +480,7 @@ impl Integrator<'_> {
                 dw: &zero,
             });
             let g = Vector6::new(g_f.x, g_f.y, g_f.z, g_m.x, g_m.y, g_m.z);
-            // Mass matrix on (acceleration, angular acceleration).
-            let (s, j) = body.spatial(&r);
-            let s = crate::rotation::skew(&s);
-            let mut m = Matrix6::zeros();
-            m.fixed_view_mut::<3, 3>(0, 0)
-                .copy_from(&(Matrix3::identity() * body.mass));
-            m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
-            m.fixed_view_mut::<3, 3>(3, 0).copy_from(&s);
-            m.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
+            let m = body.mass_matrix(&r);
             let free: Vec<(usize, usize)> = self.system.dofs.slots[i]
                 .iter()
                 .enumerate()
@@ -582,28 +548,19 @@ pub fn solve_dynamic(
     let start_time = Instant::now();
     params.validate()?;
     let alpha = Alpha::new(params.rho_inf)?;
-    let membrane = system.membrane_stiffness();
-    let x_max = system
-        .reference
-        .x
-        .iter()
-        .map(|x| x.norm())
-        .fold(0.0, f64::max);
-    #[allow(clippy::cast_precision_loss)]
-    let round_off = f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
     let weights = system.free_weights();
     let n_nodes = state.x.len();
     let mut integ = Integrator {
-        force_floor: 1e-13 * membrane * system.char_length,
+        force_floor: system.force_floor(),
+        conv: Convergence {
+            tol_force: params.newton.tol_force,
+            tol_energy: params.newton.tol_energy,
+            round_off: system.residual_round_off(),
+        },
         system,
         alpha,
         asm: Assembled::default(),
         weights,
-        conv: Convergence {
-            tol_force: params.newton.tol_force,
-            tol_energy: params.newton.tol_energy,
-            round_off,
-        },
         a_gen: Vec::new(),
         h_gen: 0.0,
         stats: Stats::default(),
@@ -834,16 +791,8 @@ fn record(
     let system = &integ.system;
     let n = |v: Vec<Vector3<f64>>| v.iter().map(|x| (*x).into()).collect();
     let r = asm.residual();
-    let reference = &system.reference;
     let (displacements, rotations) = if fields {
-        (
-            (0..state.x.len())
-                .map(|i| state.displacement(reference, i).into())
-                .collect(),
-            (0..state.x.len())
-                .map(|i| state.rotation(reference, i).into())
-                .collect(),
-        )
+        system.fields(state)
     } else {
         (Vec::new(), Vec::new())
     };

@@ -469,16 +469,8 @@ impl Driver<'_> {
         } else {
             None
         };
-        let reference = &self.system.reference;
         let (displacements, rotations) = if self.params.record_fields {
-            (
-                (0..state.x.len())
-                    .map(|i| state.displacement(reference, i).into())
-                    .collect(),
-                (0..state.x.len())
-                    .map(|i| state.rotation(reference, i).into())
-                    .collect(),
-            )
+            self.system.fields(state)
         } else {
             (Vec::new(), Vec::new())
         };
@@ -689,20 +681,8 @@ impl<'a, 'b> Walk<'a, 'b> {
             .map(|(c, v)| if c.dof.is_rotation() { lc2 * v * v } else { v * v })
             .sum();
         let weights = system.free_weights();
-        let membrane = system.membrane_stiffness();
-        let force_floor = 1e-13 * membrane * system.char_length;
-        // Element forces are sums of terms of size E t |x| that cancel: the residual cannot go
-        // below a few ulps of them (measured: about eps E t |x| per node).
-        let x_max = system
-            .reference
-            .x
-            .iter()
-            .map(|x| x.norm())
-            .fold(0.0, f64::max);
-        // (Measured 2e-8 N on a 0.2 m x 2 mm steel plate where this estimate gives 2e-7 N.)
-        #[allow(clippy::cast_precision_loss)]
-        let round_off =
-            f64::EPSILON * membrane * (x_max + system.char_length) * (system.reference.x.len() as f64).sqrt();
+        let force_floor = system.force_floor();
+        let round_off = system.residual_round_off();
         // Smallest increment worth trying: below it, the increment is lost in the load factor's
         // or the controlled DOF's round-off.
         let scale = state.t.abs().max(lambda_end.map_or(0.0, f64::abs)).max(1.0);
