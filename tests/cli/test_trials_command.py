@@ -125,7 +125,7 @@ def test_bad_file_exits_with_message_naming_it(tmp_path, capsys):
     )
     assert code == 1
     err = capsys.readouterr().err
-    assert "broken.c3d" in err and "not a readable C3D file" in err
+    assert "broken.c3d" in err and "not a C3D file" in err
 
 
 def test_missing_marker_exits_with_message(dataset, tmp_path, capsys):

@@ -141,7 +141,7 @@ def test_truncated_c3d_raises_naming_the_file(tmp_path):
 def test_wrong_format_raises_naming_the_file(tmp_path):
     bad = tmp_path / "fake.c3d"
     bad.write_text("this is not a c3d file\n")
-    with pytest.raises(TrialError, match=r"fake\.c3d: not a readable C3D file"):
+    with pytest.raises(TrialError, match=r"fake\.c3d: not a C3D file"):
         read_trial(bad)
     other = tmp_path / "data.txt"
     other.write_text("1,2,3\n")

@@ -6,6 +6,11 @@ a marker is missing). Force plates are extracted by ezc3d
 plate's force and moment units to N and N m. Metadata live in an optional
 ``TAPESPRING`` parameter group (``SENSE``, ``TAPE_PAIR``, ``SESSION``).
 
+ezc3d trusts the sizes written in the file, and a few damaged bytes can make it
+crash the interpreter or loop for minutes. `read_c3d` therefore checks the
+header and the parameter section in pure Python first (`c3d_check`), then runs
+ezc3d in a worker process with a time limit (`c3d_worker`).
+
 The C3D format stores analogs at an integer number of samples per marker frame,
 so a force plate at 1 kHz cannot be stored beside markers at 800 Hz; `write_c3d`
 refuses such a trial (use CSV, or record the plate at 4 kHz = 5 x 800 Hz).
@@ -19,12 +24,13 @@ writing; see ``_add_int_parameter``.
 
 from __future__ import annotations
 
-import struct
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .c3d_check import check_c3d
+from .c3d_worker import DEFAULT_TIMEOUT, WorkerFailure, read_raw, read_raw_isolated
 from .common import FORCE, FP_CHANNELS, LENGTH, META_KEYS, MOMENT, check_durations, unit_scale
 from .trial import ForcePlate, Metadata, Trial, TrialError
 
@@ -44,8 +50,16 @@ def read_c3d(
     sense: str | None = None,
     tape_pair: str | None = None,
     session: str | None = None,
+    isolate: bool = True,
+    timeout: float = DEFAULT_TIMEOUT,
 ) -> Trial:
     """Read a trial from a C3D file.
+
+    The header and the parameter section are first checked in Python
+    (`tapespring.trials.c3d_check.check_c3d`); ezc3d then reads the file in a
+    worker process (`tapespring.trials.c3d_worker`), so that a corrupt file that
+    makes ezc3d crash or hang ends in a `TrialError`, not in a dead or stuck
+    Python.
 
     Parameters
     ----------
@@ -53,6 +67,13 @@ def read_c3d(
         The C3D file.
     sense, tape_pair, session : str, optional
         Override the metadata stored in the file (``TAPESPRING`` group).
+    isolate : bool
+        Run ezc3d in the worker process (default). False runs it in this
+        process: it saves the worker's one-time start (0.3 s) and a few ms per
+        file, but a file the structural check lets through can then still crash
+        or hang the interpreter.
+    timeout : float
+        Time limit of the ezc3d read in the worker [s] (``isolate=True`` only).
 
     Returns
     -------
@@ -64,43 +85,50 @@ def read_c3d(
     FileNotFoundError
         If the file does not exist.
     TrialError
-        If the file is not a C3D file, is truncated, or has unknown units.
+        If the file is not a C3D file, is truncated or corrupt (the message says
+        where), makes ezc3d fail, crash or exceed ``timeout``, or has unknown units.
     """
-    import ezc3d
-
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+    layout = check_c3d(path)
     try:
-        c3d = ezc3d.c3d(str(path))
-        platforms = _force_platforms(c3d, path)
+        raw = read_raw_isolated(path, timeout) if isolate else read_raw(path)
+    except WorkerFailure as exc:
+        raise TrialError(path, f"corrupt C3D file: the C3D reader (ezc3d) {exc} on it") from None
     except Exception as exc:  # ezc3d raises OSError/RuntimeError with its own wording
         raise TrialError(path, f"not a readable C3D file ({exc})") from exc
-    header = c3d["header"]["points"]
-    points = c3d["data"]["points"]
+    points = raw["points"]
     n = points.shape[2]
-    n_declared = _declared_frames(path)
-    if n_declared is not None and n != n_declared:
-        raise TrialError(path, f"truncated C3D data: {n} of {n_declared} frames")
+    if layout.n_frames is not None and n != layout.n_frames:
+        raise TrialError(path, f"truncated C3D data: {n} of {layout.n_frames} frames")
     if n < 2:
         raise TrialError(path, f"the file holds {n} marker frame(s), at least 2 are needed")
-    params = c3d["parameters"]
-    rate = float(header["frame_rate"])
-    if not rate > 0:
+    if np.isinf(points).any():
+        # A coordinate is a number or missing (NaN); an infinite one is a damaged value.
+        _, i, frame = np.argwhere(np.isinf(points))[0]
+        label = raw["labels"][i].strip() if i < len(raw["labels"]) else f"point {i + 1}"
+        raise TrialError(
+            path, f"marker {label!r} has an infinite coordinate at frame {frame + 1} (corrupt data)"
+        )
+    rate = raw["point_rate"]
+    if not (np.isfinite(rate) and rate > 0):
         raise TrialError(path, f"invalid POINT:RATE {rate}")
-    labels = list(params["POINT"]["LABELS"]["value"])
-    unit = (params["POINT"].get("UNITS", {}).get("value") or ["mm"])[0]
+    # Some writers leave extra labels beyond POINT:USED; fewer labels than points is an error.
+    labels = raw["labels"][: points.shape[1]]
+    if len(labels) < points.shape[1]:
+        raise TrialError(
+            path, f"POINT:LABELS names {len(labels)} markers but the file holds {points.shape[1]}"
+        )
+    unit = raw["point_unit"] or "mm"
     scale = unit_scale(unit, LENGTH, path, "marker")
-    time = (header["first_frame"] + np.arange(n)) / rate
-    markers = {label.strip(): points[:3, i, :].T * scale for i, label in enumerate(labels)}
+    time = (raw["point_first_frame"] + np.arange(n)) / rate
+    markers = {label.strip(): points[:, i, :].T * scale for i, label in enumerate(labels)}
     if len(markers) != len(labels):
         raise TrialError(path, "duplicate marker labels")
 
     plates = []
-    for k, pf in enumerate(platforms):
-        analog = c3d["header"]["analogs"]
+    for k, pf in enumerate(raw["platforms"]):
         m = pf["force"].shape[1]
-        t_plate = (analog["first_frame"] + np.arange(m)) / analog["frame_rate"]
+        t_plate = (raw["analog_first_frame"] + np.arange(m)) / raw["analog_rate"]
         f_scale = unit_scale(pf["unit_force"], FORCE, path, "force")
         m_scale = unit_scale(pf["unit_moment"], MOMENT, path, "moment")
         plates.append(
@@ -112,11 +140,10 @@ def read_c3d(
             )
         )
     stored = {}
-    group = params.get("TAPESPRING", {})
     for key in META_KEYS:
-        value = group.get(key.upper(), {}).get("value")
+        value = raw["meta"].get(key.upper(), "").strip()
         if value:
-            stored[key] = str(value[0]).strip() or None
+            stored[key] = value
     overrides = {"sense": sense, "tape_pair": tape_pair, "session": session}
     stored.update({k: v for k, v in overrides.items() if v is not None})
     units = {"markers": unit}
@@ -126,63 +153,6 @@ def read_c3d(
     trial = Trial(time=time, markers=markers, force_plates=tuple(plates), metadata=metadata)
     check_durations(trial)
     return trial
-
-
-def _declared_frames(path: Path) -> int | None:
-    """Number of frames declared in the raw C3D header (None if it cannot say).
-
-    ezc3d silently reads a truncated file and rewrites its header to the frames
-    it found, so the declared count is read from the file itself: words 4 and 5
-    of the header block are the first and last frame (1-based, 16-bit, in the
-    byte order of the processor type stored in the parameter block: 84 Intel,
-    85 DEC little-endian, 86 MIPS big-endian). Files of 65535 frames or more
-    cannot state their length there.
-    """
-    with path.open("rb") as fh:
-        head = fh.read(512)
-        param_block = head[0] if head else 0
-        if param_block < 1:
-            return None
-        fh.seek(512 * (param_block - 1))
-        param_head = fh.read(4)
-    if len(head) < 10 or len(param_head) < 4:
-        return None
-    order = ">" if param_head[3] == 86 else "<"
-    first, last = struct.unpack(order + "HH", head[6:10])
-    if last >= 65535 or last < first:
-        return None
-    return last - first + 1
-
-
-def _force_platforms(c3d: ezc3d.c3d, path: Path) -> list[dict]:
-    """Force, moment and units of each force platform, computed by ezc3d.
-
-    ``ezc3d.c3d(path, extract_forceplat_data=True)`` converts force, moment,
-    centre of pressure and free moment frame by frame in Python; the paper's
-    analyses need only force and moment, so call the same ezc3d extractor
-    (``ezc3d.ezc3d.ForcePlatforms``) and convert just those two (3x faster on a
-    4 kHz record). Falls back to the documented path if the wrapper changes.
-    """
-    import ezc3d
-
-    swig = getattr(c3d, "c3d_swig", None)
-    extractor = getattr(getattr(ezc3d, "ezc3d", None), "ForcePlatforms", None)
-    if swig is None or extractor is None:
-        full = ezc3d.c3d(str(path), extract_forceplat_data=True)
-        return list(full["data"].get("platform", []))
-    out = []
-    for pf in extractor(swig).forcePlatforms():
-        force = np.array([v.to_array() for v in pf.forces()]).reshape(-1, 3)
-        moment = np.array([v.to_array() for v in pf.moments()]).reshape(-1, 3)
-        out.append(
-            {
-                "force": force.T,
-                "moment": moment.T,
-                "unit_force": pf.forceUnit(),
-                "unit_moment": pf.momentUnit(),
-            }
-        )
-    return out
 
 
 def _add_int_parameter(c3d: ezc3d.c3d, group: str, name: str, value: np.ndarray) -> None:

@@ -1,0 +1,303 @@
+"""ezc3d in a worker process with a time limit, so that a bad C3D file cannot take Python down.
+
+`check_c3d` catches the corruptions it knows, but ezc3d is C++ and trusts what
+it reads: a file that passes the structural check can still make it crash or
+loop. `read_raw` is the ezc3d part of reading a trial; `IsolatedReader` runs it
+in a worker process (``python -m tapespring.trials.c3d_worker``), started on the
+first read and kept for the next ones (the start costs about 0.3 s, once). If
+the worker dies (segmentation fault) or does not answer within the time limit,
+it is killed, the read raises a `TrialError`, and the next read starts a new
+worker.
+
+Messages on the worker's pipes are pickles preceded by their length (8 bytes,
+big-endian); the worker's own standard output is redirected to its standard
+error, so that text printed by the C++ library cannot corrupt them.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import pickle
+import queue
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+__all__ = ["DEFAULT_TIMEOUT", "IsolatedReader", "read_raw", "read_raw_isolated"]
+
+#: Default time limit of one isolated C3D read [s]: ezc3d reads about 5 MB/s (force platforms
+#: included) on a small machine, so 60 s leave a wide margin for a few-minute capture.
+DEFAULT_TIMEOUT = 60.0
+# Time limit for the worker to start (Python, numpy and ezc3d imports) [s].
+_STARTUP_TIMEOUT = 60.0
+_LENGTH = 8
+
+
+def read_raw(path: str | Path) -> dict[str, Any]:
+    """Read what a `Trial` needs from a C3D file with ezc3d (in this process).
+
+    Parameters
+    ----------
+    path : str or Path
+        The C3D file.
+
+    Returns
+    -------
+    dict
+        ``point_rate`` [Hz], ``point_first_frame``, ``points`` (ndarray, shape (3, k, n), file
+        units), ``labels``, ``point_unit`` (str or None), ``analog_rate`` [Hz],
+        ``analog_first_frame``, ``platforms`` (list of dict: ``force``, ``moment`` (3, m) in the
+        plate's units, ``unit_force``, ``unit_moment``) and ``meta`` (the ``TAPESPRING`` group:
+        upper-case key -> first value as str).
+
+    Raises
+    ------
+    Exception
+        Whatever ezc3d raises (OSError, RuntimeError, ValueError...).
+    """
+    import ezc3d
+
+    c3d = ezc3d.c3d(str(path))
+    platforms = _force_platforms(c3d, str(path))
+    params = c3d["parameters"]
+    header = c3d["header"]
+    units = params["POINT"].get("UNITS", {}).get("value")
+    meta = {}
+    for key, entry in params.get("TAPESPRING", {}).items():
+        value = entry.get("value") if isinstance(entry, dict) else None
+        if value is not None and len(value):
+            meta[key] = str(value[0])
+    return {
+        "point_rate": float(header["points"]["frame_rate"]),
+        "point_first_frame": int(header["points"]["first_frame"]),
+        "points": np.ascontiguousarray(c3d["data"]["points"][:3]),
+        "labels": [str(label) for label in params["POINT"]["LABELS"]["value"]],
+        "point_unit": str(units[0]) if units is not None and len(units) else None,
+        "analog_rate": float(header["analogs"]["frame_rate"]),
+        "analog_first_frame": int(header["analogs"]["first_frame"]),
+        "platforms": platforms,
+        "meta": meta,
+    }
+
+
+def _force_platforms(c3d: Any, path: str) -> list[dict]:
+    """Force, moment and units of each force platform, computed by ezc3d.
+
+    ``ezc3d.c3d(path, extract_forceplat_data=True)`` converts force, moment,
+    centre of pressure and free moment frame by frame in Python; the paper's
+    analyses need only force and moment, so call the same ezc3d extractor
+    (``ezc3d.ezc3d.ForcePlatforms``) and convert just those two (3x faster on a
+    4 kHz record). Falls back to the documented path if the wrapper changes.
+    """
+    import ezc3d
+
+    swig = getattr(c3d, "c3d_swig", None)
+    extractor = getattr(getattr(ezc3d, "ezc3d", None), "ForcePlatforms", None)
+    if swig is None or extractor is None:
+        full = ezc3d.c3d(path, extract_forceplat_data=True)
+        return [
+            {k: pf[k] for k in ("force", "moment", "unit_force", "unit_moment")}
+            for pf in full["data"].get("platform", [])
+        ]
+    out = []
+    for pf in extractor(swig).forcePlatforms():
+        force = np.array([v.to_array() for v in pf.forces()]).reshape(-1, 3)
+        moment = np.array([v.to_array() for v in pf.moments()]).reshape(-1, 3)
+        out.append(
+            {
+                "force": force.T,
+                "moment": moment.T,
+                "unit_force": pf.forceUnit(),
+                "unit_moment": pf.momentUnit(),
+            }
+        )
+    return out
+
+
+def _send(stream: IO[bytes], message: object) -> None:
+    payload = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(len(payload).to_bytes(_LENGTH, "big") + payload)
+    stream.flush()
+
+
+def _receive(stream: IO[bytes]) -> object | None:
+    """The next message, or None at the end of the stream."""
+    head = stream.read(_LENGTH)
+    if len(head) < _LENGTH:
+        return None
+    payload = stream.read(int.from_bytes(head, "big"))
+    return pickle.loads(payload)
+
+
+class WorkerFailure(Exception):
+    """The worker crashed or did not answer in time (the message says which)."""
+
+
+class IsolatedReader:
+    """A worker process that runs `read_raw`, restarted after a crash or a time-out.
+
+    Parameters
+    ----------
+    command : list of str, optional
+        Command that starts the worker (default: this module run by the current
+        Python). Tests pass a worker that misbehaves on purpose.
+    """
+
+    def __init__(self, command: list[str] | None = None) -> None:
+        self._command = command or [sys.executable, "-m", __name__]
+        self._proc: subprocess.Popen | None = None
+        self._pump_thread: threading.Thread | None = None
+        self._replies: queue.Queue = queue.Queue()
+        self._lock = threading.Lock()
+        self._pid = os.getpid()
+
+    def _start(self) -> None:
+        env = dict(os.environ)
+        # The worker imports this package: make it importable from where this copy lives.
+        root = str(Path(__file__).resolve().parents[2])
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH")]))
+        self._proc = subprocess.Popen(
+            self._command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env
+        )
+        self._replies = queue.Queue()
+        self._pump_thread = threading.Thread(
+            target=self._pump, args=(self._proc.stdout, self._replies), daemon=True
+        )
+        self._pump_thread.start()
+        self._wait_reply(_STARTUP_TIMEOUT, "start")
+
+    @staticmethod
+    def _pump(stream: IO[bytes], replies: queue.Queue) -> None:
+        # Reads the worker's answers; None tells the reader the worker is gone.
+        with stream:
+            try:
+                while (message := _receive(stream)) is not None:
+                    replies.put(message)
+            except Exception:  # a half-written message: the worker died while answering
+                pass
+        replies.put(None)
+
+    def _wait_reply(self, timeout: float, what: str) -> object:
+        try:
+            reply = self._replies.get(timeout=timeout)
+        except queue.Empty:
+            self._stop(kill=True)
+            raise WorkerFailure(f"did not {what} within {timeout:g} s") from None
+        if reply is None:
+            code = self._stop(kill=True)
+            raise WorkerFailure(_describe_exit(code))
+        return reply
+
+    def read(self, path: str | Path, timeout: float = DEFAULT_TIMEOUT) -> dict[str, Any]:
+        """`read_raw` in the worker.
+
+        Parameters
+        ----------
+        path : str or Path
+            The C3D file.
+        timeout : float
+            Time limit of the read [s], > 0.
+
+        Returns
+        -------
+        dict
+            See `read_raw`.
+
+        Raises
+        ------
+        WorkerFailure
+            If the worker crashed or did not answer within ``timeout``.
+        RuntimeError
+            If ezc3d raised (the message is ezc3d's).
+        """
+        if not timeout > 0:
+            raise ValueError(f"timeout must satisfy timeout > 0, got {timeout}")
+        with self._lock:
+            if self._pid != os.getpid():  # forked: the worker belongs to the parent process
+                self._proc, self._pid = None, os.getpid()
+            if self._proc is None or self._proc.poll() is not None:
+                self._start()
+            try:
+                _send(self._proc.stdin, ("read", str(path)))
+            except OSError:
+                code = self._stop(kill=True)
+                raise WorkerFailure(_describe_exit(code)) from None
+            status, value = self._wait_reply(timeout, "finish")
+        if status == "error":
+            raise RuntimeError(value)
+        return value
+
+    def _stop(self, kill: bool) -> int | None:
+        proc, self._proc = self._proc, None
+        if proc is None:
+            return None
+        if kill and proc.poll() is None:
+            proc.kill()
+        try:
+            proc.stdin.close()
+        except OSError:
+            pass
+        try:
+            code = proc.wait(timeout=5.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            code = proc.wait()
+        self._pump_thread.join(timeout=5.0)  # it closes the worker's output pipe at its end
+        return code
+
+    def close(self) -> None:
+        """Stop the worker (it also stops by itself when this process ends)."""
+        with self._lock:
+            if self._proc is not None and self._pid == os.getpid():
+                self._stop(kill=False)
+
+
+def _describe_exit(code: int | None) -> str:
+    if code is not None and code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+        return f"crashed ({name})"
+    return f"stopped unexpectedly (exit code {code})"
+
+
+_shared: IsolatedReader | None = None
+_shared_lock = threading.Lock()
+
+
+def read_raw_isolated(path: str | Path, timeout: float = DEFAULT_TIMEOUT) -> dict[str, Any]:
+    """`read_raw` in the shared worker process (see `IsolatedReader.read`)."""
+    global _shared
+    with _shared_lock:
+        if _shared is None:
+            _shared = IsolatedReader()
+            atexit.register(_shared.close)
+    return _shared.read(path, timeout)
+
+
+def _serve() -> None:
+    """The worker: answer ``("read", path)`` requests until the standard input closes."""
+    replies = os.fdopen(os.dup(sys.stdout.fileno()), "wb")
+    os.dup2(sys.stderr.fileno(), sys.stdout.fileno())  # C++ output must not reach the pipe
+    import ezc3d  # noqa: F401  (imported before announcing readiness: start-up is timed apart)
+
+    _send(replies, ("ready", None))
+    requests = sys.stdin.buffer
+    while (message := _receive(requests)) is not None:
+        _, path = message
+        try:
+            reply = ("ok", read_raw(path))
+        except Exception as exc:  # ezc3d's exceptions go back as text
+            reply = ("error", f"{type(exc).__name__}: {exc}")
+        _send(replies, reply)
+
+
+if __name__ == "__main__":
+    _serve()
