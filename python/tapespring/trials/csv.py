@@ -16,7 +16,9 @@ marker); force-plate columns are ``<plate>_Fx`` ... ``<plate>_Mz``. Units are
 given in brackets (lengths: m, cm, mm; time: s, ms; force: N, kN; moment:
 N m, N mm). A column without a unit takes the unit passed by the caller
 (``length_unit=``, ...); if there is none, reading fails. Missing samples are
-written ``nan``; empty fields are read as missing too.
+written ``nan``; empty fields are read as missing too. Any other non-finite
+value (``inf``, ``1e999``) is an error naming the file, the column and the line,
+as is a row with too few or too many fields.
 """
 
 from __future__ import annotations
@@ -67,21 +69,7 @@ def _read_table(path: Path) -> tuple[dict[str, str], list[str], list[str | None]
             raise TrialError(path, f"cannot parse header cell {cell!r}")
         names.append(match["name"])
         units.append(match["unit"].strip() if match["unit"] else None)
-    try:
-        values = np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding="utf-8")
-    except ValueError:
-        # Empty fields are missing samples; parse again, slower, reading them as NaN.
-        try:
-            values = np.loadtxt(
-                path,
-                delimiter=",",
-                skiprows=n_skip,
-                ndmin=2,
-                encoding="utf-8",
-                converters=lambda s: float(s) if s.strip() else np.nan,
-            )
-        except ValueError as exc:
-            raise TrialError(path, f"malformed or truncated data ({exc})") from exc
+    values = _read_values(path, n_skip, names)
     if values.size == 0:
         raise TrialError(path, "no data rows")
     if values.shape[1] != len(names):
@@ -90,7 +78,105 @@ def _read_table(path: Path) -> tuple[dict[str, str], list[str], list[str | None]
         )
     if names[0].lower() != "time":
         raise TrialError(path, f"the first column must be 'time', got {names[0]!r}")
+    # A value is a number or missing (NaN, empty field); inf or 1e999 is a damaged value, and
+    # a missing instant cannot be placed at all.
+    bad = np.isinf(values)
+    bad[:, 0] |= np.isnan(values[:, 0])
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        where = (
+            f"column {names[col]!r}, data row {row + 1} (line {_line_of_row(path, n_skip, row)})"
+        )
+        if np.isnan(values[row, col]):
+            raise TrialError(path, f"{where} is missing: every row needs its instant")
+        raise TrialError(
+            path,
+            f"{where} is {values[row, col]}: only 'nan' or an empty field mark a missing "
+            "sample, every other value must be a finite number",
+        )
     return meta, names, units, values
+
+
+def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
+    """The numbers below the header; a bad row raises a TrialError naming its line."""
+    try:
+        return np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding="utf-8")
+    except ValueError:
+        pass
+    # Empty fields (missing samples) or a damaged row: parse again, slower, line by line, to
+    # read empty fields as NaN or say which row and column is wrong.
+    rows = []
+    with path.open(encoding="utf-8") as fh:
+        for line_no, line in enumerate(fh, start=1):
+            if line_no <= n_skip or not line.strip():
+                continue
+            fields = line.rstrip("\r\n").split(",")
+            if len(fields) != len(names):
+                raise TrialError(
+                    path,
+                    f"line {line_no} has {len(fields)} fields but the header has {len(names)} "
+                    "columns (truncated or damaged row)",
+                )
+            row = []
+            for name, text in zip(names, fields, strict=True):
+                text = text.strip()
+                try:
+                    row.append(float(text) if text else np.nan)
+                except ValueError:
+                    raise TrialError(
+                        path, f"line {line_no}, column {name!r}: {text!r} is not a number"
+                    ) from None
+            rows.append(row)
+    return np.array(rows, dtype=float).reshape(-1, len(names))
+
+
+def _line_of_row(path: Path, n_skip: int, row: int) -> int:
+    """Line number (1-based) of data row ``row`` (0-based); blank lines are not rows."""
+    with path.open(encoding="utf-8") as fh:
+        seen = -1
+        for line_no, line in enumerate(fh, start=1):
+            if line_no > n_skip and line.strip():
+                seen += 1
+                if seen == row:
+                    return line_no
+    return n_skip + row + 1
+
+
+def _marker_columns(path: Path, names: list[str]) -> dict[str, list[int]]:
+    """Marker name -> indices of its x, y, z columns, checked complete, in order and together."""
+    found: dict[str, dict[str, int]] = {}
+    for k, name in enumerate(names[1:], start=1):
+        stem, sep, axis = name.rpartition("_")
+        if not sep or not stem or axis not in ("x", "y", "z"):
+            raise TrialError(
+                path,
+                f"column {name!r} is not a marker coordinate: marker columns are "
+                "<marker>_x, <marker>_y, <marker>_z",
+            )
+        axes = found.setdefault(stem, {})
+        if axis in axes:
+            raise TrialError(path, f"duplicate column {name!r}")
+        axes[axis] = k
+    out = {}
+    for stem, axes in found.items():
+        missing = [f"{stem}_{a}" for a in "xyz" if a not in axes]
+        if missing:
+            have = ", ".join(names[k] for k in sorted(axes.values()))
+            raise TrialError(
+                path,
+                f"marker {stem!r} is incomplete: it has {have} but no {', '.join(missing)} "
+                "(each marker needs _x, _y and _z columns)",
+            )
+        columns = [axes[a] for a in "xyz"]
+        if columns != list(range(columns[0], columns[0] + 3)):
+            raise TrialError(
+                path,
+                f"the columns of marker {stem!r} must be {stem}_x, {stem}_y, {stem}_z side by "
+                f"side, got {[names[k] for k in sorted(columns)]} at columns "
+                f"{[k + 1 for k in sorted(columns)]}",
+            )
+        out[stem] = columns
+    return out
 
 
 def _unit_for(path: Path, name: str, unit: str | None, default: str | None, arg: str) -> str:
@@ -146,25 +232,17 @@ def read_csv(
     meta, names, units, values = _read_table(path)
     t_unit = _unit_for(path, names[0], units[0], time_unit, "time_unit")
     time = values[:, 0] * unit_scale(t_unit, TIME, path, "time")
-    if (len(names) - 1) % 3 != 0:
-        raise TrialError(path, f"expected 3 columns per marker, got {len(names) - 1} columns")
     markers = {}
     found_units = set()
-    for j in range(1, len(names), 3):
-        stem = names[j].rsplit("_", 1)[0]
-        expected = [f"{stem}_{axis}" for axis in "xyz"]
-        if names[j : j + 3] != expected:
-            raise TrialError(path, f"expected marker columns {expected}, got {names[j : j + 3]}")
+    for stem, columns in _marker_columns(path, names).items():
         col_units = {
-            _unit_for(path, names[k], units[k], length_unit, "length_unit") for k in range(j, j + 3)
+            _unit_for(path, names[k], units[k], length_unit, "length_unit") for k in columns
         }
         if len(col_units) != 1:
             raise TrialError(path, f"marker {stem!r} has mixed units {sorted(col_units)}")
         unit = col_units.pop()
         found_units.add(unit)
-        if stem in markers:
-            raise TrialError(path, f"duplicate marker {stem!r}")
-        markers[stem] = values[:, j : j + 3] * unit_scale(unit, LENGTH, path, "length")
+        markers[stem] = values[:, columns] * unit_scale(unit, LENGTH, path, "length")
     if not markers:
         raise TrialError(path, "no marker columns")
     file_units = {"markers": ",".join(sorted(found_units))}
