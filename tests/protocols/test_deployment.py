@@ -61,3 +61,16 @@ def test_deployment_with_marker_gap_fails_then_succeeds_after_filling():
     filled = analyze_deployment(gappy.fill_gaps(0.02))
     reference = analyze_deployment(trial)
     np.testing.assert_allclose(filled.peaks.maxima.value, reference.peaks.maxima.value, atol=1e-3)
+
+
+def test_gap_at_the_end_of_the_record_says_to_crop_not_to_interpolate():
+    trial, _ = make_deployment_trial("opposite", seed=1, duration=2.0)
+    markers = {k: np.array(v) for k, v in trial.markers.items()}
+    markers["M2"][-40:] = np.nan
+    gappy = Trial(trial.time, markers, trial.force_plates, trial.metadata)
+    with pytest.raises(TrialError, match="cannot be interpolated") as info:
+        analyze_deployment(gappy)
+    message = str(info.value)
+    assert "fills interior gaps only" in message and "Trial.crop" in message
+    assert f"end it before t = {trial.time[-40]:.4g} s" in message
+    assert "interpolate the interior gaps" not in message  # --max-gap would not help

@@ -88,3 +88,15 @@ def test_trial_arrays_are_read_only():
     trial = _trial()
     with pytest.raises(ValueError, match="read-only"):
         trial.markers["M1"][0, 0] = 1.0
+
+
+def test_crop_keeps_the_interval_and_cuts_the_force_plates():
+    t = np.arange(100) / 100.0
+    plate = ForcePlate(np.arange(200) / 200.0, np.ones((200, 3)), np.zeros((200, 3)))
+    trial = Trial(t, {"A": np.column_stack((t, t, t))}, (plate,))
+    part = trial.crop(0.2, 0.5)
+    assert part.time[0] == pytest.approx(0.2) and part.time[-1] == pytest.approx(0.5)
+    assert part.markers["A"].shape == (31, 3)
+    assert part.force_plates[0].time[0] == pytest.approx(0.2)
+    with pytest.raises(TrialError, match="leaves 1 marker sample"):
+        trial.crop(0.5, 0.5)

@@ -34,11 +34,30 @@ def finite_marker(trial: Trial, name: str) -> np.ndarray:
     xyz = trial.marker(name)
     if np.isnan(xyz).any():
         gaps = [g for g in trial.gaps() if g.marker == name]
-        longest = max(g.duration for g in gaps)
-        raise TrialError(
-            trial.metadata.label,
+        longest = max(gaps, key=lambda g: g.duration)
+        text = (
             f"marker {name!r} has {len(gaps)} gap(s) of missing samples (longest "
-            f"{longest * 1e3:.3g} ms at t = {gaps[0].start_time:.4g} s); interpolate short "
-            "gaps with Trial.fill_gaps(max_gap) or --max-gap",
+            f"{longest.duration * 1e3:.3g} ms at t = {longest.start_time:.4g} s)"
         )
+        edges = [g for g in gaps if g.at_edge]
+        interior = [g for g in gaps if not g.at_edge]
+        advice = []
+        if interior:
+            advice.append(
+                "interpolate the interior gaps with Trial.fill_gaps(max_gap) or --max-gap"
+            )
+        if edges:
+            # Interpolation needs samples on both sides: an edge gap can only be cut off.
+            ends = []
+            for g in edges:
+                if g.start == 0:
+                    ends.append(f"start it after t = {trial.time[g.stop - 1]:.4g} s")
+                else:
+                    ends.append(f"end it before t = {g.start_time:.4g} s")
+            advice.append(
+                "a gap at the start or end of the record cannot be interpolated (--max-gap "
+                f"fills interior gaps only): crop the record ({', '.join(ends)}) with "
+                "Trial.crop or in the capture software"
+            )
+        raise TrialError(trial.metadata.label, f"{text}; {'; '.join(advice)}")
     return xyz

@@ -354,6 +354,41 @@ class Trial:
                 xyz[gap.start : gap.stop] = spline(self.time[gap.start : gap.stop])
         return dataclasses.replace(self, markers=markers)
 
+    def crop(self, start: float | None = None, stop: float | None = None) -> Trial:
+        """The part of the trial with ``start <= t <= stop`` (force plates cut alike).
+
+        Parameters
+        ----------
+        start, stop : float, optional
+            First and last instant kept [s]; None keeps that end.
+
+        Returns
+        -------
+        Trial
+            A new trial (the metadata are kept).
+
+        Raises
+        ------
+        TrialError
+            If fewer than 2 marker samples remain.
+        """
+        lo = -np.inf if start is None else start
+        hi = np.inf if stop is None else stop
+        keep = (self.time >= lo) & (self.time <= hi)
+        if np.count_nonzero(keep) < 2:
+            raise TrialError(
+                self.metadata.label,
+                f"cropping to [{lo:g}, {hi:g}] s leaves {np.count_nonzero(keep)} marker sample(s)",
+            )
+        markers = {name: xyz[keep] for name, xyz in self.markers.items()}
+        plates = []
+        for p in self.force_plates:
+            k = (p.time >= lo) & (p.time <= hi)
+            plates.append(ForcePlate(p.time[k], p.force[k], p.moment[k], p.name))
+        return dataclasses.replace(
+            self, time=self.time[keep], markers=markers, force_plates=tuple(plates)
+        )
+
     def with_metadata(self, **changes: object) -> Trial:
         """A copy of the trial whose metadata fields are replaced by ``changes``."""
         return dataclasses.replace(self, metadata=dataclasses.replace(self.metadata, **changes))
