@@ -89,9 +89,11 @@ def summary_dict(analysis: TrialsAnalysis) -> dict:
     Returns
     -------
     dict
-        ``kind``, ``n_trials`` and per-kind statistics; NaN is written as None.
+        ``kind``, ``n_trials``, ``skipped`` (file and problem of each trial left
+        out) and per-kind statistics; NaN is written as None.
     """
     out: dict = {"kind": analysis.kind, "n_trials": len(analysis.results)}
+    out["skipped"] = [{"file": s.source, "problem": s.problem} for s in analysis.skipped]
     out |= protocol_for(analysis.kind).summary(analysis)
     return _jsonable_tree(out)
 
@@ -155,6 +157,9 @@ def format_summary(analysis: TrialsAnalysis) -> str:
         )
         if j == 0:
             lines.append("  ".join("-" * w for w in widths))
+    if analysis.skipped:
+        lines.append(f"skipped {len(analysis.skipped)} trial(s):")
+        lines += [f"  {s.source}: {s.problem}" for s in analysis.skipped]
     return "\n".join(lines)
 
 
@@ -199,5 +204,8 @@ def write_report(
     folder.mkdir(parents=True, exist_ok=True)
     protocol = protocol_for(analysis.kind)
     files = [write_table(folder / "summary.csv", SUMMARY_HEADER, protocol.table_rows(analysis))]
+    if analysis.skipped:
+        rows = [(s.source, s.problem) for s in analysis.skipped]
+        files.append(write_table(folder / "skipped.csv", ["file", "problem"], rows))
     files += protocol.write_files(analysis, folder, figures)
     return files

@@ -2,9 +2,14 @@
 
 The main ``tapespring`` command calls `register` with its sub-parsers; this
 module can also be run on its own: ``python -m tapespring.cli.trials trials
-analyze ...``. Progress bars go to stderr, so that with ``--json`` the standard
-output is exactly one JSON object. Building the parser imports no analysis
-(the trials, protocols and report are imported by `run_analyze`).
+analyze ...``. Progress bars, warnings and errors go to stderr, so that with
+``--json`` the standard output is exactly one JSON object. Building the parser
+imports no analysis (the trials, protocols and report are imported by
+`run_analyze`).
+
+Exit codes: 0 when every trial was analysed, or when ``--skip-bad`` left some
+out and the summary lists them; 1 on an invalid file, trial or option (the
+message names it); 2 on a command-line syntax error (argparse).
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -19,6 +25,30 @@ from tapespring.protocols.markers import DEFAULT_MARKERS
 from tapespring.protocols.registry import KINDS
 
 __all__ = ["main", "register", "run_analyze"]
+
+_SENSES = ("opposite", "equal")  # tapespring.trials.SENSES, without importing the trials
+
+
+def _int_at_least_1(text: str) -> int:
+    """An argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {value}")
+    return value
+
+
+def _positive_seconds(text: str) -> float:
+    """An argparse type: a finite duration > 0 [s]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a duration in seconds, got {text!r}") from None
+    if not (0 < value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a duration > 0 s, got {text}")
+    return value
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -66,9 +96,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--n-peaks",
-        type=int,
+        type=_int_at_least_1,
         default=10,
-        help="deployment: maxima and minima analysed (default 10)",
+        help="deployment: maxima and minima analysed, >= 1 (default 10)",
+    )
+    p.add_argument(
+        "--frame",
+        default="lab",
+        metavar="AXES",
+        help=(
+            "deployment: the rig's frame: 'lab' (markers already in the rig's axes: x along the "
+            "deployed rod, bending about y; default), the lab axes along the rig's x, y, z "
+            "(e.g. 'x,-z,y' for a capture with z up), or 'fit' (fit the plane of motion; the "
+            "sense fixes the sign)"
+        ),
     )
     p.add_argument(
         "--window",
@@ -78,18 +119,39 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar=("LOW", "HIGH"),
         help="vibration: |peak| range fitted [m] (default 0.0004 0.004)",
     )
-    p.add_argument(
+    span = p.add_mutually_exclusive_group()
+    span.add_argument(
         "--span",
-        type=int,
-        default=101,
+        type=_int_at_least_1,
+        default=None,
+        metavar="SAMPLES",
         help="quasi-static: force smoothing span [samples] (default 101)",
+    )
+    span.add_argument(
+        "--span-time",
+        type=_positive_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="quasi-static: force smoothing span as a duration [s] (0.0253 = 101 at 4 kHz)",
     )
     p.add_argument(
         "--max-gap",
         type=float,
         default=None,
         metavar="SECONDS",
-        help="interpolate marker gaps up to this duration [s] (default: none)",
+        help=(
+            "interpolate interior marker gaps up to this duration [s] (default: none; gaps at "
+            "the start or end of a record are never filled)"
+        ),
+    )
+    p.add_argument("--sense", choices=_SENSES, help="sense of bending of every trial given")
+    p.add_argument("--session", help="session of every trial given")
+    p.add_argument("--tape-pair", help="tape pair of every trial given")
+    p.add_argument(
+        "--skip-bad",
+        action="store_true",
+        help="skip (with a warning) a trial that cannot be read or analysed, and list it in "
+        "the summary, instead of stopping",
     )
     p.add_argument(
         "--length-unit",
@@ -108,43 +170,63 @@ def run_analyze(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        0 on success, 1 if a trial or a file is invalid (the message is printed
-        on stderr).
+        0 on success (trials skipped with ``--skip-bad`` are listed in the
+        summary), 1 if a trial, a file or an option is invalid (the message is
+        printed on stderr).
     """
-    from tapespring.protocols.registry import analyze_trials
+    from tapespring.protocols.registry import analyze_trials, protocol_for
     from tapespring.report import format_summary, summary_dict, write_report
-    from tapespring.trials.load import load_trials
+    from tapespring.trials.load import load_trial_set
     from tapespring.trials.trial import TrialError
 
     progress = not args.no_progress
-    try:
-        trials = load_trials(
-            args.paths,
-            max_gap=args.max_gap,
-            required_markers=args.markers,
-            progress=progress,
-            length_unit=args.length_unit,
-        )
-        analysis = analyze_trials(
-            trials,
-            args.kind,
-            markers=args.markers,
-            n_peaks=args.n_peaks,
-            window=tuple(args.window),
-            span=args.span,
-            progress=progress,
-        )
-        write_report(analysis, args.out, figures=not args.no_figures)
-    except (TrialError, FileNotFoundError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
+    required = [args.markers[i] for i in protocol_for(args.kind).marker_roles]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            loaded = load_trial_set(
+                args.paths,
+                max_gap=args.max_gap,
+                required_markers=required,
+                progress=progress,
+                skip_bad=args.skip_bad,
+                length_unit=args.length_unit,
+                sense=args.sense,
+                session=args.session,
+                tape_pair=args.tape_pair,
+            )
+            analysis = analyze_trials(
+                loaded.trials,
+                args.kind,
+                markers=args.markers,
+                n_peaks=args.n_peaks,
+                window=tuple(args.window),
+                span=101 if args.span is None else args.span,
+                span_time=args.span_time,
+                frame=args.frame,
+                progress=progress,
+                skip_bad=args.skip_bad,
+                skipped=loaded.skipped,
+            )
+            write_report(analysis, args.out, figures=not args.no_figures)
+        except (TrialError, FileNotFoundError, ValueError) as exc:
+            _print_warnings(caught)
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+    _print_warnings(caught)
+    notes = [str(w.message) for w in caught]
     if args.json:
-        data = summary_dict(analysis) | {"report": str(args.out)}
+        data = summary_dict(analysis) | {"report": str(args.out), "warnings": notes}
         print(json.dumps(data, allow_nan=False))
     else:
         print(format_summary(analysis))
         print(f"report written to {args.out}")
     return 0
+
+
+def _print_warnings(caught: list[warnings.WarningMessage]) -> None:
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

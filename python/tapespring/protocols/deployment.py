@@ -9,6 +9,7 @@ of the initial angle and of the lateral tip excursion. Marker roles and gaps: se
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,12 +20,13 @@ from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
 from tapespring.signals.angle import bending_angle
 from tapespring.signals.circle import CircleFit, fit_circle, max_lateral_displacement
+from tapespring.signals.frame import fit_motion_frame, parse_frame, to_frame
 from tapespring.signals.levels import equilibrium_value, release_index
 from tapespring.signals.peaks import Peaks, PeakStatistics, extract_peaks, peak_statistics
 from tapespring.signals.phases import Phases, detect_phases
-from tapespring.signals.smoothing import smooth
+from tapespring.signals.smoothing import complete_windows, smooth, span_samples
 from tapespring.signals.stats import Summary, summarize
-from tapespring.trials.trial import Trial, TrialError
+from tapespring.trials.trial import Trial, TrialError, TrialWarning
 
 from .markers import DEFAULT_MARKERS, finite_marker
 from .registry import Protocol, TrialsAnalysis
@@ -68,9 +70,13 @@ class DeploymentResult:
     tip_circle : CircleFit or None
         Circle fitted to ``tip_points`` (None with fewer than 3 points).
     lateral_max : float
-        Largest lateral (y) excursion of the tip about its equilibrium [m].
+        Largest lateral (y) excursion of the tip about its equilibrium [m], over
+        the samples whose smoothing window is complete.
     force_time, force_z : ndarray or None
         Vertical force of the first force plate [s], [N] (None without plate).
+    frame : str
+        Axes the markers were analysed in: ``"lab"`` (as recorded), the signed
+        axes given (``"x,-z,y"``), ``"given"`` (a matrix) or ``"fitted"``.
     """
 
     name: str
@@ -89,6 +95,38 @@ class DeploymentResult:
     lateral_max: float
     force_time: np.ndarray | None
     force_z: np.ndarray | None
+    frame: str = "lab"
+
+
+# Sign of the initial bending angle for each sense (paper Sec. 2).
+_SENSE_SIGN = {"opposite": 1.0, "equal": -1.0}
+
+
+def _rig_frame(frame: str | np.ndarray | None) -> tuple[np.ndarray | None, str]:
+    """The rotation to the rig's axes (None: as recorded) and its label."""
+    if frame is None or (isinstance(frame, str) and frame.strip().lower() in ("", "lab")):
+        return None, "lab"
+    if isinstance(frame, str):
+        if frame.strip().lower() == "fit":
+            return None, "fitted"
+        return parse_frame(frame), frame.strip()
+    rotation = np.asarray(frame, dtype=float)
+    if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6):
+        raise ValueError("frame must be 'lab', 'fit', signed axes like 'x,-z,y' or a 3x3 rotation")
+    if np.linalg.det(rotation) < 0:
+        raise ValueError("frame is a mirror image (determinant -1): it would flip every angle")
+    return rotation, "given"
+
+
+def _angle_and_release(
+    t: np.ndarray, m1: np.ndarray, m2: np.ndarray, tail: float, threshold: float
+) -> tuple[np.ndarray, int, float]:
+    """Bending angle about its equilibrium [rad], release index, held initial angle [rad]."""
+    raw = bending_angle(m1, m2)
+    angle = raw - equilibrium_value(t, raw, tail=tail)
+    i0 = release_index(angle, threshold)
+    initial = float(np.median(angle[: max(1, i0 - 1)]))
+    return angle, i0, initial
 
 
 def analyze_deployment(
@@ -100,6 +138,8 @@ def analyze_deployment(
     release_threshold: float = np.deg2rad(2.0),
     tail: float = 1.0,
     lateral_span: int = 25,
+    lateral_span_time: float | None = None,
+    frame: str | np.ndarray | None = None,
 ) -> DeploymentResult:
     """Bending angle, peaks, phases, tip trajectory and lateral excursion of a deployment.
 
@@ -120,7 +160,24 @@ def analyze_deployment(
     lateral_span : int
         Moving-average span applied to the lateral coordinate before taking its
         maximum [samples] (25 samples = 31 ms at 800 Hz cut the 0.3 mm transverse
-        marker noise five-fold); 1 disables it.
+        marker noise five-fold); 1 disables it. The maximum is taken where the
+        window is complete: the first and last ``lateral_span // 2`` samples,
+        which MATLAB's ``smooth`` averages over shrinking windows (down to the
+        raw sample), are left out.
+    lateral_span_time : float, optional
+        The same span as a duration [s] (converted to the nearest odd number of
+        samples); replaces ``lateral_span``.
+    frame : str or ndarray, optional
+        Axes of the markers. None or ``"lab"``: as recorded (x along the
+        deployed rod, bending about y). Signed laboratory axes of the rig's x, y
+        and z, e.g. ``"x,-z,y"`` for a capture with z up and the bending axis
+        along -z (`tapespring.signals.frame.parse_frame`), or a 3x3 rotation.
+        ``"fit"``: fit the plane of motion to the markers
+        (`tapespring.signals.frame.fit_motion_frame`); the sign of the bending
+        axis is then chosen so that the initial angle agrees with the trial's
+        sense (or from the laboratory y axis, with a warning, if the sense is
+        unknown). A rig turned about the vertical shifts every angle unless the
+        frame is given or fitted.
 
     Returns
     -------
@@ -129,17 +186,56 @@ def analyze_deployment(
     Raises
     ------
     TrialError
-        If a marker is missing or has unfilled gaps, or no peak is found.
+        If a marker is missing or has unfilled gaps, no peak is found, or the
+        plane of motion cannot be fitted.
+
+    Warns
+    -----
+    TrialWarning
+        If the sign of the initial angle contradicts the trial's sense (markers
+        probably not in the rig's frame), or a fitted frame has no sense to fix
+        its sign.
     """
+    if not isinstance(n_peaks, int | np.integer) or n_peaks < 1:
+        raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
+    label = trial.metadata.label
+    sense = trial.metadata.sense
     m1, m2, m3 = (finite_marker(trial, name) for name in markers)
     t = trial.time
-    raw = bending_angle(m1, m2)
-    angle = raw - equilibrium_value(t, raw, tail=tail)
-    i0 = release_index(angle, release_threshold)
+    rotation, frame_name = _rig_frame(frame)
+    if frame_name == "fitted":
+        try:
+            rotation = fit_motion_frame(m1, m2, m3, deployed=t >= t[-1] - tail)
+        except ValueError as exc:
+            raise TrialError(label, str(exc)) from None
+    if rotation is not None:
+        m1, m2, m3 = (to_frame(rotation, m) for m in (m1, m2, m3))
+    angle, i0, initial = _angle_and_release(t, m1, m2, tail, release_threshold)
     if i0 == 0:
-        raise TrialError(trial.metadata.label, "the bending angle never leaves its initial value")
+        raise TrialError(label, "the bending angle never leaves its initial value")
+    expected = _SENSE_SIGN.get(sense)
+    if frame_name == "fitted" and expected is not None and np.sign(initial) == -expected:
+        # A fit cannot tell which way the bending axis points: the sense decides.
+        m1, m2, m3 = (to_frame(np.diag([1.0, -1.0, -1.0]), m) for m in (m1, m2, m3))
+        angle, i0, initial = _angle_and_release(t, m1, m2, tail, release_threshold)
+    elif frame_name == "fitted" and expected is None:
+        warnings.warn(
+            f"{label}: fitted frame without a sense of bending: the sign of the bending "
+            "angle follows the laboratory y axis; give the sense to fix it",
+            TrialWarning,
+            stacklevel=2,
+        )
+    elif expected is not None and np.sign(initial) == -expected:
+        warnings.warn(
+            f"{label}: initial bending angle {np.rad2deg(initial):+.1f} deg contradicts the "
+            f"{sense} sense (expected {'> 0' if expected > 0 else '< 0'}): the markers are "
+            "probably not in the rig's frame (x along the deployed rod, bending about y), so "
+            "maxima and minima are swapped; give the frame (frame='x,-z,y', --frame) or fit "
+            "it (frame='fit', --frame fit), or check the sense",
+            TrialWarning,
+            stacklevel=2,
+        )
     t_rel = float(t[i0])
-    initial = float(np.median(angle[: max(1, i0 - 1)]))
     tt, yy = t[i0:], angle[i0:]
     all_peaks = extract_peaks(tt, yy, None, prominence=prominence, t_ref=t_rel)
     if len(all_peaks.maxima) == 0 and len(all_peaks.minima) == 0:
@@ -154,8 +250,11 @@ def analyze_deployment(
     pt = np.concatenate(([t[max(0, i0 - 1)]], pt))
     tip_points = np.column_stack([np.interp(pt, t, tip_xz[:, k]) for k in range(2)])
     circle = fit_circle(tip_points) if tip_points.shape[0] >= 3 else None
-    lateral = smooth(m3[:, 1], lateral_span) if lateral_span > 1 else m3[:, 1]
-    lateral_max = max_lateral_displacement(lateral, reference=tip_eq[1])
+    span = span_samples(lateral_span_time, trial.rate) if lateral_span_time else lateral_span
+    lateral = smooth(m3[:, 1], span) if span > 1 else m3[:, 1]
+    lateral_max = max_lateral_displacement(
+        lateral[complete_windows(lateral.size, span)], reference=tip_eq[1]
+    )
 
     force_time = force_z = None
     if trial.force_plates:
@@ -179,6 +278,7 @@ def analyze_deployment(
         lateral_max=lateral_max,
         force_time=force_time,
         force_z=force_z,
+        frame=frame_name,
     )
 
 
@@ -208,7 +308,11 @@ class DeploymentGroup:
 
 
 def analyze_deployment_group(
-    trials: Iterable[Trial], *, markers: Sequence[str] = DEFAULT_MARKERS, n_peaks: int = 10
+    trials: Iterable[Trial],
+    *,
+    markers: Sequence[str] = DEFAULT_MARKERS,
+    n_peaks: int = 10,
+    frame: str | np.ndarray | None = None,
 ) -> TrialsAnalysis:
     """Analyse deployment trials, grouped by sense of bending, with the statistics of each group.
 
@@ -219,14 +323,28 @@ def analyze_deployment_group(
     markers : (str, str, str)
         Names of markers 1 (support), 2 (rod) and 3 (tip).
     n_peaks : int
-        Number of maxima and minima analysed.
+        Number of maxima and minima analysed, >= 1.
+    frame : str or ndarray, optional
+        Axes of the markers (see `analyze_deployment`).
 
     Returns
     -------
     TrialsAnalysis
         Kind ``"deployment"``, one `DeploymentGroup` per sense (in order of appearance).
     """
-    results = tuple(analyze_deployment(t, markers=markers, n_peaks=n_peaks) for t in trials)
+    results = [analyze_deployment(t, markers=markers, n_peaks=n_peaks, frame=frame) for t in trials]
+    return _combine(results, n_peaks=n_peaks)
+
+
+def _analyze_trial(
+    trial: Trial, *, markers: Sequence[str], n_peaks: int, frame: str | np.ndarray | None
+) -> DeploymentResult:
+    return analyze_deployment(trial, markers=markers, n_peaks=n_peaks, frame=frame)
+
+
+def _combine(results: Sequence[DeploymentResult], *, n_peaks: int, **_: object) -> TrialsAnalysis:
+    """Group the per-trial results by sense and compute each group's statistics."""
+    results = tuple(results)
     groups = []
     for sense in dict.fromkeys(r.sense for r in results):
         members = tuple(r for r in results if r.sense == sense)
@@ -284,6 +402,16 @@ def _summary(analysis: TrialsAnalysis) -> dict:
             "phase_iii_start": r.phases.phase_iii_start,
             "lateral_max": r.lateral_max,
             "tip_circle_radius": r.tip_circle.radius if r.tip_circle else None,
+            "frame": r.frame,
+            "peaks": {
+                kind: {
+                    "time": ext.time,
+                    "amplitude": ext.value,
+                    "amplitude_deg": np.rad2deg(ext.value),
+                    "separation": ext.separation,
+                }
+                for kind, ext in (("maxima", r.peaks.maxima), ("minima", r.peaks.minima))
+            },
         }
         for r in analysis.results
     ]
@@ -399,8 +527,10 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
-    analyze=analyze_deployment_group,
-    options=("n_peaks",),
+    analyze_trial=_analyze_trial,
+    combine=_combine,
+    options=("n_peaks", "frame"),
+    marker_roles=(0, 1, 2),
     table_rows=_table_rows,
     summary=_summary,
     write_files=_write_files,

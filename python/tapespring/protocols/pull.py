@@ -17,7 +17,7 @@ import numpy as np
 from tapespring import plot
 from tapespring.report import save_figure, summary_json, summary_row, write_table
 from tapespring.signals.pull import PullTest, analyze_pull_test
-from tapespring.signals.smoothing import smooth
+from tapespring.signals.smoothing import smooth, span_samples
 from tapespring.signals.stats import summarize
 from tapespring.trials.trial import Trial, TrialError
 
@@ -57,6 +57,7 @@ def analyze_pull_trial(
     plate: int = 0,
     span: int = 101,
     tare: float = 0.1,
+    span_time: float | None = None,
 ) -> PullTestResult:
     """Force versus displacement of a quasi-static pull test (Fig. 19, Table 2).
 
@@ -78,6 +79,10 @@ def analyze_pull_trial(
         Smoothing span of the force [samples] (paper: 101).
     tare : float
         Initial duration defining zero force and displacement [s], > 0.
+    span_time : float, optional
+        Smoothing span as a duration [s], converted at the force-plate rate to
+        the nearest odd number of samples (paper: 25.3 ms = 101 samples at
+        4 kHz); replaces ``span``.
 
     Returns
     -------
@@ -85,6 +90,8 @@ def analyze_pull_trial(
     """
     z = finite_marker(trial, marker)[:, 2]
     fp = trial.force_plate(plate)
+    if span_time is not None:
+        span = span_samples(span_time, fp.rate)
     t = trial.time
     z = z - np.median(z[t < t[0] + tare]) if np.any(t < t[0] + tare) else z - z[0]
     d = np.interp(fp.time, t, z)
@@ -121,7 +128,19 @@ def analyze_pull_group(
     TrialsAnalysis
         Kind ``"quasi-static"``, with ``summaries``.
     """
-    results = tuple(analyze_pull_trial(t, marker=markers[1], span=span) for t in trials)
+    results = [analyze_pull_trial(t, marker=markers[1], span=span) for t in trials]
+    return _combine(results)
+
+
+def _analyze_trial(
+    trial: Trial, *, markers: Sequence[str], span: int, span_time: float | None
+) -> PullTestResult:
+    return analyze_pull_trial(trial, marker=markers[1], span=span, span_time=span_time)
+
+
+def _combine(results: Sequence[PullTestResult], **_: object) -> TrialsAnalysis:
+    """Statistics of the maximum force and its displacement."""
+    results = tuple(results)
     summaries = {
         "max_force": summarize([r.test.max_force for r in results]),
         "displacement_at_max": summarize([r.test.displacement_at_max for r in results]),
@@ -146,6 +165,7 @@ def _summary(analysis: TrialsAnalysis) -> dict:
             "max_force": r.test.max_force,
             "displacement_at_max": r.test.displacement_at_max,
             "buckled": r.test.buckled,
+            "span": r.test.span,
         }
         for r in analysis.results
     ]
@@ -188,8 +208,10 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
-    analyze=analyze_pull_group,
-    options=("span",),
+    analyze_trial=_analyze_trial,
+    combine=_combine,
+    options=("span", "span_time"),
+    marker_roles=(1,),
     table_rows=_table_rows,
     summary=_summary,
     write_files=_write_files,

@@ -11,14 +11,20 @@ statistics across trials:
   (paper Table 2).
 
 Each kind is a `Protocol` defined in its own module (`deployment`, `vibration`,
-`pull`); `protocol_for` looks it up. The module of a kind is imported the first
+`pull`); `protocol_for` looks it up. A protocol analyses one trial at a time
+(``analyze_trial``) and then the set (``combine``), so that with
+``skip_bad=True`` a trial whose analysis fails is left out and listed in
+`TrialsAnalysis.skipped` instead of stopping the others. The module of a kind is imported the first
 time the kind is used, so that listing the kinds (as the command line does to
 build its parser) imports neither numpy-heavy modules nor matplotlib.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
+import math
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +33,9 @@ from typing import TYPE_CHECKING
 from .markers import DEFAULT_MARKERS
 
 if TYPE_CHECKING:
+    import numpy as np
+
+    from tapespring.trials.load import SkippedTrial
     from tapespring.trials.trial import Trial
 
     from .deployment import DeploymentGroup, DeploymentResult
@@ -60,6 +69,9 @@ class TrialsAnalysis:
         ``max_force``, ``displacement_at_max`` (quasi-static).
     sessions : tuple of (str, int, float, float)
         Vibration only: session, number of tests, mean damping ratio, mean period [s].
+    skipped : tuple of SkippedTrial
+        Trials left out (unreadable files, failed analyses) with the reason, when skipping
+        was asked for.
     """
 
     kind: str
@@ -67,6 +79,7 @@ class TrialsAnalysis:
     groups: tuple[DeploymentGroup, ...] = ()
     summaries: dict | None = None
     sessions: tuple = ()
+    skipped: tuple[SkippedTrial, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -77,11 +90,16 @@ class Protocol:
     ----------
     kind : str
         Kind of test, a key of the registry (one of `KINDS`).
-    analyze : callable
-        ``analyze(trials, *, markers, **options) -> TrialsAnalysis``: the per-trial analyses and
-        the statistics across the trials.
+    analyze_trial : callable
+        ``analyze_trial(trial, *, markers, **options) -> result``: the analysis of one trial.
+    combine : callable
+        ``combine(results, **options) -> TrialsAnalysis``: the statistics across the trials.
     options : tuple of str
-        The options of `analyze_trials` that ``analyze`` takes besides ``markers``.
+        The options of `analyze_trials` that ``analyze_trial`` and ``combine`` take besides
+        ``markers``.
+    marker_roles : tuple of int
+        The markers the kind needs, as indices into ``markers`` (0 support, 1 rod, 2 tip):
+        a pull test has no tip marker, a vibration test needs the tip only.
     table_rows : callable
         ``table_rows(analysis) -> list of rows`` of the summary table (columns
         `tapespring.report.SUMMARY_HEADER`).
@@ -94,8 +112,10 @@ class Protocol:
     """
 
     kind: str
-    analyze: Callable[..., TrialsAnalysis]
+    analyze_trial: Callable[..., object]
+    combine: Callable[..., TrialsAnalysis]
     options: tuple[str, ...]
+    marker_roles: tuple[int, ...]
     table_rows: Callable[[TrialsAnalysis], list[list[str]]]
     summary: Callable[[TrialsAnalysis], dict]
     write_files: Callable[[TrialsAnalysis, Path, bool], list[Path]]
@@ -131,7 +151,11 @@ def analyze_trials(
     n_peaks: int = 10,
     window: tuple[float, float] = (0.4e-3, 4.0e-3),
     span: int = 101,
+    span_time: float | None = None,
+    frame: str | np.ndarray | None = None,
     progress: bool = False,
+    skip_bad: bool = False,
+    skipped: Sequence[SkippedTrial] = (),
 ) -> TrialsAnalysis:
     """Analyse trials of one kind and compute the statistics across them.
 
@@ -144,24 +168,80 @@ def analyze_trials(
     markers : (str, str, str)
         Names of markers 1 (support), 2 (rod) and 3 (tip).
     n_peaks : int
-        Deployment: number of maxima and minima analysed.
+        Deployment: number of maxima and minima analysed, >= 1.
     window : (float, float)
-        Vibration: range of absolute peak displacements fitted [m].
+        Vibration: range of absolute peak displacements fitted [m], 0 <= low < high.
     span : int
-        Quasi-static: force smoothing span [samples].
+        Quasi-static: force smoothing span [samples], >= 1.
+    span_time : float, optional
+        Quasi-static: force smoothing span as a duration [s], > 0; replaces ``span``.
+    frame : str or ndarray, optional
+        Deployment: the rig's frame (`tapespring.protocols.deployment.analyze_deployment`).
     progress : bool
         Show a tqdm progress bar on stderr.
+    skip_bad : bool
+        Leave out a trial whose analysis raises a `TrialError`, with a
+        `TrialWarning`, and list it in `TrialsAnalysis.skipped`; by default the
+        error stops the analysis.
+    skipped : sequence of SkippedTrial
+        Trials already left out (by `tapespring.trials.load_trial_set`), reported
+        with the others.
 
     Returns
     -------
     TrialsAnalysis
+
+    Raises
+    ------
+    ValueError
+        If the kind or an option is invalid, or no trial is left to analyse.
+    TrialError
+        If a trial cannot be analysed (unless ``skip_bad``).
     """
     protocol = protocol_for(kind)
-    if not trials:
+    _check_options(n_peaks=n_peaks, window=window, span=span, span_time=span_time)
+    if not trials and not skipped:
         raise ValueError("no trial to analyse")
     # Imported here: the command line imports this module to build its parser.
+    import warnings
+
     from tqdm import tqdm
 
-    trials = tqdm(trials, desc=f"analysing ({kind})", unit="trial", disable=not progress)
-    given = {"n_peaks": n_peaks, "window": window, "span": span}
-    return protocol.analyze(trials, markers=markers, **{k: given[k] for k in protocol.options})
+    from tapespring.trials.load import SkippedTrial
+    from tapespring.trials.trial import TrialError, TrialWarning
+
+    given = {"n_peaks": n_peaks, "window": window, "span": span, "span_time": span_time}
+    given["frame"] = frame
+    options = {k: given[k] for k in protocol.options}
+    results = []
+    left_out = list(skipped)
+    for trial in tqdm(trials, desc=f"analysing ({kind})", unit="trial", disable=not progress):
+        try:
+            results.append(protocol.analyze_trial(trial, markers=markers, **options))
+        except TrialError as exc:
+            if not skip_bad:
+                raise
+            left_out.append(SkippedTrial(trial.metadata.label, exc.problem))
+            warnings.warn(f"skipped {exc}", TrialWarning, stacklevel=2)
+    if not results:
+        raise ValueError(f"no trial left to analyse ({len(left_out)} skipped)")
+    analysis = protocol.combine(results, **options)
+    return dataclasses.replace(analysis, skipped=tuple(left_out))
+
+
+def _check_options(*, n_peaks: object, window: object, span: object, span_time: object) -> None:
+    """Refuse option values that would give empty or meaningless statistics."""
+    if not isinstance(n_peaks, numbers.Integral) or n_peaks < 1:
+        raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
+    if not isinstance(span, numbers.Integral) or span < 1:
+        raise ValueError(f"span must be an integer >= 1 [samples], got {span!r}")
+    if span_time is not None and not (
+        isinstance(span_time, numbers.Real) and math.isfinite(span_time) and span_time > 0
+    ):
+        raise ValueError(f"span_time must be a finite duration > 0 [s], got {span_time!r}")
+    try:
+        low, high = (float(w) for w in window)
+    except (TypeError, ValueError):
+        raise ValueError(f"window must be two numbers (low, high) [m], got {window!r}") from None
+    if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high):
+        raise ValueError(f"window must satisfy 0 <= low < high [m], got ({low:g}, {high:g})")

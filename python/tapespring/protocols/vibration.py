@@ -134,7 +134,19 @@ def analyze_vibration_group(
     TrialsAnalysis
         Kind ``"vibration"``, with ``summaries`` and ``sessions``.
     """
-    results = tuple(analyze_vibration(t, marker=markers[2], window=window) for t in trials)
+    results = [analyze_vibration(t, marker=markers[2], window=window) for t in trials]
+    return _combine(results)
+
+
+def _analyze_trial(
+    trial: Trial, *, markers: Sequence[str], window: tuple[float, float]
+) -> VibrationResult:
+    return analyze_vibration(trial, marker=markers[2], window=window)
+
+
+def _combine(results: Sequence[VibrationResult], **_: object) -> TrialsAnalysis:
+    """Statistics over all tests and over the session means."""
+    results = tuple(results)
     eps = np.array([r.fit.damping_ratio for r in results])
     per = np.array([r.fit.period for r in results])
     sessions = []
@@ -238,8 +250,10 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
-    analyze=analyze_vibration_group,
+    analyze_trial=_analyze_trial,
+    combine=_combine,
     options=("window",),
+    marker_roles=(2,),
     table_rows=_table_rows,
     summary=_summary,
     write_files=_write_files,

@@ -7,7 +7,11 @@ bars, so simulated histories go through the same analyses as measured ones. SI u
 Modules
 -------
 smoothing
-    MATLAB-style moving average (`smooth`) and white-noise level (`noise_std`).
+    MATLAB-style moving average (`smooth`), spans from durations (`span_samples`), the samples
+    with a full window (`complete_windows`), white-noise level (`noise_std`).
+frame
+    The rig's frame: given as signed axes (`parse_frame`) or fitted to the markers
+    (`fit_motion_frame`); `to_frame` applies it.
 angle
     Bending angle from two markers (`bending_angle`).
 levels
@@ -44,18 +48,23 @@ __all__ = [
     "analyze_pull_test",
     "bending_angle",
     "compare_peaks",
+    "complete_windows",
     "detect_phases",
     "equilibrium_value",
     "extract_peaks",
     "fit_circle",
     "fit_damping",
+    "fit_motion_frame",
     "max_lateral_displacement",
     "noise_std",
+    "parse_frame",
     "peak_statistics",
     "release_index",
     "select_window_peaks",
     "smooth",
+    "span_samples",
     "summarize",
+    "to_frame",
 ]
 
 __getattr__, __dir__ = lazy_exports(
@@ -65,6 +74,7 @@ __getattr__, __dir__ = lazy_exports(
         "angle": ["bending_angle"],
         "circle": ["CircleFit", "fit_circle", "max_lateral_displacement"],
         "damping": ["DampingFit", "fit_damping", "select_window_peaks"],
+        "frame": ["fit_motion_frame", "parse_frame", "to_frame"],
         "levels": ["equilibrium_value", "release_index"],
         "peaks": [
             "Extrema",
@@ -72,12 +82,13 @@ __getattr__, __dir__ = lazy_exports(
             "PeakStatistics",
             "Peaks",
             "compare_peaks",
+            "complete_windows",
             "extract_peaks",
             "peak_statistics",
         ],
         "phases": ["Phases", "detect_phases"],
         "pull": ["PullTest", "analyze_pull_test"],
-        "smoothing": ["noise_std", "smooth"],
+        "smoothing": ["complete_windows", "noise_std", "smooth", "span_samples"],
         "stats": ["Summary", "summarize"],
     },
 )

@@ -1,14 +1,17 @@
 """Smoothing and noise level of uniformly sampled signals.
 
-`smooth` is MATLAB's ``smooth(y, span)`` moving average; `noise_std` estimates the
-standard deviation of white measurement noise on a smooth signal.
+`smooth` is MATLAB's ``smooth(y, span)`` moving average; `span_samples` turns a
+span given as a duration into samples, and `complete_windows` says which smoothed
+samples average a full window (near the ends MATLAB's windows shrink, down to a
+single raw sample at each end). `noise_std` estimates the standard deviation of
+white measurement noise on a smooth signal.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["noise_std", "smooth"]
+__all__ = ["complete_windows", "noise_std", "smooth", "span_samples"]
 
 
 def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
@@ -60,6 +63,52 @@ def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
         out = (csum[hi] - csum[lo]) / count
     out[count == 0] = np.nan
     return out
+
+
+def span_samples(duration: float, rate: float) -> int:
+    """The odd number of samples nearest to ``duration`` at ``rate`` (at least 1).
+
+    `smooth` uses odd spans only; the paper's 101 samples at 4 kHz are 25.3 ms:
+    ``span_samples(0.0253, 4000.0) == 101``.
+
+    Parameters
+    ----------
+    duration : float
+        Span [s], > 0.
+    rate : float
+        Sampling rate [Hz], > 0.
+
+    Returns
+    -------
+    int
+    """
+    if not (np.isfinite(duration) and duration > 0):
+        raise ValueError(f"the span duration must be a finite number > 0 s, got {duration}")
+    if not (np.isfinite(rate) and rate > 0):
+        raise ValueError(f"the sampling rate must be a finite number > 0 Hz, got {rate}")
+    return max(1, 2 * round((duration * rate - 1.0) / 2.0) + 1)
+
+
+def complete_windows(n: int, span: int) -> slice:
+    """The samples of ``smooth(y, span)`` (length ``n``) that average a full window.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    span : int
+        Smoothing span [samples], as passed to `smooth`.
+
+    Returns
+    -------
+    slice
+        ``slice(h, n - h)`` with ``h`` the half-width actually used; empty if the
+        signal is shorter than one window.
+    """
+    width = min(int(span), n)
+    width -= 1 - width % 2
+    half = max(width, 1) // 2
+    return slice(half, max(half, n - half))
 
 
 def noise_std(y: np.ndarray) -> float:

@@ -11,7 +11,10 @@ c3d
 csv
     CSV reader and writer (a marker file and an optional ``.forces.csv`` sibling).
 load
-    `read_trial` (reader chosen by suffix), `find_trial_files`, `load_trials` (with progress bar).
+    `read_trial` (reader chosen by suffix), `find_trial_files`, `load_trials` (with progress bar),
+    `load_trial_set` (bad files skipped and listed), metadata side files (``metadata.csv``).
+c3d_check, c3d_worker
+    The structural check of a C3D file and the worker process ezc3d runs in.
 samples
     Synthetic trials with known answers, for tests, examples and benchmarks.
 
@@ -22,14 +25,20 @@ from tapespring._lazy import lazy_exports
 
 __all__ = [
     "FORCES_SUFFIX",
+    "METADATA_FILE",
     "SENSES",
     "ForcePlate",
     "Gap",
     "Metadata",
+    "SkippedTrial",
     "Trial",
     "TrialError",
+    "TrialSet",
+    "TrialWarning",
     "find_trial_files",
+    "load_trial_set",
     "load_trials",
+    "read_metadata_file",
     "read_c3d",
     "read_csv",
     "read_trial",
@@ -43,7 +52,16 @@ __getattr__, __dir__ = lazy_exports(
     {
         "c3d": ["read_c3d", "write_c3d"],
         "csv": ["FORCES_SUFFIX", "read_csv", "write_csv"],
-        "load": ["find_trial_files", "load_trials", "read_trial"],
-        "trial": ["SENSES", "ForcePlate", "Gap", "Metadata", "Trial", "TrialError"],
+        "load": [
+            "METADATA_FILE",
+            "SkippedTrial",
+            "TrialSet",
+            "find_trial_files",
+            "load_trial_set",
+            "load_trials",
+            "read_metadata_file",
+            "read_trial",
+        ],
+        "trial": ["SENSES", "ForcePlate", "Gap", "Metadata", "Trial", "TrialError", "TrialWarning"],
     },
 )

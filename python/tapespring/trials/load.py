@@ -1,17 +1,88 @@
-"""Loading many trials: the reader chosen by file suffix, folders expanded, a progress bar."""
+"""Loading many trials: the reader chosen by file suffix, folders expanded, a progress bar.
+
+Metadata side file
+------------------
+A capture exported without the ``TAPESPRING`` C3D group (or CSV ``# key: value``
+lines) has no sense, tape pair or session. They can be given in a file named
+``metadata.csv`` in the folder of the trials, one row per trial file::
+
+    file,sense,tape_pair,session
+    trial-01.c3d,equal,A,1
+    trial-02.c3d,opposite,A,2
+
+``file`` is the trial's file name (or its stem); the other columns are optional
+and an empty cell says nothing. Lines starting with ``#`` are comments. Values
+given by the caller (``sense=``..., the command line's ``--sense``...) win over
+the side file, which wins over what the trial file itself stores. The side file
+is not a trial: `find_trial_files` leaves it out.
+
+Skipping bad trials
+-------------------
+`load_trial_set` with ``skip_bad=True`` leaves out a file that raises a
+`TrialError` (unreadable, corrupt, missing marker), warns (`TrialWarning`) and
+lists it in `TrialSet.skipped`; a missing path or a bad side file still raise.
+"""
 
 from __future__ import annotations
 
+import csv
+import warnings
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from tqdm import tqdm
 
 from .c3d import read_c3d
+from .common import META_KEYS
 from .csv import FORCES_SUFFIX, read_csv
-from .trial import Trial, TrialError
+from .trial import SENSES, Trial, TrialError, TrialWarning
 
-__all__ = ["find_trial_files", "load_trials", "read_trial"]
+__all__ = [
+    "METADATA_FILE",
+    "SkippedTrial",
+    "TrialSet",
+    "find_trial_files",
+    "load_trial_set",
+    "load_trials",
+    "read_metadata_file",
+    "read_trial",
+]
+
+#: Name of the metadata side file in a folder of trials.
+METADATA_FILE = "metadata.csv"
+
+
+@dataclass(frozen=True)
+class SkippedTrial:
+    """A trial left out of a batch, and why.
+
+    Attributes
+    ----------
+    source : str
+        File (or trial name).
+    problem : str
+        The error that made it unusable.
+    """
+
+    source: str
+    problem: str
+
+
+@dataclass(frozen=True)
+class TrialSet:
+    """Trials loaded from files, and the files left out.
+
+    Attributes
+    ----------
+    trials : tuple of Trial
+        In the order of the files.
+    skipped : tuple of SkippedTrial
+        Files that could not be used (``skip_bad=True`` only).
+    """
+
+    trials: tuple[Trial, ...]
+    skipped: tuple[SkippedTrial, ...] = ()
 
 
 def read_trial(path: str | Path, **options: str | None) -> Trial:
@@ -49,7 +120,8 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
     """Expand files and folders into the list of trial files.
 
     A folder contributes its ``*.c3d`` and ``*.csv`` files (not recursively,
-    sorted by name), except the ``*.forces.csv`` companions.
+    sorted by name), except the ``*.forces.csv`` companions and the metadata
+    side file (``metadata.csv``).
 
     Raises
     ------
@@ -68,6 +140,7 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
                 if p.is_file()
                 and p.suffix.lower() in (".c3d", ".csv")
                 and not p.name.endswith(FORCES_SUFFIX)
+                and p.name != METADATA_FILE
             )
             if not found:
                 raise TrialError(path, "the folder holds no .c3d or .csv trial")
@@ -79,15 +152,83 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
     return files
 
 
-def load_trials(
+def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
+    """Read a metadata side file (module documentation).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``metadata.csv`` file.
+
+    Returns
+    -------
+    dict
+        Trial file name (as written) -> {key: value} for the non-empty cells.
+
+    Raises
+    ------
+    TrialError
+        If a column is unknown, ``file`` is missing or repeated, or a sense is invalid (the
+        message names the line).
+    """
+    path = Path(path)
+    with path.open(encoding="utf-8", newline="") as fh:
+        lines = [(n, line) for n, line in enumerate(fh, start=1) if not line.startswith("#")]
+    rows = list(csv.reader(line for _, line in lines))
+    if not rows:
+        raise TrialError(path, "empty metadata file: expected a header 'file,sense,...'")
+    header = [h.strip() for h in rows[0]]
+    unknown = [h for h in header if h not in ("file", *META_KEYS)]
+    if "file" not in header or unknown:
+        raise TrialError(
+            path,
+            f"metadata columns must be 'file' and any of {', '.join(META_KEYS)}; "
+            f"got {', '.join(header)}",
+        )
+    out: dict[str, dict[str, str]] = {}
+    for (line_no, _), row in zip(lines[1:], rows[1:], strict=True):
+        if not any(cell.strip() for cell in row):
+            continue
+        if len(row) > len(header):
+            raise TrialError(path, f"line {line_no} has more cells than the header")
+        entry = {k: v.strip() for k, v in zip(header, row, strict=False) if v.strip()}
+        name = entry.pop("file", "")
+        if not name:
+            raise TrialError(path, f"line {line_no} has no file name")
+        if name in out:
+            raise TrialError(path, f"line {line_no}: {name!r} is listed twice")
+        if entry.get("sense") not in (None, *SENSES):
+            raise TrialError(
+                path, f"line {line_no}: sense must be one of {SENSES}, got {entry['sense']!r}"
+            )
+        out[name] = entry
+    return out
+
+
+def _side_metadata(files: Sequence[Path]) -> dict[Path, dict[str, str]]:
+    """The side-file entry of each trial file (empty where there is none)."""
+    tables: dict[Path, dict[str, dict[str, str]]] = {}
+    out = {}
+    for file in files:
+        folder = file.parent
+        if folder not in tables:
+            side = folder / METADATA_FILE
+            tables[folder] = read_metadata_file(side) if side.is_file() else {}
+        table = tables[folder]
+        out[file] = table.get(file.name) or table.get(file.stem) or {}
+    return out
+
+
+def load_trial_set(
     paths: str | Path | Sequence[str | Path],
     *,
     max_gap: float | None = None,
     required_markers: Sequence[str] = (),
     progress: bool = True,
+    skip_bad: bool = False,
     **options: str | None,
-) -> list[Trial]:
-    """Load many trials (files and folders of files) with a progress bar.
+) -> TrialSet:
+    """Load many trials (files and folders of files), optionally skipping the bad ones.
 
     Parameters
     ----------
@@ -100,6 +241,74 @@ def load_trials(
         Markers every trial must have; a missing one raises at load time.
     progress : bool
         Show a tqdm progress bar on stderr.
+    skip_bad : bool
+        Leave out (with a `TrialWarning`) a file that raises a `TrialError`,
+        and list it in `TrialSet.skipped`.
+    **options
+        Passed to `read_trial`: metadata (``sense``, ``tape_pair``,
+        ``session``; None keeps the side file's or the file's) and CSV units.
+
+    Returns
+    -------
+    TrialSet
+
+    Raises
+    ------
+    FileNotFoundError
+        If a path does not exist.
+    TrialError
+        If a file is invalid (unless ``skip_bad``), a folder holds no trial, or a
+        metadata side file is invalid.
+    """
+    if isinstance(paths, str | Path):
+        paths = [paths]
+    files = find_trial_files(paths)
+    side = _side_metadata(files)
+    trials, skipped = [], []
+    for file in tqdm(files, desc="loading trials", unit="trial", disable=not progress):
+        given = {k: v for k, v in options.items() if v is not None}
+        try:
+            trial = read_trial(file, **(side[file] | given))
+            for name in required_markers:
+                trial.marker(name)
+            if max_gap is not None:
+                trial = trial.fill_gaps(max_gap)
+        except TrialError as exc:
+            if not skip_bad:
+                raise
+            skipped.append(SkippedTrial(str(file), exc.problem))
+            warnings.warn(f"skipped {exc}", TrialWarning, stacklevel=2)
+            continue
+        trials.append(trial)
+    return TrialSet(tuple(trials), tuple(skipped))
+
+
+def load_trials(
+    paths: str | Path | Sequence[str | Path],
+    *,
+    max_gap: float | None = None,
+    required_markers: Sequence[str] = (),
+    progress: bool = True,
+    skip_bad: bool = False,
+    **options: str | None,
+) -> list[Trial]:
+    """Load many trials (files and folders of files) with a progress bar.
+
+    Parameters
+    ----------
+    paths : path or sequence of paths
+        Trial files and folders (see `find_trial_files`); a ``metadata.csv``
+        side file in a folder completes the trials' metadata (module docs).
+    max_gap : float, optional
+        If given, interpolate the marker gaps not longer than this [s]
+        (`Trial.fill_gaps`); by default nothing is interpolated.
+    required_markers : sequence of str
+        Markers every trial must have; a missing one raises at load time.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+    skip_bad : bool
+        Leave out a file that raises a `TrialError`, with a `TrialWarning` (use
+        `load_trial_set` to get the list of skipped files).
     **options
         Passed to `read_trial`.
 
@@ -108,15 +317,13 @@ def load_trials(
     list of Trial
         In the order of the files.
     """
-    if isinstance(paths, str | Path):
-        paths = [paths]
-    files = find_trial_files(paths)
-    trials = []
-    for file in tqdm(files, desc="loading trials", unit="trial", disable=not progress):
-        trial = read_trial(file, **options)
-        for name in required_markers:
-            trial.marker(name)
-        if max_gap is not None:
-            trial = trial.fill_gaps(max_gap)
-        trials.append(trial)
-    return trials
+    return list(
+        load_trial_set(
+            paths,
+            max_gap=max_gap,
+            required_markers=required_markers,
+            progress=progress,
+            skip_bad=skip_bad,
+            **options,
+        ).trials
+    )

@@ -26,7 +26,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-__all__ = ["ForcePlate", "Gap", "Metadata", "SENSES", "Trial", "TrialError"]
+__all__ = ["ForcePlate", "Gap", "Metadata", "SENSES", "Trial", "TrialError", "TrialWarning"]
 
 #: Senses of bending (paper Sec. 2): opposite (M, theta > 0) and equal (M, theta < 0).
 SENSES = ("opposite", "equal")
@@ -52,6 +52,14 @@ class TrialError(ValueError):
         self.source = None if source is None else str(source)
         self.problem = problem
         super().__init__(f"{self.source}: {problem}" if self.source else problem)
+
+
+class TrialWarning(UserWarning):
+    """Something about a trial the analysis went on with, but the user should know.
+
+    A trial skipped (``skip_bad``), an initial bending angle whose sign contradicts
+    the sense of bending, a frame fitted without a sense to fix its sign.
+    """
 
 
 def _frozen_array(values: np.ndarray) -> np.ndarray:

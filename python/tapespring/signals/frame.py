@@ -1,0 +1,143 @@
+"""The rig's frame: marker positions from laboratory axes to the axes the analyses assume.
+
+The deployment analyses measure the bending angle about the rig's y axis
+(`bending_angle`), with x along the deployed rod and z = x × y, so that
+opposite-sense bending is positive. A capture left in laboratory axes (z up,
+say, or a rig turned about the vertical) breaks that assumption: every angle
+shifts, or its sign flips. Two remedies:
+
+- give the frame: ``parse_frame("x,-z,y")`` says that the rig's x, y and z axes
+  are the laboratory's x, -z and y (a signed permutation, right-handed);
+- fit it (`fit_motion_frame`): the rod turns in a plane, so the direction of
+  least spread of the marker 1 -> 2 (and 1 -> 3) vectors is the bending axis y;
+  x is the deployed rod direction projected on the plane. A fit cannot tell the
+  sign of y (which way is "positive" bending); the caller chooses it (from the
+  sense of bending, for a deployment).
+
+A frame is a rotation matrix ``R`` whose rows are the rig's axes in laboratory
+coordinates: ``p_rig = R @ p_lab``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["fit_motion_frame", "parse_frame", "to_frame"]
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+# Below this ratio of spreads (in-plane second direction over first) the vectors barely turn and
+# the plane of motion is not defined: 0.02 is a rotation of about 2 degrees.
+_MIN_SPREAD_RATIO = 0.02
+
+
+def parse_frame(spec: str) -> np.ndarray:
+    """The rotation given by three signed laboratory axes, e.g. ``"x,-z,y"``.
+
+    Parameters
+    ----------
+    spec : str
+        The laboratory axes along the rig's x, y and z, comma-separated, each
+        ``x``, ``y`` or ``z`` with an optional sign.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Rows: the rig's axes in laboratory coordinates.
+
+    Raises
+    ------
+    ValueError
+        If the text is not three distinct signed axes, or the frame is left-handed.
+    """
+    parts = [p.strip().lower() for p in str(spec).split(",")]
+    rows = []
+    for part in parts:
+        sign = -1.0 if part.startswith("-") else 1.0
+        axis = part.lstrip("+-")
+        if axis not in _AXES:
+            rows = []
+            break
+        row = np.zeros(3)
+        row[_AXES[axis]] = sign
+        rows.append(row)
+    if len(rows) != 3 or len({int(np.argmax(np.abs(r))) for r in rows}) != 3:
+        raise ValueError(
+            f"frame must be three distinct signed laboratory axes such as 'x,-z,y', got {spec!r}"
+        )
+    frame = np.array(rows)
+    if np.linalg.det(frame) < 0:
+        raise ValueError(
+            f"frame {spec!r} is left-handed (a mirror image, which flips every angle): "
+            "change the sign of one axis"
+        )
+    return frame
+
+
+def to_frame(frame: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points in the rig's axes: ``points @ frame.T`` (NaN rows stay NaN).
+
+    Parameters
+    ----------
+    frame : ndarray, shape (3, 3)
+        Rotation, rows the rig's axes in laboratory coordinates.
+    points : ndarray, shape (n, 3)
+        Positions in laboratory axes [m].
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+    """
+    return np.asarray(points, dtype=float) @ np.asarray(frame, dtype=float).T
+
+
+def fit_motion_frame(
+    origin: np.ndarray, *moving: np.ndarray, deployed: np.ndarray | None = None
+) -> np.ndarray:
+    """The rig's frame fitted to markers that turn about one axis through ``origin``.
+
+    Parameters
+    ----------
+    origin : ndarray, shape (n, 3)
+        Marker on the axis (marker 1) [m].
+    *moving : ndarray, shape (n, 3)
+        Markers that turn about it (markers 2 and 3) [m]; at least one.
+    deployed : ndarray of bool, shape (n,), optional
+        Samples in the deployed state, whose mean marker 1 -> first moving marker
+        direction is the rig's x axis; default the last tenth of the record.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Rows x, y, z: y is the normal of the plane of motion (sign: the one with
+        a non-negative laboratory y component, for the caller to flip), x the
+        deployed direction in that plane, z = x × y.
+
+    Raises
+    ------
+    ValueError
+        If no moving marker is given, or the markers barely turn (no plane).
+    """
+    if not moving:
+        raise ValueError("fit_motion_frame needs at least one moving marker")
+    p0 = np.asarray(origin, dtype=float)
+    vectors = [np.asarray(m, dtype=float) - p0 for m in moving]
+    clouds = [v[np.isfinite(v).all(axis=1)] for v in vectors]
+    clouds = [c - c.mean(axis=0) for c in clouds if c.shape[0] >= 3]
+    if not clouds:
+        raise ValueError("cannot fit the plane of motion: fewer than 3 complete samples")
+    _, spread, axes = np.linalg.svd(np.vstack(clouds), full_matrices=False)
+    if not spread[1] > _MIN_SPREAD_RATIO * spread[0]:
+        raise ValueError(
+            "cannot fit the plane of motion: the markers barely turn "
+            f"(spread ratio {spread[1] / spread[0]:.2g}, needs > {_MIN_SPREAD_RATIO})"
+        )
+    y = axes[2] if axes[2][1] >= 0 else -axes[2]
+    rod = vectors[0]
+    n = rod.shape[0]
+    mask = np.zeros(n, bool) if deployed is None else np.asarray(deployed, bool)
+    if deployed is None:
+        mask[-max(1, n // 10) :] = True
+    direction = np.nanmean(rod[mask], axis=0)
+    x = direction - (direction @ y) * y
+    x /= np.linalg.norm(x)
+    return np.array([x, y, np.cross(x, y)])
