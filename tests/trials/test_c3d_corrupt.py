@@ -1,6 +1,6 @@
 """Corrupt C3D files end in a TrialError naming the problem, never in a crash or a hang.
 
-Every file is read in a child process (``c3d_harness.py``, driven by an `IsolatedReader`):
+Every file is read in a child process (``reader_harness.py``, driven by an `IsolatedReader`):
 if reading it kills or blocks that process, the test fails with that finding instead of
 taking pytest down. Before the structural check and the worker, the regression files below
 made ezc3d segfault (cut inside the parameter head, 241 dimensions, missing ANALOG:OFFSET)
@@ -18,7 +18,7 @@ from tapespring.trials import TrialError, read_c3d, write_c3d
 from tapespring.trials.c3d_worker import IsolatedReader, WorkerFailure
 from tapespring.trials.samples import make_pull_test_trial
 
-HARNESS = [sys.executable, str(Path(__file__).with_name("c3d_harness.py"))]
+HARNESS = [sys.executable, str(Path(__file__).with_name("reader_harness.py"))]
 # What a corrupt file may be reported as: every message names the file and one of these.
 CLEAR = (
     "not a C3D file",

@@ -77,3 +77,8 @@ def test_text_in_a_number_column_is_named(tmp_path):
     rows[0] = "0,1,2,3,4,five,6"
     with pytest.raises(TrialError, match=r"line 2, column 'M2_y': 'five' is not a number"):
         read_csv(_write(tmp_path, rows))
+
+
+def test_header_without_rows_is_a_trial_error_not_a_numpy_warning(tmp_path):
+    with pytest.raises(TrialError, match=r"t\.csv: no data rows"):
+        read_csv(_write(tmp_path, [], name="t.csv"))

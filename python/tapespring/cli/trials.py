@@ -40,15 +40,26 @@ def _int_at_least_1(text: str) -> int:
     return value
 
 
-def _positive_seconds(text: str) -> float:
-    """An argparse type: a finite duration > 0 [s]."""
+def _seconds(text: str, *, zero: bool) -> float:
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a duration in seconds, got {text!r}") from None
-    if not (0 < value < float("inf")):
-        raise argparse.ArgumentTypeError(f"must be a duration > 0 s, got {text}")
+    if not ((0 <= value if zero else 0 < value) and value < float("inf")):
+        raise argparse.ArgumentTypeError(
+            f"must be a finite duration {'>=' if zero else '>'} 0 s, got {text}"
+        )
     return value
+
+
+def _positive_seconds(text: str) -> float:
+    """An argparse type: a finite duration > 0 [s]."""
+    return _seconds(text, zero=False)
+
+
+def _non_negative_seconds(text: str) -> float:
+    """An argparse type: a finite duration >= 0 [s]."""
+    return _seconds(text, zero=True)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -136,7 +147,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--max-gap",
-        type=float,
+        type=_non_negative_seconds,
         default=None,
         metavar="SECONDS",
         help=(

@@ -24,6 +24,7 @@ as is a row with too few or too many fields.
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -100,7 +101,12 @@ def _read_table(path: Path) -> tuple[dict[str, str], list[str], list[str | None]
 def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
     """The numbers below the header; a bad row raises a TrialError naming its line."""
     try:
-        return np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding="utf-8")
+        with warnings.catch_warnings():
+            # A header without rows: numpy warns, the caller raises "no data rows".
+            warnings.filterwarnings("ignore", "loadtxt: input contained no data", UserWarning)
+            return np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise TrialError(path, f"not a text CSV file ({exc.reason} at byte {exc.start})") from None
     except ValueError:
         pass
     # Empty fields (missing samples) or a damaged row: parse again, slower, line by line, to

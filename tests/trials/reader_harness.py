@@ -1,4 +1,4 @@
-"""Child process for the corrupt-file tests: reads C3D files with `read_c3d` and reports.
+"""Child process for the corrupt-file tests: reads trial files with `read_trial` and reports.
 
 It speaks the protocol of `tapespring.trials.c3d_worker` (length-prefixed pickles), so the
 tests drive it with an `IsolatedReader`: if reading a file crashes or hangs this process, the
@@ -7,7 +7,7 @@ reader reports it and the test fails, instead of pytest dying with it.
 
 import sys
 
-from tapespring.trials import TrialError, read_c3d
+from tapespring.trials import TrialError, read_trial
 from tapespring.trials.c3d_worker import _receive, _send
 
 replies = sys.stdout.buffer
@@ -15,7 +15,8 @@ _send(replies, ("ready", None))
 while (message := _receive(sys.stdin.buffer)) is not None:
     _, path = message
     try:
-        trial = read_c3d(path, timeout=20.0)
+        options = {"timeout": 20.0} if path.endswith(".c3d") else {}
+        trial = read_trial(path, **options)
         outcome = {"kind": "trial", "markers": {k: v.copy() for k, v in trial.markers.items()}}
     except TrialError as exc:
         outcome = {"kind": "TrialError", "message": str(exc)}
