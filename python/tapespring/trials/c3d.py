@@ -69,9 +69,10 @@ def read_c3d(
         Override the metadata stored in the file (``TAPESPRING`` group).
     isolate : bool
         Run ezc3d in the worker process (default). False runs it in this
-        process: it saves the worker's one-time start (0.3 s) and a few ms per
-        file, but a file the structural check lets through can then still crash
-        or hang the interpreter.
+        process: it saves the worker's one-time start (0.35 s; per file the
+        worker was no slower in ``benchmarks/bench_trials.py``), but a file the
+        structural check lets through can then still crash or hang the
+        interpreter.
     timeout : float
         Time limit of the ezc3d read in the worker [s] (``isolate=True`` only).
 
