@@ -70,6 +70,13 @@ impl NodeInertia {
         self.mass == 0.0 && self.inertia == Matrix3::zeros()
     }
 
+    /// Radius of gyration about the node [m], `sqrt(tr(J) / 3m)`: the length that turns the
+    /// node's rotation into the displacement of its mass (`None` for a massless node).
+    #[must_use]
+    pub fn radius_of_gyration(&self) -> Option<f64> {
+        (self.mass > 0.0).then(|| (self.inertia.trace() / (3.0 * self.mass)).max(0.0).sqrt())
+    }
+
     /// Static moment and inertia tensor in space for the rotation `r`.
     #[must_use]
     pub fn spatial(&self, r: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {

@@ -18,7 +18,7 @@
 //! included).
 //!
 //! Step control: the local error of the displacements is estimated as `|beta - 1/6| h^2
-//! |dv_{n+1} - dv_n|` per node (rotations times the characteristic length) and kept below the
+//! |dv_{n+1} - dv_n|` per node (rotations times the node's radius of gyration) and kept below the
 //! user's tolerance; a step that fails to converge is cut back by 4, one whose error is too large
 //! is shrunk to the size the estimate asks for. The step never skips an output time.
 
@@ -378,6 +378,9 @@ impl Integrator<'_> {
         for it in 0..=params.newton.max_iterations {
             let (res, reference) = self.assemble(start, state, h, &mut r);
             residual = res;
+            if std::env::var_os("TAPE_TRACE2").is_some() {
+                eprintln!("   it {it} res {res:.3e} ref {reference:.3e}");
+            }
             if !res.is_finite() {
                 return Attempt::Failed {
                     iterations: it,
@@ -445,8 +448,12 @@ impl Integrator<'_> {
             if self.system.dofs.master[i].is_some() || self.system.inertia[i].is_empty() {
                 continue;
             }
+            // A rotation error matters through the displacement of the node's mass: for a shell
+            // node that is `t / sqrt(12)`, so the stiff, lightly loaded rotary-inertia modes of a
+            // thin shell do not dictate the step.
+            let arm = self.system.inertia[i].radius_of_gyration().unwrap_or(lc);
             let eu = (state.acc[i] - start.acc[i]).norm() * c;
-            let et = (state.dw[i] - start.dw[i]).norm() * c * lc;
+            let et = (state.dw[i] - start.dw[i]).norm() * c * arm;
             worst = worst.max(eu).max(et);
         }
         worst / tol
@@ -640,6 +647,12 @@ pub fn solve_dynamic(
             })
             .collect();
         let attempt = integ.attempt(state, &mut scratch, step_h, &a, params);
+        if std::env::var_os("TAPE_TRACE").is_some() {
+            match &attempt {
+                Attempt::Converged { iterations, error, .. } => eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} err={error:.3}", state.t),
+                Attempt::Failed { iterations, residual, why } => eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} FAIL res={residual:.3e} {why}", state.t),
+            }
+        }
         let (iterations, accepted) = match attempt {
             Attempt::Converged {
                 iterations,
