@@ -583,8 +583,16 @@ impl System {
     /// Assembles the pieces and the tangent of a dynamic step at `state` with the nodal `rates`:
     /// `f_int` includes the Kelvin-Voigt viscous forces and the tangent their damping matrix times
     /// `rates.gamma_prime` (inertia is the integrator's: see [`crate::inertia`]).
-    pub fn assemble_dynamic(&mut self, state: &State, rates: &Rates, out: &mut Assembled) {
-        self.assemble_with(state, true, None, Some(rates), out);
+    /// With `stress`, the geometric part of the tangent comes from those element stresses (the
+    /// mixed iteration, see [`Self::assemble_mixed`]).
+    pub fn assemble_dynamic(
+        &mut self,
+        state: &State,
+        rates: &Rates,
+        stress: Option<&[ElementStress]>,
+        out: &mut Assembled,
+    ) {
+        self.assemble_with(state, true, stress, Some(rates), out);
     }
 
     /// Nodal rates of every node from the velocities of the independent nodes in `state` (tied
@@ -646,21 +654,20 @@ impl System {
                 .map(|n| state.q[n].to_rotation_matrix().into_inner());
             let section = &sections[element_part[i]];
             let eta = etas[element_part[i]];
-            *en = match (stress, rates) {
-                (Some(st), _) => (
+            let viscous = rates.filter(|_| eta > 0.0).map(|r| Viscous {
+                v: e.nodes.map(|n| r.v[n]),
+                w: e.nodes.map(|n| r.w[n]),
+                eta,
+                gamma_prime: r.gamma_prime,
+            });
+            *en = match (stress, &viscous) {
+                (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg),
+                (Some(st), None) => (
                     e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
                     0.0,
                 ),
-                (None, Some(r)) if eta > 0.0 => {
-                    let viscous = Viscous {
-                        v: e.nodes.map(|n| r.v[n]),
-                        w: e.nodes.map(|n| r.w[n]),
-                        eta,
-                        gamma_prime: r.gamma_prime,
-                    };
-                    e.compute_viscous_into(&x, &q, section, &viscous, f, tangent.then_some(k))
-                }
-                (None, _) => (e.compute_into(&x, &q, section, f, tangent.then_some(k)), 0.0),
+                (None, Some(v)) => e.compute_viscous_into(&x, &q, section, v, f, tangent.then_some(k)),
+                (None, None) => (e.compute_into(&x, &q, section, f, tangent.then_some(k)), 0.0),
             };
         };
         if self.parallel {

@@ -487,6 +487,25 @@ impl ShellElement {
         self.kernel(x, q, sec, None, Some(viscous), f, k, None)
     }
 
+    /// As [`Self::compute_viscous_into`], with the geometric part of the tangent from the elastic
+    /// `stress` of the mixed iteration (see [`Self::compute_mixed_into`]; the viscous stresses,
+    /// of relative order `eta omega`, are left out of that part). `f_geo` receives the force of
+    /// the geometric stresses.
+    #[allow(clippy::too_many_arguments)]
+    pub fn compute_viscous_mixed_into(
+        &self,
+        x: &[Vector3<f64>; 4],
+        q: &[Matrix3<f64>; 4],
+        sec: &SectionStiffness,
+        viscous: &Viscous,
+        stress: &ElementStress,
+        f: &mut ElementVector,
+        k: &mut ElementMatrix,
+        f_geo: &mut ElementVector,
+    ) -> (f64, f64) {
+        self.kernel(x, q, sec, Some(stress), Some(viscous), f, Some(k), Some(f_geo))
+    }
+
     #[allow(clippy::too_many_lines, clippy::too_many_arguments)]
     fn kernel(
         &self,

@@ -29,9 +29,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use super::alpha::{advance3, Alpha};
-use super::newton::{Convergence, NewtonParams};
+use super::newton::{Convergence, NewtonParams, Stall};
 use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
+use crate::element::shell::ElementStress;
 use crate::constraint::Slot;
 use crate::error::{check_positive, Error, Result};
 use crate::inertia::Motion;
@@ -65,7 +66,10 @@ pub struct DynamicParams {
     pub max_steps: usize,
     /// Successive cut-backs allowed before the step gives up.
     pub max_cutbacks: usize,
-    /// Newton settings (`line_search` and `mixed_stress` do not apply).
+    /// Newton settings (`line_search` does not apply; `mixed_stress`, on by default, takes the
+    /// geometric stresses of the iteration matrix linearised from the predictor and the previous
+    /// iterate, which keeps Newton converging at steps where a thin shell's spurious membrane
+    /// stresses would make it diverge).
     pub newton: NewtonParams,
     /// Record nodal fields (set by the analysis runner).
     #[serde(skip)]
@@ -86,7 +90,6 @@ impl Default for DynamicParams {
             max_steps: 100_000,
             max_cutbacks: 12,
             newton: NewtonParams {
-                mixed_stress: false,
                 line_search: false,
                 ..NewtonParams::default()
             },
@@ -135,7 +138,6 @@ impl DynamicParams {
     pub fn from_options(mut o: Options) -> Result<Self> {
         let d = Self::default();
         let mut newton = NewtonParams::read(&mut o)?;
-        newton.mixed_stress = false;
         newton.line_search = false;
         let p = Self {
             duration: o.take_or("duration", d.duration)?,
@@ -172,7 +174,6 @@ impl DynamicParams {
         m.insert("max_steps".into(), self.max_steps.into());
         m.insert("max_cutbacks".into(), self.max_cutbacks.into());
         self.newton.write(&mut m);
-        m.remove("mixed_stress");
         m.remove("line_search");
         m
     }
@@ -224,6 +225,9 @@ struct Integrator<'a> {
     /// `eps sqrt(sum (m |x|)^2 + (J pi / L_c)^2)` over the nodes [kg m]: times `beta'`, the
     /// round-off of the inertia forces.
     inertia_round_off: f64,
+    /// Element stresses of the mixed iteration (linearised from the last iterate) when valid.
+    stress: Vec<ElementStress>,
+    stress_valid: bool,
 }
 
 /// Outcome of one attempted time step.
@@ -329,7 +333,8 @@ impl Integrator<'_> {
     fn assemble(&mut self, start: &State, state: &State, h: f64, r: &mut Vec<f64>) -> (f64, f64) {
         let t = Instant::now();
         let rates = self.system.rates(state, self.alpha.gamma_prime(h));
-        self.system.assemble_dynamic(state, &rates, &mut self.asm);
+        let stress = self.stress_valid.then_some(self.stress.as_slice());
+        self.system.assemble_dynamic(state, &rates, stress, &mut self.asm);
         let f_int = System::force_norm(&self.asm.f_int, &self.weights);
         let inertia = self.add_inertia(start, state, h, true);
         self.asm.residual_into(r);
@@ -367,6 +372,12 @@ impl Integrator<'_> {
             }
         }
         let dc = self.system.constrained_increments(start.t, h);
+        let mixed = params.newton.mixed_stress;
+        if mixed {
+            self.system
+                .linearised_stresses(start, &dq, &dc, &mut self.stress);
+        }
+        self.stress_valid = mixed;
         state.clone_from(start);
         self.system.update_with(state, &dq, &dc);
         state.t = start.t + h;
@@ -374,6 +385,7 @@ impl Integrator<'_> {
         // Newton corrections leave the constrained DOFs where the step put them.
         let held = vec![0.0; dc.len()];
         let mut residual = f64::NAN;
+        let mut stall = Stall::new(params.newton.stall_iterations);
         let mut a_new = self.kinematics(start, state, h, a);
         for it in 0..=params.newton.max_iterations {
             let (res, reference) = self.assemble(start, state, h, &mut r);
@@ -405,6 +417,16 @@ impl Integrator<'_> {
             if it == params.newton.max_iterations {
                 break;
             }
+            if stall.stalled(it, res) {
+                return Attempt::Failed {
+                    iterations: it,
+                    residual,
+                    why: format!(
+                        "Newton's residual has not decreased for {} iterations",
+                        params.newton.stall_iterations
+                    ),
+                };
+            }
             let t = Instant::now();
             if let Err(e) = self.system.linear.factorize(&self.asm.k_ff) {
                 return Attempt::Failed {
@@ -424,6 +446,10 @@ impl Integrator<'_> {
             }
             self.stats.solve_s += t.elapsed().as_secs_f64();
             self.stats.iterations += 1;
+            if mixed {
+                self.system
+                    .linearised_stresses(state, &delta, &held, &mut self.stress);
+            }
             self.system.update_with(state, &delta, &held);
             a_new = self.kinematics(start, state, h, a);
         }
@@ -454,6 +480,9 @@ impl Integrator<'_> {
             let arm = self.system.inertia[i].radius_of_gyration().unwrap_or(lc);
             let eu = (state.acc[i] - start.acc[i]).norm() * c;
             let et = (state.dw[i] - start.dw[i]).norm() * c * arm;
+            if std::env::var_os("TAPE_TRACE3").is_some() && eu.max(et) > worst {
+                eprintln!("      node {i} x={:?} eu={eu:.3e} et={et:.3e} m={:.3e} arm={arm:.3e}", state.x[i].as_slice(), self.system.inertia[i].mass);
+            }
             worst = worst.max(eu).max(et);
         }
         worst / tol
@@ -463,7 +492,7 @@ impl Integrator<'_> {
     /// by node (the mass matrix is block diagonal), constrained DOFs held at zero acceleration.
     fn initial_accelerations(&mut self, state: &mut State) -> Result<()> {
         let rates = self.system.rates(state, 0.0);
-        self.system.assemble_dynamic(state, &rates, &mut self.asm);
+        self.system.assemble_dynamic(state, &rates, None, &mut self.asm);
         for i in 0..state.x.len() {
             state.acc[i] = Vector3::zeros();
             state.dw[i] = Vector3::zeros();
@@ -572,6 +601,8 @@ pub fn solve_dynamic(
         h_gen: 0.0,
         stats: Stats::default(),
         inertia_round_off: 0.0,
+        stress: Vec::new(),
+        stress_valid: false,
     };
     let lc = integ.system.char_length;
     integ.inertia_round_off = f64::EPSILON
@@ -601,7 +632,7 @@ pub fn solve_dynamic(
     let mut path = DynamicPath::default();
     let mut balance = EnergyBalance::default();
     let rates = integ.system.rates(state, 0.0);
-    integ.system.assemble_dynamic(state, &rates, &mut integ.asm);
+    integ.system.assemble_dynamic(state, &rates, None, &mut integ.asm);
     integ.add_inertia(state, state, h, false);
     let mut last = Energies::of(&integ, state);
     let mech0 = last.kinetic + last.strain + last.gravity;
