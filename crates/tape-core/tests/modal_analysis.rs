@@ -318,3 +318,39 @@ fn free_decay_period_of_a_released_cantilever_is_the_modal_period() -> Result<()
     assert!(err.abs() < 0.005, "period error {err:e}");
     Ok(())
 }
+
+/// A modal step reads and writes its JSON form; inapplicable options are refused; a shift on an
+/// eigenvalue (0, with the rigid-body modes of a free plate) stops the run with the error and the
+/// history so far.
+#[test]
+fn modal_steps_from_json_and_their_failures() -> Result<()> {
+    let step = Step::from_json(serde_json::json!({"name": "m", "kind": "modal", "modes": 3, "shift": -2.0}))?;
+    assert_eq!(Step::from_json(step.to_json())?, step);
+    let err = Step::from_json(serde_json::json!({"kind": "modal", "duration": 1.0})).unwrap_err();
+    assert!(err.to_string().contains("do not apply"), "{err}");
+    let mut section = common::section(0.01, E, 0.3);
+    section.density = RHO;
+    let model = Model::try_new(flat_plate(1.0, 1.0, 4, 4)?, section)?;
+    let on_zero = Step::new_modal(
+        "on zero",
+        ModalParams {
+            modes: 3,
+            shift: Some(0.0),
+            ..ModalParams::default()
+        },
+    );
+    let result = run(&model, &[modal(7), on_zero], &Outputs::default(), &mut |_| true)?;
+    let err = result.error.expect("a singular shift");
+    assert!(err.to_string().contains("move the shift"), "{err}");
+    assert_eq!(result.history.modes.len(), 1);
+    assert_eq!(result.steps_completed, 1);
+    // No density: no mass.
+    let massless = Model::try_new(flat_plate(1.0, 1.0, 2, 2)?, common::section(0.01, E, 0.3))?;
+    let result = run(&massless, &[modal(3)], &Outputs::default(), &mut |_| true)?;
+    assert!(result
+        .error
+        .expect("no mass")
+        .to_string()
+        .contains("without mass"));
+    Ok(())
+}
