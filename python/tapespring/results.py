@@ -346,9 +346,7 @@ class Results:
             # Files of format 1 have no energy balance.
             d = {k: f[k] if k in f else np.full(n, np.nan) for k in _ARRAYS}
             # Files of formats 1 and 2 have no modes.
-            modes = [
-                _load_modes(f, i, entry) for i, entry in enumerate(meta.pop("modes", []))
-            ]
+            modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.pop("modes", []))]
         d.update(meta)
         d["modes"] = modes
         return cls.from_dict(d)
