@@ -242,7 +242,7 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
         })
         .min(n)
     };
-    let mut rng = Lcg(0x5eed_0f_e16e);
+    let mut rng = Lcg(0x005e_ed0f_e16e);
     let mut basis = Basis {
         v: Vec::new(),
         mv: Vec::new(),

@@ -339,11 +339,21 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
             ..ModalParams::default()
         },
     );
+    // Zero is a rigid-body eigenvalue only to round-off, so K - 0 M usually factorises with tiny
+    // pivots, and shift-invert then finds the rigid-body modes (as it should); if a pivot is
+    // exactly zero the step stops with a message.
     let result = run(&model, &[modal(7), on_zero], &Outputs::default(), &mut |_| true)?;
-    let err = result.error.expect("a singular shift");
-    assert!(err.to_string().contains("move the shift"), "{err}");
-    assert_eq!(result.history.modes.len(), 1);
-    assert_eq!(result.steps_completed, 1);
+    let f7 = result.history.modes[0].frequencies_hz[6];
+    match result.error {
+        Some(err) => {
+            assert!(err.to_string().contains("move the shift"), "{err}");
+            assert_eq!((result.history.modes.len(), result.steps_completed), (1, 1));
+        }
+        None => {
+            let f = &result.history.modes[1].frequencies_hz;
+            assert!(f.iter().all(|f| f.abs() < 1e-3 * f7), "{f:?}");
+        }
+    }
     // No density: no mass.
     let massless = Model::try_new(flat_plate(1.0, 1.0, 2, 2)?, common::section(0.01, E, 0.3))?;
     let result = run(&massless, &[modal(3)], &Outputs::default(), &mut |_| true)?;
