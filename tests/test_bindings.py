@@ -468,7 +468,7 @@ def test_a_panic_becomes_tape_error():
         lambda: core.tape_spring_mesh(0.1, 0.01, 1.0, 0.0),
         lambda: core.tape_spring_mesh(0.1, 0.01, 1.0, 1e-3, twist=float("nan")),
         lambda: core.tape_section_centroid_z(0.01, 7.0),
-        lambda: core.step_defaults("modal"),
+        lambda: core.step_defaults("buckling"),
     ],
 )
 def test_bad_generator_and_step_arguments_are_value_errors(call):

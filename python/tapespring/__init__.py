@@ -7,6 +7,9 @@ analysis
     `Model`, `Step`, `Outputs`, `run`).
 results
     `Results`: everything an analysis recorded, saved and loaded with its settings.
+modes
+    `Modes` of a modal step, the free-DOF stiffness and mass (`SystemMatrices`) and
+    `modal_scipy`, the same eigenproblem solved by SciPy.
 shell
     Shell meshes, and static equilibrium paths in one call.
 scenarios
@@ -44,6 +47,7 @@ __all__ = [
     "__version__",
     "analysis",
     "cli",
+    "modes",
     "plot",
     "protocols",
     "report",

@@ -165,8 +165,10 @@ def run(
     """Run the steps; keys: step, t, iterations, residual, negative_eigenvalues, jump, event,
     strain_energy, gravity_energy, kinetic_energy, work_loads, work_prescribed,
     viscous_dissipation, numerical_dissipation, marker_names, marker_positions, marker_rotations,
-    reaction_dofs, reactions, field_records, displacements, rotations, ndof, stats, step_stats,
-    error, cancelled, steps_completed, settings."""
+    reaction_dofs, reactions, field_records, displacements, rotations, ndof, modes (one dict per
+    modal step: step, name, record, t, shift, eigenvalues, frequencies_hz, periods_s,
+    mode_shapes, effective_masses, residuals, below_shift, equilibrium_residual, matrices),
+    stats, step_stats, error, cancelled, steps_completed, settings."""
 
 def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]: ...
 def tape_spring_mesh(

@@ -2,8 +2,9 @@
 
 A :class:`Model` (the native ``tapespring._core.Model``) describes what is simulated: shell parts
 with their sections, reference nodes, rigid bodies, rigid ties, constraints, loads, gravity and
-markers. A :class:`Step` says what to compute next (a static equilibrium path) and which
-constraints, loads or gravity to switch on or off at its start, by id. :func:`run` carries the
+markers. A :class:`Step` says what to compute next (a static equilibrium path, a transient, or
+the vibration modes of the current state) and which constraints, loads or gravity to switch on or
+off at its start, by id. :func:`run` carries the
 state from step to step and records one history: time (the load factor in static steps), marker
 tracks, reactions, energies, stability, and nodal fields at a chosen interval; the initial state
 is its first record.
@@ -38,6 +39,7 @@ from typing import Any
 
 from tapespring import _core
 from tapespring._core import ConvergenceError, Model, TapeError
+from tapespring.modes import SystemMatrices
 from tapespring.results import Results
 
 __all__ = [
@@ -50,9 +52,11 @@ __all__ = [
     "TapeError",
     "constant",
     "linear",
+    "modal_step_options",
     "ramp",
     "run",
     "step_options",
+    "system_matrices",
     "table",
 ]
 
@@ -107,6 +111,20 @@ def dynamic_step_options() -> dict[str, Any]:
     return options
 
 
+def modal_step_options() -> dict[str, Any]:
+    """Every option of a modal step, with its default value.
+
+    ``modes`` (number of modes, 10); ``shift`` [Hz] (signed shift frequency, ``sigma = sign(f)
+    (2 pi f)^2``; None: automatic, negative, below the rigid-body modes); ``tolerance`` (relative
+    residual of the eigenpairs, 1e-8); ``reference_point`` [m] (axes of the rotational effective
+    masses); ``matrices`` (keep the free-DOF stiffness and mass with the modes).
+    """
+    options = dict(_core.step_defaults("modal"))
+    for key in ("name", "kind", "activate", "deactivate"):
+        options.pop(key)
+    return options
+
+
 @dataclass(frozen=True)
 class Step:
     """An analysis step: what it computes, and what it switches on and off at its start.
@@ -116,7 +134,8 @@ class Step:
     name : str
         Name, in messages and results.
     kind : str
-        ``"static"``: an equilibrium path; ``"dynamic"``: a transient over a duration.
+        ``"static"``: an equilibrium path; ``"dynamic"``: a transient over a duration;
+        ``"modal"``: the vibration modes of the current state.
     activate, deactivate : tuple of str
         Ids of constraints, loads or gravity switched on and off at the start of the step.
     options : mapping
@@ -160,6 +179,50 @@ class Step:
         """
         return cls(
             name, "dynamic", tuple(activate), tuple(deactivate), {"duration": duration, **options}
+        )
+
+    @classmethod
+    def modal(
+        cls,
+        name: str = "modal",
+        *,
+        modes: int = 10,
+        shift: float | None = None,
+        matrices: bool = False,
+        activate: Sequence[str] = (),
+        deactivate: Sequence[str] = (),
+        **options: Any,
+    ) -> Step:
+        """A modal step: the `modes` vibration modes of the current state, which it leaves as is.
+
+        ``K phi = omega^2 M phi`` with the tangent stiffness at the state (pre-stress and large
+        deformation included) and the nodal mass, constrained DOFs removed; the modes nearest the
+        shift (the lowest ones by default). The results go to :attr:`Results.modes`; the step
+        adds no record. Switching in a modal step acts at once, as in a dynamic step.
+
+        Parameters
+        ----------
+        name : str
+            Name of the step.
+        modes : int
+            Number of modes.
+        shift : float, optional
+            Signed shift frequency [Hz]: ``sigma = sign(shift) (2 pi shift)^2`` [rad^2/s^2]. None:
+            automatic and negative (below the rigid-body modes at 0, where ``K - sigma M`` is
+            singular). It must not be a natural frequency.
+        matrices : bool
+            Keep the free-DOF stiffness and mass (:class:`tapespring.modes.SystemMatrices`).
+        activate, deactivate : sequence of str
+            Ids switched on and off at the start of the step.
+        **options
+            The other options of :func:`modal_step_options` (``tolerance``, ``reference_point``).
+        """
+        return cls(
+            name,
+            "modal",
+            tuple(activate),
+            tuple(deactivate),
+            {"modes": int(modes), "shift": shift, "matrices": bool(matrices), **options},
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -266,3 +329,36 @@ def run(
         err.result = results  # type: ignore[attr-defined]
         raise err
     return results
+
+
+def system_matrices(
+    model: Model, steps: Sequence[Step | Mapping[str, Any]] = (), *, name: str = "matrices"
+) -> SystemMatrices:
+    """The free-DOF tangent stiffness and mass of `model` after `steps` (as SciPy CSR matrices).
+
+    Runs `steps` (none: the reference configuration) followed by a modal step of no mode that
+    keeps the matrices. For the matrices at a state in the middle of an analysis, put a
+    ``Step.modal(..., matrices=True)`` there instead and read ``Results.modes[i].matrices``.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    steps : sequence of Step or dict
+        The steps leading to the state.
+    name : str
+        Name of the modal step appended.
+
+    Returns
+    -------
+    SystemMatrices
+
+    Raises
+    ------
+    ConvergenceError
+        If a step stops early.
+    """
+    results = run(model, [*steps, Step.modal(name, modes=0, matrices=True)])
+    matrices = results.modes[-1].matrices
+    assert matrices is not None
+    return matrices

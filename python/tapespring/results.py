@@ -15,10 +15,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tapespring.modes import Modes, SystemMatrices
+
 __all__ = ["Results"]
 
 _FORMAT = "tapespring.Results"
-_VERSION = 2
+# 3: modal steps' results (``modes``).
+_VERSION = 3
+# Arrays of each modal step, saved as ``modes<i>_<name>``.
+_MODE_ARRAYS = (
+    "eigenvalues",
+    "frequencies_hz",
+    "periods_s",
+    "mode_shapes",
+    "effective_masses",
+    "residuals",
+)
+_MODE_SCALARS = ("step", "name", "record", "t", "shift", "below_shift", "equilibrium_residual")
 
 # Per-record arrays and their dtypes, in the order of the native dict and of the saved file.
 _ARRAYS: dict[str, Any] = {
@@ -88,6 +101,10 @@ class Results:
         Nodal displacements [m] and rotation vectors [rad] at `field_records`.
     ndof : ndarray of int, shape (n_steps_run,)
         Free DOFs of each step's numbering.
+    modes : tuple of Modes
+        The results of each modal step, in step order (a modal step adds no record; see
+        :class:`tapespring.modes.Modes`). :attr:`frequencies_hz`, :attr:`periods_s`,
+        :attr:`mode_shapes` and :attr:`effective_masses` gather them per modal step.
     stats : dict
         Counters and timings of the whole analysis; `step_stats` per step.
     error : str or None
@@ -123,6 +140,7 @@ class Results:
     displacements: NDArray[np.float64]
     rotations: NDArray[np.float64]
     ndof: NDArray[np.int64]
+    modes: tuple[Modes, ...] = ()
     stats: dict[str, Any] = field(default_factory=dict)
     step_stats: tuple[dict[str, Any], ...] = ()
     error: str | None = None
@@ -134,8 +152,18 @@ class Results:
     def from_dict(cls, d: Mapping[str, Any]) -> Results:
         """Build from the dict returned by :func:`tapespring._core.run`."""
         arrays = {k: np.asarray(d[k], dtype=dt) for k, dt in _ARRAYS.items()}
+        steps = list(dict(d["settings"]).get("steps", []))
+
+        def step_settings(k: int) -> dict[str, Any]:
+            return dict(steps[k]) if 0 <= k < len(steps) else {}
+
+        modes = tuple(
+            m if isinstance(m, Modes) else Modes.from_dict(m, step_settings(int(m["step"])))
+            for m in d.get("modes", [])
+        )
         return cls(
             **arrays,
+            modes=modes,
             event=tuple(d["event"]),
             marker_names=tuple(d["marker_names"]),
             reaction_dofs=tuple((int(n), str(k)) for n, k in d["reaction_dofs"]),
@@ -146,6 +174,26 @@ class Results:
             steps_completed=int(d["steps_completed"]),
             settings=dict(d["settings"]),
         )
+
+    @property
+    def frequencies_hz(self) -> tuple[NDArray[np.float64], ...]:
+        """Frequencies [Hz] of each modal step's modes, shape (n_modes,) each."""
+        return tuple(m.frequencies_hz for m in self.modes)
+
+    @property
+    def periods_s(self) -> tuple[NDArray[np.float64], ...]:
+        """Periods [s] of each modal step's modes, shape (n_modes,) each."""
+        return tuple(m.periods_s for m in self.modes)
+
+    @property
+    def mode_shapes(self) -> tuple[NDArray[np.float64], ...]:
+        """Mass-normalised mode shapes of each modal step, shape (n_modes, n_nodes, 6) each."""
+        return tuple(m.mode_shapes for m in self.modes)
+
+    @property
+    def effective_masses(self) -> tuple[NDArray[np.float64], ...]:
+        """Effective masses of each modal step's modes, shape (n_modes, 6) each."""
+        return tuple(m.effective_masses for m in self.modes)
 
     @property
     def n_records(self) -> int:
@@ -249,10 +297,28 @@ class Results:
             "cancelled": self.cancelled,
             "steps_completed": self.steps_completed,
             "settings": self.settings,
+            "modes": [
+                {
+                    **{k: getattr(m, k) for k in _MODE_SCALARS},
+                    "settings": m.settings,
+                    "matrices": m.matrices is not None,
+                }
+                for m in self.modes
+            ],
         }
+        mode_arrays: dict[str, Any] = {}
+        for i, m in enumerate(self.modes):
+            for k in _MODE_ARRAYS:
+                mode_arrays[f"modes{i}_{k}"] = getattr(m, k)
+            if m.matrices is not None:
+                for name, mat in (("k", m.matrices.stiffness), ("m", m.matrices.mass)):
+                    for part in ("data", "indices", "indptr"):
+                        mode_arrays[f"modes{i}_{name}_{part}"] = getattr(mat, part)
+                mode_arrays[f"modes{i}_free_dofs"] = m.matrices.free_dofs
         np.savez(
             path,
             **{k: getattr(self, k) for k in _ARRAYS},
+            **mode_arrays,
             meta=np.array(json.dumps(meta)),
         )
         return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
@@ -279,5 +345,36 @@ class Results:
             n = f["t"].shape[0]
             # Files of format 1 have no energy balance.
             d = {k: f[k] if k in f else np.full(n, np.nan) for k in _ARRAYS}
+            # Files of formats 1 and 2 have no modes.
+            modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.pop("modes", []))]
         d.update(meta)
+        d["modes"] = modes
         return cls.from_dict(d)
+
+
+def _load_modes(f: Any, i: int, entry: Mapping[str, Any]) -> Modes:
+    """The modes of modal step `i` of a saved file (`entry`: its scalars)."""
+    matrices = None
+    if entry["matrices"]:
+        from scipy.sparse import csr_matrix
+
+        free = np.asarray(f[f"modes{i}_free_dofs"], dtype=np.int64)
+        n = free.shape[0]
+
+        def csr(name: str) -> Any:
+            parts = (f[f"modes{i}_{name}_{p}"] for p in ("data", "indices", "indptr"))
+            return csr_matrix(tuple(parts), shape=(n, n))
+
+        matrices = SystemMatrices(stiffness=csr("k"), mass=csr("m"), free_dofs=free)
+    return Modes(
+        step=int(entry["step"]),
+        name=str(entry["name"]),
+        record=int(entry["record"]),
+        t=float(entry["t"]),
+        shift=float(entry["shift"]),
+        **{k: np.asarray(f[f"modes{i}_{k}"], dtype=float) for k in _MODE_ARRAYS},
+        below_shift=int(entry["below_shift"]),
+        equilibrium_residual=float(entry["equilibrium_residual"]),
+        matrices=matrices,
+        settings=dict(entry["settings"]),
+    )

@@ -12,6 +12,10 @@
 //! * a load (or gravity) switched **on** acts as `value * f(t)` from the start of the step (give it
 //!   a function that starts at zero there, such as a ramp, to apply it gradually).
 //!
+//! Dynamic and modal steps switch at once (a released constraint or load is simply gone). A modal
+//! step ([`crate::solver::modal`]) computes the vibration modes of the current state without
+//! changing it and adds no record: its [`crate::solver::Modes`] go to [`History::modes`].
+//!
 //! The numbering of the unknowns, the sparsity pattern and the symbolic factorisation are rebuilt
 //! only when the set of constrained DOFs changes.
 
@@ -27,7 +31,8 @@ use crate::model::{Load, Model};
 use crate::options::Options;
 use crate::output::{Fields, History, Outputs};
 use crate::solver::{
-    solve_dynamic, solve_static, Control, DynamicParams, EnergyBalance, StaticParams, StaticStep, Stats,
+    solve_dynamic, solve_modal, solve_static, Control, DynamicParams, EnergyBalance, ModalParams, StaticParams,
+    StaticStep, Stats,
 };
 use crate::state::State;
 use crate::time_function::TimeFunction;
@@ -39,6 +44,8 @@ pub enum StepKind {
     Static(StaticParams),
     /// A transient dynamic analysis over a duration.
     Dynamic(DynamicParams),
+    /// The vibration modes of the current state (which it does not change).
+    Modal(ModalParams),
 }
 
 /// An analysis step: what it computes and what it switches at its start.
@@ -77,9 +84,21 @@ impl Step {
         }
     }
 
-    /// A step from a flat JSON object: `name`, `kind` (`"static"` or `"dynamic"`), `activate` and
-    /// `deactivate` (lists of ids), and the options of its kind (see
-    /// [`StaticParams::from_options`] and [`DynamicParams::from_options`]).
+    /// A modal step with `params`, switching nothing.
+    #[must_use]
+    pub fn new_modal(name: &str, params: ModalParams) -> Self {
+        Self {
+            name: name.to_owned(),
+            kind: StepKind::Modal(params),
+            activate: Vec::new(),
+            deactivate: Vec::new(),
+        }
+    }
+
+    /// A step from a flat JSON object: `name`, `kind` (`"static"`, `"dynamic"` or `"modal"`),
+    /// `activate` and `deactivate` (lists of ids), and the options of its kind (see
+    /// [`StaticParams::from_options`], [`DynamicParams::from_options`] and
+    /// [`ModalParams::from_options`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming a bad, inapplicable or unknown option.
@@ -96,9 +115,12 @@ impl Step {
             "dynamic" => StepKind::Dynamic(
                 DynamicParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
             ),
+            "modal" => StepKind::Modal(
+                ModalParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
+            ),
             other => {
                 return Err(Error::InvalidParameter(format!(
-                    "step '{name}': unknown kind '{other}' (expected 'static' or 'dynamic')"
+                    "step '{name}': unknown kind '{other}' (expected 'static', 'dynamic' or 'modal')"
                 )))
             }
         };
@@ -118,6 +140,7 @@ impl Step {
         let (kind, options) = match &self.kind {
             StepKind::Static(p) => ("static", p.to_options()),
             StepKind::Dynamic(p) => ("dynamic", p.to_options()),
+            StepKind::Modal(p) => ("modal", p.to_options()),
         };
         m.insert("kind".into(), kind.into());
         m.insert("activate".into(), self.activate.clone().into());
@@ -129,7 +152,7 @@ impl Step {
     fn static_params(&self) -> Option<&StaticParams> {
         match &self.kind {
             StepKind::Static(p) => Some(p),
-            StepKind::Dynamic(_) => None,
+            StepKind::Dynamic(_) | StepKind::Modal(_) => None,
         }
     }
 }
@@ -181,6 +204,7 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
         match &step.kind {
             StepKind::Static(p) => p.validate(),
             StepKind::Dynamic(p) => p.validate(),
+            StepKind::Modal(p) => p.validate(),
         }
         .map_err(|e| e.context(&context))?;
         for id in &step.activate {
@@ -356,7 +380,7 @@ pub fn run(
             for id in &step.deactivate {
                 activity.switch(model, id, false)?;
             }
-            // A static step releases over its load-factor range; a dynamic one at once.
+            // A static step releases over its load-factor range; a dynamic or modal one at once.
             let t1 = step.static_params().map(|p| match p.control {
                 Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => lambda_end,
                 Control::Displacement { .. } => state.t,
@@ -379,6 +403,38 @@ pub fn run(
             }
         }
         history.ndof.push(system.n_free());
+        let context = format!("step {k} '{}'", step.name);
+        if let StepKind::Modal(p) = &step.kind {
+            match solve_modal(&mut system, &state, p) {
+                Ok((mut modes, mut stats)) => {
+                    modes.step = k;
+                    modes.name.clone_from(&step.name);
+                    modes.record = history.len() - 1;
+                    history.modes.push(modes);
+                    stats.symbolic_analyses = std::mem::take(&mut symbolic);
+                    result.stats.add(&stats);
+                    result.step_stats.push(stats);
+                }
+                Err(e) => {
+                    // Kept with the history so far, as a failed static or dynamic step is.
+                    result.step_stats.push(Stats::default());
+                    result.error = Some(e.context(&context).in_step(&step.name));
+                    break;
+                }
+            }
+            if !progress(&Progress {
+                step: k,
+                name: &step.name,
+                n_steps: steps.len(),
+                t: state.t,
+                records: history.len(),
+            }) {
+                result.cancelled = true;
+                break;
+            }
+            result.steps_completed += 1;
+            continue;
+        }
         let n_steps = steps.len();
         let mut records = history.len();
         let mut cb = |s: &StaticStep, _: &Stats| {
@@ -391,7 +447,6 @@ pub fn run(
                 records,
             })
         };
-        let context = format!("step {k} '{}'", step.name);
         let (records, mut stats, cancelled, error) = match &step.kind {
             StepKind::Static(p) => {
                 let mut params = p.clone();
@@ -406,6 +461,7 @@ pub fn run(
                 let path = solve_dynamic(&mut system, &mut state, &params, &mut cb).map_err(|e| e.context(&context))?;
                 (path.steps, path.stats, path.cancelled, path.error)
             }
+            StepKind::Modal(_) => unreachable!("modal steps are handled above"),
         };
         stats.symbolic_analyses = std::mem::take(&mut symbolic);
         result.stats.add(&stats);

@@ -25,6 +25,7 @@ pub mod analysis;
 pub mod assembly;
 pub mod constraint;
 pub mod dof;
+pub mod eigen;
 pub mod inertia;
 pub mod linalg;
 pub mod model;

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::dof::Dof;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::solver::{EnergyBalance, Event, StaticStep};
+use crate::solver::{EnergyBalance, Event, Modes, StaticStep};
 
 /// What to record besides the time, the markers and the energies.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -113,6 +113,10 @@ pub struct History {
     pub fields: Vec<Fields>,
     /// Free DOFs of the numbering of each analysis step.
     pub ndof: Vec<usize>,
+    /// The modes of each modal step, in step order (a modal step adds no record: it analyses the
+    /// last one, [`Modes::record`]).
+    #[serde(default)]
+    pub modes: Vec<Modes>,
 }
 
 impl History {

@@ -5,6 +5,7 @@ pub mod alpha;
 pub mod control;
 pub mod dynamics;
 mod events;
+pub mod modal;
 pub mod newton;
 mod relax;
 pub mod statics;
@@ -18,6 +19,7 @@ use crate::options::Options;
 
 pub use control::StepController;
 pub use dynamics::{solve_dynamic, DynamicParams, DynamicPath, EnergyBalance};
+pub use modal::{solve_modal, ModalParams, Modes, SystemMatrices};
 pub use newton::NewtonParams;
 pub use statics::solve_static;
 

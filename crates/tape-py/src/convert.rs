@@ -483,5 +483,61 @@ pub fn history_to_dict<'py>(py: Python<'py>, h: &History, n_nodes: usize) -> PyR
     d.set_item("displacements", fields(|f| &f.displacements)?.into_pyarray(py))?;
     d.set_item("rotations", fields(|f| &f.rotations)?.into_pyarray(py))?;
     d.set_item("ndof", counts_to_numpy(py, h.ndof.iter().copied()))?;
+    let modes = h
+        .modes
+        .iter()
+        .map(|m| modes_to_dict(py, m, n_nodes))
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("modes", PyList::new(py, modes)?)?;
+    Ok(d)
+}
+
+/// The modes of a modal step as a dict: scalars, arrays (`mode_shapes` of shape
+/// `(n_modes, n_nodes, 6)`, `effective_masses` `(n_modes, 6)`) and, if recorded, `matrices`
+/// (compressed columns: `n`, `indptr`, `indices`, `stiffness`, `mass`, and `free_dofs` rows of
+/// (node, DOF index)).
+fn modes_to_dict<'py>(py: Python<'py>, m: &tape_core::solver::Modes, n_nodes: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("step", m.step)?;
+    d.set_item("name", &m.name)?;
+    d.set_item("record", m.record)?;
+    d.set_item("t", m.t)?;
+    d.set_item("shift", m.shift)?;
+    d.set_item("eigenvalues", vec_to_numpy(py, m.eigenvalues.clone()))?;
+    d.set_item("frequencies_hz", vec_to_numpy(py, m.frequencies_hz.clone()))?;
+    d.set_item("periods_s", vec_to_numpy(py, m.periods_s.clone()))?;
+    let n_modes = m.eigenvalues.len();
+    let flat: Vec<f64> = m.mode_shapes.iter().flatten().copied().collect();
+    let shapes = Array3::from_shape_vec((n_modes, if n_modes == 0 { 0 } else { n_nodes }, 6), flat)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("inconsistent mode shapes: {e}")))?;
+    d.set_item("mode_shapes", shapes.into_pyarray(py))?;
+    d.set_item("effective_masses", rows_to_numpy(py, &m.effective_masses))?;
+    d.set_item("residuals", vec_to_numpy(py, m.residuals.clone()))?;
+    d.set_item("below_shift", m.below_shift)?;
+    d.set_item("equilibrium_residual", m.equilibrium_residual)?;
+    let matrices = match &m.matrices {
+        None => None,
+        Some(k) => {
+            let md = PyDict::new(py);
+            md.set_item("n", k.n)?;
+            md.set_item("indptr", indices_to_numpy(py, &k.col_ptr))?;
+            md.set_item("indices", indices_to_numpy(py, &k.row_idx))?;
+            md.set_item("stiffness", vec_to_numpy(py, k.stiffness.clone()))?;
+            md.set_item("mass", vec_to_numpy(py, k.mass.clone()))?;
+            let rows: Vec<[i64; 2]> = k
+                .free_dofs
+                .iter()
+                .map(|&(n, dof)| {
+                    [
+                        i64::try_from(n).unwrap_or(i64::MAX),
+                        i64::try_from(dof.index()).unwrap_or(0),
+                    ]
+                })
+                .collect();
+            md.set_item("free_dofs", rows_to_numpy(py, &rows))?;
+            Some(md)
+        }
+    };
+    d.set_item("matrices", matrices)?;
     Ok(d)
 }

@@ -1,0 +1,264 @@
+"""Vibration modes: what a modal step records, the free-DOF matrices, and a SciPy cross-check.
+
+A modal step (:meth:`tapespring.analysis.Step.modal`) solves ``K phi = omega^2 M phi`` on the
+free equations at the current state: ``K`` is the tangent stiffness (pre-stress and large
+deformation included; its symmetric part), ``M`` the nodal mass matrix (lumped shell mass, rotary
+inertia, rigid bodies and tied nodes). Its results are a :class:`Modes`; with ``matrices=True``
+it also keeps ``K`` and ``M`` as a :class:`SystemMatrices`, which :func:`modal_scipy` solves
+independently with :func:`scipy.sparse.linalg.eigsh`.
+
+This module uses numpy and scipy only (it never imports the compiled core).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "Modes",
+    "ScipyModes",
+    "SystemMatrices",
+    "auto_shift",
+    "frequency_hz",
+    "modal_scipy",
+    "shift_from_hz",
+]
+
+#: Names of the six nodal degrees of freedom, in solver order.
+_DOFS = ("ux", "uy", "uz", "rx", "ry", "rz")
+#: Factor of the automatic shift ``-factor * min(K_ii / M_ii)`` (as in the native solver).
+_AUTO_SHIFT_FACTOR = 1e-6
+
+
+def shift_from_hz(f: float) -> float:
+    """Eigenvalue shift [rad^2/s^2] of a signed shift frequency `f` [Hz]: ``sign(f) (2 pi f)^2``."""
+    return float(np.sign(f) * (2.0 * np.pi * f) ** 2)
+
+
+def frequency_hz(eigenvalues: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Signed frequencies [Hz] ``sign(l) sqrt(|l|) / (2 pi)`` of eigenvalues `l` [rad^2/s^2]."""
+    lam = np.asarray(eigenvalues, dtype=float)
+    return np.sign(lam) * np.sqrt(np.abs(lam)) / (2.0 * np.pi)
+
+
+@dataclass(frozen=True, eq=False)
+class SystemMatrices:
+    """Free x free tangent stiffness and mass at a state, with the numbering of the equations.
+
+    Attributes
+    ----------
+    stiffness : scipy.sparse.csr_matrix, shape (n, n)
+        Tangent stiffness ``d(f_int - f_ext)/dq`` [N/m, N, N m]. Not exactly symmetric at a
+        stressed state (finite-rotation terms); eigen-solvers use ``(K + K^T) / 2``.
+    mass : scipy.sparse.csr_matrix, shape (n, n)
+        Mass [kg, kg m, kg m^2], block diagonal by node.
+    free_dofs : ndarray of int, shape (n, 2)
+        ``(node, dof index)`` of each free equation; the DOF index counts ``ux, uy, uz, rx, ry,
+        rz`` from 0.
+    """
+
+    stiffness: Any
+    mass: Any
+    free_dofs: NDArray[np.int64]
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> SystemMatrices:
+        """Build from the compressed-column dict of the native results."""
+        from scipy.sparse import csc_matrix
+
+        n = int(d["n"])
+        indptr = np.asarray(d["indptr"], dtype=np.int64)
+        indices = np.asarray(d["indices"], dtype=np.int64)
+
+        def csr(values: Any) -> Any:
+            return csc_matrix(
+                (np.asarray(values, dtype=float), indices, indptr), shape=(n, n)
+            ).tocsr()
+
+        return cls(
+            stiffness=csr(d["stiffness"]),
+            mass=csr(d["mass"]),
+            free_dofs=np.asarray(d["free_dofs"], dtype=np.int64).reshape(-1, 2),
+        )
+
+    @property
+    def n(self) -> int:
+        """Number of free equations."""
+        return int(self.free_dofs.shape[0])
+
+    def dof_names(self) -> list[tuple[int, str]]:
+        """``(node, dof name)`` of each free equation."""
+        return [(int(n), _DOFS[int(d)]) for n, d in self.free_dofs]
+
+    def to_nodal(self, vector: NDArray[np.float64], n_nodes: int) -> NDArray[np.float64]:
+        """A free-equation vector as nodal rows ``(n_nodes, 6)`` (0 where not free).
+
+        Tied nodes, whose DOFs are not equations, are left at 0.
+        """
+        out = np.zeros((n_nodes, 6))
+        out[self.free_dofs[:, 0], self.free_dofs[:, 1]] = np.asarray(vector, dtype=float)
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class Modes:
+    """The vibration modes computed by one modal step.
+
+    Attributes
+    ----------
+    step : int
+        Index of the analysis step.
+    name : str
+        Its name.
+    record : int
+        The history record of the state analysed (the last one before the step).
+    t : float
+        Time of that state [s] (the load factor after a static step).
+    shift : float
+        Eigenvalue shift used [rad^2/s^2]; the modes are those nearest it.
+    eigenvalues : ndarray, shape (n_modes,)
+        ``omega^2`` [rad^2/s^2], increasing.
+    frequencies_hz : ndarray, shape (n_modes,)
+        ``sign(omega^2) sqrt(|omega^2|) / (2 pi)`` [Hz]; negative for an unstable state's
+        divergent modes, about 0 for rigid-body modes.
+    periods_s : ndarray, shape (n_modes,)
+        ``1 / f`` [s], infinite where ``omega^2 <= 0``.
+    mode_shapes : ndarray, shape (n_modes, n_nodes, 6)
+        Nodal ``ux, uy, uz, rx, ry, rz`` of each mode, mass-normalised (``phi^T M phi = 1``)
+        [m/sqrt(kg), rad/sqrt(kg)]; constrained DOFs are 0; the largest component is positive.
+    effective_masses : ndarray, shape (n_modes, 6)
+        Effective masses ``(phi^T M r)^2`` of the rigid motions along x, y, z [kg] and about the
+        axes through the step's ``reference_point`` [kg m^2] (free DOFs only).
+    residuals : ndarray, shape (n_modes,)
+        Relative residual of each eigenpair (below the step's ``tolerance``).
+    below_shift : int
+        Number of eigenvalues below the shift (Sturm count).
+    equilibrium_residual : float
+        Residual norm of the state analysed [N] (small at an equilibrium).
+    matrices : SystemMatrices or None
+        ``K`` and ``M`` of the free equations, if the step asked for them.
+    settings : dict
+        The step's options.
+    """
+
+    step: int
+    name: str
+    record: int
+    t: float
+    shift: float
+    eigenvalues: NDArray[np.float64]
+    frequencies_hz: NDArray[np.float64]
+    periods_s: NDArray[np.float64]
+    mode_shapes: NDArray[np.float64]
+    effective_masses: NDArray[np.float64]
+    residuals: NDArray[np.float64]
+    below_shift: int = 0
+    equilibrium_residual: float = 0.0
+    matrices: SystemMatrices | None = None
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], settings: Mapping[str, Any] | None = None) -> Modes:
+        """Build from one entry of the native results' ``modes`` list."""
+        n = len(d["eigenvalues"])
+        shapes = np.asarray(d["mode_shapes"], dtype=float)
+        matrices = d.get("matrices")
+        return cls(
+            step=int(d["step"]),
+            name=str(d["name"]),
+            record=int(d["record"]),
+            t=float(d["t"]),
+            shift=float(d["shift"]),
+            eigenvalues=np.asarray(d["eigenvalues"], dtype=float),
+            frequencies_hz=np.asarray(d["frequencies_hz"], dtype=float),
+            periods_s=np.asarray(d["periods_s"], dtype=float),
+            mode_shapes=shapes.reshape(n, -1, 6) if n else shapes.reshape(0, 0, 6),
+            effective_masses=np.asarray(d["effective_masses"], dtype=float).reshape(n, 6),
+            residuals=np.asarray(d["residuals"], dtype=float),
+            below_shift=int(d["below_shift"]),
+            equilibrium_residual=float(d["equilibrium_residual"]),
+            matrices=None if matrices is None else SystemMatrices.from_dict(matrices),
+            settings=dict(settings or {}),
+        )
+
+    @property
+    def n_modes(self) -> int:
+        """Number of modes."""
+        return int(self.eigenvalues.shape[0])
+
+
+@dataclass(frozen=True, eq=False)
+class ScipyModes:
+    """Eigenpairs of :func:`modal_scipy`.
+
+    Attributes
+    ----------
+    eigenvalues : ndarray, shape (n_modes,)
+        ``omega^2`` [rad^2/s^2], increasing.
+    frequencies_hz : ndarray, shape (n_modes,)
+        Signed frequencies [Hz].
+    vectors : ndarray, shape (n, n_modes)
+        Mass-normalised eigenvectors on the free equations.
+    shift : float
+        The shift used [rad^2/s^2].
+    """
+
+    eigenvalues: NDArray[np.float64]
+    frequencies_hz: NDArray[np.float64]
+    vectors: NDArray[np.float64]
+    shift: float
+
+
+def auto_shift(matrices: SystemMatrices) -> float:
+    """The native solver's default shift [rad^2/s^2]: ``-1e-6 min(K_ii / M_ii)`` over the free
+    equations with positive diagonals (-1 if there is none)."""
+    k = matrices.stiffness.diagonal()
+    m = matrices.mass.diagonal()
+    ok = (k > 0) & (m > 0)
+    if not np.any(ok):
+        return -1.0
+    return float(-_AUTO_SHIFT_FACTOR * np.min(k[ok] / m[ok]))
+
+
+def modal_scipy(
+    matrices: SystemMatrices, modes: int = 10, *, shift_hz: float | None = None
+) -> ScipyModes:
+    """The `modes` eigenpairs of ``(K + K^T)/2 phi = omega^2 M phi`` nearest the shift, by SciPy.
+
+    Runs :func:`scipy.sparse.linalg.eigsh` in shift-invert mode on exported matrices: an
+    independent check of the native modal step, and a way to use SciPy's options.
+
+    Parameters
+    ----------
+    matrices : SystemMatrices
+        From a modal step with ``matrices=True`` (or :func:`tapespring.analysis.system_matrices`).
+    modes : int, optional
+        Number of eigenpairs (fewer than the number of free equations).
+    shift_hz : float, optional
+        Signed shift frequency [Hz] (``sigma = sign(f) (2 pi f)^2``); default: :func:`auto_shift`.
+
+    Returns
+    -------
+    ScipyModes
+    """
+    from scipy.sparse.linalg import eigsh
+
+    k = matrices.stiffness
+    k_sym = ((k + k.T) * 0.5).tocsc()
+    m = matrices.mass.tocsc()
+    sigma = auto_shift(matrices) if shift_hz is None else shift_from_hz(shift_hz)
+    values, vectors = eigsh(k_sym, k=int(modes), M=m, sigma=sigma, which="LM")
+    order = np.argsort(values)
+    values = values[order]
+    vectors = vectors[:, order]
+    return ScipyModes(
+        eigenvalues=values,
+        frequencies_hz=frequency_hz(values),
+        vectors=vectors,
+        shift=sigma,
+    )

@@ -1,0 +1,138 @@
+"""Modal steps from Python: the native eigensolver against SciPy's on the exported matrices, at a
+deformed, pre-stressed state; rigid-body modes and effective masses of a free plate; the free-DOF
+matrices; results saved and loaded with their modes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from tapespring.analysis import Model, Step, modal_step_options, run, system_matrices
+from tapespring.modes import auto_shift, modal_scipy
+from tapespring.results import Results
+from tapespring.shell import flat_plate_mesh
+
+E, RHO, L, B, T = 2e11, 7850.0, 0.2, 0.02, 2e-3
+
+
+def strip(poisson: float = 0.3) -> tuple[Model, dict[str, np.ndarray]]:
+    nodes, quads, sets = flat_plate_mesh(L, B, 16, 2)
+    model = Model(
+        nodes, quads, node_sets=sets, thickness=T, youngs_modulus=E, poisson=poisson, density=RHO
+    )
+    model.fix("x0", "all")
+    return model, sets
+
+
+def test_modal_step_options_and_dict():
+    options = modal_step_options()
+    assert options == {
+        "modes": 10,
+        "shift": None,
+        "tolerance": 1e-8,
+        "reference_point": [0.0, 0.0, 0.0],
+        "matrices": False,
+    }
+    step = Step.modal("m", modes=3, shift=-2.0, tolerance=1e-9)
+    assert step.to_dict()["kind"] == "modal"
+    assert step.to_dict()["shift"] == -2.0
+    model, _ = strip()
+    with pytest.raises(ValueError, match="duration"):
+        run(model, [Step.modal("m", duration=1.0)])
+    with pytest.raises(ValueError, match="tolerance"):
+        run(model, [Step.modal("m", tolerance=0.5)])
+
+
+def test_native_modes_match_scipy_at_a_prestressed_deformed_state():
+    """Bent by a tip load and stretched, the strip's tangent is that of a deformed, stressed state
+    (with the small skew terms of finite rotations): the native solver and eigsh on the exported
+    matrices agree to 1e-6 (both converge to round-off; the tolerance allows for the conditioning
+    of the high modes)."""
+    model, sets = strip()
+    for n in sets["x1"]:
+        model.add_load(int(n), "uz", -2.0)
+        model.add_load(int(n), "ux", 300.0)
+    results = run(
+        model,
+        [
+            Step.static("load", increments=4),
+            Step.modal("modes", modes=8, matrices=True),
+        ],
+    )
+    modes = results.modes[0]
+    assert modes.record == results.n_records - 1
+    assert results.strain_energy[-1] > 0.0
+    matrices = modes.matrices
+    assert matrices is not None
+    assert modes.shift == pytest.approx(auto_shift(matrices), rel=1e-12)
+    ref = modal_scipy(matrices, 8)
+    np.testing.assert_allclose(modes.frequencies_hz, ref.frequencies_hz, rtol=1e-6)
+    # Same shapes (up to sign) where the eigenvalue is simple.
+    m = matrices.mass
+    for k in range(8):
+        phi = modes.mode_shapes[k][matrices.free_dofs[:, 0], matrices.free_dofs[:, 1]]
+        assert abs(phi @ (m @ ref.vectors[:, k])) == pytest.approx(1.0, abs=1e-6)
+    assert results.frequencies_hz[0] is modes.frequencies_hz
+    assert results.mode_shapes[0].shape == (8, model.n_nodes, 6)
+    # The state is not changed: a second modal step finds the same modes.
+    again = run(
+        model,
+        [Step.static("load", increments=4), Step.modal("a", modes=3), Step.modal("b", modes=3)],
+    )
+    np.testing.assert_allclose(again.frequencies_hz[0], again.frequencies_hz[1], rtol=1e-10)
+
+
+def test_free_plate_has_six_rigid_modes_carrying_the_whole_mass():
+    nodes, quads, sets = flat_plate_mesh(1.0, 1.0, 6, 6)
+    model = Model(
+        nodes, quads, node_sets=sets, thickness=0.01, youngs_modulus=E, poisson=0.3, density=RHO
+    )
+    results = run(model, [Step.modal("free", modes=9, reference_point=[0.5, 0.5, 0.0])])
+    modes = results.modes[0]
+    f = modes.frequencies_hz
+    assert np.all(np.abs(f[:6]) < 1e-3 * f[6])
+    assert np.all(modes.periods_s[6:] == 1.0 / f[6:])
+    mass = model.total_mass
+    np.testing.assert_allclose(modes.effective_masses[:6, :3].sum(axis=0), mass, rtol=1e-8)
+    # Rotational effective masses about the centre: the plate's moments of inertia (lumped).
+    assert modes.effective_masses[:6, 5].sum() == pytest.approx(mass / 6.0, rel=0.1)
+
+
+def test_system_matrices_number_the_free_dofs():
+    model, sets = strip()
+    mats = system_matrices(model)
+    n_free = 6 * (model.n_nodes - len(sets["x0"]))
+    assert mats.stiffness.shape == mats.mass.shape == (n_free, n_free)
+    assert mats.n == n_free
+    assert not set(sets["x0"].tolist()) & set(mats.free_dofs[:, 0].tolist())
+    assert abs(mats.mass - mats.mass.T).max() == 0.0
+    # Unit acceleration along z: the mass the free nodes carry.
+    uz = (mats.free_dofs[:, 1] == 2).astype(float)
+    free_mass = RHO * T * L * B * (1 - 1 / 32)
+    assert uz @ (mats.mass @ uz) == pytest.approx(free_mass, rel=1e-12)
+    names = mats.dof_names()
+    assert names[0][1] == "ux" and len(names) == n_free
+    # At the reference state the stiffness is symmetric to round-off.
+    k = mats.stiffness
+    assert abs(k - k.T).max() <= 1e-12 * abs(k).max()
+    # The first frequency of the unstressed narrow strip is near Euler-Bernoulli's (E modulus).
+    f1 = modal_scipy(mats, 1).frequencies_hz[0]
+    beam = 1.8751**2 / (2 * math.pi) * math.sqrt(E * T**2 / (12 * RHO) / L**4)
+    assert f1 == pytest.approx(beam, rel=0.01)
+
+
+def test_results_with_modes_round_trip(tmp_path):
+    model, _ = strip(poisson=0.0)
+    results = run(model, [Step.modal("m", modes=4, matrices=True)])
+    path = results.save(tmp_path / "modal")
+    back = Results.load(path)
+    assert len(back.modes) == 1
+    a, b = results.modes[0], back.modes[0]
+    for key in ("eigenvalues", "frequencies_hz", "periods_s", "mode_shapes", "effective_masses"):
+        np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+    assert (a.step, a.name, a.record, a.t, a.shift) == (b.step, b.name, b.record, b.t, b.shift)
+    assert b.settings["modes"] == 4
+    assert a.matrices is not None and b.matrices is not None
+    assert abs(a.matrices.stiffness - b.matrices.stiffness).max() == 0.0
+    np.testing.assert_array_equal(a.matrices.free_dofs, b.matrices.free_dofs)
