@@ -27,6 +27,7 @@ pub mod constraint;
 pub mod dof;
 pub mod inertia;
 pub mod linalg;
+pub mod memory;
 pub mod model;
 pub mod options;
 pub mod output;

@@ -7,6 +7,7 @@ pub mod dynamics;
 mod events;
 pub mod newton;
 mod relax;
+mod retrace;
 pub mod statics;
 
 use serde::{Deserialize, Serialize};

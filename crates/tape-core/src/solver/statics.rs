@@ -37,6 +37,7 @@ use std::time::Instant;
 use super::control::{GiveUp, StepController};
 use super::events::{after_step, Point};
 use super::newton::{Convergence, Stall};
+use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
@@ -550,6 +551,8 @@ struct PathState {
     last_negative: Option<usize>,
     /// After a jump or a branch switch: the load-factor increment of the restarting step.
     restart: Option<f64>,
+    /// Arc-length only: the states followed so far, to stop a path that returns onto itself.
+    memory: Option<PathMemory>,
 }
 
 /// What the driver does after a stage of an increment.
@@ -771,6 +774,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 history: Vec::new(),
                 last_negative: None,
                 restart: None,
+                memory: arc_control.then(PathMemory::new),
             },
             path: StaticPath::default(),
             progress,
@@ -780,6 +784,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             monitor,
             scale,
         };
+        if let Some(m) = &mut w.p.memory {
+            m.restart(state, &w.s.system.reference);
+        }
         if w.locate {
             // The start of the path is the first point of the location history (the assembly is
             // the one the first increment needs anyway).
@@ -1047,7 +1054,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             return None;
         };
         let start = saved.t;
-        if (start - end) * (state.t - end) >= 0.0 || self.p.last_dlambda.is_none() {
+        // The first step lands too: one that overshoots lambda_end (a large initial increment)
+        // would otherwise carry the path away from it.
+        if (start - end) * (state.t - end) >= 0.0 {
             return None;
         }
         let mut trial = saved.clone();
@@ -1084,6 +1093,37 @@ impl<'a, 'b> Walk<'a, 'b> {
             if reached && self.p.last_dlambda.is_some() {
                 return Flow::Stop;
             }
+        }
+        if let Some(back) = self
+            .p
+            .memory
+            .as_mut()
+            .and_then(|m| m.visit(state, &self.s.system.reference))
+        {
+            let end = self.lambda_end.unwrap_or(f64::NAN);
+            let detail = if back.reversed {
+                format!(
+                    "it turned back at t = {:.6e} and is retracing the path it followed, through the states of \
+                     increment {} (t = {:.6e}); it would only repeat them until the step limit. lambda_end = {end} \
+                     was not reached: it may lie beyond the load factor the structure carries on this path, or a \
+                     step jumped across a sharp turn (a smaller initial_increment or max_increment_factor keeps \
+                     the steps on the path)",
+                    back.t_turn, back.increment_old, back.t_old
+                )
+            } else {
+                format!(
+                    "it closed a loop, passing again in the same sense through the states of increment {} \
+                     (t = {:.6e}); it would only go round until the step limit. lambda_end = {end} is not on this \
+                     loop",
+                    back.increment_old, back.t_old
+                )
+            };
+            self.path.error = Some(Error::PathReturned {
+                step: None,
+                t: state.t,
+                detail,
+            });
+            return Flow::Stop;
         }
         self.p.last_dlambda = Some(out.dlambda);
         self.s.previous = Some((out.dq, out.dlambda));
@@ -1164,6 +1204,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         let keep_going = (self.progress)(&st, &self.s.stats);
         self.path.steps.push(st);
         self.s.previous = None;
+        if let Some(m) = &mut self.p.memory {
+            m.restart(state, &self.s.system.reference);
+        }
         self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
         self.p.control.cutbacks = 0;
         self.p.history.clear();
