@@ -33,6 +33,12 @@ fn section(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ShellSection> {
             )));
         }
     }
+    // Every section parameter is a number: name the one that is not (serde's message would not).
+    for (key, v) in kwargs.iter().flat_map(|k| k.iter()) {
+        if !v.is_none() {
+            convert::float(&v, &format!("section parameter {key}"))?;
+        }
+    }
     let value = match kwargs {
         Some(k) => convert::to_json(k.as_any(), "section")?,
         None => Value::Object(serde_json::Map::new()),

@@ -855,7 +855,9 @@ impl<'a, 'b> Walk<'a, 'b> {
                     let ds = initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt();
                     if !(ds.is_finite() && ds > 0.0) {
                         return Err(Error::InvalidModel(
-                            "arc-length control needs a load or a prescribed motion that changes with the load factor and acts on the free DOFs"
+                            "arc-length control: the loads and prescribed motions act on no free DOF (they are all on \
+                             constrained DOFs, or do not change with the load factor), so the path has no direction; \
+                             load a free DOF, or prescribe a motion that changes with the load factor"
                                 .into(),
                         ));
                     }
