@@ -85,7 +85,9 @@ def test_a_bad_memory_limit_is_named():
         """,
         TAPESPRING_MEMORY_LIMIT="lots",
     )
-    assert code == 0 and "ValueError: invalid parameter: TAPESPRING_MEMORY_LIMIT = 'lots'" in out, out
+    assert code == 0 and "ValueError: invalid parameter: TAPESPRING_MEMORY_LIMIT = 'lots'" in out, (
+        out
+    )
 
 
 # -- mesh validity at any scale ----------------------------------------------------------------
@@ -122,7 +124,9 @@ def test_out_of_range_coordinates_are_refused_for_their_size(scale, message):
 
 
 def test_a_twist_that_folds_the_mesh_is_named():
-    with pytest.raises(ValueError, match="imperfection_deg = 1000000.0 is not a small imperfection"):
+    with pytest.raises(
+        ValueError, match="imperfection_deg = 1000000.0 is not a small imperfection"
+    ):
         BendingSetup(imperfection_deg=1e6).validate()
     with pytest.raises(ValueError, match="the twist imperfection twist = 17453.29"):
         shell.tape_spring_mesh(0.1, 0.0155, 1.2, 2e-3, twist=math.radians(1e6))
@@ -210,7 +214,9 @@ def _roof(thickness, force, n=4):
     """The hinged roof of Sze et al. (2004, 3.8), quarter model, central force ``force * t``."""
     r, half_length = 2540.0, 254.0
     nodes, quads, sets = shell.cylindrical_panel_mesh(r, half_length, 0.0, 0.1, n, n)
-    m = Model(nodes, quads, node_sets=sets, thickness=thickness, youngs_modulus=3102.75, poisson=0.3)
+    m = Model(
+        nodes, quads, node_sets=sets, thickness=thickness, youngs_modulus=3102.75, poisson=0.3
+    )
     m.fix("x1", ["ux", "ry", "rz"])
     m.fix("phi0", ["uy", "rx", "rz"])
     m.fix("phi1", ["ux", "uy", "uz"])

@@ -916,7 +916,8 @@ impl<'a, 'b> Walk<'a, 'b> {
                 _ => false,
             };
             if !relaxed {
-                self.path.error = Some(give_up(&self.p, why, rejection, state, params));
+                let force = self.s.reference_force();
+                self.path.error = Some(give_up(&self.p, why, rejection, state, params, force));
                 return Flow::Stop;
             }
             let relaxed = Relaxed {
@@ -1074,7 +1075,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         self.s.invalidate();
         self.s.stats.cutbacks += 1;
         if let Err(why) = self.p.control.reject() {
-            self.path.error = Some(give_up(&self.p, why, &Rejection::Landing, state, self.s.params));
+            let force = self.s.reference_force();
+            self.path.error = Some(give_up(&self.p, why, &Rejection::Landing, state, self.s.params, force));
             return Some(Flow::Stop);
         }
         Some(Flow::Next)
@@ -1249,17 +1251,30 @@ impl<'a, 'b> Walk<'a, 'b> {
 }
 
 /// The error that ends a path whose increment could not be made to converge.
-fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams) -> Error {
+/// `force` is the reference force of the convergence test [N].
+fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams, force: f64) -> Error {
     let (iterations, residual) = last.newton();
     let how = match why {
         GiveUp::Cutbacks => format!("increment cut back {} times", params.max_cutbacks),
         GiveUp::RoundOff => format!("increment cut back to {:.3e}, below round-off", p.control.size.abs()),
     };
+    let tol = params.newton.tol_force * force;
+    // Newton brought the residual to a millionth of the forces but not to the tolerance: the
+    // tolerance is below what floating point resolves here (small loads against E t L), not a
+    // limit point.
+    let precision = matches!(last, Rejection::NotConverged { .. }) && residual <= 1e-6 * force && residual > tol;
     let hint = match params.control {
+        _ if precision => format!(
+            "; the residual stopped at {residual:.3e} N, {:.1e} of the forces ({force:.3e} N) but above the \
+             tolerance tol_force = {} of them: the loads are small against the structure's stiffness and \
+             round-off stops Newton there; pass a larger tol_force (e.g. 1e-6)",
+            residual / force,
+            params.newton.tol_force
+        ),
         Control::Load { .. } | Control::Displacement { .. } => {
-            "; if the structure reached a limit point (a snap), arc-length control follows it"
+            "; if the structure reached a limit point (a snap), arc-length control follows it".to_owned()
         }
-        Control::ArcLength { .. } => "",
+        Control::ArcLength { .. } => String::new(),
     };
     Error::NotConverged {
         step: None,
