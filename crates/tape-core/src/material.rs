@@ -95,7 +95,7 @@ impl ShellSection {
     /// [`Error::InvalidParameter`] naming the first bad field.
     pub fn validate(&self) -> Result<()> {
         check_positive("thickness (t) [m]", self.thickness)?;
-        check_positive("youngs_modulus (E) [Pa]", self.youngs_modulus)?;
+        check_positive("youngs_modulus (Young's modulus E) [Pa]", self.youngs_modulus)?;
         if !(self.poisson > -1.0 && self.poisson < 0.5) {
             return Err(Error::InvalidParameter(format!(
                 "poisson (Poisson's ratio nu) must lie in (-1, 0.5) (got {})",

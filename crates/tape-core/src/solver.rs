@@ -256,7 +256,7 @@ impl StaticParams {
                     ));
                 }
                 if !(1..=MAX_INCREMENTS).contains(max_steps) {
-                    return bad(format!("max_steps must lie in [1, {MAX_INCREMENTS}] (got {max_steps})"));
+                    return bad(format!("max_steps must be in [1, {MAX_INCREMENTS}] (got {max_steps})"));
                 }
                 if direction.abs() != 1.0 {
                     return bad(format!("direction must be +1 or -1 (got {direction})"));
