@@ -649,17 +649,8 @@ pub fn solve_dynamic(
         let attempt = integ.attempt(state, &mut scratch, step_h, &a, params);
         if std::env::var_os("TAPE_TRACE").is_some() {
             match &attempt {
-                Attempt::Converged { iterations, error, .. } => {
-                    eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} err={error:.3}", state.t)
-                }
-                Attempt::Failed {
-                    iterations,
-                    residual,
-                    why,
-                } => eprintln!(
-                    "TRACE t={:.6} h={step_h:.3e} it={iterations} FAIL res={residual:.3e} {why}",
-                    state.t
-                ),
+                Attempt::Converged { iterations, error, .. } => eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} err={error:.3}", state.t),
+                Attempt::Failed { iterations, residual, why } => eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} FAIL res={residual:.3e} {why}", state.t),
             }
         }
         let (iterations, accepted) = match attempt {
