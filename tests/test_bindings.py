@@ -292,7 +292,7 @@ def test_no_constraint_is_rejected():
         ({"node": 2}, r"\['node'\] do not apply to control 'load'"),
         ({"initial_increment": 0.1}, "do not apply to control 'load'"),
         ({"tol_forse": 1e-6}, "are not options of a step"),
-        ({"increments": 0}, "increments >= 1"),
+        ({"increments": 0}, r"increments in \[1, 1000000\]"),
         ({"increments": -3}, "option increments = -3"),
         ({"lambda_end": float("nan")}, r"\['lambda_end'\] must be finite"),
         ({"control": "arc-length", "direction": 2}, "direction must be \\+1 or -1"),

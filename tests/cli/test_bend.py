@@ -87,7 +87,7 @@ def test_bad_value_is_rejected_by_the_parser(option, value, message, capsys):
     ("option", "value", "message"),
     [
         ("--theta-max", "0", "--theta-max must be a non-zero angle"),
-        ("--poisson", "0.5", "Poisson's ratio nu must lie in (-1, 0.5)"),
+        ("--poisson", "0.5", "Poisson's ratio nu) must lie in (-1, 0.5)"),
     ],
 )
 def test_bad_value_exits_non_zero_with_a_message(option, value, message, capsys):

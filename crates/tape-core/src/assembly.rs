@@ -277,6 +277,9 @@ impl System {
     /// Invalid mesh, section or constraints.
     pub fn try_with(model: &Model, activity: &Activity) -> Result<Self> {
         model.validate()?;
+        // Before anything of the size of the mesh times the element's buffers is allocated: a
+        // failed allocation would abort the process.
+        crate::memory::MemoryEstimate::of_mesh(model.mesh.n_nodes(), model.mesh.quads.len()).check()?;
         let triads = model.mesh.reference_triads()?;
         let mut element_part = vec![0; model.mesh.quads.len()];
         for (k, part) in model.parts.iter().enumerate() {

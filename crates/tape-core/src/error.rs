@@ -29,6 +29,20 @@ pub enum Error {
         /// What was tried and why it failed.
         detail: String,
     },
+    /// The analysis would need more memory than the machine has (see [`crate::memory`]).
+    #[error("not enough memory: {0}")]
+    OutOfMemory(String),
+    /// An arc-length path came back onto a stretch it had already followed (it retraces itself,
+    /// or closes a loop) and would only repeat it until the step limit.
+    #[error("the path returned onto itself{} at t = {t:.6e} (load factor in static steps): {detail}", in_step(.step))]
+    PathReturned {
+        /// Name of the analysis step, when run by [`crate::analysis::run`].
+        step: Option<String>,
+        /// Time (load factor) of the last state recorded.
+        t: f64,
+        /// Where, and what to do about it.
+        detail: String,
+    },
     /// A step ran out of increments before reaching its end.
     #[error(
         "step limit reached{}: {steps} increments brought t to {t:.6e}, short of {target:.6e}; raise the step's max_steps (or its initial increment)",
@@ -56,7 +70,9 @@ impl Error {
     /// The same error, attributed to the analysis step `name`.
     #[must_use]
     pub fn in_step(mut self, name: &str) -> Self {
-        if let Self::NotConverged { step, .. } | Self::StepLimit { step, .. } = &mut self {
+        if let Self::NotConverged { step, .. } | Self::StepLimit { step, .. } | Self::PathReturned { step, .. } =
+            &mut self
+        {
             *step = Some(name.to_owned());
         }
         self
@@ -72,6 +88,7 @@ impl Error {
             Self::InvalidMesh(m) => Self::InvalidMesh(format!("{context}: {m}")),
             Self::InvalidModel(m) => Self::InvalidModel(format!("{context}: {m}")),
             Self::Factorisation(m) => Self::Factorisation(format!("{context}: {m}")),
+            Self::OutOfMemory(m) => Self::OutOfMemory(format!("{context}: {m}")),
             other => other,
         }
     }

@@ -28,6 +28,7 @@ pub mod dof;
 pub mod eigen;
 pub mod inertia;
 pub mod linalg;
+pub mod memory;
 pub mod model;
 pub mod options;
 pub mod output;

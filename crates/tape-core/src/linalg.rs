@@ -259,10 +259,13 @@ impl LinearSolver {
         } else {
             (Side::Upper, (upper, upper_src))
         };
-        let work = MemBuffer::new(StackReq::any_of(&[
+        let req = StackReq::any_of(&[
             ldlt.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
             ldlt.solve_in_place_scratch::<f64>(1, Par::Seq),
-        ]));
+        ]);
+        // The exact size of the factor is known before its values are allocated.
+        crate::memory::check_factor(n, nnz, ldlt.len_val(), req.unaligned_bytes_required())?;
+        let work = MemBuffer::new(req);
         Ok(Self {
             l_values: vec![0.0; ldlt.len_val()],
             symbolic,
@@ -285,6 +288,12 @@ impl LinearSolver {
             lu_fallbacks: 0,
             refinement_sweeps: 0,
         })
+    }
+
+    /// Number of entries of the factor (values of `L` in the LDL^T factorisation).
+    #[must_use]
+    pub fn factor_entries(&self) -> usize {
+        self.ldlt.len_val()
     }
 
     /// Numeric factorisation of the matrix with `values` (in pattern order).

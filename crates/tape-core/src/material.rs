@@ -94,11 +94,11 @@ impl ShellSection {
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first bad field.
     pub fn validate(&self) -> Result<()> {
-        check_positive("thickness t [m]", self.thickness)?;
-        check_positive("Young's modulus E [Pa]", self.youngs_modulus)?;
+        check_positive("thickness (t) [m]", self.thickness)?;
+        check_positive("youngs_modulus (Young's modulus E) [Pa]", self.youngs_modulus)?;
         if !(self.poisson > -1.0 && self.poisson < 0.5) {
             return Err(Error::InvalidParameter(format!(
-                "Poisson's ratio nu must lie in (-1, 0.5) (got {})",
+                "poisson (Poisson's ratio nu) must lie in (-1, 0.5) (got {})",
                 self.poisson
             )));
         }
@@ -110,12 +110,12 @@ impl ShellSection {
         }
         if !(self.eta.is_finite() && self.eta >= 0.0) {
             return Err(Error::InvalidParameter(format!(
-                "Kelvin-Voigt viscosity eta [s] must be finite and >= 0 (got {})",
+                "eta (Kelvin-Voigt viscosity) [s] must be finite and >= 0 (got {})",
                 self.eta
             )));
         }
-        check_positive("shear correction factor", self.shear_factor)?;
-        check_positive("drilling factor", self.drilling_factor)?;
+        check_positive("shear_factor (shear correction factor)", self.shear_factor)?;
+        check_positive("drilling_factor", self.drilling_factor)?;
         Ok(())
     }
 

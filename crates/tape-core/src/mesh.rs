@@ -25,6 +25,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
+/// Largest admissible coordinate magnitude [m]: the element computations form products of up to
+/// four lengths, which stay far inside the range of `f64` (1e308) below this.
+pub const MAX_COORDINATE: f64 = 1e50;
+/// Smallest admissible element size (largest edge) [m], for the same reason (1e-308).
+pub const MIN_LENGTH: f64 = 1e-50;
+/// Smallest admissible element size relative to its distance from the origin: coordinates carry
+/// a round-off of `1e-16` of their magnitude, so such an element's shape is known to `1e-8`.
+pub const MIN_RELATIVE_SIZE: f64 = 1e-8;
+
 /// A rigid placement `x -> R x + translation`, with `R = exp(rotation^)` (rotation vector [rad]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -127,7 +136,12 @@ impl Mesh {
         })
     }
 
-    /// Checks indices, finiteness, repeated nodes in an element and element areas.
+    /// Checks indices, finiteness, the range of the coordinates, repeated nodes in an element,
+    /// element sizes and shapes.
+    ///
+    /// Every test is dimensionless, so a mesh and the same mesh scaled by any factor within the
+    /// admissible range are accepted or refused alike: the shape tests work on the element's
+    /// coordinates relative to its first node divided by its largest edge.
     ///
     /// # Errors
     /// [`Error::InvalidMesh`] naming the first problem found.
@@ -136,6 +150,13 @@ impl Mesh {
             if !x.iter().all(|c| c.is_finite()) {
                 return Err(Error::InvalidMesh(format!(
                     "node {i} has a non-finite coordinate {x:?}"
+                )));
+            }
+            if x.amax() > MAX_COORDINATE {
+                return Err(Error::InvalidMesh(format!(
+                    "node {i} lies {:.3e} m from the origin: coordinates are in metres and must be within {MAX_COORDINATE:e} m \
+                     (products of lengths in the element computations would overflow)",
+                    x.amax()
                 )));
             }
         }
@@ -158,17 +179,38 @@ impl Mesh {
                     }
                 }
             }
-            // Corner normals must all be non-zero and point the same way: this rejects collapsed,
-            // bow-tie and inverted (non-convex) quadrilaterals. Both tests compare quantities of
-            // the same dimension (area, area squared), so they hold at any length scale.
             let x = quad.map(|n| self.nodes[n]);
-            let diag = (x[2] - x[0]).cross(&(x[3] - x[1]));
-            let scale = (x[2] - x[0]).norm() * (x[3] - x[1]).norm();
+            let size = (0..4)
+                .map(|a| (x[(a + 1) % 4] - x[a]).norm())
+                .fold(0.0, f64::max);
+            let far = x.iter().map(|p| p.amax()).fold(0.0, f64::max);
+            if size < MIN_LENGTH {
+                return Err(Error::InvalidMesh(format!(
+                    "element {e} is {size:.3e} m across: elements must be larger than {MIN_LENGTH:e} m (products of \
+                     lengths in the element computations would underflow; are the coordinates in metres?)"
+                )));
+            }
+            if size < MIN_RELATIVE_SIZE * far {
+                return Err(Error::InvalidMesh(format!(
+                    "element {e} is {size:.3e} m across at {far:.3e} m from the origin: an element smaller than \
+                     {MIN_RELATIVE_SIZE:e} of its distance from the origin has its shape lost in round-off (move the \
+                     model near the origin, or use larger elements)"
+                )));
+            }
+            // Corner normals must all be non-zero and point the same way: this rejects collapsed,
+            // bow-tie and inverted (non-convex) quadrilaterals. The coordinates are relative to the
+            // first node and divided by the largest edge, so the tests are dimensionless and free of
+            // overflow and underflow at any admissible length scale.
+            let y = x.map(|p| (p - x[0]) / size);
+            let diag = (y[2] - y[0]).cross(&(y[3] - y[1]));
+            let scale = (y[2] - y[0]).norm() * (y[3] - y[1]).norm();
             if diag.norm() <= 1e-10 * scale || scale == 0.0 {
-                return Err(Error::InvalidMesh(format!("element {e} is degenerate (zero area)")));
+                return Err(Error::InvalidMesh(format!(
+                    "element {e} is degenerate: its area is zero (its four nodes are on one line)"
+                )));
             }
             for a in 0..4 {
-                let c = (x[(a + 1) % 4] - x[a]).cross(&(x[(a + 3) % 4] - x[a]));
+                let c = (y[(a + 1) % 4] - y[a]).cross(&(y[(a + 3) % 4] - y[a]));
                 if c.dot(&diag) <= 1e-8 * scale * scale {
                     return Err(Error::InvalidMesh(format!(
                         "element {e} is degenerate or inverted at its corner node {} (non-convex or twisted quadrilateral)",
@@ -328,9 +370,36 @@ mod tests {
 
     #[test]
     fn validity_does_not_depend_on_the_length_scale() {
-        for h in [1e-6, 1e-4, 1e-2, 1.0, 1e3] {
+        for h in [1e-40, 1e-12, 1e-6, 1e-4, 1e-2, 1.0, 1e3, 1e12, 1e40] {
             assert!(square(h).validate().is_ok(), "h = {h}");
         }
+        // A bow-tie is refused at every scale, for its shape.
+        for h in [1e-40, 1e-3, 1.0, 1e40] {
+            let mut m = square(h);
+            m.quads[0] = [0, 1, 3, 4];
+            let err = m.validate().unwrap_err().to_string();
+            assert!(err.contains("element 0 is degenerate"), "h = {h}: {err}");
+        }
+    }
+
+    #[test]
+    fn out_of_range_scales_are_refused_for_their_size() {
+        let mut huge = square(1.0);
+        huge.nodes.iter_mut().for_each(|x| *x *= 1e150);
+        let err = huge.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("node 1 lies 1.000e150 m from the origin") && err.contains("metres"),
+            "{err}"
+        );
+        let mut tiny = square(1.0);
+        tiny.nodes.iter_mut().for_each(|x| *x *= 1e-150);
+        let err = tiny.validate().unwrap_err().to_string();
+        assert!(err.contains("element 0 is 1.000e-150 m across"), "{err}");
+        // A 1 um element 1000 km from the origin: its shape is lost in round-off.
+        let mut far = square(1e-6);
+        far.nodes.iter_mut().for_each(|x| x.x += 1e6);
+        let err = far.validate().unwrap_err().to_string();
+        assert!(err.contains("lost in round-off"), "{err}");
     }
 
     #[test]

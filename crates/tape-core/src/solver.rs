@@ -8,6 +8,7 @@ mod events;
 pub mod modal;
 pub mod newton;
 mod relax;
+mod retrace;
 pub mod statics;
 
 use serde::{Deserialize, Serialize};
@@ -154,6 +155,10 @@ impl Default for StaticParams {
     }
 }
 
+/// Largest number of increments (`increments`, `max_steps`) a static step accepts: a million
+/// increments of even a small model take hours, so a larger count is a mistake, not a request.
+pub const MAX_INCREMENTS: usize = 1_000_000;
+
 /// Options of each control in flat option maps.
 const LOAD_OPTIONS: [&str; 2] = ["lambda_end", "increments"];
 const DISPLACEMENT_OPTIONS: [&str; 4] = ["node", "dof", "delta", "increments"];
@@ -219,16 +224,16 @@ impl StaticParams {
         }
         match &self.control {
             Control::Load { lambda_end, increments } => {
-                if !lambda_end.is_finite() || *increments == 0 {
+                if !lambda_end.is_finite() || !(1..=MAX_INCREMENTS).contains(increments) {
                     return bad(format!(
-                        "load control needs a finite lambda_end and increments >= 1 (got {lambda_end}, {increments})"
+                        "load control needs a finite lambda_end and increments in [1, {MAX_INCREMENTS}] (got {lambda_end}, {increments})"
                     ));
                 }
             }
             Control::Displacement { delta, increments, .. } => {
-                if !delta.is_finite() || *delta == 0.0 || *increments == 0 {
+                if !delta.is_finite() || *delta == 0.0 || !(1..=MAX_INCREMENTS).contains(increments) {
                     return bad(format!(
-                        "displacement control needs a finite non-zero delta and increments >= 1 (got {delta}, {increments})"
+                        "displacement control needs a finite non-zero delta and increments in [1, {MAX_INCREMENTS}] (got {delta}, {increments})"
                     ));
                 }
             }
@@ -252,8 +257,8 @@ impl StaticParams {
                         "max_increment_factor must be finite and >= 1 (got {max_increment_factor})"
                     ));
                 }
-                if *max_steps == 0 {
-                    return bad("max_steps must be >= 1".into());
+                if !(1..=MAX_INCREMENTS).contains(max_steps) {
+                    return bad(format!("max_steps must be in [1, {MAX_INCREMENTS}] (got {max_steps})"));
                 }
                 if direction.abs() != 1.0 {
                     return bad(format!("direction must be +1 or -1 (got {direction})"));

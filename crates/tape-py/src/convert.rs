@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use nalgebra::Vector3;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::{Map, Number, Value};
@@ -111,6 +111,137 @@ pub fn float_rows<const N: usize>(obj: &Bound<'_, PyAny>, what: &str) -> PyResul
         .collect()
 }
 
+/// The Python type name of `obj`, for messages.
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+}
+
+/// `repr(obj)`, shortened, for messages.
+fn shown(obj: &Bound<'_, PyAny>) -> String {
+    let r = obj
+        .repr()
+        .map_or_else(|_| "?".to_owned(), |r| r.to_string());
+    if r.chars().count() > 60 {
+        format!("{}...", r.chars().take(57).collect::<String>())
+    } else {
+        r
+    }
+}
+
+/// A real number (an int, a float or a numpy scalar; not a bool or a string). Its range is
+/// checked by tape-core, which names the model item.
+///
+/// # Errors
+/// `TypeError` naming the argument `what`.
+pub fn float(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
+    if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be a number (got {} of type {})",
+            shown(obj),
+            type_name(obj)
+        )));
+    }
+    obj.extract::<f64>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be a number (got {} of type {})",
+            shown(obj),
+            type_name(obj)
+        ))
+    })
+}
+
+/// An integer (an int or a numpy integer; a float only if integral, as for indices).
+///
+/// # Errors
+/// `TypeError` for a value that is not a number, `ValueError` for a non-integral one or one
+/// beyond 64 bits, both naming `what`.
+pub fn integer(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<i64> {
+    if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be an integer (got {} of type {})",
+            shown(obj),
+            type_name(obj)
+        )));
+    }
+    if obj.hasattr("__index__").unwrap_or(false) {
+        return obj
+            .extract::<i64>()
+            .map_err(|_| PyValueError::new_err(format!("{what} = {} is out of range (64 bits)", shown(obj))));
+    }
+    let v = float(obj, what).map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be an integer (got {} of type {})",
+            shown(obj),
+            type_name(obj)
+        ))
+    })?;
+    #[allow(clippy::cast_possible_truncation)]
+    if v.is_finite() && v.fract() == 0.0 && v.abs() < 9.2e18 {
+        Ok(v as i64)
+    } else {
+        Err(PyValueError::new_err(format!("{what} must be an integer (got {v})")))
+    }
+}
+
+/// A string.
+///
+/// # Errors
+/// `TypeError` naming `what`.
+pub fn text(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
+    obj.cast::<PyString>()
+        .map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{what} must be a string (got {} of type {})",
+                shown(obj),
+                type_name(obj)
+            ))
+        })?
+        .to_str()
+        .map(str::to_owned)
+}
+
+/// An optional string (None: absent).
+///
+/// # Errors
+/// `TypeError` naming `what`.
+pub fn opt_text(obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Option<String>> {
+    obj.filter(|o| !o.is_none())
+        .map(|o| text(o, what))
+        .transpose()
+}
+
+/// A boolean (`True`, `False` or a numpy bool).
+///
+/// # Errors
+/// `TypeError` naming `what`.
+pub fn flag(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<bool> {
+    obj.extract::<bool>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be True or False (got {} of type {})",
+            shown(obj),
+            type_name(obj)
+        ))
+    })
+}
+
+/// The `active` argument of constraints, loads and gravity (for `from_py_with`).
+///
+/// # Errors
+/// See [`flag`].
+pub fn active_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    flag(obj, "active")
+}
+
+/// The `tolerance` argument of `nodes_at` [m] (for `from_py_with`).
+///
+/// # Errors
+/// See [`float`].
+pub fn tolerance_arg(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    float(obj, "tolerance")
+}
+
 /// Checks that an index is non-negative.
 pub fn index(value: i64, what: &str) -> PyResult<usize> {
     usize::try_from(value).map_err(|_| PyValueError::new_err(format!("{what} must be >= 0 (got {value})")))
@@ -168,6 +299,21 @@ pub fn node_selection(mesh: &Mesh, obj: &Bound<'_, PyAny>, what: &str) -> PyResu
 /// One DOF from its name.
 pub fn dof(name: &str) -> PyResult<Dof> {
     crate::error::to_py(Dof::try_from_name(name))
+}
+
+/// One DOF from the argument `what`, which must be a DOF name.
+///
+/// # Errors
+/// `TypeError` if it is not a string, `ValueError` for an unknown name.
+pub fn dof_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Dof> {
+    dof(&text(obj, what).map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be a DOF name among {:?} (got {} of type {})",
+            Dof::NAMES,
+            shown(obj),
+            type_name(obj)
+        ))
+    })?)
 }
 
 /// DOFs given as `"all"`, one name, or a sequence of names.

@@ -3,14 +3,15 @@
 //! | tape-core error                                    | Python exception              |
 //! |----------------------------------------------------|-------------------------------|
 //! | `InvalidParameter`, `InvalidMesh`, `InvalidModel`  | `ValueError`                  |
-//! | `NotConverged`, `StepLimit`                        | `ConvergenceError`            |
+//! | `NotConverged`, `StepLimit`, `PathReturned`        | `ConvergenceError`            |
+//! | `OutOfMemory`                                      | `MemoryError`                 |
 //! | `Factorisation`                                    | `TapeError`                   |
 //! | a panic inside tape-core (a bug)                   | `TapeError`                   |
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::{PyException, PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use tape_core::Error;
 
@@ -42,7 +43,10 @@ impl From<PyTapeError> for PyErr {
             Error::InvalidParameter(_) | Error::InvalidMesh(_) | Error::InvalidModel(_) => {
                 PyValueError::new_err(e.0.to_string())
             }
-            Error::NotConverged { .. } | Error::StepLimit { .. } => ConvergenceError::new_err(e.0.to_string()),
+            Error::NotConverged { .. } | Error::StepLimit { .. } | Error::PathReturned { .. } => {
+                ConvergenceError::new_err(e.0.to_string())
+            }
+            Error::OutOfMemory(_) => PyMemoryError::new_err(e.0.to_string()),
             Error::Factorisation(_) => TapeError::new_err(e.0.to_string()),
         }
     }

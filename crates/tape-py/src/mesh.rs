@@ -8,7 +8,8 @@ use crate::convert;
 use crate::error::{guard, to_py};
 
 /// A count (elements ...) that must be `>= min`.
-fn count(name: &str, value: i64, min: usize) -> PyResult<usize> {
+fn count(name: &str, value: &Bound<'_, PyAny>, min: usize) -> PyResult<usize> {
+    let value = convert::integer(value, name)?;
     usize::try_from(value)
         .ok()
         .filter(|v| *v >= min)
@@ -28,14 +29,16 @@ fn mesh_tuple<'py>(
 /// `twist` [rad] rotates the sections about x by `twist sin(pi x / L)` (an imperfection).
 #[pyfunction]
 #[pyo3(signature = (length, radius, alpha, mesh_size, *, twist = 0.0))]
-pub fn tape_spring_mesh(
-    py: Python<'_>,
-    length: f64,
-    radius: f64,
-    alpha: f64,
-    mesh_size: f64,
-    twist: f64,
-) -> PyResult<Bound<'_, PyAny>> {
+pub fn tape_spring_mesh<'py>(
+    py: Python<'py>,
+    length: &Bound<'py, PyAny>,
+    radius: &Bound<'py, PyAny>,
+    alpha: &Bound<'py, PyAny>,
+    mesh_size: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = twist_arg)] twist: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (length, radius) = (convert::float(length, "length")?, convert::float(radius, "radius")?);
+    let (alpha, mesh_size) = (convert::float(alpha, "alpha")?, convert::float(mesh_size, "mesh_size")?);
     if !twist.is_finite() {
         return Err(PyValueError::new_err(format!("twist must be finite (got {twist})")));
     }
@@ -43,16 +46,36 @@ pub fn tape_spring_mesh(
         let mut mesh = generate::tape_spring(&TapeGeometry { length, radius, alpha }, mesh_size)?;
         if twist != 0.0 {
             generate::apply_twist_imperfection(&mut mesh, length, twist);
+            // A twist that turns neighbouring sections far apart folds the elements: say so,
+            // rather than blame the mesh.
+            mesh.validate().map_err(|e| {
+                tape_core::Error::InvalidParameter(format!(
+                    "the twist imperfection twist = {twist} rad deforms the tape's mesh too much ({e}); a twist \
+                     imperfection is a small angle (a fraction of a degree to a few degrees)"
+                ))
+            })?;
         }
         Ok(mesh)
     })
+}
+
+/// The `twist` argument [rad] (for `from_py_with`).
+fn twist_arg(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    convert::float(obj, "twist")
 }
 
 /// Flat plate `[0, lx] x [0, ly]` in the x-y plane: `(nodes, quads, node_sets)` with sets x0, x1,
 /// y0, y1, all.
 #[pyfunction]
 #[pyo3(signature = (lx, ly, nx, ny))]
-pub fn flat_plate_mesh(py: Python<'_>, lx: f64, ly: f64, nx: i64, ny: i64) -> PyResult<Bound<'_, PyAny>> {
+pub fn flat_plate_mesh<'py>(
+    py: Python<'py>,
+    lx: &Bound<'py, PyAny>,
+    ly: &Bound<'py, PyAny>,
+    nx: &Bound<'py, PyAny>,
+    ny: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (lx, ly) = (convert::float(lx, "lx")?, convert::float(ly, "ly")?);
     let (nx, ny) = (count("nx", nx, 1)?, count("ny", ny, 1)?);
     mesh_tuple(py, || generate::flat_plate(lx, ly, nx, ny))
 }
@@ -60,15 +83,17 @@ pub fn flat_plate_mesh(py: Python<'_>, lx: f64, ly: f64, nx: i64, ny: i64) -> Py
 /// Cylindrical panel about the x axis: `(nodes, quads, node_sets)` with sets x0, x1, phi0, phi1, all.
 #[pyfunction]
 #[pyo3(signature = (radius, length, phi0, phi1, n_axial, n_arc))]
-pub fn cylindrical_panel_mesh(
-    py: Python<'_>,
-    radius: f64,
-    length: f64,
-    phi0: f64,
-    phi1: f64,
-    n_axial: i64,
-    n_arc: i64,
-) -> PyResult<Bound<'_, PyAny>> {
+pub fn cylindrical_panel_mesh<'py>(
+    py: Python<'py>,
+    radius: &Bound<'py, PyAny>,
+    length: &Bound<'py, PyAny>,
+    phi0: &Bound<'py, PyAny>,
+    phi1: &Bound<'py, PyAny>,
+    n_axial: &Bound<'py, PyAny>,
+    n_arc: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (radius, length) = (convert::float(radius, "radius")?, convert::float(length, "length")?);
+    let (phi0, phi1) = (convert::float(phi0, "phi0")?, convert::float(phi1, "phi1")?);
     let (n_axial, n_arc) = (count("n_axial", n_axial, 1)?, count("n_arc", n_arc, 1)?);
     mesh_tuple(py, || {
         generate::cylindrical_panel(radius, length, phi0, phi1, n_axial, n_arc)
@@ -84,7 +109,8 @@ pub fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
 /// Height of the centroid of a tape spring's cross-section arc above the arc's middle point [m]:
 /// `R (1 - sin(alpha/2) / (alpha/2))`.
 #[pyfunction]
-pub fn tape_section_centroid_z(radius: f64, alpha: f64) -> PyResult<f64> {
+pub fn tape_section_centroid_z(radius: &Bound<'_, PyAny>, alpha: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let (radius, alpha) = (convert::float(radius, "radius")?, convert::float(alpha, "alpha")?);
     let g = TapeGeometry {
         length: 1.0,
         radius,

@@ -5,7 +5,7 @@
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyString};
 use serde_json::Value;
 use tape_core::material::ShellSection;
 use tape_core::mesh::{Mesh, Placement};
@@ -33,6 +33,12 @@ fn section(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ShellSection> {
             )));
         }
     }
+    // Every section parameter is a number: name the one that is not (serde's message would not).
+    for (key, v) in kwargs.iter().flat_map(|k| k.iter()) {
+        if !v.is_none() {
+            convert::float(&v, &format!("section parameter {key}"))?;
+        }
+    }
     let value = match kwargs {
         Some(k) => convert::to_json(k.as_any(), "section")?,
         None => Value::Object(serde_json::Map::new()),
@@ -56,11 +62,7 @@ fn placement(rotation: Option<&Bound<'_, PyAny>>, translation: Option<&Bound<'_,
     })
 }
 
-fn mesh_of(
-    nodes: &Bound<'_, PyAny>,
-    quads: &Bound<'_, PyAny>,
-    node_sets: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Mesh> {
+fn mesh_of(nodes: &Bound<'_, PyAny>, quads: &Bound<'_, PyAny>, node_sets: Option<&Bound<'_, PyAny>>) -> PyResult<Mesh> {
     let nodes = convert::float_rows::<3>(nodes, "nodes")?;
     let quads = convert::index_rows::<4>(quads, "quads")?;
     if quads.is_empty() {
@@ -69,11 +71,21 @@ fn mesh_of(
         ));
     }
     let mut mesh = to_py(Mesh::try_new(nodes.into_iter().map(Into::into).collect(), quads))?;
-    if let Some(sets) = node_sets {
+    if let Some(sets) = node_sets.filter(|s| !s.is_none()) {
+        let sets = sets.cast::<PyDict>().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "node_sets must be a dict mapping names (str) to node indices (got {})",
+                sets.get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+            ))
+        })?;
         for (name, set) in sets.iter() {
-            let name: String = name
-                .extract()
-                .map_err(|_| PyValueError::new_err("node_sets must map names (str) to node indices"))?;
+            let name: String = name.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "node_sets must map names (str) to node indices (got the key {name})"
+                ))
+            })?;
             let set = convert::index_vec(&set, &format!("node_sets['{name}']"))?;
             to_py(mesh.add_node_set(&name, set))?;
         }
@@ -90,7 +102,7 @@ impl PyModel {
     fn new(
         nodes: Option<&Bound<'_, PyAny>>,
         quads: Option<&Bound<'_, PyAny>>,
-        node_sets: Option<&Bound<'_, PyDict>>,
+        node_sets: Option<&Bound<'_, PyAny>>,
         section_kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let mut model = Self {
@@ -105,7 +117,15 @@ impl PyModel {
                 }
             }
             (Some(n), Some(q)) => {
-                model.add_part("", n, q, None, None, node_sets, section_kwargs)?;
+                model.add_part(
+                    &PyString::new(n.py(), "").into_any(),
+                    n,
+                    q,
+                    None,
+                    None,
+                    node_sets,
+                    section_kwargs,
+                )?;
             }
             _ => return Err(PyValueError::new_err("give both nodes and quads, or neither")),
         }
@@ -118,14 +138,16 @@ impl PyModel {
     #[allow(clippy::too_many_arguments)]
     fn add_part(
         &mut self,
-        name: &str,
+        name: &Bound<'_, PyAny>,
         nodes: &Bound<'_, PyAny>,
         quads: &Bound<'_, PyAny>,
         rotation: Option<&Bound<'_, PyAny>>,
         translation: Option<&Bound<'_, PyAny>>,
-        node_sets: Option<&Bound<'_, PyDict>>,
+        node_sets: Option<&Bound<'_, PyAny>>,
         section_kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<usize> {
+        let name = convert::text(name, "name")?;
+        let name = name.as_str();
         let mesh = mesh_of(nodes, quads, node_sets)?;
         let section = section(section_kwargs)?;
         let placement = placement(rotation, translation)?;
@@ -186,14 +208,16 @@ impl PyModel {
     }
 
     /// Adds (or replaces) a named node set.
-    fn add_node_set(&mut self, name: &str, nodes: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn add_node_set(&mut self, name: &Bound<'_, PyAny>, nodes: &Bound<'_, PyAny>) -> PyResult<()> {
+        let name = convert::text(name, "name")?;
+        let name = name.as_str();
         let nodes = convert::index_vec(nodes, "nodes")?;
         to_py(self.inner.mesh.add_node_set(name, nodes))
     }
 
     /// The nodes of a named set.
-    fn node_set<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let set = to_py(self.inner.mesh.node_set(name))?;
+    fn node_set<'py>(&self, py: Python<'py>, name: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let set = to_py(self.inner.mesh.node_set(&convert::text(name, "name")?))?;
         Ok(convert::indices_to_numpy(py, set))
     }
 
@@ -230,7 +254,17 @@ impl PyModel {
     /// The node nearest to each of `points` (shape (n, 3)); `ValueError` if one is farther than
     /// `tolerance` [m].
     #[pyo3(signature = (points, tolerance = 1e-6))]
-    fn nodes_at<'py>(&self, py: Python<'py>, points: &Bound<'_, PyAny>, tolerance: f64) -> PyResult<Bound<'py, PyAny>> {
+    fn nodes_at<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'_, PyAny>,
+        #[pyo3(from_py_with = convert::tolerance_arg)] tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "tolerance must be finite and >= 0 (got {tolerance})"
+            )));
+        }
         let pts: Vec<nalgebra::Vector3<f64>> = convert::float_rows::<3>(points, "points")?
             .into_iter()
             .map(Into::into)
@@ -248,9 +282,10 @@ impl PyModel {
         &mut self,
         nodes: &Bound<'_, PyAny>,
         dofs: Option<&Bound<'_, PyAny>>,
-        id: Option<String>,
-        active: bool,
+        id: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = convert::active_arg)] active: bool,
     ) -> PyResult<()> {
+        let id = convert::opt_text(id, "id")?;
         let nodes = convert::node_selection(&self.inner.mesh, nodes, "nodes")?;
         if nodes.is_empty() {
             return Err(PyValueError::new_err("nodes is empty: name at least one node to fix"));
@@ -280,18 +315,18 @@ impl PyModel {
     fn prescribe(
         &mut self,
         node: &Bound<'_, PyAny>,
-        dof: &str,
-        value: f64,
+        dof: &Bound<'_, PyAny>,
+        value: &Bound<'_, PyAny>,
         function: Option<&Bound<'_, PyAny>>,
-        id: Option<String>,
-        active: bool,
+        id: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = convert::active_arg)] active: bool,
     ) -> PyResult<()> {
         let node = convert::node(node, "node")?;
         let c = Constraint {
-            id,
+            id: convert::opt_text(id, "id")?,
             node,
-            dof: convert::dof(dof)?,
-            value,
+            dof: convert::dof_arg(dof, "dof")?,
+            value: convert::float(value, "value")?,
             function: convert::time_function(function, TimeFunction::Linear, "function")?,
             active,
         };
@@ -311,18 +346,18 @@ impl PyModel {
     fn add_load(
         &mut self,
         node: &Bound<'_, PyAny>,
-        dof: &str,
-        value: f64,
+        dof: &Bound<'_, PyAny>,
+        value: &Bound<'_, PyAny>,
         function: Option<&Bound<'_, PyAny>>,
-        id: Option<String>,
-        active: bool,
+        id: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = convert::active_arg)] active: bool,
     ) -> PyResult<()> {
         let node = convert::node(node, "node")?;
         to_py(self.inner.add_load_with(Load {
-            id,
+            id: convert::opt_text(id, "id")?,
             node,
-            dof: convert::dof(dof)?,
-            value,
+            dof: convert::dof_arg(dof, "dof")?,
+            value: convert::float(value, "value")?,
             function: convert::time_function(function, TimeFunction::Linear, "function")?,
             active,
         }))
@@ -335,11 +370,12 @@ impl PyModel {
     fn add_rigid_body(
         &mut self,
         node: &Bound<'_, PyAny>,
-        mass: f64,
+        mass: &Bound<'_, PyAny>,
         centre_of_mass: Option<&Bound<'_, PyAny>>,
         inertia: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         let node = convert::node(node, "node")?;
+        let mass = convert::float(mass, "mass")?;
         let centre_of_mass = centre_of_mass.map_or(Ok(nalgebra::Vector3::zeros()), |c| {
             convert::vector3(c, "centre_of_mass")
         })?;
@@ -365,7 +401,7 @@ impl PyModel {
     }
 
     /// Puts a point mass [kg] on `node` (a rigid body without inertia or offset).
-    fn add_point_mass(&mut self, node: &Bound<'_, PyAny>, mass: f64) -> PyResult<()> {
+    fn add_point_mass(&mut self, node: &Bound<'_, PyAny>, mass: &Bound<'_, PyAny>) -> PyResult<()> {
         self.add_rigid_body(node, mass, None, None)
     }
 
@@ -376,12 +412,12 @@ impl PyModel {
         &mut self,
         acceleration: &Bound<'_, PyAny>,
         function: Option<&Bound<'_, PyAny>>,
-        id: Option<String>,
-        active: bool,
+        id: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = convert::active_arg)] active: bool,
     ) -> PyResult<()> {
         let ramp = TimeFunction::Ramp { start: 0.0, end: 1.0 };
         to_py(self.inner.set_gravity(Gravity {
-            id,
+            id: convert::opt_text(id, "id")?,
             acceleration: convert::vector3(acceleration, "acceleration")?,
             function: convert::time_function(function, ramp, "function")?,
             active,
@@ -410,14 +446,16 @@ impl PyModel {
 
     /// Adds a marker `name` following `node`, at `offset` [m] from it (rotating with it).
     #[pyo3(signature = (name, node, *, offset = None))]
-    fn add_marker(&mut self, name: &str, node: &Bound<'_, PyAny>, offset: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    fn add_marker(
+        &mut self,
+        name: &Bound<'_, PyAny>,
+        node: &Bound<'_, PyAny>,
+        offset: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let name = convert::text(name, "name")?;
         let node = convert::node(node, "node")?;
         let offset = offset.map_or(Ok(nalgebra::Vector3::zeros()), |o| convert::vector3(o, "offset"))?;
-        to_py(self.inner.add_marker(Marker {
-            name: name.to_owned(),
-            node,
-            offset,
-        }))
+        to_py(self.inner.add_marker(Marker { name, node, offset }))
     }
 
     /// Constrained DOFs as (node, dof) pairs, in model order (the default reaction columns).
@@ -475,8 +513,10 @@ impl PyModel {
 
     /// A model from the JSON of `to_json` (checked as a whole).
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        let inner: Model = serde_json::from_str(text).map_err(|e| PyValueError::new_err(format!("model JSON: {e}")))?;
+    fn from_json(text: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let text = convert::text(text, "text")?;
+        let inner: Model =
+            serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("model JSON: {e}")))?;
         to_py(inner.validate())?;
         Ok(Self { inner })
     }
@@ -485,7 +525,7 @@ impl PyModel {
         self.to_json()
     }
 
-    fn __setstate__(&mut self, state: &str) -> PyResult<()> {
+    fn __setstate__(&mut self, state: &Bound<'_, PyAny>) -> PyResult<()> {
         *self = Self::from_json(state)?;
         Ok(())
     }

@@ -56,6 +56,15 @@ __all__ = [
 #: Fewest elements across the width (and along the length) of a tape that a bending run accepts.
 MIN_ELEMENTS = 4
 
+#: Largest angle of the section's arc that one element may subtend [deg]: the flat element then
+#: lies within ``R (1 - cos 10 deg)``, 1.5 % of R, of the arc (the paper's tape at the coarsest
+#: size that gives 4 elements across: 17.5 degrees).
+MAX_ELEMENT_ANGLE_DEG = 20.0
+
+#: Largest twist imperfection amplitude [deg]: an imperfection is a small twist that selects a
+#: branch at a bifurcation (the equal-sense runs use 0.1), not a pre-twisted tape.
+MAX_IMPERFECTION_DEG = 10.0
+
 
 @dataclass(frozen=True)
 class BendingSetup:
@@ -143,6 +152,10 @@ class BendingSetup:
                 raise ValueError(f"{name} must be a number (got {value!r})")
             if not math.isfinite(value):
                 raise ValueError(f"{name} must be finite (got {value})")
+        for name in ("unload", "jump", "switch_branches"):
+            value = getattr(self, name)
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"{name} must be True or False (got {value!r})")
         if not 0.0 < abs(self.theta_max_deg) < 360.0:
             raise ValueError(
                 f"theta_max_deg must be non-zero and within (-360, 360) degrees "
@@ -153,13 +166,24 @@ class BendingSetup:
         # A coarser mesh does not represent the curved section, and the fold that forms in it, at
         # all (38 mm elements on this tape gave M_max = 1.45 N m instead of 0.30).
         width = self.radius * math.radians(self.alpha_deg)
-        coarsest = min(width, self.length) / MIN_ELEMENTS
+        coarsest = min(
+            min(width, self.length) / MIN_ELEMENTS,
+            self.radius * math.radians(MAX_ELEMENT_ANGLE_DEG),
+        )
         if self.mesh_size > coarsest:
             raise ValueError(
                 f"mesh_size = {self.mesh_size} m is too coarse for a tape "
                 f"{width * 1e3:.2f} mm wide and {self.length * 1e3:.1f} mm long: at least "
-                f"{MIN_ELEMENTS} elements are needed across and along it "
+                f"{MIN_ELEMENTS} elements are needed across and along it, each subtending at most "
+                f"{MAX_ELEMENT_ANGLE_DEG:g} degrees of the section's arc "
                 f"(mesh_size <= {coarsest:.3e} m)"
+            )
+        if abs(self.imperfection_deg) > MAX_IMPERFECTION_DEG:
+            raise ValueError(
+                f"imperfection_deg = {self.imperfection_deg} is not a small imperfection: the "
+                f"amplitude of the twist that selects a branch must lie within "
+                f"[-{MAX_IMPERFECTION_DEG:g}, {MAX_IMPERFECTION_DEG:g}] degrees (0.1 in the "
+                f"equal-sense runs)"
             )
         if self.locate_tolerance_deg <= 0.0:
             raise ValueError(f"locate_tolerance_deg must be > 0 (got {self.locate_tolerance_deg})")

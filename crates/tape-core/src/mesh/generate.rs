@@ -13,6 +13,9 @@ fn grid(nx: usize, ny: usize, place: impl Fn(f64, f64) -> Vector3<f64>) -> Resul
             "element counts must be >= 1 (got {nx} x {ny})"
         )));
     }
+    // Sizes are checked before the allocation, which would abort the process if it failed.
+    let n_nodes = (nx.checked_add(1)).and_then(|a| ny.checked_add(1).and_then(|b| a.checked_mul(b)));
+    crate::memory::check_mesh(n_nodes, nx.checked_mul(ny))?;
     let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1));
     for j in 0..=ny {
         for i in 0..=nx {
@@ -129,10 +132,9 @@ pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
     let arc = geometry.radius * geometry.alpha;
     let mut na = (arc / h).round().max(2.0) as usize;
     na += na % 2;
-    if nx * na > 20_000_000 {
+    if nx.checked_mul(na).is_none_or(|e| e > 20_000_000) {
         return Err(Error::InvalidParameter(format!(
-            "element size h = {h} m gives {} elements: too many",
-            nx * na
+            "mesh size h = {h} m gives {nx} x {na} elements, more than the 20 000 000 this generator makes: use a larger h"
         )));
     }
     let g = *geometry;

@@ -37,6 +37,7 @@ use std::time::Instant;
 use super::control::{GiveUp, StepController};
 use super::events::{after_step, Point};
 use super::newton::{Convergence, Stall};
+use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
@@ -550,6 +551,8 @@ struct PathState {
     last_negative: Option<usize>,
     /// After a jump or a branch switch: the load-factor increment of the restarting step.
     restart: Option<f64>,
+    /// Arc-length only: the states followed so far, to stop a path that returns onto itself.
+    memory: Option<PathMemory>,
 }
 
 /// What the driver does after a stage of an increment.
@@ -771,6 +774,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 history: Vec::new(),
                 last_negative: None,
                 restart: None,
+                memory: arc_control.then(PathMemory::new),
             },
             path: StaticPath::default(),
             progress,
@@ -780,6 +784,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             monitor,
             scale,
         };
+        if let Some(m) = &mut w.p.memory {
+            m.restart(state, &w.s.system.reference);
+        }
         if w.locate {
             // The start of the path is the first point of the location history (the assembly is
             // the one the first increment needs anyway).
@@ -848,7 +855,9 @@ impl<'a, 'b> Walk<'a, 'b> {
                     let ds = initial_increment * (s.dot_w(&dq_b, &dq_b) + s.c_lambda).sqrt();
                     if !(ds.is_finite() && ds > 0.0) {
                         return Err(Error::InvalidModel(
-                            "arc-length control needs a load or a prescribed motion that changes with the load factor and acts on the free DOFs"
+                            "arc-length control: the loads and prescribed motions act on no free DOF (they are all on \
+                             constrained DOFs, or do not change with the load factor), so the path has no direction; \
+                             load a free DOF, or prescribe a motion that changes with the load factor"
                                 .into(),
                         ));
                     }
@@ -907,7 +916,8 @@ impl<'a, 'b> Walk<'a, 'b> {
                 _ => false,
             };
             if !relaxed {
-                self.path.error = Some(give_up(&self.p, why, rejection, state, params));
+                let force = self.s.reference_force();
+                self.path.error = Some(give_up(&self.p, why, rejection, state, params, force));
                 return Flow::Stop;
             }
             let relaxed = Relaxed {
@@ -1047,7 +1057,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             return None;
         };
         let start = saved.t;
-        if (start - end) * (state.t - end) >= 0.0 || self.p.last_dlambda.is_none() {
+        // The first step lands too: one that overshoots lambda_end (a large initial increment)
+        // would otherwise carry the path away from it.
+        if (start - end) * (state.t - end) >= 0.0 {
             return None;
         }
         let mut trial = saved.clone();
@@ -1063,7 +1075,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         self.s.invalidate();
         self.s.stats.cutbacks += 1;
         if let Err(why) = self.p.control.reject() {
-            self.path.error = Some(give_up(&self.p, why, &Rejection::Landing, state, self.s.params));
+            let force = self.s.reference_force();
+            self.path.error = Some(give_up(&self.p, why, &Rejection::Landing, state, self.s.params, force));
             return Some(Flow::Stop);
         }
         Some(Flow::Next)
@@ -1084,6 +1097,37 @@ impl<'a, 'b> Walk<'a, 'b> {
             if reached && self.p.last_dlambda.is_some() {
                 return Flow::Stop;
             }
+        }
+        if let Some(back) = self
+            .p
+            .memory
+            .as_mut()
+            .and_then(|m| m.visit(state, &self.s.system.reference))
+        {
+            let end = self.lambda_end.unwrap_or(f64::NAN);
+            let detail = if back.reversed {
+                format!(
+                    "it turned back at t = {:.6e} and is retracing the path it followed, through the states of \
+                     increment {} (t = {:.6e}); it would only repeat them until the step limit. lambda_end = {end} \
+                     was not reached: it may lie beyond the load factor the structure carries on this path, or a \
+                     step jumped across a sharp turn (a smaller initial_increment or max_increment_factor keeps \
+                     the steps on the path)",
+                    back.t_turn, back.increment_old, back.t_old
+                )
+            } else {
+                format!(
+                    "it closed a loop, passing again in the same sense through the states of increment {} \
+                     (t = {:.6e}); it would only go round until the step limit. lambda_end = {end} is not on this \
+                     loop",
+                    back.increment_old, back.t_old
+                )
+            };
+            self.path.error = Some(Error::PathReturned {
+                step: None,
+                t: state.t,
+                detail,
+            });
+            return Flow::Stop;
         }
         self.p.last_dlambda = Some(out.dlambda);
         self.s.previous = Some((out.dq, out.dlambda));
@@ -1164,6 +1208,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         let keep_going = (self.progress)(&st, &self.s.stats);
         self.path.steps.push(st);
         self.s.previous = None;
+        if let Some(m) = &mut self.p.memory {
+            m.restart(state, &self.s.system.reference);
+        }
         self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
         self.p.control.cutbacks = 0;
         self.p.history.clear();
@@ -1204,17 +1251,30 @@ impl<'a, 'b> Walk<'a, 'b> {
 }
 
 /// The error that ends a path whose increment could not be made to converge.
-fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams) -> Error {
+/// `force` is the reference force of the convergence test [N].
+fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams, force: f64) -> Error {
     let (iterations, residual) = last.newton();
     let how = match why {
         GiveUp::Cutbacks => format!("increment cut back {} times", params.max_cutbacks),
         GiveUp::RoundOff => format!("increment cut back to {:.3e}, below round-off", p.control.size.abs()),
     };
+    let tol = params.newton.tol_force * force;
+    // Newton brought the residual to a millionth of the forces but not to the tolerance: the
+    // tolerance is below what floating point resolves here (small loads against E t L), not a
+    // limit point.
+    let precision = matches!(last, Rejection::NotConverged { .. }) && residual <= 1e-6 * force && residual > tol;
     let hint = match params.control {
+        _ if precision => format!(
+            "; the residual stopped at {residual:.3e} N, {:.1e} of the forces ({force:.3e} N) but above the \
+             tolerance tol_force = {} of them: the loads are small against the structure's stiffness and \
+             round-off stops Newton there; pass a larger tol_force (e.g. 1e-6)",
+            residual / force,
+            params.newton.tol_force
+        ),
         Control::Load { .. } | Control::Displacement { .. } => {
-            "; if the structure reached a limit point (a snap), arc-length control follows it"
+            "; if the structure reached a limit point (a snap), arc-length control follows it".to_owned()
         }
-        Control::ArcLength { .. } => "",
+        Control::ArcLength { .. } => String::new(),
     };
     Error::NotConverged {
         step: None,
