@@ -21,10 +21,10 @@
 //! with `m` the mass, `s = sum m_i c_i` the static moment and `J = sum (J_i + m_i (|c_i|^2 I -
 //! c_i c_i^T))` the inertia tensor about the node (parallel axes), `c_i` the offsets of the masses
 //! from the node in the reference configuration. Shell nodes carry a translational mass
-//! `rho t int N_a dA` and an isotropic rotary inertia `rho t^3/12 int N_a dA` about every axis:
-//! the through-thickness rotary inertia of the two bending rotations, and the same small value
-//! for the drilling rotation, which has no physical inertia of its own but must keep the mass
-//! matrix regular. Isotropic, it has no gyroscopic term and does not depend on the orientation.
+//! `rho t int N_a dA`, the through-thickness rotary inertia `rho t^3/12 int N_a dA` about the two
+//! in-plane axes, and about the normal (the drilling rotation, which has no physical inertia of
+//! its own but must keep the mass matrix regular) the in-plane spin of the node's quarter-element
+//! patches, `sum rho t w^2 / 6`: see `System::try_new` for why not the small rotary value.
 
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use serde::{Deserialize, Serialize};

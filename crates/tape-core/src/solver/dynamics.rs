@@ -32,8 +32,8 @@ use super::alpha::{advance3, Alpha};
 use super::newton::{Convergence, NewtonParams, Stall};
 use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
-use crate::element::shell::ElementStress;
 use crate::constraint::Slot;
+use crate::element::shell::ElementStress;
 use crate::error::{check_positive, Error, Result};
 use crate::inertia::Motion;
 use crate::options::Options;
@@ -334,7 +334,8 @@ impl Integrator<'_> {
         let t = Instant::now();
         let rates = self.system.rates(state, self.alpha.gamma_prime(h));
         let stress = self.stress_valid.then_some(self.stress.as_slice());
-        self.system.assemble_dynamic(state, &rates, stress, &mut self.asm);
+        self.system
+            .assemble_dynamic(state, &rates, stress, &mut self.asm);
         let f_int = System::force_norm(&self.asm.f_int, &self.weights);
         let inertia = self.add_inertia(start, state, h, true);
         self.asm.residual_into(r);
@@ -390,9 +391,6 @@ impl Integrator<'_> {
         for it in 0..=params.newton.max_iterations {
             let (res, reference) = self.assemble(start, state, h, &mut r);
             residual = res;
-            if std::env::var_os("TAPE_TRACE2").is_some() {
-                eprintln!("   it {it} res {res:.3e} ref {reference:.3e}");
-            }
             if !res.is_finite() {
                 return Attempt::Failed {
                     iterations: it,
@@ -480,9 +478,6 @@ impl Integrator<'_> {
             let arm = self.system.inertia[i].radius_of_gyration().unwrap_or(lc);
             let eu = (state.acc[i] - start.acc[i]).norm() * c;
             let et = (state.dw[i] - start.dw[i]).norm() * c * arm;
-            if std::env::var_os("TAPE_TRACE3").is_some() && eu.max(et) > worst {
-                eprintln!("      node {i} x={:?} eu={eu:.3e} et={et:.3e} m={:.3e} arm={arm:.3e}", state.x[i].as_slice(), self.system.inertia[i].mass);
-            }
             worst = worst.max(eu).max(et);
         }
         worst / tol
@@ -492,7 +487,8 @@ impl Integrator<'_> {
     /// by node (the mass matrix is block diagonal), constrained DOFs held at zero acceleration.
     fn initial_accelerations(&mut self, state: &mut State) -> Result<()> {
         let rates = self.system.rates(state, 0.0);
-        self.system.assemble_dynamic(state, &rates, None, &mut self.asm);
+        self.system
+            .assemble_dynamic(state, &rates, None, &mut self.asm);
         for i in 0..state.x.len() {
             state.acc[i] = Vector3::zeros();
             state.dw[i] = Vector3::zeros();
@@ -632,7 +628,9 @@ pub fn solve_dynamic(
     let mut path = DynamicPath::default();
     let mut balance = EnergyBalance::default();
     let rates = integ.system.rates(state, 0.0);
-    integ.system.assemble_dynamic(state, &rates, None, &mut integ.asm);
+    integ
+        .system
+        .assemble_dynamic(state, &rates, None, &mut integ.asm);
     integ.add_inertia(state, state, h, false);
     let mut last = Energies::of(&integ, state);
     let mech0 = last.kinetic + last.strain + last.gravity;
@@ -678,21 +676,6 @@ pub fn solve_dynamic(
             })
             .collect();
         let attempt = integ.attempt(state, &mut scratch, step_h, &a, params);
-        if std::env::var_os("TAPE_TRACE").is_some() {
-            match &attempt {
-                Attempt::Converged { iterations, error, .. } => {
-                    eprintln!("TRACE t={:.6} h={step_h:.3e} it={iterations} err={error:.3}", state.t)
-                }
-                Attempt::Failed {
-                    iterations,
-                    residual,
-                    why,
-                } => eprintln!(
-                    "TRACE t={:.6} h={step_h:.3e} it={iterations} FAIL res={residual:.3e} {why}",
-                    state.t
-                ),
-            }
-        }
         let (iterations, accepted) = match attempt {
             Attempt::Converged {
                 iterations,
