@@ -5,6 +5,9 @@ Commands
 bend
     Moment-rotation curve of one tape spring in pure bending (paper Fig. 4), with a summary,
     optional CSV, PNG and JSON outputs (see :mod:`tapespring.cli.bend`).
+release
+    A tape spring with a tip body folded, released and followed in time (issue 8, 6.g; see
+    :mod:`tapespring.cli.release`).
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -25,7 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, trials
+    from . import bend, release, trials
 
     parser = argparse.ArgumentParser(
         prog="tapespring",
@@ -33,6 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True)
     bend.register(sub)
+    release.register(sub)
     trials.register(sub)
     return parser
 

@@ -12,8 +12,9 @@ import argparse
 import json
 import math
 import sys
+from typing import Any
 
-__all__ = ["register", "run"]
+__all__ = ["add_tape_options", "register", "run", "tape_fields"]
 
 
 def _positive(name: str):
@@ -27,6 +28,47 @@ def _positive(name: str):
         return value
 
     return parse
+
+
+def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
+    """Add the tape's geometry, material and mesh options (defaults from the `BendingSetup` `d`).
+
+    Shared by the commands that build a tape spring (``bend``, ``release``); read back by
+    `tape_fields`.
+    """
+    p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
+    p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
+    p.add_argument(
+        "--alpha", type=_positive("alpha"), default=d.alpha_deg, help="subtended angle [deg]"
+    )
+    p.add_argument("--thickness", type=_positive("thickness"), default=d.thickness, help="t [m]")
+    p.add_argument(
+        "--youngs-modulus",
+        "-E",
+        type=_positive("Young's modulus"),
+        default=d.youngs_modulus,
+        help="E [Pa]",
+    )
+    p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
+    p.add_argument(
+        "--mesh-size",
+        type=_positive("mesh size"),
+        default=d.mesh_size,
+        help="element size [m] (default 0.002)",
+    )
+
+
+def tape_fields(args: argparse.Namespace) -> dict[str, Any]:
+    """The `BendingSetup` fields given by the options of `add_tape_options`."""
+    return {
+        "length": args.length,
+        "radius": args.radius,
+        "alpha_deg": args.alpha,
+        "thickness": args.thickness,
+        "youngs_modulus": args.youngs_modulus,
+        "poisson": args.poisson,
+        "mesh_size": args.mesh_size,
+    }
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -55,26 +97,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "--theta-max=-90). All values in SI units; angles in degrees."
         ),
     )
-    p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
-    p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
-    p.add_argument(
-        "--alpha", type=_positive("alpha"), default=d.alpha_deg, help="subtended angle [deg]"
-    )
-    p.add_argument("--thickness", type=_positive("thickness"), default=d.thickness, help="t [m]")
-    p.add_argument(
-        "--youngs-modulus",
-        "-E",
-        type=_positive("Young's modulus"),
-        default=d.youngs_modulus,
-        help="E [Pa]",
-    )
-    p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
-    p.add_argument(
-        "--mesh-size",
-        type=_positive("mesh size"),
-        default=d.mesh_size,
-        help="element size [m] (default 0.002)",
-    )
+    add_tape_options(p, d)
     p.add_argument(
         "--theta-max",
         type=float,
@@ -135,13 +158,7 @@ def run(args: argparse.Namespace) -> int:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.
         imperfection = 0.1 if args.theta_max < 0 else 0.0
     setup = BendingSetup(
-        length=args.length,
-        radius=args.radius,
-        alpha_deg=args.alpha,
-        thickness=args.thickness,
-        youngs_modulus=args.youngs_modulus,
-        poisson=args.poisson,
-        mesh_size=args.mesh_size,
+        **tape_fields(args),
         theta_max_deg=args.theta_max,
         unload=args.unload,
         imperfection_deg=imperfection,

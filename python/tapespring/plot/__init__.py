@@ -12,6 +12,9 @@ trials
 
 bending
     The moment-rotation curve of a tape spring in pure bending (paper Fig. 4).
+
+release
+    The free motion of a released tape spring: end angle and energy balance (returns a Figure).
 """
 
 from tapespring._lazy import lazy_exports
@@ -24,6 +27,7 @@ __all__ = [
     "plot_free_decay",
     "plot_peak_differences",
     "plot_pull_test",
+    "plot_release",
     "plot_series_comparison",
     "plot_tip_trajectory",
     "plot_variation_coefficients",
@@ -32,5 +36,9 @@ __all__ = [
 __getattr__, __dir__ = lazy_exports(
     __name__,
     __all__,
-    {"trials": [n for n in __all__ if n != "plot_bending"], "bending": ["plot_bending"]},
+    {
+        "trials": [n for n in __all__ if n not in ("plot_bending", "plot_release")],
+        "bending": ["plot_bending"],
+        "release": ["plot_release"],
+    },
 )

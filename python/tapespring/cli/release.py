@@ -1,0 +1,187 @@
+"""Command line: ``tapespring release``.
+
+A tape spring with a rigid tip body is folded slowly by rotating its free end, then released: it
+deploys dynamically through the snap (issue 8, scenario 6.g). Prints a summary, optionally
+writes the histories as CSV, a plot of the angle and the energy terms, and a JSON object. The
+scenario (`tapespring.scenarios.release`) and matplotlib are imported by `run`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+from typing import Any
+
+from .bend import _positive, add_tape_options, tape_fields
+
+__all__ = ["register", "run"]
+
+
+def _non_negative(name: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not math.isfinite(value) or value < 0.0:
+            raise argparse.ArgumentTypeError(f"{name} must be finite and >= 0 (got {text})")
+        return value
+
+    return parse
+
+
+def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``release`` command to a CLI.
+
+    Parameters
+    ----------
+    sub
+        The object returned by ``parser.add_subparsers(dest="command")``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``release`` parser.
+    """
+    from tapespring.scenarios.release import ReleaseSetup
+
+    d = ReleaseSetup()
+    p = sub.add_parser(
+        "release",
+        help="fold a tape spring with a tip body, release it and follow its deployment",
+        description=(
+            "A tape spring clamped at one end carries a rigid body on its other end section. "
+            "That end is rotated about y to --fold-deg (positive: opposite sense; negative: "
+            "equal sense) by a static step, then released: the tape deploys freely for "
+            "--duration seconds (generalised-alpha with adaptive time steps). All values in "
+            "SI units; angles in degrees."
+        ),
+    )
+    p.add_argument(
+        "--fold-deg",
+        type=float,
+        default=d.fold_deg,
+        help="fold angle [deg], positive opposite sense, negative equal sense (default 60)",
+    )
+    p.add_argument("--tip-mass", type=_non_negative("tip mass"), default=d.tip_mass, help="m [kg]")
+    p.add_argument(
+        "--tip-inertia",
+        type=_non_negative("tip inertia"),
+        default=d.tip_inertia,
+        help="moment of inertia of the tip body about each axis [kg m^2]",
+    )
+    p.add_argument(
+        "--duration",
+        type=_positive("duration"),
+        default=d.duration,
+        help="free motion after the release [s]",
+    )
+    p.add_argument("--eta", type=_non_negative("eta"), default=d.eta, help="Kelvin-Voigt eta [s]")
+    p.add_argument(
+        "--rho-inf", type=float, default=d.rho_inf, help="spectral radius at infinity, in [0, 1]"
+    )
+    p.add_argument(
+        "--gravity", type=float, default=d.gravity, help="gravity along -z [m/s^2] (default 0)"
+    )
+    p.add_argument(
+        "--planar",
+        action="store_true",
+        help="after the release, keep the free end in the x-z plane (held in y, about x and z)",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=_non_negative("tolerance"),
+        default=d.tolerance,
+        help="local error tolerance of the time steps [m] (0: the solver's default)",
+    )
+    add_tape_options(p, d.tape)
+    p.add_argument("--csv", help="write time_s, theta_deg, moment_Nm and the energies to this CSV")
+    p.add_argument("--plot", help="write the angle and energy histories as a PNG")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+    return p
+
+
+def _write_csv(result: Any, path: str) -> None:
+    names = list(result.energy)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["time_s", "theta_deg", "moment_Nm", *(f"{n}_J" for n in names)])
+        for k in range(result.time_s.size):
+            w.writerow(
+                [
+                    f"{result.time_s[k]:.9g}",
+                    f"{result.theta_deg[k]:.9g}",
+                    f"{result.moment_Nm[k]:.9g}",
+                    *(f"{result.energy[n][k]:.9g}" for n in names),
+                ]
+            )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``tapespring release``; returns the exit code.
+
+    Returns
+    -------
+    int
+        0 on success, 1 if the fold or the motion stopped early (what was computed is still
+        written), 2 on bad input (the message is printed on stderr).
+    """
+    from tapespring.analysis import ConvergenceError
+    from tapespring.scenarios.bending import BendingSetup
+    from tapespring.scenarios.release import ReleaseSetup, release
+
+    try:
+        setup = ReleaseSetup(
+            tape=BendingSetup(**tape_fields(args)),
+            fold_deg=args.fold_deg,
+            tip_mass=args.tip_mass,
+            tip_inertia=args.tip_inertia,
+            duration=args.duration,
+            eta=args.eta,
+            rho_inf=args.rho_inf,
+            gravity=args.gravity,
+            planar=args.planar,
+            tolerance=args.tolerance,
+        )
+        result = release(setup, progress=not (args.no_progress or args.json))
+        failure = None
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except ConvergenceError as exc:
+        if exc.result is None:
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+        result, failure = exc.result, str(exc)
+    if args.csv:
+        _write_csv(result, args.csv)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from tapespring.plot.release import plot_release
+
+        fig = plot_release(result)
+        fig.savefig(args.plot, dpi=150)
+        plt.close(fig)
+    summary = result.summary()
+    if args.json:
+        json.dump(summary, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        print(result.describe())
+        if args.csv:
+            print(f"  histories written to {args.csv}")
+        if args.plot:
+            print(f"  plot written to {args.plot}")
+    if failure is not None:
+        print(f"warning: the run stopped early: {failure}", file=sys.stderr)
+        return 1
+    return 0

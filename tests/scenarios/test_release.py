@@ -1,0 +1,109 @@
+"""The release scenario (issue 8, 6.g): a tape spring with a 10 g tip body, folded to 60 degrees
+in opposite sense by a static step, then released.
+
+On the 4 mm mesh (1014 DOFs) to keep CI short; full-size runs are in
+``benchmarks/bench_release.py``. Numbers quoted were measured with this build (2 cores,
+release): the tape first straightens in about 45 ms, passes through the straight configuration
+and folds in equal sense (the overshoot of the paper's phase I).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from tapespring.cli import main
+from tapespring.scenarios.bending import BendingSetup, bend
+from tapespring.scenarios.release import ReleaseSetup, release, release_model
+
+TAPE = BendingSetup(mesh_size=4e-3)
+
+
+@pytest.fixture(scope="module")
+def early():
+    """The first 20 ms after the release (before the tape reaches straight)."""
+    return release(ReleaseSetup(tape=TAPE, duration=0.02))
+
+
+def test_fold_follows_the_static_bending_curve(early):
+    # The fold is the bending scenario's loading step on a model that also has mass and a tip
+    # body; at rest neither may change the statics: the same peak moment to 1 % (the issue's
+    # tolerance; measured equal to round-off, the static solver never sees the mass).
+    curve = bend(replace(TAPE, theta_max_deg=60.0, jump=True))
+    _, clamped, _ = release_model(early.setup)
+    fold = early.results.in_step(0)
+    m_fold = np.max(np.abs(early.results.reaction(clamped, "ry")[fold]))
+    assert m_fold == pytest.approx(np.max(np.abs(curve.moment)), rel=0.01)
+
+
+def test_release_starts_from_rest_and_deploys(early):
+    assert early.results.error is None
+    assert early.time_s[0] == 0.0 and early.theta_deg[0] == pytest.approx(60.0, abs=1e-6)
+    # Consistent initial accelerations: no jolt, the kinetic energy grows from zero smoothly.
+    assert early.energy["kinetic"][0] == 0.0
+    # Measured: 51.6 deg after 20 ms, on the way down from 60 (it swings 60 -> 37 -> 52).
+    assert early.theta_deg.min() < 45.0
+    stored = early.energy["strain"][0]
+    # Without damping the scheme dissipates (rho_inf = 0.7), though not at every step in this
+    # nonlinear regime: measured -6e-6 of the stored energy at worst, cumulated.
+    assert np.all(early.energy["numerical"] > -1e-4 * stored)
+
+
+def test_halving_the_tolerance_leaves_the_history(early):
+    # Measured: 0.27 deg at most over the 24-degree swing (local error 1e-4 m per step against
+    # 5e-5); 0.5 deg is 2 % of the swing.
+    fine = release(ReleaseSetup(tape=TAPE, duration=0.02, tolerance=0.5e-4))
+    t = np.linspace(0.0, 0.02, 201)
+    coarse_theta = np.interp(t, early.time_s, early.theta_deg)
+    fine_theta = np.interp(t, fine.time_s, fine.theta_deg)
+    assert np.max(np.abs(coarse_theta - fine_theta)) < 0.5
+
+
+def test_kelvin_voigt_dissipates(early):
+    # The paper's eta: the high-frequency content of the release is damped. Measured: 15 mJ of
+    # the 84 mJ dissipated in 20 ms; the remainder of the balance (viscous power by the
+    # trapezoidal rule, see docs/dynamics.md) is 4 % of that.
+    damped = release(ReleaseSetup(tape=TAPE, duration=0.02, eta=1.73e-4))
+    e0, e1 = early.energy, damped.energy
+    mech = e1["kinetic"][-1] + e1["strain"][-1]
+    assert mech < e0["kinetic"][-1] + e0["strain"][-1] - 0.05 * e0["strain"][0]
+    assert e1["viscous"][-1] > 0.05 * e0["strain"][0]
+    assert abs(e1["numerical"][-1]) < 0.1 * e1["viscous"][-1]
+
+
+def test_release_through_the_snap_keeps_the_energy_bounded():
+    # Through the straight configuration into an equal-sense fold (60 ms). With the drilling
+    # rotation's inertia at rho t^3 / 12 this run gained energy (numerical dissipation -0.18 J
+    # against 0.084 J stored) and its steps collapsed to 3e-7 s; now no step is given up and the
+    # scheme only dissipates.
+    r = release(ReleaseSetup(tape=TAPE, duration=0.06))
+    assert r.results.error is None
+    assert r.theta_deg.min() < 0.0 < r.theta_deg.max()
+    stored = r.energy["strain"][0]
+    # Measured: the cumulated numerical dissipation never below 0, kinetic + strain never above
+    # the stored energy; 1e-4 of it is the allowance of the early test.
+    assert np.all(r.energy["numerical"] > -1e-4 * stored)
+    total = r.energy["kinetic"] + r.energy["strain"]
+    assert np.all(total <= stored * (1 + 1e-4))
+
+
+def test_release_command_json(capsys):
+    code = main(
+        ["release", "--mesh-size", "4e-3", "--duration", "0.003", "--json", "--fold-deg", "40"]
+    )
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("time_s", "theta_deg", "moment_Nm", "energy", "steps", "rejected_steps"):
+        assert key in out
+    for key in ("newton_iterations", "ndof", "wall_s"):
+        assert key in out
+    assert out["time_s"][-1] == pytest.approx(0.003)
+    assert out["theta_deg"][0] == pytest.approx(40.0, abs=1e-6)
+    assert set(out["energy"]) >= {"kinetic", "strain", "viscous", "numerical"}
+
+
+def test_release_command_refuses_bad_input(capsys):
+    assert main(["release", "--rho-inf", "2"]) == 2
+    assert "rho_inf" in capsys.readouterr().err
