@@ -17,14 +17,17 @@ from typing import Any
 __all__ = ["add_tape_options", "register", "run", "tape_fields"]
 
 
-def _positive(name: str):
+def _positive(name: str, *, zero: bool = False):
+    """An argparse type: a finite number > 0 (>= 0 with `zero`), named `name` in errors."""
+
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        if not math.isfinite(value) or value <= 0.0:
-            raise argparse.ArgumentTypeError(f"{name} must be finite and > 0 (got {text})")
+        if not math.isfinite(value) or value < 0.0 or (value == 0.0 and not zero):
+            bound = ">= 0" if zero else "> 0"
+            raise argparse.ArgumentTypeError(f"{name} must be finite and {bound} (got {text})")
         return value
 
     return parse

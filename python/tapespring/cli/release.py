@@ -11,26 +11,12 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
 import sys
 from typing import Any
 
 from .bend import _positive, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
-
-
-def _non_negative(name: str):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        if not math.isfinite(value) or value < 0.0:
-            raise argparse.ArgumentTypeError(f"{name} must be finite and >= 0 (got {text})")
-        return value
-
-    return parse
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -66,10 +52,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=d.fold_deg,
         help="fold angle [deg], positive opposite sense, negative equal sense (default 60)",
     )
-    p.add_argument("--tip-mass", type=_non_negative("tip mass"), default=d.tip_mass, help="m [kg]")
+    p.add_argument(
+        "--tip-mass", type=_positive("tip mass", zero=True), default=d.tip_mass, help="m [kg]"
+    )
     p.add_argument(
         "--tip-inertia",
-        type=_non_negative("tip inertia"),
+        type=_positive("tip inertia", zero=True),
         default=d.tip_inertia,
         help="moment of inertia of the tip body about each axis [kg m^2]",
     )
@@ -79,7 +67,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=d.duration,
         help="free motion after the release [s]",
     )
-    p.add_argument("--eta", type=_non_negative("eta"), default=d.eta, help="Kelvin-Voigt eta [s]")
+    p.add_argument(
+        "--eta", type=_positive("eta", zero=True), default=d.eta, help="Kelvin-Voigt eta [s]"
+    )
     p.add_argument(
         "--rho-inf", type=float, default=d.rho_inf, help="spectral radius at infinity, in [0, 1]"
     )
@@ -93,7 +83,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_non_negative("tolerance"),
+        type=_positive("tolerance", zero=True),
         default=d.tolerance,
         help="local error tolerance of the time steps [m] (0: the solver's default)",
     )
