@@ -168,11 +168,12 @@ class ReleaseResult:
         s = self.summary()
         sense = "opposite" if self.setup.fold_deg > 0 else "equal"
         e = self.energy
-        stored = float(e["strain"][0] + e["kinetic"][0])
+        stored = float(e["strain"][0] + e["kinetic"][0]) if self.time_s.size else 0.0
+        reached = self.time_s[-1] if self.time_s.size else 0.0
         lines = [
             f"tape spring released from {self.setup.fold_deg:+.1f} deg ({sense} sense) with a "
             f"{self.setup.tip_mass * 1e3:.1f} g tip body, {s['ndof']} DOFs",
-            f"  free motion {self.time_s[-1]:.4g} s in {s['steps']} steps "
+            f"  free motion {reached:.4g} s in {s['steps']} steps "
             f"({s['rejected_steps']} rejected, {s['newton_iterations']} Newton iterations), "
             f"wall time {self.wall_s:.1f} s",
         ]
@@ -221,14 +222,17 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
     ValueError
         For a bad setup.
     tapespring.analysis.ConvergenceError
-        If the fold or the motion stops early (its ``result`` holds what was recorded).
+        If the fold or the motion stops early; its ``result`` is the `ReleaseResult` of what was
+        recorded (the free motion up to the failure, empty if the fold failed).
     """
-    from tapespring.analysis import Outputs, run
+    from tapespring.analysis import ConvergenceError, Outputs, run
 
     start = time.perf_counter()
     model, clamped, tip = release_model(setup)
     outputs = Outputs(reactions=((clamped, "ry"), (tip, "ry")))
-    results = run(model, release_steps(setup, tip), outputs=outputs, progress=progress)
+    results = run(
+        model, release_steps(setup, tip), outputs=outputs, progress=progress, raise_on_error=False
+    )
     free = results.in_step(1)
     t0 = results.t[free[0] - 1] if free.size else 0.0
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free
@@ -242,7 +246,7 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         "viscous": np.nan_to_num(results.viscous_dissipation[idx]),
         "numerical": np.nan_to_num(results.numerical_dissipation[idx]),
     }
-    return ReleaseResult(
+    out = ReleaseResult(
         time_s=results.t[idx] - t0,
         theta_deg=np.degrees(rot),
         moment_Nm=results.reaction(clamped, "ry")[idx],
@@ -251,3 +255,10 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         setup=setup,
         wall_s=time.perf_counter() - start,
     )
+    if results.error is not None:
+        err = ConvergenceError(
+            f"{results.error} (the release recorded so far is kept in the 'result' attribute)"
+        )
+        err.result = out  # type: ignore[attr-defined]
+        raise err
+    return out
