@@ -472,9 +472,10 @@ impl Integrator<'_> {
             if self.system.dofs.master[i].is_some() || self.system.inertia[i].is_empty() {
                 continue;
             }
-            // A rotation error matters through the displacement of the node's mass: for a shell
-            // node that is `t / sqrt(12)`, so the stiff, lightly loaded rotary-inertia modes of a
-            // thin shell do not dictate the step.
+            // A rotation error matters through the displacement of the node's mass, over its
+            // radius of gyration: for an interior shell node about an eighth of the element size
+            // (the drilling patch inertia dominates the trace), far below the model's size, so
+            // the stiff rotary modes of a thin shell do not dictate the step.
             let arm = self.system.inertia[i].radius_of_gyration().unwrap_or(lc);
             let eu = (state.acc[i] - start.acc[i]).norm() * c;
             let et = (state.dw[i] - start.dw[i]).norm() * c * arm;
