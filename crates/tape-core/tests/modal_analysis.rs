@@ -26,8 +26,8 @@
 mod common;
 
 use tape_core::mesh::generate::flat_plate;
-use tape_core::model::{Load, Marker};
-use tape_core::solver::{Control, DynamicParams, ModalParams, Modes, NewtonParams, StaticParams};
+use tape_core::model::Load;
+use tape_core::solver::{Control, ModalParams, Modes, StaticParams};
 use tape_core::{run, Dof, History, Model, Outputs, Result, Step, TimeFunction};
 
 use std::f64::consts::PI;
@@ -98,23 +98,10 @@ fn nafems_fv12_free_square_plate() -> Result<()> {
     Ok(())
 }
 
-const E: f64 = 2e11;
-const RHO: f64 = 7850.0;
-const T: f64 = 2e-3;
-const B: f64 = 0.02;
-
-/// `f = c^2 / (2 pi) sqrt(E I / (rho A L^4))` of a beam of modulus `modulus`.
-fn beam_frequency(c: f64, modulus: f64, l: f64) -> f64 {
-    c * c / (2.0 * PI) * (modulus * T * T / (12.0 * RHO) / l.powi(4)).sqrt()
-}
+use common::strip::{self, beam_frequency, B, E, RHO, T};
 
 fn cantilever(poisson: f64, l: f64) -> Result<Model> {
-    let mut section = common::section(T, E, poisson);
-    section.density = RHO;
-    let mut model = Model::try_new(flat_plate(l, B, 16, 2)?, section)?;
-    let x0 = model.mesh.node_set("x0")?.to_vec();
-    model.fix(&x0, &Dof::ALL)?;
-    Ok(model)
+    strip::clamped(l, poisson, 0.0)
 }
 
 /// The first mode of a clamped strip against Euler-Bernoulli. With nu = 0 the strip is a beam:
@@ -242,71 +229,14 @@ fn axial_prestress_shifts_the_frequency_as_the_beam_formula_says() -> Result<()>
 fn free_decay_period_of_a_released_cantilever_is_the_modal_period() -> Result<()> {
     let l = 0.2;
     let mut model = cantilever(0.0, l)?;
-    let tip: Vec<usize> = model.mesh.node_set("x1")?.to_vec();
-    for &n in &tip {
-        model.add_load_with(Load {
-            id: Some("push".into()),
-            node: n,
-            dof: Dof::Uz,
-            value: -0.05,
-            function: TimeFunction::Linear,
-            active: true,
-        })?;
-    }
-    model.add_marker(Marker {
-        name: "tip".into(),
-        node: tip[1],
-        offset: nalgebra::Vector3::zeros(),
-    })?;
+    strip::push_tip(&mut model)?;
     // Modes of the unloaded strip (the push is switched off in the modal step only for this run).
     let mut unloaded = model.clone();
     unloaded.loads.clear();
     let period = modes_of(&unloaded, &[modal(1)])?.modes[0].periods_s[0];
     let h = period / 100.0;
-    let bend = Step::new_static(
-        "bend",
-        StaticParams {
-            control: Control::Load {
-                lambda_end: 1.0,
-                increments: 1,
-            },
-            ..StaticParams::default()
-        },
-    );
-    let mut release = Step::new_dynamic(
-        "release",
-        DynamicParams {
-            duration: 4.2 * period,
-            rho_inf: 1.0,
-            initial_step: h,
-            max_step: h,
-            adaptive: false,
-            newton: NewtonParams {
-                tol_force: 1e-10,
-                ..DynamicParams::default().newton
-            },
-            ..DynamicParams::default()
-        },
-    );
-    release.deactivate = vec!["push".into()];
-    let hist = modes_of(&model, &[bend, release])?;
-    let z: Vec<f64> = hist
-        .marker("tip")
-        .expect("tip")
-        .iter()
-        .map(|p| p[2])
-        .collect();
-    let first = hist
-        .step
-        .iter()
-        .position(|&s| s == 1)
-        .expect("dynamic records");
-    let mut up = Vec::new();
-    for k in first..z.len() {
-        if z[k - 1] < 0.0 && z[k] >= 0.0 {
-            up.push(hist.t[k - 1] + (hist.t[k] - hist.t[k - 1]) * (-z[k - 1]) / (z[k] - z[k - 1]));
-        }
-    }
+    let hist = modes_of(&model, &strip::bend_then_release(1.0, h, 4.2 * period))?;
+    let (up, _) = strip::crossings_and_peaks(&hist);
     assert!(up.len() >= 3, "{} crossings", up.len());
     #[allow(clippy::cast_precision_loss)]
     let measured = (up[up.len() - 1] - up[0]) / (up.len() - 1) as f64;

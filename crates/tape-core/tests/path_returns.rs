@@ -19,26 +19,13 @@
 
 mod common;
 
-use nalgebra::Vector3;
-use tape_core::mesh::generate::cylindrical_panel;
 use tape_core::solver::{solve_static, Control, StaticParams, StaticPath};
-use tape_core::{Dof, Error, Model, Result, System};
+use tape_core::{Error, Result, System};
 
 fn roof(lambda_end: f64, initial_increment: f64) -> Result<(StaticPath, usize)> {
     let (r, half_length) = (2540.0, 254.0);
-    let mesh = cylindrical_panel(r, half_length, 0.0, 0.1, 4, 4)?;
-    let mut model = Model::try_new(mesh, common::section(6.35, 3102.75, 0.3))?;
-    let middle = model.mesh.node_set("x1")?.to_vec();
-    let crown = model.mesh.node_set("phi0")?.to_vec();
-    let hinged = model.mesh.node_set("phi1")?.to_vec();
-    model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
-    model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
-    model.fix(&hinged, &Dof::TRANSLATIONS)?;
-    let c = model
-        .mesh
-        .nearest_node(&Vector3::new(half_length, 0.0, r))
-        .expect("the mesh has nodes");
-    model.add_load(c, Dof::Uz, -600.0 / 4.0)?;
+    let section = common::section(6.35, 3102.75, 0.3);
+    let (model, c) = common::hinged_roof_quarter(r, half_length, 0.1, 4, section, 600.0)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
     let params = StaticParams {

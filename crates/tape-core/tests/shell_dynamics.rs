@@ -16,100 +16,20 @@
 
 mod common;
 
-use tape_core::mesh::generate::flat_plate;
-use tape_core::model::Marker;
-use tape_core::solver::{Control, DynamicParams, NewtonParams, StaticParams};
-use tape_core::{run, Dof, History, Model, Outputs, Result, Step};
+use tape_core::{run, History, Model, Outputs, Result};
 
-const E: f64 = 2e11;
-const RHO: f64 = 7850.0;
+use common::strip::{beam_frequency, bend_then_release as steps, crossings_and_peaks, push_tip, E};
+
 const L: f64 = 0.2;
-const B: f64 = 0.02;
-const T: f64 = 2e-3;
 
 fn strip(eta: f64) -> Result<Model> {
-    let mut section = common::section(T, E, 0.0);
-    section.density = RHO;
-    section.eta = eta;
-    let mut model = Model::try_new(flat_plate(L, B, 16, 2)?, section)?;
-    let x0 = model.mesh.node_set("x0")?.to_vec();
-    model.fix(&x0, &Dof::ALL)?;
-    let tip: Vec<usize> = model.mesh.node_set("x1")?.to_vec();
-    for &n in &tip {
-        model.add_load_with(tape_core::model::Load {
-            id: Some("push".into()),
-            node: n,
-            dof: Dof::Uz,
-            value: -0.05,
-            function: tape_core::TimeFunction::Linear,
-            active: true,
-        })?;
-    }
-    model.add_marker(Marker {
-        name: "tip".into(),
-        node: tip[1],
-        offset: nalgebra::Vector3::zeros(),
-    })?;
+    let mut model = common::strip::clamped(L, 0.0, eta)?;
+    push_tip(&mut model)?;
     Ok(model)
 }
 
-fn steps(rho_inf: f64, h: f64, duration: f64) -> Vec<Step> {
-    let bend = Step::new_static(
-        "bend",
-        StaticParams {
-            control: Control::Load {
-                lambda_end: 1.0,
-                increments: 1,
-            },
-            ..StaticParams::default()
-        },
-    );
-    let mut release = Step::new_dynamic(
-        "release",
-        DynamicParams {
-            duration,
-            rho_inf,
-            initial_step: h,
-            max_step: h,
-            adaptive: false,
-            newton: NewtonParams {
-                tol_force: 1e-10,
-                ..DynamicParams::default().newton
-            },
-            ..DynamicParams::default()
-        },
-    );
-    release.deactivate = vec!["push".into()];
-    vec![bend, release]
-}
-
 fn first_frequency() -> f64 {
-    let ei_over_rho_a = E * T * T / (12.0 * RHO);
-    1.8751_f64.powi(2) / (2.0 * std::f64::consts::PI) * (ei_over_rho_a / L.powi(4)).sqrt()
-}
-
-/// Times of the upward zero crossings and the values of the maxima of the tip deflection in
-/// the dynamic step (linear interpolation between records; parabolic through the three
-/// records about each maximum).
-fn crossings_and_peaks(h: &History) -> (Vec<f64>, Vec<f64>) {
-    let z: Vec<f64> = h.marker("tip").expect("tip").iter().map(|p| p[2]).collect();
-    let start = h
-        .step
-        .iter()
-        .position(|&s| s == 1)
-        .expect("dynamic records")
-        - 1;
-    let (mut up, mut peaks) = (Vec::new(), Vec::new());
-    for k in start + 1..z.len() - 1 {
-        if z[k - 1] < 0.0 && z[k] >= 0.0 {
-            up.push(h.t[k - 1] + (h.t[k] - h.t[k - 1]) * (-z[k - 1]) / (z[k] - z[k - 1]));
-        }
-        if z[k] > z[k - 1] && z[k] >= z[k + 1] {
-            let (a, b, c) = (z[k - 1], z[k], z[k + 1]);
-            peaks.push(b + (a - c).powi(2) / (8.0 * (2.0 * b - a - c)));
-        }
-    }
-    (up, peaks)
+    beam_frequency(1.8751, E, L)
 }
 
 #[test]

@@ -378,19 +378,7 @@ fn hinged_roof_snaps_through_along_sze_curve() -> Result<()> {
     let table = &p["tabulated"]["h_12_7"];
     let (p_ref, w_ref) = (common::nums(&table["P"]), common::nums(&table["minus_w_C"]));
 
-    let mesh = cylindrical_panel(r, half_length, 0.0, theta, 8, 8)?;
-    let mut model = Model::try_new(mesh, section)?;
-    let middle = model.mesh.node_set("x1")?.to_vec();
-    let crown = model.mesh.node_set("phi0")?.to_vec();
-    let hinged = model.mesh.node_set("phi1")?.to_vec();
-    model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
-    model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
-    model.fix(&hinged, &Dof::TRANSLATIONS)?;
-    let c = model
-        .mesh
-        .nearest_node(&Vector3::new(half_length, 0.0, r))
-        .expect("the mesh has nodes");
-    model.add_load(c, Dof::Uz, -p_max / 4.0)?;
+    let (model, c) = common::hinged_roof_quarter(r, half_length, theta, 8, section, p_max)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
     let params = StaticParams {

@@ -10,7 +10,7 @@ use tape_core::assembly::Assembled;
 use tape_core::linalg::LinearSolver;
 use tape_core::material::ShellSection;
 use tape_core::mesh::Mesh;
-use tape_core::{Model, Result, System};
+use tape_core::{Dof, Model, Result, System};
 
 /// Homogeneous isotropic section; the other fields (drilling factor, shear factor) keep their defaults.
 pub fn section(thickness: f64, youngs_modulus: f64, poisson: f64) -> ShellSection {
@@ -292,5 +292,142 @@ pub fn value_at_load(lambdas: &[f64], values: &[f64], level: f64, first: bool) -
         (0..n).find_map(segment)
     } else {
         (0..n).rev().find_map(segment)
+    }
+}
+
+/// Quarter model of the hinged cylindrical roof (Sze et al. 2004): a panel of radius `r` and
+/// half-length `half_length`, opening `theta` [rad] from the crown, `n x n` elements, symmetric at
+/// the middle (`x1`) and the crown (`phi0`), hinged along the straight edge (`phi1`), with a
+/// quarter of the load `p` [N] pushing the crown's centre down. Returns the model and that node.
+pub fn hinged_roof_quarter(
+    r: f64,
+    half_length: f64,
+    theta: f64,
+    n: usize,
+    section: ShellSection,
+    p: f64,
+) -> Result<(Model, usize)> {
+    let mesh = tape_core::mesh::generate::cylindrical_panel(r, half_length, 0.0, theta, n, n)?;
+    let mut model = Model::try_new(mesh, section)?;
+    let middle = model.mesh.node_set("x1")?.to_vec();
+    let crown = model.mesh.node_set("phi0")?.to_vec();
+    let hinged = model.mesh.node_set("phi1")?.to_vec();
+    model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
+    model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
+    model.fix(&hinged, &Dof::TRANSLATIONS)?;
+    let c = model
+        .mesh
+        .nearest_node(&Vector3::new(half_length, 0.0, r))
+        .expect("the mesh has nodes");
+    model.add_load(c, Dof::Uz, -p / 4.0)?;
+    Ok((model, c))
+}
+
+/// The steel strip of the dynamics tests: E = 2e11 Pa, rho = 7850 kg/m^3, width 0.02 m, 2 mm
+/// thick, 16 x 2 elements, clamped at x = 0 (node set `x0`).
+pub mod strip {
+    use tape_core::mesh::generate::flat_plate;
+    use tape_core::model::{Load, Marker};
+    use tape_core::solver::{Control, DynamicParams, NewtonParams, StaticParams};
+    use tape_core::{Dof, History, Model, Result, Step, TimeFunction};
+
+    pub const E: f64 = 2e11;
+    pub const RHO: f64 = 7850.0;
+    pub const B: f64 = 0.02;
+    pub const T: f64 = 2e-3;
+
+    /// `f = c^2 / (2 pi) sqrt(E I / (rho A L^4))` [Hz] of the strip as a beam of modulus
+    /// `modulus` [Pa] and length `l` [m].
+    pub fn beam_frequency(c: f64, modulus: f64, l: f64) -> f64 {
+        c * c / (2.0 * std::f64::consts::PI) * (modulus * T * T / (12.0 * RHO) / l.powi(4)).sqrt()
+    }
+
+    /// The clamped strip of length `length` [m] with Poisson's ratio `poisson` and Kelvin-Voigt
+    /// `eta` [s].
+    pub fn clamped(length: f64, poisson: f64, eta: f64) -> Result<Model> {
+        let mut section = super::section(T, E, poisson);
+        section.density = RHO;
+        section.eta = eta;
+        let mut model = Model::try_new(flat_plate(length, B, 16, 2)?, section)?;
+        let x0 = model.mesh.node_set("x0")?.to_vec();
+        model.fix(&x0, &Dof::ALL)?;
+        Ok(model)
+    }
+
+    /// Adds the tip load `"push"` (-0.05 N along z on each node of the free end, linear in the
+    /// load factor) and the marker `"tip"` at the middle of the free end.
+    pub fn push_tip(model: &mut Model) -> Result<()> {
+        let tip: Vec<usize> = model.mesh.node_set("x1")?.to_vec();
+        for &n in &tip {
+            model.add_load_with(Load {
+                id: Some("push".into()),
+                node: n,
+                dof: Dof::Uz,
+                value: -0.05,
+                function: TimeFunction::Linear,
+                active: true,
+            })?;
+        }
+        model.add_marker(Marker {
+            name: "tip".into(),
+            node: tip[1],
+            offset: nalgebra::Vector3::zeros(),
+        })
+    }
+
+    /// A static step applying the push, then a dynamic step of fixed steps `h` [s] releasing it
+    /// for `duration` [s] (Newton to 1e-10).
+    pub fn bend_then_release(rho_inf: f64, h: f64, duration: f64) -> Vec<Step> {
+        let bend = Step::new_static(
+            "bend",
+            StaticParams {
+                control: Control::Load {
+                    lambda_end: 1.0,
+                    increments: 1,
+                },
+                ..StaticParams::default()
+            },
+        );
+        let mut release = Step::new_dynamic(
+            "release",
+            DynamicParams {
+                duration,
+                rho_inf,
+                initial_step: h,
+                max_step: h,
+                adaptive: false,
+                newton: NewtonParams {
+                    tol_force: 1e-10,
+                    ..DynamicParams::default().newton
+                },
+                ..DynamicParams::default()
+            },
+        );
+        release.deactivate = vec!["push".into()];
+        vec![bend, release]
+    }
+
+    /// Times of the upward zero crossings and the values of the maxima of the tip deflection in
+    /// the dynamic step (linear interpolation between records; parabolic through the three
+    /// records about each maximum).
+    pub fn crossings_and_peaks(h: &History) -> (Vec<f64>, Vec<f64>) {
+        let z: Vec<f64> = h.marker("tip").expect("tip").iter().map(|p| p[2]).collect();
+        let start = h
+            .step
+            .iter()
+            .position(|&s| s == 1)
+            .expect("dynamic records")
+            - 1;
+        let (mut up, mut peaks) = (Vec::new(), Vec::new());
+        for k in start + 1..z.len() - 1 {
+            if z[k - 1] < 0.0 && z[k] >= 0.0 {
+                up.push(h.t[k - 1] + (h.t[k] - h.t[k - 1]) * (-z[k - 1]) / (z[k] - z[k - 1]));
+            }
+            if z[k] > z[k - 1] && z[k] >= z[k + 1] {
+                let (a, b, c) = (z[k - 1], z[k], z[k + 1]);
+                peaks.push(b + (a - c).powi(2) / (8.0 * (2.0 * b - a - c)));
+            }
+        }
+        (up, peaks)
     }
 }
