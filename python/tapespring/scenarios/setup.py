@@ -10,8 +10,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
-__all__ = ["PAPER_TAPE", "TapeSpring"]
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "CONFIGURATIONS",
+    "PAPER_SETUP",
+    "PAPER_TAPE",
+    "SENSES",
+    "SetupModel",
+    "SetupSpec",
+    "TapeSpring",
+    "build_setup",
+    "check_sense",
+]
 
 
 @dataclass(frozen=True)
@@ -57,3 +71,424 @@ class TapeSpring:
 
 #: The paper's tape: Table 1 geometry, Table 5 identified thickness and modulus.
 PAPER_TAPE = TapeSpring()
+
+
+# ---------------------------------------------------------------------------------------------
+# The experimental set-up (paper Sec. 3, Figs. 5, 8, 10, 20, 21, 25)
+# ---------------------------------------------------------------------------------------------
+
+#: Configurations of the set-up: the dummy appendix (deployments), nothing beyond the rod (the
+#: quasi-static pull), the additional weight instead of the appendix (static identification and
+#: small-amplitude vibrations).
+CONFIGURATIONS = ("appendix", "bare", "weight")
+
+#: Senses of the initial fold: the tapes' centre of curvature above them (opposite sense when
+#: folded downwards) or the block turned upside down (equal sense).
+SENSES = ("opposite", "equal")
+
+
+@dataclass(frozen=True)
+class SetupSpec:
+    """The paper's experimental set-up: its figures and the dimensions this project chose.
+
+    Coordinates are the set-up's own frame, which is the paper's frame of each sense: x along
+    the deployed set-up from the clamped ends of the tapes, y across, z normal to the tapes'
+    chords on the side of their centre of curvature. In the laboratory the equal-sense block is
+    upside down, so its gravity points along +z in this frame (the paper turns its y and z axes
+    with the block, Sec. 4, so that the bending angle keeps the sign convention of Sec. 2).
+
+    **From the paper** (Sec. 3-5, Tables 1 and 5, ``reference/paper.toml``): the tapes; two of
+    them with the same orientation, clamped at the big interfaces; small interfaces and their
+    screws as rigid bodies; rod and dummy appendix as flexible shells; meshes of 2 mm (tapes) and
+    3 mm (rod, appendix); free-end mass 77 g (two small interfaces, rod, appendix); set-up length
+    about 236 mm without the support (4.3 mm lateral motion is 1.82 % of it); initial bending
+    angles +95.5 and -91.2 deg; fold at under 2 mm/s held 5 s; pull at 1 mm/s; g = 9.81 m/s^2.
+
+    **Chosen here** (the paper gives no value; each with its reason):
+
+    * ``tape_spacing`` 40 mm centre to centre: two 17.8 mm tapes side by side with a gap about
+      their width, as in Figs. 8 and 10; it sets only the torsional stiffness of the pair.
+    * small interfaces 15 mm long (x) by 25 mm (y) by 12 mm (z), 25 g each with the screw: an
+      aluminium clamp pair around a 17.8 mm tape with a steel M3 screw; with the rod and
+      appendix below they give the 77 g.
+    * the rod: an aluminium bar across the two interfaces (along y, 80 mm by 10 mm, 3 mm thick,
+      12 g with its drilled holes). Marker 2 in its middle is then level with the small
+      interfaces, where Table 3 puts markers 1-2 and where the pull string of Sec. 4.2 pulls.
+      The holes are represented by the density (mass / volume), not in the mesh.
+    * the dummy appendix: an aluminium plate (along x, 40 mm wide, 2 mm thick, 15 g), from the
+      rod to the tip at 235 mm. The mass split keeps the free end's centre of mass about 124
+      mm from the clamp, 74 mm from the tapes' middle: eq. (1) with the analytical equal-sense
+      residual moment of two tapes (0.062 N m) then allows 86 g there, so 77 g deploys in both
+      senses, as the set-up was designed to (Sec. 3.1).
+    * the additional weight (Figs. 21, 25): a rigid steel block fixed under the rod's middle,
+      ``weight_length`` along x beyond the rod, marker 3 at its tip; its mass is pinned by
+      Table 6 (see ``weight_mass``).
+    * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp; marker 1 on top
+      of the first small interface; marker 2 on the rod's middle; marker 3 at the tip of the
+      appendix or the weight. Marker heights above the parts are not modelled.
+
+    Every value can be overridden (``dataclasses.replace``).
+
+    Attributes
+    ----------
+    tape : TapeSpring
+        Geometry and material of each tape (Tables 1 and 5).
+    tape_spacing : float
+        Distance between the two tapes' mid-lines [m].
+    mesh_tape, mesh_plates : float
+        Element sizes of the tapes and of the rod and appendix [m] (paper: 2 mm and 3 mm).
+    interface_length, interface_width, interface_height : float
+        Size of each small interface [m] (x, y, z).
+    interface_mass : float
+        Mass of each small interface with its screw [kg].
+    rod_length, rod_width, rod_thickness, rod_mass : float
+        The rod [m, kg]: length across (y), width along x, thickness, mass.
+    appendix_width, appendix_thickness, appendix_mass : float
+        The dummy appendix [m, kg]; it runs along x from the rod to ``setup_length``.
+    plate_youngs_modulus, plate_poisson : float
+        Material of the rod and appendix (aluminium) [Pa, -].
+    setup_length : float
+        Distance from the clamp to the tip of the appendix [m] (paper: about 236 mm).
+    weight_mass, weight_length, weight_width, weight_height : float
+        The additional weight [kg, m].
+    support_marker : tuple of float
+        Position of marker 0 on the support [m].
+    gravity : float
+        Gravitational acceleration [m/s^2].
+    initial_angle_opposite_deg, initial_angle_equal_deg : float
+        Initial bending angles of the deployment tests [deg] (Sec. 4.1).
+    fold_rate : float
+        Speed at which marker 2 is driven to its folded position [m/s] (paper: under 2 mm/s).
+    hold : float
+        Time the folded set-up is held before the release [s] (paper: 5 s).
+    pull_rate : float
+        Speed of the quasi-static pull [m/s] (paper: 1 mm/s).
+    """
+
+    tape: TapeSpring = PAPER_TAPE
+    tape_spacing: float = 0.040
+    mesh_tape: float = 2e-3
+    mesh_plates: float = 3e-3
+    interface_length: float = 0.015
+    interface_width: float = 0.025
+    interface_height: float = 0.012
+    interface_mass: float = 0.025
+    rod_length: float = 0.080
+    rod_width: float = 0.010
+    rod_thickness: float = 3e-3
+    rod_mass: float = 0.012
+    appendix_width: float = 0.040
+    appendix_thickness: float = 2e-3
+    appendix_mass: float = 0.015
+    plate_youngs_modulus: float = 70e9
+    plate_poisson: float = 0.33
+    setup_length: float = 0.235
+    weight_mass: float = 0.060
+    weight_length: float = 0.050
+    weight_width: float = 0.020
+    weight_height: float = 0.020
+    support_marker: tuple[float, float, float] = (-0.030, 0.0, 0.030)
+    gravity: float = 9.81
+    initial_angle_opposite_deg: float = 95.5
+    initial_angle_equal_deg: float = -91.2
+    fold_rate: float = 2e-3
+    hold: float = 5.0
+    pull_rate: float = 1e-3
+
+    @property
+    def rod_x(self) -> float:
+        """Position of the rod's near edge along x [m] (the far end of the small interfaces)."""
+        return self.tape.length + self.interface_length
+
+    @property
+    def appendix_x(self) -> float:
+        """Position of the appendix's root along x [m] (the rod's far edge)."""
+        return self.rod_x + self.rod_width
+
+    @property
+    def appendix_length(self) -> float:
+        """Length of the appendix along x [m]."""
+        return self.setup_length - self.appendix_x
+
+    @property
+    def free_end_mass(self) -> float:
+        """Mass of the two small interfaces, the rod and the appendix [kg] (paper: 77 g)."""
+        return 2.0 * self.interface_mass + self.rod_mass + self.appendix_mass
+
+    def initial_angle_deg(self, sense: str) -> float:
+        """The initial bending angle of a deployment in `sense` [deg]."""
+        check_sense(sense)
+        return (
+            self.initial_angle_opposite_deg if sense == "opposite" else self.initial_angle_equal_deg
+        )
+
+    def validate(self) -> None:
+        """Check every value.
+
+        Raises
+        ------
+        ValueError
+            Naming the bad value.
+        """
+        if not isinstance(self.tape, TapeSpring):
+            raise ValueError(f"tape must be a TapeSpring (got {self.tape!r})")
+        for name, value in vars(self.tape).items():
+            _check_number(f"tape.{name}", value, positive=True)
+        if not -1.0 < self.tape.poisson < 0.5:
+            raise ValueError(f"tape.poisson must lie in (-1, 0.5) (got {self.tape.poisson})")
+        for name, value in vars(self).items():
+            if name in ("tape", "support_marker"):
+                continue
+            positive = not name.startswith("initial_angle")
+            _check_number(name, value, positive=positive)
+        if len(self.support_marker) != 3:
+            raise ValueError(f"support_marker must have 3 coordinates (got {self.support_marker})")
+        for value in self.support_marker:
+            _check_number("support_marker", value, positive=False)
+        if not -1.0 < self.plate_poisson < 0.5:
+            raise ValueError(f"plate_poisson must lie in (-1, 0.5) (got {self.plate_poisson})")
+        if self.appendix_length <= self.mesh_plates:
+            raise ValueError(
+                f"setup_length {self.setup_length} m leaves no room for the appendix beyond the "
+                f"rod, which ends at x = {self.appendix_x} m"
+            )
+        chord = 2.0 * self.tape.radius * math.sin(self.tape.alpha / 2.0)
+        if self.tape_spacing <= chord:
+            raise ValueError(
+                f"tape_spacing {self.tape_spacing} m must exceed the tapes' chord {chord:.4g} m "
+                "(they would overlap)"
+            )
+        if self.rod_length < self.tape_spacing + self.interface_width:
+            raise ValueError(
+                f"rod_length {self.rod_length} m must span both interfaces "
+                f"(>= tape_spacing + interface_width = "
+                f"{self.tape_spacing + self.interface_width} m)"
+            )
+        if self.appendix_width > self.rod_length:
+            raise ValueError("appendix_width must not exceed rod_length")
+        for name in ("mesh_tape", "mesh_plates"):
+            size = getattr(self, name)
+            if size > self.tape.length / 4.0:
+                raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
+
+
+def check_sense(sense: str) -> None:
+    """Raise ValueError unless `sense` is ``"opposite"`` or ``"equal"``."""
+    if sense not in SENSES:
+        raise ValueError(f"sense must be one of {SENSES} (got {sense!r})")
+
+
+def _check_number(name: str, value: object, *, positive: bool) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{name} must be a number (got {value!r})")
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite (got {value})")
+    if positive and value <= 0.0:
+        raise ValueError(f"{name} must be > 0 (got {value})")
+
+
+#: The set-up with the paper's figures and this project's choices.
+PAPER_SETUP = SetupSpec()
+
+
+@dataclass(frozen=True)
+class SetupModel:
+    """A built set-up: the model and the nodes the scenarios drive and read.
+
+    Attributes
+    ----------
+    model : tapespring.Model
+        Tapes, rod, appendix (shells), interfaces and weight (rigid bodies), the clamp, gravity
+        (id ``"gravity"``, ramped in over the load factor 0 to 1 and constant after) and the
+        markers ``marker0`` to ``marker3`` (``marker3`` absent in the bare configuration).
+    spec : SetupSpec
+        What it was built from.
+    configuration, sense : str
+        See :data:`CONFIGURATIONS` and :data:`SENSES`.
+    clamp : int
+        Reference node of the clamped ends (fixed; its reactions are the forces the support
+        feels from the tapes).
+    interfaces : tuple of int
+        Reference nodes of the two small interfaces.
+    rod_middle : int
+        The rod's middle node (marker 2, where the fold and the pull are driven).
+    tip : int or None
+        The node carrying marker 3: the appendix's tip node or the weight's reference node.
+    down : float
+        Sign of "downwards" along z in this frame: -1 in opposite sense, +1 in equal sense.
+    """
+
+    model: Any
+    spec: SetupSpec
+    configuration: str
+    sense: str
+    clamp: int
+    interfaces: tuple[int, int]
+    rod_middle: int
+    tip: int | None
+    down: float
+
+    @property
+    def gravity_vector(self) -> tuple[float, float, float]:
+        """Gravitational acceleration in the set-up's frame [m/s^2]."""
+        return (0.0, 0.0, self.down * self.spec.gravity)
+
+
+def _count(length: float, size: float, *, even: bool = False) -> int:
+    n = max(1, math.ceil(length / size - 1e-9))
+    if even and n % 2:
+        n += 1
+    return n
+
+
+def _box_inertia(mass: float, a: float, b: float, c: float) -> list[list[float]]:
+    """Inertia tensor [kg m^2] of a uniform box of sides a, b, c about its centre."""
+    return [
+        [mass * (b * b + c * c) / 12.0, 0.0, 0.0],
+        [0.0, mass * (a * a + c * c) / 12.0, 0.0],
+        [0.0, 0.0, mass * (a * a + b * b) / 12.0],
+    ]
+
+
+def build_setup(
+    spec: SetupSpec = PAPER_SETUP, *, configuration: str = "appendix", sense: str = "opposite"
+) -> SetupModel:
+    """Build the model of the set-up in one of its configurations.
+
+    The tapes (one part each, ``tape0`` at y = -spacing/2 and ``tape1`` at +spacing/2) have
+    their x = 0 sections tied to the clamp node, fixed, and their x = L sections tied to the
+    small interfaces' reference nodes; each interface also holds the rod's near edge over its
+    width. The rod (part ``rod``) lies flat in the plane z = 0 of the tapes' mid-line. The
+    appendix (part ``appendix``) or the weight (a rigid body) is tied to the rod's far edge
+    over its width.
+
+    Parameters
+    ----------
+    spec : SetupSpec
+        Dimensions and materials.
+    configuration : str
+        ``"appendix"``, ``"bare"`` or ``"weight"``.
+    sense : str
+        ``"opposite"`` or ``"equal"``: the sign of gravity along z in the set-up's frame.
+
+    Returns
+    -------
+    SetupModel
+
+    Raises
+    ------
+    ValueError
+        For a bad spec, configuration or sense.
+    """
+    from tapespring import _core
+    from tapespring.analysis import Model, ramp
+    from tapespring.shell import flat_plate_mesh, tape_spring_mesh
+
+    spec.validate()
+    check_sense(sense)
+    if configuration not in CONFIGURATIONS:
+        raise ValueError(f"configuration must be one of {CONFIGURATIONS} (got {configuration!r})")
+    tape = spec.tape
+    down = -1.0 if sense == "opposite" else 1.0
+    model = Model()
+    tape_section = {
+        "thickness": tape.thickness,
+        "youngs_modulus": tape.youngs_modulus,
+        "poisson": tape.poisson,
+        "density": tape.density,
+    }
+    mesh = tape_spring_mesh(tape.length, tape.radius, tape.alpha, spec.mesh_tape)
+    half = spec.tape_spacing / 2.0
+    for i, y in enumerate((-half, half)):
+        model.add_part(
+            f"tape{i}", mesh.nodes, mesh.quads, translation=[0.0, y, 0.0],
+            node_sets=mesh.node_sets, **tape_section,
+        )  # fmt: skip
+    zc = _core.tape_section_centroid_z(tape.radius, tape.alpha)
+
+    clamp = model.add_node([0.0, 0.0, zc])
+    ends = np.concatenate([model.node_set("tape0.end0"), model.node_set("tape1.end0")])
+    model.tie(ends, clamp)
+    model.fix(clamp, "all", id="clamp")
+
+    def plate(name: str, lx: float, ly: float, thickness: float, mass: float, x0: float) -> None:
+        nx = _count(lx, spec.mesh_plates, even=True)
+        ny = _count(ly, spec.mesh_plates, even=True)
+        nodes, quads, sets = flat_plate_mesh(lx, ly, nx, ny)
+        model.add_part(
+            name, nodes, quads, translation=[x0, -ly / 2.0, 0.0], node_sets=sets,
+            thickness=thickness, youngs_modulus=spec.plate_youngs_modulus,
+            poisson=spec.plate_poisson, density=mass / (lx * ly * thickness),
+        )  # fmt: skip
+
+    plate("rod", spec.rod_width, spec.rod_length, spec.rod_thickness, spec.rod_mass, spec.rod_x)
+    nodes = model.nodes
+    rod_near = model.node_set("rod.x0")
+    rod_far = model.node_set("rod.x1")
+
+    def within(ids: NDArray[np.int64], y: float, width: float) -> NDArray[np.int64]:
+        return ids[np.abs(nodes[ids, 1] - y) <= width / 2.0 + 1e-9]
+
+    interfaces = []
+    x_if = tape.length + spec.interface_length / 2.0
+    for i, y in enumerate((-half, half)):
+        node = model.add_node([x_if, y, zc])
+        held = np.concatenate(
+            [model.node_set(f"tape{i}.end1"), within(rod_near, y, spec.interface_width)]
+        )
+        model.tie(held, node)
+        inertia = _box_inertia(
+            spec.interface_mass,
+            spec.interface_length,
+            spec.interface_width,
+            spec.interface_height,
+        )
+        model.add_rigid_body(node, spec.interface_mass, inertia=inertia)
+        interfaces.append(node)
+    rod_middle = model.nearest_node([spec.rod_x + spec.rod_width / 2.0, 0.0, 0.0])
+
+    tip: int | None = None
+    if configuration == "appendix":
+        plate(
+            "appendix",
+            spec.appendix_length,
+            spec.appendix_width,
+            spec.appendix_thickness,
+            spec.appendix_mass,
+            spec.appendix_x,
+        )
+        joint = model.add_node([spec.appendix_x, 0.0, 0.0])
+        held = np.concatenate(
+            [model.node_set("appendix.x0"), within(rod_far, 0.0, spec.appendix_width)]
+        )
+        model.tie(held, joint)
+        tip = model.nearest_node([spec.setup_length, 0.0, 0.0])
+    elif configuration == "weight":
+        tip = model.add_node([spec.appendix_x, 0.0, 0.0])
+        model.tie(within(rod_far, 0.0, spec.weight_width), tip)
+        inertia = _box_inertia(
+            spec.weight_mass, spec.weight_length, spec.weight_width, spec.weight_height
+        )
+        # The block hangs below the rod (away from the tapes' centre of curvature).
+        com = [spec.weight_length / 2.0, 0.0, -spec.weight_height / 2.0]
+        model.add_rigid_body(tip, spec.weight_mass, centre_of_mass=com, inertia=inertia)
+
+    model.set_gravity([0.0, 0.0, down * spec.gravity], function=ramp(0.0, 1.0), id="gravity")
+    model.add_marker("marker0", clamp, offset=np.asarray(spec.support_marker) - [0.0, 0.0, zc])
+    model.add_marker("marker1", interfaces[0])
+    model.add_marker("marker2", rod_middle)
+    if configuration == "appendix":
+        model.add_marker("marker3", tip)
+    elif configuration == "weight":
+        model.add_marker("marker3", tip, offset=[spec.weight_length, 0.0, 0.0])
+    return SetupModel(
+        model=model,
+        spec=spec,
+        configuration=configuration,
+        sense=sense,
+        clamp=clamp,
+        interfaces=(interfaces[0], interfaces[1]),
+        rod_middle=rod_middle,
+        tip=tip,
+        down=down,
+    )
