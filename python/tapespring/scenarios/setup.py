@@ -17,9 +17,11 @@ from numpy.typing import NDArray
 
 __all__ = [
     "CONFIGURATIONS",
+    "PAPER_BOUNDS",
     "PAPER_SETUP",
     "PAPER_TAPE",
     "SENSES",
+    "IdentificationBounds",
     "SetupModel",
     "SetupSpec",
     "TapeSpring",
@@ -71,6 +73,28 @@ class TapeSpring:
 
 #: The paper's tape: Table 1 geometry, Table 5 identified thickness and modulus.
 PAPER_TAPE = TapeSpring()
+
+
+@dataclass(frozen=True)
+class IdentificationBounds:
+    """Bounds of the thickness and Young's modulus searched in the identification (Table 4).
+
+    Attributes
+    ----------
+    thickness_min, thickness_max : float
+        Thickness t [m] (Table 4: 0.12 to 0.20 mm).
+    youngs_modulus_min, youngs_modulus_max : float
+        Young's modulus E [Pa] (Table 4: 100 to 220 GPa).
+    """
+
+    thickness_min: float = 0.12e-3
+    thickness_max: float = 0.20e-3
+    youngs_modulus_min: float = 100e9
+    youngs_modulus_max: float = 220e9
+
+
+#: Table 4: the (t, E) range of the identification, also the range of the design study (Fig. 7).
+PAPER_BOUNDS = IdentificationBounds()
 
 
 # ---------------------------------------------------------------------------------------------
