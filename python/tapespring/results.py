@@ -7,15 +7,18 @@ state (time 0, before the first step). Units are SI (m, N, N m, J, rad).
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from tapespring.modes import Modes, SystemMatrices
+
+if TYPE_CHECKING:
+    from tapespring.trials.trial import Metadata, Trial
 
 __all__ = ["Results"]
 
@@ -273,6 +276,35 @@ class Results:
         if hits.size == 0:
             raise KeyError(f"the fields of record {r} were not kept (kept: {self.field_records})")
         return self.displacements[hits[0]], self.rotations[hits[0]]
+
+    def to_trial(
+        self,
+        *,
+        markers: Mapping[str, str],
+        force_nodes: Sequence[int] | None = None,
+        rate_hz: float = 800.0,
+        force_rate_hz: float = 1000.0,
+        steps: Sequence[int] | None = None,
+        origin: ArrayLike | None = None,
+        metadata: Metadata | None = None,
+    ) -> Trial:
+        """The history sampled like a motion-capture trial (markers at `rate_hz` [Hz], the force
+        plate from the reactions at `force_nodes`, with the sign a plate under the support reads).
+
+        See :func:`tapespring.trials.simulated.results_to_trial` for the parameters.
+        """
+        from tapespring.trials.simulated import results_to_trial
+
+        return results_to_trial(
+            self,
+            markers=markers,
+            force_nodes=force_nodes,
+            rate_hz=rate_hz,
+            force_rate_hz=force_rate_hz,
+            steps=steps,
+            origin=origin,
+            metadata=metadata,
+        )
 
     def in_step(self, step: int) -> NDArray[np.int64]:
         """Indices of the records of analysis step `step` (the initial state belongs to none)."""

@@ -17,6 +17,9 @@ c3d_check, c3d_worker
     The structural check of a C3D file and the worker process ezc3d runs in.
 samples
     Synthetic trials with known answers, for tests, examples and benchmarks.
+simulated
+    `results_to_trial`: the history of an analysis sampled like a motion-capture trial (markers
+    at a uniform rate, the force plate from the support's reactions).
 
 The names below are imported on first use.
 """
@@ -42,6 +45,7 @@ __all__ = [
     "read_c3d",
     "read_csv",
     "read_trial",
+    "results_to_trial",
     "write_c3d",
     "write_csv",
 ]
@@ -62,6 +66,7 @@ __getattr__, __dir__ = lazy_exports(
             "read_metadata_file",
             "read_trial",
         ],
+        "simulated": ["results_to_trial"],
         "trial": ["SENSES", "ForcePlate", "Gap", "Metadata", "Trial", "TrialError", "TrialWarning"],
     },
 )

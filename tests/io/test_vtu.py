@@ -1,0 +1,82 @@
+"""ParaView series: a strip cantilever bent by a tip load in four increments, its fields kept at
+every other record; the VTU files read back with meshio give the deformed positions."""
+
+from __future__ import annotations
+
+import sys
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+import pytest
+from tapespring.analysis import Model, Outputs, Step, run
+from tapespring.io import write_pvd
+from tapespring.shell import flat_plate_mesh
+
+
+@pytest.fixture(scope="module")
+def bent():
+    nodes, quads, sets = flat_plate_mesh(0.1, 0.01, 6, 1)
+    model = Model(nodes, quads, node_sets=sets, thickness=1e-3, youngs_modulus=2e11, poisson=0.0)
+    model.fix("x0", "all")
+    tip = model.add_node([0.1, 0.005, 0.0])
+    model.tie("x1", tip)
+    model.add_load(tip, "uz", 20.0)
+    results = run(model, [Step.static("load", increments=4)], outputs=Outputs(field_interval=2))
+    return model, tip, results
+
+
+def test_series_holds_the_deformed_mesh(bent, tmp_path):
+    model, tip, r = bent
+    pvd = write_pvd(r, model, tmp_path / "out" / "bent")
+    assert pvd == tmp_path / "out" / "bent.pvd"
+    root = ET.parse(pvd).getroot()
+    assert root.get("type") == "Collection"
+    datasets = root.findall("Collection/DataSet")
+    assert [float(d.get("timestep")) for d in datasets] == r.t[r.field_records].tolist()
+    files = [d.get("file") for d in datasets]
+    assert files == [f"bent/bent_{k:06d}.vtu" for k in r.field_records]
+    for record, name in zip(r.field_records, files, strict=True):
+        mesh = meshio.read(pvd.parent / name)
+        u, theta = r.field(record)
+        np.testing.assert_allclose(mesh.points, model.nodes + u)
+        np.testing.assert_allclose(mesh.point_data["displacement"], u)
+        np.testing.assert_allclose(mesh.point_data["rotation"], theta)
+        np.testing.assert_array_equal(mesh.cells_dict["quad"], model.quads)
+        # The tip's reference node belongs to no element: written as a vertex cell.
+        np.testing.assert_array_equal(mesh.cells_dict["vertex"].ravel(), [tip])
+    # The tip moved up by the load; the record of the last state shows it.
+    assert meshio.read(pvd.parent / files[-1]).points[tip, 2] > 1e-3
+
+
+def test_chosen_records_and_the_saved_mesh(bent, tmp_path):
+    # Results read back from a file carry the mesh in their settings: no model needed.
+    _, tip, r = bent
+    pvd = write_pvd(r, None, tmp_path / "last.pvd", records=[-1])
+    datasets = ET.parse(pvd).getroot().findall("Collection/DataSet")
+    assert len(datasets) == 1 and float(datasets[0].get("timestep")) == r.t[-1]
+    mesh = meshio.read(tmp_path / datasets[0].get("file"))
+    np.testing.assert_allclose(mesh.points[tip], [0.1, 0.005, 0.0] + r.field(-1)[0][tip])
+
+
+def test_missing_fields_and_mismatched_model_are_refused(bent, tmp_path):
+    model, _, r = bent
+    no_fields = run(model, [Step.static("load", increments=1)])
+    with pytest.raises(ValueError, match=r"no nodal fields.*field_interval"):
+        write_pvd(no_fields, model, tmp_path / "none.pvd")
+    assert r.field_records.tolist() == [0, 2, 4]
+    with pytest.raises(ValueError, match=r"fields of record\(s\) \[1, 3\] were not kept"):
+        write_pvd(r, model, tmp_path / "bad.pvd", records=[1, -2])
+    with pytest.raises(ValueError, match=r"record\(s\) \[5\] out of range"):
+        write_pvd(r, model, tmp_path / "bad.pvd", records=[5])
+    mesh = flat_plate_mesh(0.1, 0.01, 2, 1)
+    other = Model(*mesh[:2], thickness=1e-3, youngs_modulus=2e11, poisson=0.3)
+    with pytest.raises(ValueError, match="the model has 6 nodes but the results' fields have 15"):
+        write_pvd(r, other, tmp_path / "other.pvd")
+
+
+def test_without_meshio_the_error_says_how_to_install_it(bent, tmp_path, monkeypatch):
+    model, _, r = bent
+    monkeypatch.setitem(sys.modules, "meshio", None)
+    with pytest.raises(ImportError, match="pip install meshio"):
+        write_pvd(r, model, tmp_path / "x.pvd")

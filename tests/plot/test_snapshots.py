@@ -1,0 +1,52 @@
+"""Snapshots of the deformed model (Fig. 13 style): a PNG is drawn from records and times."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import pytest
+from tapespring.analysis import Model, Outputs, Step, run
+from tapespring.plot.snapshots import plot_snapshots
+from tapespring.shell import flat_plate_mesh
+
+
+@pytest.fixture(scope="module")
+def bent():
+    nodes, quads, sets = flat_plate_mesh(0.1, 0.01, 6, 1)
+    model = Model(nodes, quads, node_sets=sets, thickness=1e-3, youngs_modulus=2e11, poisson=0.0)
+    model.fix("x0", "all")
+    tip = model.add_node([0.1, 0.005, 0.0])
+    model.tie("x1", tip)
+    model.add_load(tip, "uz", 20.0)
+    results = run(model, [Step.static("load", increments=4)], outputs=Outputs(field_interval=2))
+    return model, results
+
+
+def test_snapshots_png_is_written(bent, tmp_path):
+    model, r = bent
+    ax = plot_snapshots(r, model, [0, 0.5, -1])
+    assert ax.get_xlabel() == "x [mm]" and ax.get_ylabel() == "z [mm]"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "t = 0 s",
+        "t = 0.5 s",
+        "t = 1 s",
+    ]
+    # The deformed tip, in mm, is within the drawn limits.
+    assert ax.get_ylim()[1] >= 1e3 * r.field(-1)[0][:, 2].max()
+    path = tmp_path / "snapshots.png"
+    ax.figure.savefig(path, dpi=60)
+    plt.close(ax.figure)
+    assert path.stat().st_size > 1000
+
+
+def test_snapshots_refuse_bad_views_and_records(bent):
+    model, r = bent
+    fig, ax = plt.subplots()
+    plot_snapshots(r, None, [-1], view="xy", ax=ax, legend=False)
+    assert ax.get_legend() is None
+    with pytest.raises(ValueError, match="view must be two distinct letters"):
+        plot_snapshots(r, model, [-1], view="xx", ax=ax)
+    with pytest.raises(ValueError, match=r"fields of record 1 were not kept"):
+        plot_snapshots(r, model, [1], ax=ax)
+    with pytest.raises(ValueError, match="records_or_times is empty"):
+        plot_snapshots(r, model, [], ax=ax)
+    plt.close(fig)
