@@ -208,9 +208,11 @@ class SetupSpec:
       mm from the clamp, 74 mm from the tapes' middle: eq. (1) with the analytical equal-sense
       residual moment of two tapes (0.062 N m) then allows 86 g there, so 77 g deploys in both
       senses, as the set-up was designed to (Sec. 3.1).
-    * the additional weight (Figs. 21, 25): a rigid steel block fixed under the rod's middle,
-      ``weight_length`` along x beyond the rod, marker 3 at its tip; its mass is pinned by
-      Table 6 (see ``weight_mass``).
+    * the additional weight (Figs. 21, 25): a rigid steel block (50 x 20 x 20 mm) fixed under
+      the rod's middle and reaching beyond it along x, marker 3 at its tip. Its mass, 120 g, is
+      pinned by Table 6: it puts marker 3 of the folded equilibrium 114 mm below its deployed
+      position (Table 6: 111.6 mm) on a 5 mm mesh. The small-vibration period (Table 8) is
+      then a prediction.
     * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp; marker 1 on top
       of the first small interface; marker 2 on the rod's middle; marker 3 at the tip of the
       appendix or the weight; markers 1-3 15 mm above the tapes' mid-line plane (an active
@@ -225,6 +227,9 @@ class SetupSpec:
     ----------
     tape : TapeSpring
         Geometry and material of each tape (Tables 1 and 5).
+    eta : float
+        Kelvin-Voigt viscosity of the tapes [s] (Table 8: 1.73e-4; the paper's single
+        equivalent parameter for the damping of the whole structure, Sec. 5).
     tape_spacing : float
         Distance between the two tapes' mid-lines [m].
     mesh_tape, mesh_plates : float
@@ -261,6 +266,7 @@ class SetupSpec:
     """
 
     tape: TapeSpring = PAPER_TAPE
+    eta: float = PAPER_MODEL.eta
     tape_spacing: float = 0.040
     mesh_tape: float = 2e-3
     mesh_plates: float = 3e-3
@@ -278,7 +284,7 @@ class SetupSpec:
     plate_youngs_modulus: float = 70e9
     plate_poisson: float = 0.33
     setup_length: float = 0.235
-    weight_mass: float = 0.060
+    weight_mass: float = 0.120
     weight_length: float = 0.050
     weight_width: float = 0.020
     weight_height: float = 0.020
@@ -335,12 +341,14 @@ class SetupSpec:
         for name, value in vars(self).items():
             if name in ("tape", "support_marker"):
                 continue
-            positive = not name.startswith("initial_angle")
+            positive = not name.startswith("initial_angle") and name != "eta"
             _check_number(name, value, positive=positive)
         if len(self.support_marker) != 3:
             raise ValueError(f"support_marker must have 3 coordinates (got {self.support_marker})")
         for value in self.support_marker:
             _check_number("support_marker", value, positive=False)
+        if self.eta < 0.0:
+            raise ValueError(f"eta must be >= 0 s (got {self.eta})")
         if not -1.0 < self.plate_poisson < 0.5:
             raise ValueError(f"plate_poisson must lie in (-1, 0.5) (got {self.plate_poisson})")
         if self.appendix_length <= self.mesh_plates:
@@ -492,6 +500,7 @@ def build_setup(
         "youngs_modulus": tape.youngs_modulus,
         "poisson": tape.poisson,
         "density": tape.density,
+        "eta": spec.eta,
     }
     mesh = tape_spring_mesh(tape.length, tape.radius, tape.alpha, spec.mesh_tape)
     half = spec.tape_spacing / 2.0
