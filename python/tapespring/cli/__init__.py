@@ -8,6 +8,9 @@ bend
 release
     A tape spring with a tip body folded, released and followed in time (issue 8, 6.g; see
     :mod:`tapespring.cli.release`).
+max-mass
+    Largest free-end mass two tape springs deploy passively against gravity, over a grid of
+    thickness and Young's modulus (paper Sec. 3.1, Fig. 7; see :mod:`tapespring.cli.max_mass`).
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -28,7 +31,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, release, trials
+    from . import bend, max_mass, release, trials
 
     parser = argparse.ArgumentParser(
         prog="tapespring",
@@ -37,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     bend.register(sub)
     release.register(sub)
+    max_mass.register(sub)
     trials.register(sub)
     return parser
 

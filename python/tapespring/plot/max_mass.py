@@ -1,0 +1,190 @@
+"""The maximum mass for a passive deployment over (t, E), like the paper's Fig. 7."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from tapespring.scenarios.max_mass import MaxMassResult
+
+__all__ = ["plot_max_mass", "plot_max_mass_figure"]
+
+_EQUATION = {"opposite": "eq. (2)", "equal": "eq. (3)"}
+
+
+def plot_max_mass(
+    result: MaxMassResult,
+    *,
+    sense: str = "equal",
+    ax: Axes | None = None,
+    analytical: bool = True,
+    levels: int | np.ndarray | None = None,
+    colorbar: bool = True,
+    resolution: int = 121,
+) -> Axes:
+    """Contours of the maximum mass m_max [g] over thickness [mm] and Young's modulus [GPa].
+
+    The finite-element field is filled and drawn in solid, labelled contours; between the grid
+    points it is the interpolated ratio FE / analytical times the analytical mass
+    (:meth:`MaxMassResult.m_max_at`), so the contours follow the exact ``E t^3`` dependence
+    instead of straight segments between the points. The analytical masses (eqs. 1-3) are the
+    dashed red contours at the same levels. Dots mark the runs; a star marks the paper's tape
+    (Table 5) when it lies in the grid.
+
+    Parameters
+    ----------
+    result : MaxMassResult
+        A study with at least two values of t and of E.
+    sense : str
+        ``"equal"`` (the paper's Fig. 7) or ``"opposite"``; must be in the result.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure is made if None.
+    analytical : bool
+        Draw the analytical contours.
+    levels : int or array, optional
+        Contour levels [g], or their number; about 10 rounded levels by default.
+    colorbar : bool
+        Add a colour bar for the filled field.
+    resolution : int
+        Points per axis of the interpolated field, >= 2.
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Raises
+    ------
+    ValueError
+        If the grid has fewer than two values of t or of E, or the sense is not in the result.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import MaxNLocator
+
+    from tapespring.scenarios.max_mass import analytical_max_mass
+    from tapespring.scenarios.setup import PAPER_TAPE
+
+    i = result.sense_index(sense)
+    if result.thickness.size < 2 or result.youngs_modulus.size < 2:
+        raise ValueError(
+            "a contour plot needs at least 2 values of t and of E "
+            f"(got {result.thickness.size} x {result.youngs_modulus.size})"
+        )
+    if resolution < 2:
+        raise ValueError(f"resolution must be >= 2 (got {resolution})")
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.0, 5.0), constrained_layout=True)
+    t = np.linspace(result.thickness[0], result.thickness[-1], resolution)
+    e = np.linspace(result.youngs_modulus[0], result.youngs_modulus[-1], resolution)
+    tt, ee = np.meshgrid(t, e)
+    x, y = tt * 1e3, ee / 1e9
+    fe = np.ma.masked_invalid(result.m_max_at(sense, tt, ee) * 1e3)
+    an = analytical_max_mass(result.settings, sense, tt, ee) * 1e3
+    if levels is None or isinstance(levels, int):
+        values = np.concatenate([fe.compressed(), an.ravel()])
+        ticks = MaxNLocator(nbins=levels or 10).tick_values(values.min(), values.max())
+        levels = np.asarray(ticks, dtype=float)
+    else:
+        levels = np.asarray(levels, dtype=float)
+
+    handles = []
+    if fe.count():
+        filled = ax.contourf(x, y, fe, levels=levels, cmap="Blues", alpha=0.85, extend="both")
+        lines = ax.contour(x, y, fe, levels=levels, colors="black", linewidths=0.9)
+        ax.clabel(lines, fmt="%g", fontsize=7.5, inline=True, inline_spacing=3)
+        if colorbar:
+            cb = ax.figure.colorbar(filled, ax=ax, shrink=0.95, pad=0.02)
+            cb.set_label(r"$m_{\max}$ [g] (finite elements)")
+        handles.append(Line2D([], [], color="black", linewidth=0.9, label="finite elements"))
+    if analytical:
+        lines_an = ax.contour(
+            x, y, an, levels=levels, colors="tab:red", linewidths=1.0, linestyles="--"
+        )
+        ax.clabel(lines_an, fmt="%g", fontsize=7, inline=True, inline_spacing=3)
+        handles.append(
+            Line2D([], [], color="tab:red", linestyle="--", label=f"analytical, {_EQUATION[sense]}")
+        )
+    gt, ge = np.meshgrid(result.thickness * 1e3, result.youngs_modulus / 1e9, indexing="ij")
+    done = np.isfinite(result.residual_moment[i])
+    ax.plot(gt[done], ge[done], "k.", markersize=4, linestyle="none", clip_on=False, zorder=5)
+    handles.append(Line2D([], [], color="black", marker=".", linestyle="none", label="runs"))
+    if (~done).any():
+        ax.plot(
+            gt[~done],
+            ge[~done],
+            "x",
+            color="tab:red",
+            markersize=6,
+            linestyle="none",
+            clip_on=False,
+        )
+        handles.append(
+            Line2D([], [], color="tab:red", marker="x", linestyle="none", label="failed run")
+        )
+    paper = result.paper_tape_m_max(sense)
+    if paper is not None:
+        px, py = PAPER_TAPE.thickness * 1e3, PAPER_TAPE.youngs_modulus / 1e9
+        ax.plot(px, py, marker="*", color="gold", markeredgecolor="black", markersize=12)
+        ax.annotate(
+            f"{paper * 1e3:.0f} g",
+            (px, py),
+            xytext=(7, 5),
+            textcoords="offset points",
+            fontsize=8,
+            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "0.6", "alpha": 0.9},
+        )
+        handles.append(
+            Line2D(
+                [],
+                [],
+                marker="*",
+                color="gold",
+                markeredgecolor="black",
+                markersize=10,
+                linestyle="none",
+                label="paper's tape (Table 5)",
+            )
+        )
+    ax.set_xlabel("thickness $t$ [mm]")
+    ax.set_ylabel("Young's modulus $E$ [GPa]")
+    ax.set_title(f"{sense} sense", fontsize=11)
+    # Below the axes: inside, it would hide contours and their labels.
+    ax.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.13),
+        ncol=len(handles),
+        fontsize=7.5,
+        frameon=False,
+        handlelength=1.8,
+        columnspacing=1.2,
+    )
+    return ax
+
+
+def plot_max_mass_figure(result: MaxMassResult) -> Figure:
+    """One panel per sense of `result` (:func:`plot_max_mass`), side by side, with a title.
+
+    Returns
+    -------
+    matplotlib Figure
+    """
+    import matplotlib.pyplot as plt
+
+    n = len(result.senses)
+    fig, axes = plt.subplots(1, n, figsize=(6.0 * n, 5.2), constrained_layout=True, squeeze=False)
+    for ax, sense in zip(axes[0], result.senses, strict=True):
+        plot_max_mass(result, sense=sense, ax=ax)
+    st = result.settings
+    fig.suptitle(
+        "Maximum mass for a passive deployment\n"
+        rf"$m_{{\max}} = 2\,|M^*({st.angle_deg:g}°)|\,/\,(g\,l)$, "
+        f"$l$ = {result.lever_arm * 1e3:g} mm, {st.mesh_size * 1e3:g} mm mesh",
+        fontsize=10.5,
+    )
+    return fig
