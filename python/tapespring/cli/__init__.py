@@ -11,6 +11,9 @@ release
 max-mass
     Largest free-end mass two tape springs deploy passively against gravity, over a grid of
     thickness and Young's modulus (paper Sec. 3.1, Fig. 7; see :mod:`tapespring.cli.max_mass`).
+deploy, pull, vibrate
+    The paper's set-up: deployment (Sec. 4.1, 6.1), quasi-static pull (Sec. 4.2, 6.2) and
+    small-amplitude vibrations (Sec. 5.2); see :mod:`tapespring.scenarios`.
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -31,7 +34,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, max_mass, release, trials
+    from . import bend, deploy, max_mass, pull, release, trials, vibrate
 
     parser = argparse.ArgumentParser(
         prog="tapespring",
@@ -40,6 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     bend.register(sub)
     release.register(sub)
+    deploy.register(sub)
+    pull.register(sub)
+    vibrate.register(sub)
     max_mass.register(sub)
     trials.register(sub)
     return parser

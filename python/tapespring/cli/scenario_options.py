@@ -1,0 +1,136 @@
+"""Options shared by the set-up's commands (``deploy``, ``pull``, ``vibrate``): the set-up spec's
+main values and the outputs, and the code that writes a scenario's outputs."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from .bend import _positive
+
+__all__ = ["add_output_options", "add_spec_options", "finish", "spec_from_args"]
+
+
+def add_spec_options(p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float) -> None:
+    """Add the set-up's options (mesh sizes, tape material, eta) with the given mesh defaults."""
+    from tapespring.scenarios.setup import PAPER_SETUP
+
+    s = PAPER_SETUP
+    g = p.add_argument_group("set-up (paper's values and this project's choices by default)")
+    g.add_argument(
+        "--mesh-tape",
+        type=_positive("mesh size"),
+        default=mesh_tape,
+        help=f"element size of the tapes [m] (paper: 2e-3; default {mesh_tape:g})",
+    )
+    g.add_argument(
+        "--mesh-plates",
+        type=_positive("mesh size"),
+        default=mesh_plates,
+        help=f"element size of the rod and appendix [m] (paper: 3e-3; default {mesh_plates:g})",
+    )
+    g.add_argument(
+        "--thickness", type=_positive("thickness"), default=s.tape.thickness, help="t [m]"
+    )
+    g.add_argument(
+        "--youngs-modulus",
+        type=_positive("Young's modulus"),
+        default=s.tape.youngs_modulus,
+        help="E [Pa]",
+    )
+    g.add_argument(
+        "--eta", type=_positive("eta", zero=True), default=s.eta, help="Kelvin-Voigt eta [s]"
+    )
+
+
+def spec_from_args(args: argparse.Namespace) -> Any:
+    """The :class:`SetupSpec` of the parsed options."""
+    from dataclasses import replace
+
+    from tapespring.scenarios.setup import PAPER_SETUP
+
+    tape = replace(PAPER_SETUP.tape, thickness=args.thickness, youngs_modulus=args.youngs_modulus)
+    return replace(
+        PAPER_SETUP,
+        tape=tape,
+        eta=args.eta,
+        mesh_tape=args.mesh_tape,
+        mesh_plates=args.mesh_plates,
+    )
+
+
+def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
+    """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
+    p.add_argument("--csv", help=f"write {csv_what} to this CSV file")
+    p.add_argument("--plot", help="write the figure to this PNG file")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def write_columns(path: str, columns: dict[str, Sequence[float]]) -> None:
+    """Write equal-length columns to a CSV file."""
+    names = list(columns)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(names)
+        for row in zip(*(columns[n] for n in names), strict=True):
+            w.writerow([f"{v:.9g}" for v in row])
+
+
+def finish(
+    args: argparse.Namespace,
+    run: Callable[[], Any],
+    columns: Callable[[Any], dict[str, Sequence[float]]],
+    plot: Callable[[Any, str], None],
+) -> int:
+    """Run a scenario and write its outputs; returns the exit code.
+
+    0 on success; 1 if the run stopped early (what was computed is still written); 2 on bad
+    input (the message on stderr).
+    """
+    from tapespring.analysis import ConvergenceError
+
+    failure = None
+    try:
+        result = run()
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except ConvergenceError as exc:
+        result = getattr(exc, "result", None)
+        if result is None:
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+        failure = str(exc)
+    if args.csv:
+        write_columns(args.csv, columns(result))
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")  # files only: no display needed
+        plot(result, args.plot)
+    if args.json:
+        print(json.dumps(result.summary(), default=_plain))
+    else:
+        print(result.describe())
+        for name in ("csv", "plot"):
+            if getattr(args, name):
+                print(f"  wrote {getattr(args, name)}")
+    if failure is not None:
+        print(f"error: {failure}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _plain(value: Any) -> Any:
+    import numpy as np
+
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)

@@ -1,0 +1,403 @@
+"""Deployment of the set-up (paper Sec. 4.1 and 6.1, Figs. 12-14, 17-18, 27-33).
+
+The set-up with the dummy appendix (:func:`tapespring.scenarios.setup.build_setup`,
+configuration ``"appendix"``), in opposite or equal sense, in four analysis steps:
+
+1. ``gravity`` (static): the deployed equilibrium under gravity, the reference of the bending
+   angle.
+2. ``fold`` (static): the rod's middle (marker 2) is driven along a circular arc to the position
+   at which the bending angle, measured as in the experiments from the support marker to marker
+   2, equals the paper's initial angle (+95.5 or -91.2 deg); the path passes the buckling of the
+   tapes on an arc-length path (jumping at the snap). The paper drives that node at under 2 mm/s
+   and then holds it 5 s so that the motion dies out: the equilibrium of a static step is the
+   state both lead to, so neither the rate nor the hold is simulated (``settle`` adds a dynamic
+   hold if wanted).
+3. ``settle`` (dynamic, optional, ``settle > 0``): the fold held for that time.
+4. ``release`` (dynamic): marker 2 is released with accelerations consistent with the state
+   (no jolt) and the set-up deploys for ``duration`` seconds (generalised-alpha, ``rho_inf``,
+   adaptive steps landing on the marker sampling instants).
+
+The bending angle is that of the experiments (:func:`tapespring.signals.angle.bending_angle`
+from the support marker to marker 2), relative to the gravity equilibrium of step 1 (exact, where
+a measured record uses its tail). Peaks and phases go through the measured records' analysis
+(:func:`tapespring.signals.peaks.extract_peaks`, :func:`tapespring.signals.phases.detect_phases`);
+:meth:`DeploymentSimulation.to_trial` turns the run into a :class:`tapespring.trials.Trial`
+(markers M1 support, M2 rod, M3 appendix tip; the force plate under the clamp) for the trial
+tool chain.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tapespring.scenarios.setup import (
+    PAPER_MODEL,
+    PAPER_SETUP,
+    SetupModel,
+    SetupSpec,
+    build_setup,
+    check_sense,
+)
+
+__all__ = ["DeploymentSettings", "DeploymentSimulation", "deploy", "fold_target"]
+
+#: Trial marker names of the set-up's markers (the trial tool chain's M1 support, M2 rod, M3 tip).
+TRIAL_MARKERS = {"marker0": "M1", "marker2": "M2", "marker3": "M3"}
+
+
+@dataclass(frozen=True)
+class DeploymentSettings:
+    """What a deployment run does.
+
+    Attributes
+    ----------
+    spec : SetupSpec
+        The set-up (configuration ``"appendix"``); ``spec.eta`` is the tapes' viscosity.
+    sense : str
+        ``"opposite"`` or ``"equal"``.
+    duration : float
+        Motion simulated after the release [s] (paper: 10 s).
+    settle : float
+        Dynamic hold of the fold before the release [s] (0: the static fold's equilibrium).
+    rho_inf : float
+        Spectral radius at infinity of generalised-alpha (paper: 0.7).
+    sample_rate : float
+        Rate of the recorded histories [Hz] (the steps land on its multiples; the paper's motion
+        capture runs at 800 Hz).
+    tolerance : float
+        Local error tolerance of the time steps [m] (0: the solver's default).
+    n_peaks : int
+        Maxima and minima of the bending angle reported (paper: 10).
+    """
+
+    spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)
+    sense: str = "opposite"
+    duration: float = 10.0
+    settle: float = 0.0
+    rho_inf: float = PAPER_MODEL.rho_inf
+    sample_rate: float = 800.0
+    tolerance: float = 1e-4
+    n_peaks: int = 10
+
+    def validate(self) -> None:
+        """Raise ValueError naming a bad value."""
+        self.spec.validate()
+        check_sense(self.sense)
+        for name in ("duration", "sample_rate"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(f"{name} must be a number (got {value!r})")
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"{name} must be finite and > 0 (got {value})")
+        if not (math.isfinite(self.settle) and self.settle >= 0.0):
+            raise ValueError(f"settle must be finite and >= 0 s (got {self.settle})")
+        if not 0.0 <= self.rho_inf <= 1.0:
+            raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
+        if not (math.isfinite(self.tolerance) and self.tolerance >= 0.0):
+            raise ValueError(f"tolerance must be finite and >= 0 (got {self.tolerance})")
+        if not (isinstance(self.n_peaks, int) and self.n_peaks >= 1):
+            raise ValueError(f"n_peaks must be an integer >= 1 (got {self.n_peaks!r})")
+
+
+def _angle(p1: NDArray[np.float64], p2: NDArray[np.float64]) -> float:
+    d = p2 - p1
+    return math.atan2(-d[2], d[0])
+
+
+def fold_target(built: SetupModel, sense: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The path of marker 2's node in the fold: points of a circular arc in the x-z plane.
+
+    The arc turns the node about the middle of the tapes (the fold's place in the paper's
+    Figs. 11 and 13) until the angle of the support-marker-to-marker-2 vector has changed by
+    the paper's initial bending angle.
+
+    Returns
+    -------
+    fraction, displacement : ndarray
+        Path parameter in [0, 1] (shape (k,)) and the node's displacement there [m] (k, 3).
+    """
+    spec = built.spec
+    model = built.model
+    target = math.radians(spec.initial_angle_deg(sense))
+    x = model.nodes[built.rod_middle]
+    marker_offset = np.array([0.0, 0.0, -built.down * spec.marker_height])
+    support = np.asarray(spec.support_marker, dtype=float)
+    pivot = np.array([spec.tape.length / 2.0, 0.0, 0.0])
+
+    def turned(theta: float) -> NDArray[np.float64]:
+        c, s = math.cos(theta), math.sin(theta)
+        r = x - pivot
+        return pivot + np.array([c * r[0] + s * r[2], r[1], -s * r[0] + c * r[2]])
+
+    angle0 = _angle(support, x + marker_offset)
+
+    def change(theta: float) -> float:
+        # The marker turns with the rod.
+        c, s = math.cos(theta), math.sin(theta)
+        m = np.array([s * marker_offset[2], 0.0, c * marker_offset[2]])
+        return _angle(support, turned(theta) + m) - angle0 - target
+
+    lo, hi = 0.0, 2.0 * target
+    for _ in range(200):  # bisection: change() is monotonic in theta over this range
+        mid = 0.5 * (lo + hi)
+        if (change(mid) > 0.0) == (target > 0.0):
+            hi = mid
+        else:
+            lo = mid
+    theta_end = 0.5 * (lo + hi)
+    fraction = np.linspace(0.0, 1.0, 21)
+    path = np.array([turned(f * theta_end) - x for f in fraction])
+    return fraction, path
+
+
+@dataclass(frozen=True)
+class DeploymentSimulation:
+    """A simulated deployment.
+
+    Attributes
+    ----------
+    time_s : ndarray
+        Time from the release [s] (the release state first).
+    angle_deg : ndarray
+        Bending angle relative to the gravity equilibrium [deg].
+    clamp_force_N : ndarray
+        Vertical force on the support from the tapes (the force plate's Fz, with the sign the
+        plate measures) [N].
+    tip_m : ndarray
+        Position of the appendix tip (marker 3) [m], shape (n, 3).
+    peaks : tapespring.signals.peaks.Peaks or None
+        The first ``n_peaks`` maxima and minima of the angle (None if none).
+    phases : tapespring.signals.phases.Phases or None
+    energy : dict of ndarray
+        kinetic, strain, gravity, viscous and numerical energy [J] from the release.
+    settings : DeploymentSettings
+    setup : SetupModel
+    results : tapespring.Results
+    wall_s : float
+    """
+
+    time_s: NDArray[np.float64]
+    angle_deg: NDArray[np.float64]
+    clamp_force_N: NDArray[np.float64]
+    tip_m: NDArray[np.float64]
+    peaks: Any
+    phases: Any
+    energy: dict[str, NDArray[np.float64]]
+    settings: DeploymentSettings
+    setup: SetupModel
+    results: Any
+    wall_s: float
+
+    def to_trial(self, *, rate_hz: float | None = None) -> Any:
+        """The release and the motion as a :class:`tapespring.trials.Trial`.
+
+        Markers M1 (support), M2 (rod), M3 (appendix tip) resampled at `rate_hz` (default: the
+        run's sample rate); one force plate under the clamp (1 kHz).
+        """
+        from tapespring.trials.trial import Metadata
+
+        rate = self.settings.sample_rate if rate_hz is None else rate_hz
+        steps = [len(self.results.step_stats) - 1]
+        meta = Metadata(label=f"simulated deployment ({self.settings.sense} sense)")
+        return self.results.to_trial(
+            markers=TRIAL_MARKERS,
+            force_nodes=[self.setup.clamp],
+            rate_hz=rate,
+            steps=steps,
+            metadata=meta,
+        )
+
+    def summary(self) -> dict[str, Any]:
+        """The figures as JSON-ready values, with the settings."""
+        r = self.results
+        stats = r.step_stats[-1] if len(r.step_stats) else {}
+        peaks: dict[str, Any] = {"max_time_s": [], "max_deg": [], "min_time_s": [], "min_deg": []}
+        if self.peaks is not None:
+            for kind, ext in (("max", self.peaks.maxima), ("min", self.peaks.minima)):
+                peaks[f"{kind}_time_s"] = np.asarray(ext.time).tolist()
+                peaks[f"{kind}_deg"] = np.degrees(np.asarray(ext.value)).tolist()
+        phases = {"phase_ii_start_s": None, "phase_iii_start_s": None}
+        if self.phases is not None:
+            phases = {
+                "phase_ii_start_s": self.phases.phase_ii_start,
+                "phase_iii_start_s": self.phases.phase_iii_start,
+            }
+        lateral = (
+            float(np.max(np.abs(self.tip_m[:, 1] - self.tip_m[0, 1]))) if self.tip_m.size else 0.0
+        )
+        return {
+            "sense": self.settings.sense,
+            "initial_angle_deg": float(self.angle_deg[0]) if self.angle_deg.size else None,
+            "final_angle_deg": float(self.angle_deg[-1]) if self.angle_deg.size else None,
+            "peaks": peaks,
+            "phases": phases,
+            "max_clamp_force_N": float(np.max(np.abs(self.clamp_force_N)))
+            if self.clamp_force_N.size
+            else None,
+            "max_lateral_tip_displacement_m": lateral,
+            "time_s": self.time_s.tolist(),
+            "angle_deg": self.angle_deg.tolist(),
+            "clamp_force_N": self.clamp_force_N.tolist(),
+            "energy_J": {k: v.tolist() for k, v in self.energy.items()},
+            "steps": int(stats.get("steps", 0)),
+            "rejected_steps": int(stats.get("cutbacks", 0)),
+            "newton_iterations": int(r.stats.get("iterations", 0)),
+            "factorisations": int(r.stats.get("factorisations", 0)),
+            "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
+            "wall_s": self.wall_s,
+            "completed": r.completed,
+            "error": r.error,
+            "settings": asdict(self.settings),
+        }
+
+    def describe(self) -> str:
+        """A few lines for a person."""
+        s = self.summary()
+        reached = self.time_s[-1] if self.time_s.size else 0.0
+        lines = [
+            f"deployment of the set-up, {self.settings.sense} sense, {s['ndof']} DOFs: "
+            f"{reached:.3g} s of motion in {s['steps']} steps ({s['rejected_steps']} rejected, "
+            f"{s['newton_iterations']} Newton iterations in all), wall time {self.wall_s:.1f} s",
+        ]
+        if self.angle_deg.size:
+            lines.append(
+                f"  bending angle {self.angle_deg[0]:+.1f} deg at the release, "
+                f"{self.angle_deg[-1]:+.1f} deg at the end (range {self.angle_deg.min():+.1f} "
+                f"to {self.angle_deg.max():+.1f} deg)"
+            )
+        p = s["peaks"]
+        for kind in ("max", "min"):
+            if p[f"{kind}_time_s"]:
+                items = ", ".join(
+                    f"{a:+.1f} deg at {t:.3f} s"
+                    for t, a in zip(p[f"{kind}_time_s"][:5], p[f"{kind}_deg"][:5], strict=True)
+                )
+                lines.append(f"  first {kind}ima: {items}")
+        ph = s["phases"]
+        lines.append(
+            "  phases: II from "
+            + ("-" if ph["phase_ii_start_s"] is None else f"{ph['phase_ii_start_s']:.2f} s")
+            + ", III from "
+            + ("-" if ph["phase_iii_start_s"] is None else f"{ph['phase_iii_start_s']:.2f} s")
+        )
+        if s["max_clamp_force_N"] is not None:
+            lines.append(f"  largest vertical clamp force {s['max_clamp_force_N']:.2f} N")
+        if s["error"]:
+            lines.append(f"  stopped early: {s['error']}")
+        return "\n".join(lines)
+
+
+def deploy(
+    settings: DeploymentSettings = DeploymentSettings(), *, progress: bool = False
+) -> DeploymentSimulation:
+    """Fold the set-up, release it and follow its deployment.
+
+    Raises
+    ------
+    ValueError
+        For bad settings.
+    tapespring.analysis.ConvergenceError
+        If a step stops early (its ``result`` is the `DeploymentSimulation` recorded so far).
+    """
+    from tapespring.analysis import ConvergenceError, Outputs, Step, ramp, run
+    from tapespring.signals.angle import bending_angle
+    from tapespring.signals.peaks import extract_peaks
+    from tapespring.signals.phases import detect_phases
+
+    settings.validate()
+    start = time.perf_counter()
+    built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
+    model, node = built.model, built.rod_middle
+    fraction, path = fold_target(built, settings.sense)
+    # Pulled vertically, as by the rope of the experiments, down to the height of the arc's end
+    # (the node is free along x: a fold forms where the tapes choose).
+    model.prescribe(node, "uz", path[-1, 2], function=ramp(1.0, 2.0), id="fold", active=False)
+    dynamic: dict[str, Any] = {
+        "rho_inf": settings.rho_inf,
+        "output_interval": 1.0 / settings.sample_rate,
+    }
+    if settings.tolerance > 0.0:
+        dynamic["tolerance"] = settings.tolerance
+    steps = [
+        Step.static("gravity", increments=4, lambda_end=1.0),
+        Step.static(
+            "fold",
+            activate=["fold"],
+            control="arc-length",
+            lambda_end=2.0,
+            initial_increment=0.02,
+            max_increment_factor=20.0,
+            max_steps=500,
+            jump=True,
+            stability=True,
+            tol_force=1e-6,
+            tol_energy=1e-12,
+        ),
+    ]
+    if settings.settle > 0.0:
+        steps.append(Step.dynamic("settle", duration=settings.settle, **dynamic))
+    steps.append(
+        Step.dynamic("release", duration=settings.duration, deactivate=["fold"], **dynamic)
+    )
+    outputs = Outputs(reactions=((built.clamp, d) for d in ("ux", "uy", "uz", "rx", "ry", "rz")))
+    results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
+
+    names = results.marker_names
+    m0, m2, m3 = (names.index(n) for n in ("marker0", "marker2", "marker3"))
+    gravity = results.in_step(0)
+    ref = gravity[-1] if gravity.size else 0
+    angle0 = bending_angle(
+        results.marker_positions[[ref], m0], results.marker_positions[[ref], m2]
+    )[0]
+    free = results.in_step(len(steps) - 1)
+    idx = np.concatenate([[free[0] - 1], free]) if free.size else free.astype(np.int64)
+    t = results.t[idx] - results.t[idx[0]] if idx.size else np.zeros(0)
+    angle = (
+        bending_angle(results.marker_positions[idx, m0], results.marker_positions[idx, m2]) - angle0
+    )
+    # The plate measures minus the support's reaction on the structure, upwards in the
+    # laboratory, which is -z of the set-up's frame in equal sense: Fz_lab = down * r_z.
+    force = built.down * results.reaction(built.clamp, "uz")[idx]
+    peaks = phases = None
+    if t.size > 8:
+        # The peak analysis wants uniform samples, as the motion capture's.
+        tu = np.arange(0.0, t[-1] + 1e-12, 1.0 / settings.sample_rate)
+        au = np.interp(tu, t, angle)
+        try:
+            peaks = extract_peaks(tu, au, settings.n_peaks)
+            phases = detect_phases(extract_peaks(tu, au, None))
+        except ValueError:
+            peaks = phases = None
+    energy = {
+        "kinetic": results.kinetic_energy[idx],
+        "strain": results.strain_energy[idx],
+        "gravity": results.gravity_energy[idx],
+        "viscous": np.nan_to_num(results.viscous_dissipation[idx]),
+        "numerical": np.nan_to_num(results.numerical_dissipation[idx]),
+    }
+    out = DeploymentSimulation(
+        time_s=t,
+        angle_deg=np.degrees(angle),
+        clamp_force_N=force,
+        tip_m=results.marker_positions[idx, m3],
+        peaks=peaks,
+        phases=phases,
+        energy=energy,
+        settings=settings,
+        setup=built,
+        results=results,
+        wall_s=time.perf_counter() - start,
+    )
+    if results.error is not None:
+        err = ConvergenceError(
+            f"{results.error} (the deployment so far is in the 'result' attribute)"
+        )
+        err.result = out  # type: ignore[attr-defined]
+        raise err
+    return out
