@@ -1,0 +1,177 @@
+"""The paper's set-up: its spec, its builder, and the pull and vibration tests on it.
+
+Meshes are coarse (5 mm tapes) except where a figure of the paper is checked; the tolerances say
+what they rest on.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from tapespring.cli import main
+from tapespring.scenarios.pull import PullSettings, pull
+from tapespring.scenarios.setup import (
+    PAPER_MODEL,
+    PAPER_SETUP,
+    SetupSpec,
+    build_setup,
+)
+from tapespring.scenarios.vibration import VibrationSettings, vibrate
+
+COARSE = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=5e-3)
+
+
+def tape_mass(spec: SetupSpec) -> float:
+    t = spec.tape
+    return t.density * t.thickness * t.radius * t.alpha * t.length
+
+
+def flexibility(spec: SetupSpec, lever: float) -> float:
+    """Euler-Bernoulli flexibility [m/N] of the two tapes as one cantilever loaded at `lever`
+    beyond their free ends through a rigid extension."""
+    t = spec.tape
+    phi = np.linspace(-t.alpha / 2, t.alpha / 2, 4001)
+    z = t.radius * (1.0 - np.cos(phi))
+    zbar = np.trapezoid(z, phi) / t.alpha
+    inertia = t.thickness * t.radius * np.trapezoid((z - zbar) ** 2, phi)
+    ei = 2.0 * t.youngs_modulus * inertia
+    length = t.length
+    return (length**3 / 3.0 + length**2 * lever + length * lever**2) / ei
+
+
+def test_spec_keeps_the_papers_figures() -> None:
+    s = PAPER_SETUP
+    assert s.free_end_mass == pytest.approx(0.077, abs=1e-12)
+    assert s.setup_length == pytest.approx(0.235, rel=0.01)  # "about 236 mm" (4.3 mm = 1.82 %)
+    assert (s.mesh_tape, s.mesh_plates) == (2e-3, 3e-3)
+    assert (s.initial_angle_opposite_deg, s.initial_angle_equal_deg) == (95.5, -91.2)
+    assert s.eta == PAPER_MODEL.eta
+
+
+@pytest.mark.parametrize("configuration", ["appendix", "bare", "weight"])
+def test_builder_puts_every_mass_in_the_model(configuration: str) -> None:
+    built = build_setup(COARSE, configuration=configuration)
+    s = COARSE
+    rest = 2 * s.interface_mass + s.rod_mass
+    rest += {"appendix": s.appendix_mass, "bare": 0.0, "weight": s.weight_mass}[configuration]
+    # The plates and bodies exactly; the tapes as their faceted mesh (5 mm elements subtend
+    # 17.5 deg of the section: chord / arc = 1 - 0.4 %).
+    tapes = built.model.total_mass - rest
+    assert tapes == pytest.approx(2 * tape_mass(s), rel=5e-3)
+    assert tapes < 2 * tape_mass(s)
+    markers = {"marker0", "marker1", "marker2"} | (
+        set() if configuration == "bare" else {"marker3"}
+    )
+    assert set(built.model.markers) == markers
+    assert len(built.model.rigid_bodies) == 2 + (configuration == "weight")
+
+
+def test_equal_sense_turns_gravity_and_markers_over() -> None:
+    up = build_setup(COARSE, configuration="bare", sense="opposite")
+    down = build_setup(COARSE, configuration="bare", sense="equal")
+    assert up.gravity_vector == (0.0, 0.0, -9.81)
+    assert down.gravity_vector == (0.0, 0.0, 9.81)
+    assert (up.down, down.down) == (-1.0, 1.0)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"tape_spacing": 0.01}, "overlap"),
+        ({"interface_mass": -1.0}, "interface_mass"),
+        ({"mesh_tape": float("nan")}, "mesh_tape"),
+        ({"setup_length": 0.12}, "appendix"),
+        ({"eta": -1e-4}, "eta"),
+        ({"tape": replace(PAPER_SETUP.tape, thickness=0.0)}, "thickness"),
+    ],
+)
+def test_bad_spec_is_named(change: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        build_setup(replace(PAPER_SETUP, **change))
+
+
+def test_unknown_configuration_or_sense_is_refused() -> None:
+    with pytest.raises(ValueError, match="configuration"):
+        build_setup(COARSE, configuration="folded")
+    with pytest.raises(ValueError, match="sense"):
+        build_setup(COARSE, sense="up")
+
+
+def test_pull_starts_at_the_cantilever_stiffness_and_buckles() -> None:
+    result = pull(PullSettings(spec=COARSE, max_displacement=0.02))
+    d, f = result.displacement_m, result.force_N
+    # Initial stiffness against Euler-Bernoulli for the two tapes (the rod's middle is 20 mm
+    # beyond them through the rigid interfaces), between its two limits: the section free to
+    # contract sideways (modulus E) and held by the clamps (E / (1 - nu^2), 10 % stiffer); a
+    # 100 mm tape clamped over its 17.8 mm width lies between. Measured: 1022 N/m on a 3 mm
+    # mesh, 1101 N/m on this 5 mm one (the coarse mesh is 8 % stiff): 5 % above the upper limit
+    # is allowed for it.
+    first = np.flatnonzero(d > 0)[0]
+    k_free = 1.0 / flexibility(COARSE, COARSE.interface_length + COARSE.rod_width / 2)
+    k_held = k_free / (1.0 - COARSE.tape.poisson**2)
+    assert k_free < f[first] / d[first] < 1.05 * k_held
+    # A maximum, located, then the drop of buckling (to under a fifth of it).
+    assert result.located
+    assert f[-1] < 0.2 * result.max_force_N
+    assert 5e-3 < result.max_force_displacement_m < 15e-3
+
+
+def test_pull_maximum_against_the_papers_model() -> None:
+    # The paper's meshes are 2 mm and 3 mm; on 3 mm everywhere the maximum force is 7.64 N
+    # (Table 9's model: 7.6 N; 2 mm tapes give 7.16 N): within 5 %, the mesh's own spread.
+    spec = replace(PAPER_SETUP, mesh_tape=3e-3, mesh_plates=3e-3)
+    result = pull(PullSettings(spec=spec, max_displacement=0.016))
+    assert result.max_force_N == pytest.approx(PAPER_MODEL.pull_max_force, rel=0.05)
+    # Its displacement is reported (11.4 mm against 10.1 mm), not asserted beyond the band of
+    # the experiments (Table 2: 10.8 mm, spread 4.6 mm).
+    assert abs(result.max_force_displacement_m - PAPER_MODEL.pull_displacement_exp) < 4.6e-3
+
+
+def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> None:
+    # Ten times the paper's eta, so that the peaks cross the 0.4-4 mm window within 1 s.
+    spec = replace(COARSE, eta=10 * PAPER_MODEL.eta)
+    sim = vibrate(VibrationSettings(spec=spec, duration=1.0))
+    assert sim.fit is not None, sim.fit_error
+    assert sim.fit.peak_time.size >= 8
+    # Transient against modal period: the issue's 1 %; measured 0.3 %.
+    assert sim.fit.period == pytest.approx(sim.modal_periods_s[0], rel=0.01)
+    # Damping ratio against eta omega / 2 of the linearised Kelvin-Voigt system. The fit also
+    # sees generalised-alpha's dissipation (rho_inf = 0.7, 1.25 ms steps: about 1e-3 of damping
+    # ratio at this period) and the undamped rod storing some strain energy: 3 %.
+    assert sim.fit.damping_ratio == pytest.approx(sim.kelvin_voigt_damping_ratio, rel=0.03)
+    # Damping ratio proportional to eta: the paper's eta gives a tenth (checked in benchmarks).
+    summary = sim.summary()
+    assert summary["period_s"] == sim.fit.period
+    json.dumps(summary)
+
+
+def test_pull_command_writes_json_csv_and_plot(tmp_path, capsys) -> None:
+    csv_path, png = tmp_path / "pull.csv", tmp_path / "pull.png"
+    code = main(
+        [
+            "pull",
+            "--mesh-tape=5e-3",
+            "--mesh-plates=5e-3",
+            "--max-displacement=0.016",
+            "--json",
+            f"--csv={csv_path}",
+            f"--plot={png}",
+        ]
+    )
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["max_force_N"] > 0 and math.isfinite(out["max_force_displacement_m"])
+    assert out["settings"]["spec"]["tape_spacing"] == PAPER_SETUP.tape_spacing
+    assert csv_path.read_text().startswith("displacement_m,force_N")
+    assert png.stat().st_size > 10_000
+
+
+def test_commands_refuse_bad_input(capsys) -> None:
+    assert main(["pull", "--mesh-tape=1.0", "--no-progress"]) == 2
+    assert "mesh_tape" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["vibrate", "--thickness=-1"])
