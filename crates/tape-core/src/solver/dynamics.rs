@@ -638,6 +638,7 @@ pub fn solve_dynamic(
 
     let eps_t = 1e-12 * params.duration.max(t_end.abs());
     let mut cutbacks = 0;
+    let mut retry = false;
     let mut scratch = state.clone();
     while state.t < t_end - eps_t {
         if path.steps.len() >= params.max_steps {
@@ -656,7 +657,10 @@ pub fn solve_dynamic(
             target = target.min(t0 + k * params.output_interval);
         }
         let mut step_h = h.min(target - state.t);
-        if target - state.t - step_h < 0.25 * step_h {
+        if retry {
+            // After a rejection the step must shrink: stretching it to the target would retry
+            // the rejected size for ever.
+        } else if target - state.t - step_h < 0.25 * step_h {
             // Avoid a sliver before the target.
             step_h = target - state.t;
         } else if target - state.t < 2.0 * step_h {
@@ -732,6 +736,7 @@ pub fn solve_dynamic(
                 (iterations, false)
             }
         };
+        retry = !accepted;
         if !accepted {
             if h < min_step {
                 path.error = Some(Error::NotConverged {
