@@ -11,7 +11,7 @@ __all__ = ["register", "run"]
 
 #: Defaults of the command: a coarse mesh and a short motion, so that it answers in well under a
 #: minute; the paper's run is ``--mesh-tape 2e-3 --mesh-plates 3e-3 --duration 10``.
-DEFAULT_DURATION = 0.3
+DEFAULT_DURATION = 1.0
 DEFAULT_MESH_TAPE = 5e-3
 DEFAULT_MESH_PLATES = 10e-3
 

@@ -5,21 +5,21 @@ configuration ``"appendix"``), in opposite or equal sense, in four analysis step
 
 1. ``gravity`` (static): the deployed equilibrium under gravity, the reference of the bending
    angle.
-2. ``fold`` (static): the rod's middle (marker 2) is driven along a circular arc to the position
-   at which the bending angle, measured as in the experiments from the support marker to marker
-   2, equals the paper's initial angle (+95.5 or -91.2 deg); the path passes the buckling of the
-   tapes on an arc-length path (jumping at the snap). The paper drives that node at under 2 mm/s
-   and then holds it 5 s so that the motion dies out: the equilibrium of a static step is the
-   state both lead to, so neither the rate nor the hold is simulated (``settle`` adds a dynamic
-   hold if wanted).
+2. ``fold`` (static): the free end is turned about y, at both small interfaces, by the paper's
+   initial angle (+95.5 or -91.2 deg), free to translate, on an arc-length path that passes the
+   buckling of the tapes (jumping at the snap). The paper drives marker 2 to its measured folded
+   position (which it does not give) at under 2 mm/s and holds it 5 s so that the motion dies
+   out: the equilibrium of a static step is the state both lead to, so neither the rate nor the
+   hold is simulated (``settle`` adds a dynamic hold if wanted).
 3. ``settle`` (dynamic, optional, ``settle > 0``): the fold held for that time.
 4. ``release`` (dynamic): marker 2 is released with accelerations consistent with the state
    (no jolt) and the set-up deploys for ``duration`` seconds (generalised-alpha, ``rho_inf``,
    adaptive steps landing on the marker sampling instants).
 
-The bending angle is that of the experiments (:func:`tapespring.signals.angle.bending_angle`
-from the support marker to marker 2), relative to the gravity equilibrium of step 1 (exact, where
-a measured record uses its tail). Peaks and phases go through the measured records' analysis
+The bending angle is that of the experiments (:func:`tapespring.signals.angle.bending_angle` of
+the vector from marker 1, on a small interface, to marker 2, in the middle of the rod: the
+rotation of the free end), relative to the gravity equilibrium of step 1 (exact, where a
+measured record uses its tail). Peaks and phases go through the measured records' analysis
 (:func:`tapespring.signals.peaks.extract_peaks`, :func:`tapespring.signals.phases.detect_phases`);
 :meth:`DeploymentSimulation.to_trial` turns the run into a :class:`tapespring.trials.Trial`
 (markers M1 support, M2 rod, M3 appendix tip; the force plate under the clamp) for the trial
@@ -45,10 +45,11 @@ from tapespring.scenarios.setup import (
     check_sense,
 )
 
-__all__ = ["DeploymentSettings", "DeploymentSimulation", "deploy", "fold_target"]
+__all__ = ["TRIAL_MARKERS", "DeploymentSettings", "DeploymentSimulation", "deploy"]
 
-#: Trial marker names of the set-up's markers (the trial tool chain's M1 support, M2 rod, M3 tip).
-TRIAL_MARKERS = {"marker0": "M1", "marker2": "M2", "marker3": "M3"}
+#: Trial marker names of the set-up's markers: the bending angle of the trial analysis is that of
+#: the M1 -> M2 vector (markers 1 and 2, on the free end), M3 the appendix tip.
+TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
 
 
 @dataclass(frozen=True)
@@ -103,57 +104,6 @@ class DeploymentSettings:
             raise ValueError(f"tolerance must be finite and >= 0 (got {self.tolerance})")
         if not (isinstance(self.n_peaks, int) and self.n_peaks >= 1):
             raise ValueError(f"n_peaks must be an integer >= 1 (got {self.n_peaks!r})")
-
-
-def _angle(p1: NDArray[np.float64], p2: NDArray[np.float64]) -> float:
-    d = p2 - p1
-    return math.atan2(-d[2], d[0])
-
-
-def fold_target(built: SetupModel, sense: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The path of marker 2's node in the fold: points of a circular arc in the x-z plane.
-
-    The arc turns the node about the middle of the tapes (the fold's place in the paper's
-    Figs. 11 and 13) until the angle of the support-marker-to-marker-2 vector has changed by
-    the paper's initial bending angle.
-
-    Returns
-    -------
-    fraction, displacement : ndarray
-        Path parameter in [0, 1] (shape (k,)) and the node's displacement there [m] (k, 3).
-    """
-    spec = built.spec
-    model = built.model
-    target = math.radians(spec.initial_angle_deg(sense))
-    x = model.nodes[built.rod_middle]
-    marker_offset = np.array([0.0, 0.0, -built.down * spec.marker_height])
-    support = np.asarray(spec.support_marker, dtype=float)
-    pivot = np.array([spec.tape.length / 2.0, 0.0, 0.0])
-
-    def turned(theta: float) -> NDArray[np.float64]:
-        c, s = math.cos(theta), math.sin(theta)
-        r = x - pivot
-        return pivot + np.array([c * r[0] + s * r[2], r[1], -s * r[0] + c * r[2]])
-
-    angle0 = _angle(support, x + marker_offset)
-
-    def change(theta: float) -> float:
-        # The marker turns with the rod.
-        c, s = math.cos(theta), math.sin(theta)
-        m = np.array([s * marker_offset[2], 0.0, c * marker_offset[2]])
-        return _angle(support, turned(theta) + m) - angle0 - target
-
-    lo, hi = 0.0, 2.0 * target
-    for _ in range(200):  # bisection: change() is monotonic in theta over this range
-        mid = 0.5 * (lo + hi)
-        if (change(mid) > 0.0) == (target > 0.0):
-            hi = mid
-        else:
-            lo = mid
-    theta_end = 0.5 * (lo + hi)
-    fraction = np.linspace(0.0, 1.0, 21)
-    path = np.array([turned(f * theta_end) - x for f in fraction])
-    return fraction, path
 
 
 @dataclass(frozen=True)
@@ -313,11 +263,13 @@ def deploy(
     settings.validate()
     start = time.perf_counter()
     built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
-    model, node = built.model, built.rod_middle
-    fraction, path = fold_target(built, settings.sense)
-    # Pulled vertically, as by the rope of the experiments, down to the height of the arc's end
-    # (the node is free along x: a fold forms where the tapes choose).
-    model.prescribe(node, "uz", path[-1, 2], function=ramp(1.0, 2.0), id="fold", active=False)
+    model = built.model
+    # The free end is turned to the initial angle about y at both small interfaces, free to
+    # translate: the tapes fold where they choose, and the bending angle (the free end's
+    # rotation) starts exactly at the paper's value.
+    angle = math.radians(settings.spec.initial_angle_deg(settings.sense))
+    for interface in built.interfaces:
+        model.prescribe(interface, "ry", angle, function=ramp(1.0, 2.0), id="fold", active=False)
     dynamic: dict[str, Any] = {
         "rho_inf": settings.rho_inf,
         "output_interval": 1.0 / settings.sample_rate,
@@ -349,17 +301,17 @@ def deploy(
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
 
     names = results.marker_names
-    m0, m2, m3 = (names.index(n) for n in ("marker0", "marker2", "marker3"))
+    m1, m2, m3 = (names.index(n) for n in ("marker1", "marker2", "marker3"))
     gravity = results.in_step(0)
     ref = gravity[-1] if gravity.size else 0
     angle0 = bending_angle(
-        results.marker_positions[[ref], m0], results.marker_positions[[ref], m2]
+        results.marker_positions[[ref], m1], results.marker_positions[[ref], m2]
     )[0]
     free = results.in_step(len(steps) - 1)
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free.astype(np.int64)
     t = results.t[idx] - results.t[idx[0]] if idx.size else np.zeros(0)
     angle = (
-        bending_angle(results.marker_positions[idx, m0], results.marker_positions[idx, m2]) - angle0
+        bending_angle(results.marker_positions[idx, m1], results.marker_positions[idx, m2]) - angle0
     )
     # The plate measures minus the support's reaction on the structure, upwards in the
     # laboratory, which is -z of the set-up's frame in equal sense: Fz_lab = down * r_z.
