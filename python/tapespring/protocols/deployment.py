@@ -148,7 +148,7 @@ def analyze_deployment(
     trial : Trial
         A deployment record that ends at rest in the deployed equilibrium.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip).
+        Names of markers 1 and 2 (on the free end) and 3 (tip).
     n_peaks : int
         Number of maxima and of minima kept (paper: 10).
     prominence : float, optional
@@ -321,7 +321,7 @@ def analyze_deployment_group(
     trials : iterable of Trial
         The trials.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip).
+        Names of markers 1 and 2 (on the free end) and 3 (tip).
     n_peaks : int
         Number of maxima and minima analysed, >= 1.
     frame : str or ndarray, optional

@@ -1,8 +1,12 @@
 """Marker roles of the set-up, shared by the protocols.
 
-Marker roles follow the paper (Sec. 4): marker 1 on the fixation support,
-marker 2 in the middle of the rod, marker 3 at the appendix tip (or on the
-additional weight of the vibration tests). Names are passed as
+Marker roles: the bending angle is that of the vector from marker 1 to marker 2
+(paper Sec. 4), both on the free end (the paper's markers 1-2 on a small
+interface and in the middle of the rod, Table 3), so that it is the free end's
+rotation: the initial angles of 95.5 and -91.2 deg cannot be reached by the
+chord from a marker on the fixation support to the rod when the tapes fold near
+their middle. Marker 3 is at the appendix tip (or on the additional weight of
+the vibration tests). Names are passed as
 ``markers=(m1, m2, m3)``; the default is ``("M1", "M2", "M3")``.
 
 Samples still missing (NaN) in a marker that an analysis needs make it fail
