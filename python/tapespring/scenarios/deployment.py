@@ -154,7 +154,9 @@ class DeploymentSimulation:
 
         rate = self.settings.sample_rate if rate_hz is None else rate_hz
         steps = [len(self.results.step_stats) - 1]
-        meta = Metadata(label=f"simulated deployment ({self.settings.sense} sense)")
+        meta = Metadata(
+            name=f"simulated deployment ({self.settings.sense} sense)", sense=self.settings.sense
+        )
         return self.results.to_trial(
             markers=TRIAL_MARKERS,
             force_nodes=[self.setup.clamp],

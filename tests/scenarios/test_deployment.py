@@ -1,0 +1,113 @@
+"""The set-up's deployment (paper Sec. 4.1, 6.1) on a coarse mesh and a short motion.
+
+5 mm tapes, 10 mm rod and appendix, 0.6 s after the release (the paper's run is 2-3 mm and 10 s:
+a benchmark). What is checked holds on any mesh fine enough to fold: the release angle, the
+swing through straight into an equal-sense fold and back, the time of the first maximum, the
+clamp force's peaks at the straight configuration, the energy balance, and the trial export.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from tapespring.scenarios.deployment import DeploymentSettings, DeploymentSimulation, deploy
+from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
+from tapespring.signals.angle import bending_angle
+from tapespring.signals.peaks import extract_peaks
+
+COARSE = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3)
+
+
+@pytest.fixture(scope="module")
+def opposite() -> DeploymentSimulation:
+    return deploy(DeploymentSettings(spec=COARSE, sense="opposite", duration=0.6))
+
+
+def test_release_starts_at_the_papers_angle_at_rest(opposite: DeploymentSimulation) -> None:
+    # The fold turns the free end by exactly the initial angle; markers 1-2 sit on it (the rod
+    # between them bends a little under gravity: 0.05 deg).
+    assert opposite.angle_deg[0] == pytest.approx(PAPER_SETUP.initial_angle_opposite_deg, abs=0.05)
+    assert opposite.energy["kinetic"][0] == 0.0
+    # Released from rest, not jolted (the consistent start itself is tested on the single tape in
+    # test_release.py): the kinetic energy of the first step is a small part of what the fold
+    # stores, and it grows from there.
+    e = opposite.energy
+    stored = e["strain"][0] + e["gravity"][0]
+    assert 0.0 < e["kinetic"][1] < 1e-3 * stored
+    assert e["kinetic"][5] > e["kinetic"][1]
+
+
+def test_swings_through_straight_and_peaks_near_half_a_second(
+    opposite: DeploymentSimulation,
+) -> None:
+    peaks = opposite.peaks
+    assert peaks is not None
+    # Phase I: from the opposite-sense fold through straight into an equal-sense fold, back.
+    first_min_t, first_min = peaks.minima.time[0], np.degrees(peaks.minima.value[0])
+    first_max_t, first_max = peaks.maxima.time[0], np.degrees(peaks.maxima.value[0])
+    assert first_min < -20.0 and first_max > 20.0
+    assert first_min_t < first_max_t
+    # The paper's first maximum peak: near 0.5 s (Sec. 6.1); 0.49 s measured here.
+    assert first_max_t == pytest.approx(PAPER_MODEL.first_max_peak_time_opposite, abs=0.1)
+
+
+def test_clamp_force_peaks_when_the_angle_crosses_zero(opposite: DeploymentSimulation) -> None:
+    t, a, f = opposite.time_s, opposite.angle_deg, opposite.clamp_force_N
+    crossings = t[:-1][np.sign(a[:-1]) != np.sign(a[1:])]
+    assert crossings.size >= 2
+    # The largest force changes (folds forming and vanishing) happen within 30 ms of a
+    # crossing: the half-period of the swing is about 0.25 s.
+    g = np.abs(f - f[0])
+    top = t[np.argsort(g)[-3:]]
+    for instant in top:
+        assert np.min(np.abs(crossings - instant)) < 0.03
+
+
+def test_energy_only_decreases(opposite: DeploymentSimulation) -> None:
+    e = opposite.energy
+    mechanical = e["kinetic"] + e["strain"] + e["gravity"]
+    # Nothing works on the released set-up: its mechanical energy never rises above what the
+    # fold stored, to 1e-3 of it (generalised-alpha at rho_inf = 0.7 can gain a little at a
+    # single step, issue 8: 1.3e-4 measured, at the first step), and Kelvin-Voigt dissipates.
+    assert np.max(mechanical - mechanical[0]) < 1e-3 * mechanical[0]
+    assert mechanical[-1] < 0.9 * mechanical[0]
+    assert e["viscous"][-1] > 0.0
+    # The remainder (numerical dissipation) is not checked for sign here: with eta > 0 it also
+    # holds the error of the trapezoidal viscous work (issue 8), which is negative in this run.
+
+
+def test_trial_gives_the_simulations_peaks(opposite: DeploymentSimulation) -> None:
+    trial = opposite.to_trial()
+    assert set(trial.markers) == {"M1", "M2", "M3"}
+    ref = opposite.angle_deg[0] - np.degrees(
+        bending_angle(trial.marker("M1")[:1], trial.marker("M2")[:1])[0]
+    )
+    angle = np.degrees(bending_angle(trial.marker("M1"), trial.marker("M2"))) + ref
+    t = trial.time - trial.time[0]
+    peaks = extract_peaks(t, np.radians(angle), 10)
+    sim = opposite.peaks
+    n = min(peaks.maxima.time.size, sim.maxima.time.size)
+    assert n >= 1
+    # Same instants to the 800 Hz sampling, same amplitudes to 0.05 deg.
+    np.testing.assert_allclose(peaks.maxima.time[:n], sim.maxima.time[:n], atol=1.0 / 800)
+    np.testing.assert_allclose(peaks.maxima.value[:n], sim.maxima.value[:n], atol=1e-3)
+    # The force plate under the support: at the release it carries the set-up's weight plus
+    # the fold's hold (a downward pull on the plate, Fz < 0).
+    assert trial.force_plates[0].force[0, 2] < 0.0
+
+
+def test_summary_is_plain_json(opposite: DeploymentSimulation) -> None:
+    s = json.loads(json.dumps(opposite.summary()))
+    assert s["sense"] == "opposite"
+    assert {"peaks", "phases", "wall_s", "max_clamp_force_N"} <= set(s)
+    assert s["settings"]["spec"]["mesh_tape"] == 5e-3
+
+
+def test_bad_settings_are_named() -> None:
+    with pytest.raises(ValueError, match="sense"):
+        deploy(DeploymentSettings(spec=COARSE, sense="sideways"))
+    with pytest.raises(ValueError, match="duration"):
+        deploy(DeploymentSettings(spec=COARSE, duration=-1.0))
