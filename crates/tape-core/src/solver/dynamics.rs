@@ -580,6 +580,7 @@ pub fn solve_dynamic(
 ) -> Result<DynamicPath> {
     let start_time = Instant::now();
     params.validate()?;
+    let linear_counts = (system.linear.refinement_sweeps, system.linear.lu_fallbacks);
     let alpha = Alpha::new(params.rho_inf)?;
     let weights = system.free_weights();
     let n_nodes = state.x.len();
@@ -792,6 +793,8 @@ pub fn solve_dynamic(
         }
     }
     integ.stats.wall_s = start_time.elapsed().as_secs_f64();
+    integ.stats.refinement_sweeps = integ.system.linear.refinement_sweeps - linear_counts.0;
+    integ.stats.lu_fallbacks = integ.system.linear.lu_fallbacks - linear_counts.1;
     path.stats = integ.stats;
     Ok(path)
 }
