@@ -111,3 +111,36 @@ def test_bad_settings_are_named() -> None:
         deploy(DeploymentSettings(spec=COARSE, sense="sideways"))
     with pytest.raises(ValueError, match="duration"):
         deploy(DeploymentSettings(spec=COARSE, duration=-1.0))
+
+
+def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> None:
+    from tapespring.protocols.deployment import analyze_deployment
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial("opposite", duration=3.0)
+    measured = analyze_deployment(trial)
+    c = opposite.compare(measured, n=3)
+    # Simulation minus experiment, peak by peak; None where the short run has no peak.
+    first_min = np.degrees(opposite.peaks.minima.value[0] - measured.peaks.minima.value[0])
+    assert c["min_amplitude_deg"][0] == pytest.approx(first_min)
+    assert len(c["max_amplitude_deg"]) == 3 and c["max_amplitude_deg"][2] is None
+    assert c["initial_angle_deg"]["simulation"] == pytest.approx(95.5, abs=0.05)
+    json.dumps(c)
+
+
+def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
+    from tapespring.cli import main
+    from tapespring.trials.csv import write_csv
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial("equal", duration=2.0)
+    path = write_csv(trial, tmp_path / "equal.csv")
+    png = tmp_path / "deploy.png"
+    args = ["deploy", "--sense=equal", "--duration=0.3", "--json", f"--plot={png}"]
+    assert main([*args, f"--experiment={path}"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["sense"] == "equal" and out["initial_angle_deg"] == pytest.approx(-91.2, abs=0.05)
+    assert out["comparison"]["initial_angle_deg"]["experiment"] < 0
+    assert png.stat().st_size > 10_000
+    assert main([*args, f"--experiment={tmp_path / 'missing.csv'}"]) == 2
+    assert "missing.csv" in capsys.readouterr().err

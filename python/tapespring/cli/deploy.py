@@ -47,6 +47,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=d.tolerance,
         help="local error tolerance of the time steps [m] (0: the solver's default)",
     )
+    p.add_argument(
+        "--experiment",
+        metavar="FILE",
+        help="a recorded deployment (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
+        "drawn under the simulation, and its first peaks compared with the simulation's",
+    )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(p, "time_s, angle_deg and clamp_force_N")
     p.set_defaults(func=run)
@@ -56,7 +62,22 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
     input)."""
+    from dataclasses import replace
+
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
+
+    measured = None
+    if args.experiment:
+        from tapespring.protocols.deployment import analyze_deployment
+        from tapespring.trials.load import read_trial
+
+        try:
+            measured = analyze_deployment(read_trial(args.experiment))
+        except (OSError, ValueError) as exc:
+            import sys
+
+            print(f"error: {args.experiment}: {exc}", file=sys.stderr)
+            return 2
 
     def simulate() -> object:
         settings = DeploymentSettings(
@@ -66,13 +87,16 @@ def run(args: argparse.Namespace) -> int:
             rho_inf=args.rho_inf,
             tolerance=args.tolerance,
         )
-        return deploy(settings, progress=not (args.no_progress or args.json))
+        result = deploy(settings, progress=not (args.no_progress or args.json))
+        if measured is not None:
+            result = replace(result, comparison=result.compare(measured))
+        return result
 
     def plot(result: object, path: str) -> None:
         from tapespring.plot.setup import plot_deployment
         from tapespring.report import save_figure
 
-        save_figure(plot_deployment(result), path)
+        save_figure(plot_deployment(result, measured), path)
 
     def columns(result: object) -> dict:
         r = result

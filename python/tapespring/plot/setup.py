@@ -37,6 +37,13 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     top.set_ylabel("bending angle [deg]")
     top.set_title(f"deployment, {sim.settings.sense} sense")
     top.legend(loc="upper right", frameon=False)
+    if trial_result is not None and getattr(trial_result, "force_time", None) is not None:
+        bottom.plot(
+            trial_result.force_time - trial_result.release_time,
+            trial_result.force_z,
+            color="tab:blue",
+            lw=0.6,
+        )
     bottom.plot(sim.time_s, sim.clamp_force_N, color="tab:red", lw=0.8)
     bottom.set_ylabel("clamp force $F_z$ [N]")
     bottom.set_xlabel("time from release [s]")

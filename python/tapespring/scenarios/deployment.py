@@ -130,6 +130,8 @@ class DeploymentSimulation:
     setup : SetupModel
     results : tapespring.Results
     wall_s : float
+    comparison : dict or None
+        Peak differences against a measured deployment (:meth:`compare`), if one was given.
     """
 
     time_s: NDArray[np.float64]
@@ -143,6 +145,7 @@ class DeploymentSimulation:
     setup: SetupModel
     results: Any
     wall_s: float
+    comparison: dict[str, Any] | None = None
 
     def to_trial(self, *, rate_hz: float | None = None) -> Any:
         """The release and the motion as a :class:`tapespring.trials.Trial`.
@@ -164,6 +167,52 @@ class DeploymentSimulation:
             steps=steps,
             metadata=meta,
         )
+
+    def compare(self, measured: Any, *, n: int | None = None) -> dict[str, Any]:
+        """Peak-by-peak differences against a measured deployment (paper Figs. 28, 30).
+
+        Parameters
+        ----------
+        measured : tapespring.protocols.deployment.DeploymentResult
+            The trial analysis of a recorded deployment (``analyze_deployment``).
+        n : int, optional
+            Peaks compared of each kind (default: the settings' ``n_peaks``).
+
+        Returns
+        -------
+        dict
+            ``max_amplitude_deg``, ``min_amplitude_deg`` (simulation minus experiment) and
+            ``max_separation_s``, ``min_separation_s`` (differences of the times between
+            successive peaks, the first from the release), per peak (None where one series has
+            fewer peaks); ``initial_angle_deg`` of both; the trial's name. A peak the paper
+            leaves aside is dropped by the caller (the lists keep the paper's numbering).
+
+        Raises
+        ------
+        ValueError
+            If this run found no peak.
+        """
+        from tapespring.signals.peaks import compare_peaks
+
+        if self.peaks is None:
+            raise ValueError("the simulation has no peak to compare (run it longer)")
+        k = self.settings.n_peaks if n is None else n
+        c = compare_peaks(measured.peaks.head(k), self.peaks.head(k), k)
+
+        def listed(values: NDArray[np.float64], scale: float) -> list[float | None]:
+            return [None if not np.isfinite(v) else float(v) * scale for v in values]
+
+        return {
+            "trial": measured.name,
+            "initial_angle_deg": {
+                "simulation": float(self.angle_deg[0]),
+                "experiment": float(np.degrees(measured.initial_angle)),
+            },
+            "max_amplitude_deg": listed(c.max_amplitude, 180.0 / np.pi),
+            "min_amplitude_deg": listed(c.min_amplitude, 180.0 / np.pi),
+            "max_separation_s": listed(c.max_separation, 1.0),
+            "min_separation_s": listed(c.min_separation, 1.0),
+        }
 
     def summary(self) -> dict[str, Any]:
         """The figures as JSON-ready values, with the settings."""
@@ -205,6 +254,7 @@ class DeploymentSimulation:
             "wall_s": self.wall_s,
             "completed": r.completed,
             "error": r.error,
+            "comparison": self.comparison,
             "settings": asdict(self.settings),
         }
 
@@ -240,6 +290,14 @@ class DeploymentSimulation:
         )
         if s["max_clamp_force_N"] is not None:
             lines.append(f"  largest vertical clamp force {s['max_clamp_force_N']:.2f} N")
+        c = self.comparison
+        if c is not None:
+            amp = [abs(v) for v in c["max_amplitude_deg"] + c["min_amplitude_deg"] if v is not None]
+            lines.append(
+                f"  against {c['trial'] or 'the experiment'}: initial angle "
+                f"{c['initial_angle_deg']['experiment']:+.1f} deg measured; peak amplitudes "
+                + (f"differ by up to {max(amp):.1f} deg" if amp else "not comparable")
+            )
         if s["error"]:
             lines.append(f"  stopped early: {s['error']}")
         return "\n".join(lines)
