@@ -41,8 +41,13 @@ from tapespring.scenarios.setup import (
     PAPER_SETUP,
     SetupModel,
     SetupSpec,
+    buckling_step,
     build_setup,
     check_sense,
+    drive,
+    dynamic_options,
+    gravity_step,
+    raise_if_stopped,
 )
 
 __all__ = ["TRIAL_MARKERS", "DeploymentSettings", "DeploymentSimulation", "deploy"]
@@ -315,7 +320,7 @@ def deploy(
     tapespring.analysis.ConvergenceError
         If a step stops early (its ``result`` is the `DeploymentSimulation` recorded so far).
     """
-    from tapespring.analysis import ConvergenceError, Outputs, Step, ramp, run
+    from tapespring.analysis import Outputs, Step, run
     from tapespring.signals.angle import bending_angle
     from tapespring.signals.peaks import extract_peaks
     from tapespring.signals.phases import detect_phases
@@ -329,29 +334,9 @@ def deploy(
     # rotation) starts exactly at the paper's value.
     angle = math.radians(settings.spec.initial_angle_deg(settings.sense))
     for interface in built.interfaces:
-        model.prescribe(interface, "ry", angle, function=ramp(1.0, 2.0), id="fold", active=False)
-    dynamic: dict[str, Any] = {
-        "rho_inf": settings.rho_inf,
-        "output_interval": 1.0 / settings.sample_rate,
-    }
-    if settings.tolerance > 0.0:
-        dynamic["tolerance"] = settings.tolerance
-    steps = [
-        Step.static("gravity", increments=4, lambda_end=1.0),
-        Step.static(
-            "fold",
-            activate=["fold"],
-            control="arc-length",
-            lambda_end=2.0,
-            initial_increment=0.02,
-            max_increment_factor=20.0,
-            max_steps=500,
-            jump=True,
-            stability=True,
-            tol_force=1e-6,
-            tol_energy=1e-12,
-        ),
-    ]
+        drive(model, interface, "ry", angle, "fold")
+    dynamic = dynamic_options(settings.rho_inf, settings.sample_rate, settings.tolerance)
+    steps = [gravity_step(), buckling_step("fold", activate=("fold",))]
     if settings.settle > 0.0:
         steps.append(Step.dynamic("settle", duration=settings.settle, **dynamic))
     steps.append(
@@ -406,10 +391,5 @@ def deploy(
         results=results,
         wall_s=time.perf_counter() - start,
     )
-    if results.error is not None:
-        err = ConvergenceError(
-            f"{results.error} (the deployment so far is in the 'result' attribute)"
-        )
-        err.result = out  # type: ignore[attr-defined]
-        raise err
+    raise_if_stopped(results, out, "deployment")
     return out

@@ -21,7 +21,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.setup import PAPER_SETUP, SetupSpec, build_setup
+from tapespring.scenarios.setup import (
+    PAPER_SETUP,
+    SetupSpec,
+    buckling_step,
+    build_setup,
+    drive,
+    gravity_step,
+    raise_if_stopped,
+)
 
 __all__ = ["PullResult", "PullSettings", "pull"]
 
@@ -132,35 +140,19 @@ def pull(settings: PullSettings = PullSettings(), *, progress: bool = False) -> 
     tapespring.analysis.ConvergenceError
         If the path stops before buckling (its ``result`` is the `PullResult` so far).
     """
-    from tapespring.analysis import ConvergenceError, Outputs, Step, ramp, run
+    from tapespring.analysis import Outputs, run
     from tapespring.signals.pull import analyze_pull_test
 
     settings.validate()
     start = time.perf_counter()
     built = build_setup(settings.spec, configuration="bare", sense="opposite")
     model, node = built.model, built.rod_middle
-    model.prescribe(
-        node,
-        "uz",
-        built.down * settings.max_displacement,
-        function=ramp(1.0, 2.0),
-        id="pull",
-        active=False,
-    )
+    drive(model, node, "uz", built.down * settings.max_displacement, "pull")
     steps = [
-        Step.static("gravity", increments=4, lambda_end=1.0),
-        Step.static(
+        gravity_step(),
+        buckling_step(
             "pull",
-            activate=["pull"],
-            control="arc-length",
-            lambda_end=2.0,
-            initial_increment=0.02,
-            max_increment_factor=20.0,
-            max_steps=400,
-            jump=True,
-            stability=True,
-            tol_force=1e-6,
-            tol_energy=1e-12,
+            activate=("pull",),
             locate_limit_points=True,
             monitor_node=node,
             monitor_dof="uz",
@@ -190,8 +182,5 @@ def pull(settings: PullSettings = PullSettings(), *, progress: bool = False) -> 
         results=results,
         wall_s=time.perf_counter() - start,
     )
-    if results.error is not None:
-        err = ConvergenceError(f"{results.error} (the pull so far is in the 'result' attribute)")
-        err.result = out  # type: ignore[attr-defined]
-        raise err
+    raise_if_stopped(results, out, "pull")
     return out

@@ -599,3 +599,62 @@ def build_setup(
         tip=tip,
         down=down,
     )
+
+
+# ---------------------------------------------------------------------------------------------
+# Steps shared by the set-up's scenarios
+# ---------------------------------------------------------------------------------------------
+
+
+def gravity_step() -> Any:
+    """The first step of every test: gravity ramped in, to the deployed (loaded) equilibrium."""
+    from tapespring.analysis import Step
+
+    return Step.static("gravity", increments=4, lambda_end=1.0)
+
+
+def buckling_step(name: str, *, activate: tuple[str, ...] = (), **options: Any) -> Any:
+    """A static step over the load factor 1 to 2 on an arc-length path that passes the buckling
+    of the tapes (jumping at the snap, stability of every state): the pull, the fold and the
+    weight's push. `options` override or add step options (e.g. monitoring)."""
+    from tapespring.analysis import Step
+
+    settings: dict[str, Any] = {
+        "control": "arc-length",
+        "lambda_end": 2.0,
+        "initial_increment": 0.02,
+        "max_increment_factor": 20.0,
+        "max_steps": 500,
+        "jump": True,
+        "stability": True,
+        "tol_force": 1e-6,
+        "tol_energy": 1e-12,
+    }
+    return Step.static(name, activate=list(activate), **(settings | options))
+
+
+def drive(model: Any, node: int, dof: str, value: float, id: str) -> None:
+    """Prescribe `dof` of `node` to move by `value` over the load factor 1 to 2 of a
+    :func:`buckling_step`, inactive until that step switches `id` on."""
+    from tapespring.analysis import ramp
+
+    model.prescribe(node, dof, value, function=ramp(1.0, 2.0), id=id, active=False)
+
+
+def dynamic_options(rho_inf: float, sample_rate: float, tolerance: float) -> dict[str, Any]:
+    """Options of a dynamic step of the set-up: steps landing on the samples at `sample_rate`
+    [Hz]; `tolerance` [m] (0: the solver's default)."""
+    options: dict[str, Any] = {"rho_inf": rho_inf, "output_interval": 1.0 / sample_rate}
+    if tolerance > 0.0:
+        options["tolerance"] = tolerance
+    return options
+
+
+def raise_if_stopped(results: Any, result: Any, what: str) -> None:
+    """Raise ConvergenceError carrying `result` (what was recorded) if the run stopped early."""
+    from tapespring.analysis import ConvergenceError
+
+    if results.error is not None:
+        err = ConvergenceError(f"{results.error} (the {what} so far is in the 'result' attribute)")
+        err.result = result  # type: ignore[attr-defined]
+        raise err

@@ -24,7 +24,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP, SetupSpec, build_setup
+from tapespring.scenarios.setup import (
+    PAPER_MODEL,
+    PAPER_SETUP,
+    SetupSpec,
+    build_setup,
+    drive,
+    dynamic_options,
+    gravity_step,
+    raise_if_stopped,
+)
 
 __all__ = ["VibrationSettings", "VibrationSimulation", "vibrate"]
 
@@ -189,29 +198,17 @@ def vibrate(
     tapespring.analysis.ConvergenceError
         If a step stops early (its ``result`` is the `VibrationSimulation` so far).
     """
-    from tapespring.analysis import ConvergenceError, Outputs, Step, ramp, run
+    from tapespring.analysis import Outputs, Step, run
     from tapespring.signals.damping import fit_damping
 
     settings.validate()
     start = time.perf_counter()
     built = build_setup(settings.spec, configuration="weight", sense="opposite")
     model, tip = built.model, built.tip
-    model.prescribe(
-        tip,
-        "uz",
-        built.down * settings.initial_displacement,
-        function=ramp(1.0, 2.0),
-        id="push",
-        active=False,
-    )
-    options: dict[str, Any] = {
-        "rho_inf": settings.rho_inf,
-        "output_interval": 1.0 / settings.sample_rate,
-    }
-    if settings.tolerance > 0.0:
-        options["tolerance"] = settings.tolerance
+    drive(model, tip, "uz", built.down * settings.initial_displacement, "push")
+    options = dynamic_options(settings.rho_inf, settings.sample_rate, settings.tolerance)
     steps = [
-        Step.static("gravity", increments=4, lambda_end=1.0),
+        gravity_step(),
         Step.modal("modes", modes=settings.modes),
         Step.static("push", activate=["push"], increments=4, lambda_end=2.0),
         Step.dynamic("free", duration=settings.duration, deactivate=["push"], **options),
@@ -241,8 +238,5 @@ def vibrate(
         results=results,
         wall_s=time.perf_counter() - start,
     )
-    if results.error is not None:
-        err = ConvergenceError(f"{results.error} (the decay so far is in the 'result' attribute)")
-        err.result = out  # type: ignore[attr-defined]
-        raise err
+    raise_if_stopped(results, out, "decay")
     return out
