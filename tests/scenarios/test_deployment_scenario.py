@@ -135,12 +135,14 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
 
     trial, _ = make_deployment_trial("equal", duration=2.0)
     path = write_csv(trial, tmp_path / "equal.csv")
-    png = tmp_path / "deploy.png"
+    png, pvd, snaps = tmp_path / "deploy.png", tmp_path / "run.pvd", tmp_path / "snaps.png"
     args = ["deploy", "--sense=equal", "--duration=0.3", "--json", f"--plot={png}"]
-    assert main([*args, f"--experiment={path}"]) == 0
+    assert main([*args, f"--experiment={path}", f"--vtu={pvd}", f"--snapshots={snaps}"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["sense"] == "equal" and out["initial_angle_deg"] == pytest.approx(-91.2, abs=0.05)
     assert out["comparison"]["initial_angle_deg"]["experiment"] < 0
-    assert png.stat().st_size > 10_000
+    assert png.stat().st_size > 10_000 and snaps.stat().st_size > 10_000
+    # The ParaView series: one file per kept record (every 16th of 241, and the last).
+    assert len(list((tmp_path / "run").glob("*.vtu"))) >= 15
     assert main([*args, f"--experiment={tmp_path / 'missing.csv'}"]) == 2
     assert "missing.csv" in capsys.readouterr().err

@@ -53,6 +53,17 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="a recorded deployment (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
         "drawn under the simulation, and its first peaks compared with the simulation's",
     )
+    p.add_argument(
+        "--vtu",
+        metavar="FILE.pvd",
+        help="write the deformed set-up as a ParaView series (every 16th record: 50 Hz at 800 Hz "
+        "samples; needs meshio)",
+    )
+    p.add_argument(
+        "--snapshots",
+        metavar="FILE.png",
+        help="draw the set-up from the side at the release and every --duration/5 s (Fig. 13)",
+    )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(p, "time_s, angle_deg and clamp_force_N")
     p.set_defaults(func=run)
@@ -86,6 +97,7 @@ def run(args: argparse.Namespace) -> int:
             duration=args.duration,
             rho_inf=args.rho_inf,
             tolerance=args.tolerance,
+            field_interval=16 if (args.vtu or args.snapshots) else 0,
         )
         result = deploy(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
@@ -98,8 +110,32 @@ def run(args: argparse.Namespace) -> int:
 
         save_figure(plot_deployment(result, measured), path)
 
+    def fields(result: object) -> None:
+        r = result  # a DeploymentSimulation
+        if args.vtu:
+            from tapespring.io.vtu import write_pvd
+
+            write_pvd(r.results, r.setup.model, args.vtu)  # type: ignore[attr-defined]
+            if not args.json:
+                print(f"  wrote {args.vtu}")
+        if args.snapshots:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            from tapespring.plot.snapshots import plot_snapshots
+            from tapespring.report import save_figure
+
+            # Simulation time of the release: the records' time runs on from the static steps.
+            span = float(r.time_s[-1])  # type: ignore[attr-defined]
+            t0 = float(r.results.t[-1]) - span  # type: ignore[attr-defined]
+            times = [t0 + k * span / 5.0 for k in range(6)]
+            ax = plot_snapshots(r.results, r.setup.model, times)  # type: ignore[attr-defined]
+            save_figure(ax.figure, args.snapshots)
+            if not args.json:
+                print(f"  wrote {args.snapshots}")
+
     def columns(result: object) -> dict:
         r = result
         return {"time_s": r.time_s, "angle_deg": r.angle_deg, "clamp_force_N": r.clamp_force_N}  # type: ignore[attr-defined]
 
-    return finish(args, simulate, columns, plot)
+    return finish(args, simulate, columns, plot, extra=fields)

@@ -86,11 +86,12 @@ def finish(
     run: Callable[[], Any],
     columns: Callable[[Any], dict[str, Sequence[float]]],
     plot: Callable[[Any, str], None],
+    extra: Callable[[Any], None] | None = None,
 ) -> int:
     """Run a scenario and write its outputs; returns the exit code.
 
     0 on success; 1 if the run stopped early (what was computed is still written); 2 on bad
-    input (the message on stderr).
+    input (the message on stderr). `extra` writes further outputs after the summary.
     """
     from tapespring.analysis import ConvergenceError
 
@@ -120,6 +121,8 @@ def finish(
         for name in ("csv", "plot"):
             if getattr(args, name):
                 print(f"  wrote {getattr(args, name)}")
+    if extra is not None:
+        extra(result)
     if failure is not None:
         print(f"error: {failure}", file=sys.stderr)
         return 1

@@ -80,6 +80,9 @@ class DeploymentSettings:
         Local error tolerance of the time steps [m] (0: the solver's default).
     n_peaks : int
         Maxima and minima of the bending angle reported (paper: 10).
+    field_interval : int
+        Keep the nodal displacements and rotations every `field_interval`-th record, for
+        ParaView series and snapshots (0: none; the last record is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)
@@ -90,6 +93,7 @@ class DeploymentSettings:
     sample_rate: float = 800.0
     tolerance: float = 1e-4
     n_peaks: int = 10
+    field_interval: int = 0
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
@@ -107,6 +111,10 @@ class DeploymentSettings:
             raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
         if not (math.isfinite(self.tolerance) and self.tolerance >= 0.0):
             raise ValueError(f"tolerance must be finite and >= 0 (got {self.tolerance})")
+        if not (isinstance(self.field_interval, int) and self.field_interval >= 0):
+            raise ValueError(
+                f"field_interval must be an integer >= 0 (got {self.field_interval!r})"
+            )
         if not (isinstance(self.n_peaks, int) and self.n_peaks >= 1):
             raise ValueError(f"n_peaks must be an integer >= 1 (got {self.n_peaks!r})")
 
@@ -342,7 +350,10 @@ def deploy(
     steps.append(
         Step.dynamic("release", duration=settings.duration, deactivate=["fold"], **dynamic)
     )
-    outputs = Outputs(reactions=((built.clamp, d) for d in ("ux", "uy", "uz", "rx", "ry", "rz")))
+    outputs = Outputs(
+        reactions=tuple((built.clamp, d) for d in ("ux", "uy", "uz", "rx", "ry", "rz")),
+        field_interval=settings.field_interval,
+    )
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
 
     names = results.marker_names
