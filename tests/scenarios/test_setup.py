@@ -175,3 +175,24 @@ def test_commands_refuse_bad_input(capsys) -> None:
     assert "mesh_tape" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["vibrate", "--thickness=-1"])
+
+
+def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None:
+    from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+
+    result = equilibrium(EquilibriumSettings(spec=COARSE))
+    assert result.found
+    # The equilibrium lies where the pushing force changes sign after the buckle: the force
+    # is positive before and negative after, on the path.
+    k = np.argmin(np.abs(result.push_m - result.marker3_m[2]))
+    assert result.force_N[np.argmax(result.force_N)] > 0.0
+    # Marker 3 is where the weight's mass was pinned (Table 6: 111.6 mm; 106.5 mm on this
+    # 5 mm mesh, 113.0 mm on 3 mm): within 10 % here.
+    assert result.marker3_m[2] == pytest.approx(PAPER_MODEL.marker3_dz, rel=0.10)
+    assert abs(result.push_m[k] - result.marker3_m[2]) < 0.01
+    assert result.unstable_modes >= 0
+    json.dumps(result.summary())
+    code = main(["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--json"])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["marker_displacements_m"]["marker3_dz_m"] == pytest.approx(result.marker3_m[2])

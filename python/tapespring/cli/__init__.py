@@ -11,9 +11,10 @@ release
 max-mass
     Largest free-end mass two tape springs deploy passively against gravity, over a grid of
     thickness and Young's modulus (paper Sec. 3.1, Fig. 7; see :mod:`tapespring.cli.max_mass`).
-deploy, pull, vibrate
-    The paper's set-up: deployment (Sec. 4.1, 6.1), quasi-static pull (Sec. 4.2, 6.2) and
-    small-amplitude vibrations (Sec. 5.2); see :mod:`tapespring.scenarios`.
+deploy, pull, vibrate, equilibrium
+    The paper's set-up: deployment (Sec. 4.1, 6.1), quasi-static pull (Sec. 4.2, 6.2),
+    small-amplitude vibrations (Sec. 5.2) and the static identification configuration
+    (Sec. 5.1); see :mod:`tapespring.scenarios`.
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -34,7 +35,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, deploy, max_mass, pull, release, trials, vibrate
+    from . import bend, deploy, equilibrium, max_mass, pull, release, trials, vibrate
 
     parser = argparse.ArgumentParser(
         prog="tapespring",
@@ -45,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     release.register(sub)
     deploy.register(sub)
     pull.register(sub)
+    equilibrium.register(sub)
     vibrate.register(sub)
     max_mass.register(sub)
     trials.register(sub)
