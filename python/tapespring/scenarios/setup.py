@@ -210,9 +210,10 @@ class SetupSpec:
       senses, as the set-up was designed to (Sec. 3.1).
     * the additional weight (Figs. 21, 25): a rigid steel block (50 x 20 x 20 mm) fixed under
       the rod's middle and reaching beyond it along x, marker 3 at its tip. Its mass, 120 g, is
-      pinned by Table 6: it puts marker 3 of the folded equilibrium 114 mm below its deployed
-      position (Table 6: 111.6 mm) on a 5 mm mesh. The small-vibration period (Table 8) is
-      then a prediction.
+      pinned by Table 6: it puts marker 3 of the folded equilibrium
+      (:mod:`tapespring.scenarios.equilibrium`) 113.0 mm below its deployed position on a 3 mm
+      mesh (Table 6: 111.6 mm). The small-vibration period (Table 8) is then a prediction:
+      0.1075 s on the paper's meshes, against the paper's model 0.110 s.
     * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp; marker 1 on top
       of the first small interface; marker 2 on the rod's middle; marker 3 at the tip of the
       appendix or the weight; markers 1-3 15 mm above the tapes' mid-line plane (an active
