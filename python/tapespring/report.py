@@ -68,6 +68,8 @@ def summary_json(s: Summary, deg: bool = False) -> dict:
 
 def jsonable(value: object) -> object:
     """JSON-safe: NaN becomes None, numpy scalars and arrays become Python objects."""
+    if isinstance(value, np.bool_):
+        return bool(value)
     if isinstance(value, np.ndarray):
         return [jsonable(v) for v in value.tolist()]
     if isinstance(value, float | np.floating):
@@ -95,14 +97,15 @@ def summary_dict(analysis: TrialsAnalysis) -> dict:
     out: dict = {"kind": analysis.kind, "n_trials": len(analysis.results)}
     out["skipped"] = [{"file": s.source, "problem": s.problem} for s in analysis.skipped]
     out |= protocol_for(analysis.kind).summary(analysis)
-    return _jsonable_tree(out)
+    return jsonable_tree(out)
 
 
-def _jsonable_tree(value: object) -> object:
+def jsonable_tree(value: object) -> object:
+    """`jsonable` through nested dicts, lists and tuples (tuples become lists)."""
     if isinstance(value, dict):
-        return {k: _jsonable_tree(v) for k, v in value.items()}
+        return {k: jsonable_tree(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_jsonable_tree(v) for v in value]
+        return [jsonable_tree(v) for v in value]
     return jsonable(value)
 
 

@@ -182,15 +182,17 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
 
     result = equilibrium(EquilibriumSettings(spec=COARSE))
     assert result.found
-    # The equilibrium lies where the pushing force changes sign after the buckle: the force
-    # is positive before and negative after, on the path.
-    k = np.argmin(np.abs(result.push_m - result.marker3_m[2]))
-    assert result.force_N[np.argmax(result.force_N)] > 0.0
+    # The equilibrium lies between two successive states of the push path whose pushing forces
+    # straddle zero, after the force's maximum (the buckle), and its marker 3 between theirs.
+    f, u = result.force_N, result.push_m
+    peak = int(np.argmax(f))
+    sign = np.flatnonzero((f[peak:-1] > 0.0) & (f[peak + 1 :] <= 0.0))
+    assert sign.size >= 1
+    k = peak + int(sign[0])
+    assert min(u[k], u[k + 1]) <= result.marker3_m[2] <= max(u[k], u[k + 1])
     # Marker 3 is where the weight's mass was pinned (Table 6: 111.6 mm; 106.5 mm on this
     # 5 mm mesh, 113.0 mm on 3 mm): within 10 % here.
     assert result.marker3_m[2] == pytest.approx(PAPER_MODEL.marker3_dz, rel=0.10)
-    assert abs(result.push_m[k] - result.marker3_m[2]) < 0.01
-    assert result.unstable_modes >= 0
     json.dumps(result.summary())
     code = main(["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--json"])
     assert code == 0

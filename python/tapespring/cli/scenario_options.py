@@ -4,10 +4,10 @@ main values and the outputs, and the code that writes a scenario's outputs."""
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from .bend import _positive
@@ -71,16 +71,6 @@ def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-def write_columns(path: str, columns: dict[str, Sequence[float]]) -> None:
-    """Write equal-length columns to a CSV file."""
-    names = list(columns)
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(names)
-        for row in zip(*(columns[n] for n in names), strict=True):
-            w.writerow([f"{v:.9g}" for v in row])
-
-
 def finish(
     args: argparse.Namespace,
     run: Callable[[], Any],
@@ -94,6 +84,7 @@ def finish(
     input (the message on stderr). `extra` writes further outputs after the summary.
     """
     from tapespring.analysis import ConvergenceError
+    from tapespring.report import jsonable_tree, write_table
 
     failure = None
     try:
@@ -108,14 +99,15 @@ def finish(
             return 1
         failure = str(exc)
     if args.csv:
-        write_columns(args.csv, columns(result))
+        table = columns(result)
+        write_table(Path(args.csv), list(table), zip(*table.values(), strict=True))
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")  # files only: no display needed
         plot(result, args.plot)
     if args.json:
-        print(json.dumps(result.summary(), default=_plain))
+        print(json.dumps(jsonable_tree(result.summary()), default=str))
     else:
         print(result.describe())
         for name in ("csv", "plot"):
@@ -127,13 +119,3 @@ def finish(
         print(f"error: {failure}", file=sys.stderr)
         return 1
     return 0
-
-
-def _plain(value: Any) -> Any:
-    import numpy as np
-
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return str(value)

@@ -43,6 +43,7 @@ from tapespring.scenarios.setup import (
     SetupSpec,
     buckling_step,
     build_setup,
+    check_number,
     check_sense,
     drive,
     dynamic_options,
@@ -100,11 +101,7 @@ class DeploymentSettings:
         self.spec.validate()
         check_sense(self.sense)
         for name in ("duration", "sample_rate"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{name} must be a number (got {value!r})")
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be finite and > 0 (got {value})")
+            check_number(name, getattr(self, name), positive=True)
         if not (math.isfinite(self.settle) and self.settle >= 0.0):
             raise ValueError(f"settle must be finite and >= 0 s (got {self.settle})")
         if not 0.0 <= self.rho_inf <= 1.0:

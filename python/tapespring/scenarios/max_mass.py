@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tapespring.report import jsonable_tree
 from tapespring.scenarios.bending import BendingSetup, analytical_residual_moment
 from tapespring.scenarios.setup import (
     PAPER_BOUNDS,
@@ -468,7 +469,7 @@ class MaxMassResult:
         """
 
         def grid(a: NDArray[Any]) -> list[Any]:
-            return [[_plain(v) for v in row] for row in a]
+            return jsonable_tree(a)  # type: ignore[return-value]
 
         per_sense: dict[str, dict[str, Any]] = {
             "residual_moment_Nm": {},
@@ -496,7 +497,7 @@ class MaxMassResult:
             per_sense["run_wall_s"][s] = grid(self.run_wall_s[i])
             per_sense["m_max_paper_tape_kg"][s] = self.paper_tape_m_max(s)
         return {
-            "settings": _plain(asdict(self.settings)),
+            "settings": jsonable_tree(asdict(self.settings)),
             "senses": list(self.senses),
             "thickness_m": self.thickness.tolist(),
             "youngs_modulus_Pa": self.youngs_modulus.tolist(),
@@ -511,21 +512,6 @@ class MaxMassResult:
             "errors": list(self.errors),
             "cancelled": self.cancelled,
         }
-
-
-def _plain(value: Any) -> Any:
-    """JSON-ready copy: tuples to lists, numpy scalars to Python, NaN to None."""
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, (np.bool_, bool)):
-        return bool(value)
-    if isinstance(value, (np.floating, float)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
 
 
 def max_mass(
@@ -659,7 +645,8 @@ def write_csv(result: MaxMassResult, path: str | Path) -> None:
     path = Path(path)
     m, ma, r = result.m_max, result.m_max_analytical, result.ratio
     with path.open("w", newline="") as fh:
-        fh.write("# tapespring max-mass: " + json.dumps(_plain(asdict(result.settings))) + "\n")
+        settings = json.dumps(jsonable_tree(asdict(result.settings)))
+        fh.write(f"# tapespring max-mass: {settings}\n")
         writer = csv.writer(fh)
         writer.writerow(CSV_COLUMNS)
         for i, s in enumerate(result.senses):

@@ -28,6 +28,7 @@ __all__ = [
     "SetupSpec",
     "TapeSpring",
     "build_setup",
+    "check_number",
     "check_sense",
 ]
 
@@ -336,18 +337,18 @@ class SetupSpec:
         if not isinstance(self.tape, TapeSpring):
             raise ValueError(f"tape must be a TapeSpring (got {self.tape!r})")
         for name, value in vars(self.tape).items():
-            _check_number(f"tape.{name}", value, positive=True)
+            check_number(f"tape.{name}", value, positive=True)
         if not -1.0 < self.tape.poisson < 0.5:
             raise ValueError(f"tape.poisson must lie in (-1, 0.5) (got {self.tape.poisson})")
         for name, value in vars(self).items():
             if name in ("tape", "support_marker"):
                 continue
             positive = not name.startswith("initial_angle") and name != "eta"
-            _check_number(name, value, positive=positive)
+            check_number(name, value, positive=positive)
         if len(self.support_marker) != 3:
             raise ValueError(f"support_marker must have 3 coordinates (got {self.support_marker})")
         for value in self.support_marker:
-            _check_number("support_marker", value, positive=False)
+            check_number("support_marker", value, positive=False)
         if self.eta < 0.0:
             raise ValueError(f"eta must be >= 0 s (got {self.eta})")
         if not -1.0 < self.plate_poisson < 0.5:
@@ -383,7 +384,8 @@ def check_sense(sense: str) -> None:
         raise ValueError(f"sense must be one of {SENSES} (got {sense!r})")
 
 
-def _check_number(name: str, value: object, *, positive: bool) -> None:
+def check_number(name: str, value: object, *, positive: bool) -> None:
+    """Raise ValueError naming `name` unless `value` is a finite number (and > 0 if `positive`)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{name} must be a number (got {value!r})")
     if not math.isfinite(value):

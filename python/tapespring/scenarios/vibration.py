@@ -29,6 +29,7 @@ from tapespring.scenarios.setup import (
     PAPER_SETUP,
     SetupSpec,
     build_setup,
+    check_number,
     drive,
     dynamic_options,
     gravity_step,
@@ -77,11 +78,7 @@ class VibrationSettings:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         for name in ("initial_displacement", "duration", "sample_rate"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-                raise ValueError(f"{name} must be a number > 0 (got {value!r})")
-            if not np.isfinite(value):
-                raise ValueError(f"{name} must be finite (got {value})")
+            check_number(name, getattr(self, name), positive=True)
         if not 0.0 <= self.rho_inf <= 1.0:
             raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
         if not self.tolerance >= 0.0:
