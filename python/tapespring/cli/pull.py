@@ -5,7 +5,15 @@ from __future__ import annotations
 import argparse
 
 from .bend import _positive
-from .scenario_options import add_output_options, add_spec_options, finish, spec_from_args
+from .scenario_options import (
+    add_comparison_options,
+    add_output_options,
+    add_spec_options,
+    analyze_experiment,
+    finish,
+    spec_from_args,
+    write_vtu,
+)
 
 __all__ = ["register", "run"]
 
@@ -18,7 +26,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description=(
             "The set-up without the dummy appendix sags under gravity; the middle of its rod is "
             "then pulled down by static displacement control past the buckling of the tapes. "
-            "Prints the maximum force and its displacement against the paper's model (Table 9)."
+            "Prints the maximum force and its displacement against the paper's model (Table 9); "
+            "with --experiment, against a recorded pull test too, both analysed as 'tapespring "
+            "trials' does (the simulation sampled as a trial pulled at 1 mm/s)."
         ),
     )
     p.add_argument(
@@ -27,6 +37,13 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=0.020,
         help="displacement of marker 2 at the end of the pull [m] (default 0.02)",
     )
+    add_comparison_options(
+        p,
+        experiment="a pull test (marker M2 pulled, force plate under the support): its force "
+        "against the displacement drawn under the simulation (Fig. 34), its maximum force and "
+        "displacement compared with the simulation's and the paper's model (Table 9)",
+        vtu="every state of the pull path; the series' time is the path's load factor",
+    )
     add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3)
     add_output_options(p, "displacement_m and force_N")
     p.set_defaults(func=run)
@@ -34,20 +51,49 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring pull``; returns the exit code (0, 1 stopped early, 2 bad input)."""
+    """Handler of ``tapespring pull``; returns the exit code (0, 1 stopped early or no
+    comparison, 2 bad input or experiment file)."""
+    import sys
+    from dataclasses import replace
+
     from tapespring.scenarios.pull import PullSettings, pull
 
+    measured = None
+    if args.experiment:
+        from tapespring.protocols.pull import analyze_pull_trial
+
+        measured = analyze_experiment(args.experiment, analyze_pull_trial)
+        if measured is None:
+            return 2
+    problems: list[str] = []
+
     def simulate() -> object:
-        settings = PullSettings(spec=spec_from_args(args), max_displacement=args.max_displacement)
-        return pull(settings, progress=not (args.no_progress or args.json))
+        settings = PullSettings(
+            spec=spec_from_args(args),
+            max_displacement=args.max_displacement,
+            field_interval=1 if args.vtu else 0,
+        )
+        result = pull(settings, progress=not (args.no_progress or args.json))
+        if measured is not None:
+            try:
+                result = replace(result, comparison=result.compare(measured))
+            except ValueError as exc:
+                problems.append(f"no comparison with {args.experiment}: {exc}")
+        return result
 
     def plot(result: object, path: str) -> None:
         from tapespring.plot.setup import plot_pull
         from tapespring.report import save_figure
 
-        save_figure(plot_pull(result), path)
+        save_figure(plot_pull(result, measured), path)
 
     def columns(result: object) -> dict:
         return {"displacement_m": result.displacement_m, "force_N": result.force_N}  # type: ignore[attr-defined]
 
-    return finish(args, simulate, columns, plot)
+    def extra(result: object) -> None:
+        write_vtu(args, result.results, result.setup.model)  # type: ignore[attr-defined]
+        for problem in problems:
+            print(f"error: {problem}", file=sys.stderr)
+
+    code = finish(args, simulate, columns, plot, extra=extra)
+    return 1 if problems and code == 0 else code

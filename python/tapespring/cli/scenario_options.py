@@ -12,7 +12,15 @@ from typing import Any
 
 from .bend import _positive
 
-__all__ = ["add_output_options", "add_spec_options", "finish", "spec_from_args"]
+__all__ = [
+    "add_comparison_options",
+    "add_output_options",
+    "add_spec_options",
+    "analyze_experiment",
+    "finish",
+    "spec_from_args",
+    "write_vtu",
+]
 
 
 def add_spec_options(p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float) -> None:
@@ -119,3 +127,51 @@ def finish(
         print(f"error: {failure}", file=sys.stderr)
         return 1
     return 0
+
+
+def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: str) -> None:
+    """Add ``--experiment FILE`` (a recorded trial to compare with; `experiment` says what is
+    done with it) and ``--vtu FILE.pvd`` (a ParaView series; `vtu` says which states)."""
+    p.add_argument(
+        "--experiment",
+        metavar="FILE",
+        help="a recorded trial (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
+        + experiment,
+    )
+    p.add_argument(
+        "--vtu",
+        metavar="FILE.pvd",
+        help=f"write the deformed set-up as a ParaView series ({vtu}; needs meshio)",
+    )
+
+
+def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
+    """Read a recorded trial (C3D or CSV) and analyse it with `analyze` (a protocol function).
+
+    Returns the analysis, or None after printing ``error: FILE: problem`` on stderr if the file
+    is missing, unreadable or corrupt, or the analysis refuses it (the caller exits with 2).
+    """
+    from tapespring.trials.load import read_trial
+
+    try:
+        return analyze(read_trial(path))
+    except (OSError, ValueError) as exc:
+        message = str(exc)
+        if isinstance(exc, OSError) and exc.strerror:
+            message = exc.strerror
+        if str(path) not in message and str(Path(path)) not in message:
+            message = f"{path}: {message}"
+        print(f"error: {message}", file=sys.stderr)
+        return None
+
+
+def write_vtu(args: argparse.Namespace, results: Any, model: Any) -> None:
+    """Write ``--vtu`` (if given) from `results` with nodal fields and the `model` run (None:
+    the mesh saved in the results); says so unless ``--json``."""
+    if not getattr(args, "vtu", None):
+        return
+    from tapespring.io.vtu import write_pvd
+
+    path = write_pvd(results, model, args.vtu)
+    if not args.json:
+        print(f"  wrote {path}")

@@ -13,6 +13,14 @@ For the Kelvin-Voigt material ``sigma = C (eps + eta d(eps)/dt)`` the damping ma
 linearised system is ``eta K_material``, so a mode of pulsation ``omega`` has the damping ratio
 ``eta omega / 2`` (the rod and the weight, undamped, store a small part of the strain energy).
 The summary reports that value beside the fitted one.
+
+Comparison with a recorded free decay (Tables 7-8, Fig. 23): :meth:`VibrationSimulation.to_trial`
+samples the decay like a recording (markers at the sample rate, the pushed state held before the
+release), and :meth:`VibrationSimulation.compare` puts that trial and the recorded one through the
+same protocol function (:func:`tapespring.protocols.vibration.analyze_vibration`: equilibrium
+from the record's tail, release detection, damping fit in the window): the period and the
+damping ratio of both, their differences, and the paper's model beside them
+(:class:`VibrationComparison`).
 """
 
 from __future__ import annotations
@@ -36,7 +44,10 @@ from tapespring.scenarios.setup import (
     raise_if_stopped,
 )
 
-__all__ = ["VibrationSettings", "VibrationSimulation", "vibrate"]
+__all__ = ["VibrationComparison", "VibrationSettings", "VibrationSimulation", "vibrate"]
+
+#: Trial marker names of the set-up's markers (marker 3 on the additional weight is analysed).
+TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
 
 
 @dataclass(frozen=True)
@@ -63,6 +74,9 @@ class VibrationSettings:
         Local error tolerance of the time steps [m] (0: the solver's default).
     modes : int
         Vibration modes computed about the loaded equilibrium.
+    field_interval : int
+        Keep the nodal displacements and rotations every `field_interval`-th record, for
+        ParaView series (0: none; the last record is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)
@@ -73,6 +87,7 @@ class VibrationSettings:
     sample_rate: float = 800.0
     tolerance: float = 1e-4
     modes: int = 4
+    field_interval: int = 0
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
@@ -88,6 +103,9 @@ class VibrationSettings:
             raise ValueError(f"window must satisfy 0 <= low < high (got {self.window})")
         if not (isinstance(self.modes, int) and self.modes >= 1):
             raise ValueError(f"modes must be an integer >= 1 (got {self.modes!r})")
+        k = self.field_interval
+        if isinstance(k, bool) or not isinstance(k, int) or k < 0:
+            raise ValueError(f"field_interval must be an integer >= 0 (got {k!r})")
 
 
 @dataclass(frozen=True)
@@ -109,6 +127,8 @@ class VibrationSimulation:
     settings : VibrationSettings
     results : tapespring.Results
     wall_s : float
+    comparison : VibrationComparison or None
+        The comparison with a recorded free decay (:meth:`compare`), if one was given.
     """
 
     time_s: NDArray[np.float64]
@@ -119,6 +139,72 @@ class VibrationSimulation:
     settings: VibrationSettings
     results: Any
     wall_s: float
+    comparison: VibrationComparison | None = None
+
+    def to_trial(self, *, rate_hz: float | None = None, hold: float = 0.25) -> Any:
+        """The free decay sampled like a recorded vibration test, as a
+        :class:`tapespring.trials.Trial`.
+
+        Parameters
+        ----------
+        rate_hz : float, optional
+            Marker sampling rate [Hz] (default: the run's ``sample_rate``, where the records
+            fall on the samples).
+        hold : float
+            Rest in the pushed state before the release [s], >= 0 (a recording starts before
+            the hand lets go; the protocol takes the held value from the first samples).
+
+        Returns
+        -------
+        tapespring.trials.Trial
+            Markers ``M1``, ``M2`` (rod) and ``M3`` (on the additional weight) [m] in the
+            set-up's frame (the laboratory's: opposite sense, z up); no force plate. The release
+            is at ``hold`` seconds after the trial's start, which is the release's simulation
+            time.
+        """
+        from tapespring.scenarios.pull import rest_before
+        from tapespring.trials.trial import Metadata
+
+        rate = self.settings.sample_rate if rate_hz is None else rate_hz
+        trial = self.results.to_trial(
+            markers=TRIAL_MARKERS,
+            rate_hz=rate,
+            steps=[3],  # the free decay (vibrate)
+            metadata=Metadata(name="simulated free decay", units={"markers": "m"}),
+        )
+        return rest_before(trial, hold)
+
+    def compare(self, trial: Any) -> VibrationComparison:
+        """The period and the damping ratio against a recorded free decay (Tables 7-8).
+
+        Both the recording and this decay sampled as a trial (:meth:`to_trial`) go through
+        :func:`tapespring.protocols.vibration.analyze_vibration` (marker ``M3``, the settings'
+        ``window``).
+
+        Parameters
+        ----------
+        trial : tapespring.trials.Trial or tapespring.protocols.vibration.VibrationResult
+            The recorded free decay, or its analysis.
+
+        Returns
+        -------
+        VibrationComparison
+
+        Raises
+        ------
+        tapespring.trials.TrialError
+            If marker ``M3`` is missing or has gaps, or a damping fit is impossible (for the
+            simulation: too short a run for 3 peaks in the window).
+        """
+        from tapespring.protocols.vibration import VibrationResult, analyze_vibration
+
+        window = self.settings.window
+        if isinstance(trial, VibrationResult):
+            measured = trial
+        else:
+            measured = analyze_vibration(trial, window=window)
+        simulated = analyze_vibration(self.to_trial(), window=window)
+        return VibrationComparison(simulation=simulated, experiment=measured)
 
     @property
     def kelvin_voigt_damping_ratio(self) -> float:
@@ -153,6 +239,7 @@ class VibrationSimulation:
             "completed": r.completed,
             "error": r.error,
             "settings": asdict(self.settings),
+            "comparison": None if self.comparison is None else self.comparison.summary(),
         }
         return out
 
@@ -180,6 +267,92 @@ class VibrationSimulation:
         )
         if s["error"]:
             lines.append(f"  stopped early: {s['error']}")
+        if self.comparison is not None:
+            lines += ["", self.comparison.table()]
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class VibrationComparison:
+    """A simulated free decay against a recorded one (paper Tables 7-8, Fig. 23).
+
+    Both are analyses of :func:`tapespring.protocols.vibration.analyze_vibration`: the same
+    equilibrium, release and damping fit. Differences are simulation minus experiment; relative
+    ones are divided by the experiment's value (Table 8's Delta, with its sign).
+
+    Attributes
+    ----------
+    simulation : tapespring.protocols.vibration.VibrationResult
+        The simulated decay, sampled as a trial.
+    experiment : tapespring.protocols.vibration.VibrationResult
+        The recorded decay.
+    """
+
+    simulation: Any
+    experiment: Any
+
+    @property
+    def period_difference_s(self) -> float:
+        """Period, simulation minus experiment [s]."""
+        return self.simulation.fit.period - self.experiment.fit.period
+
+    @property
+    def damping_ratio_difference(self) -> float:
+        """Damping ratio, simulation minus experiment [-]."""
+        return self.simulation.fit.damping_ratio - self.experiment.fit.damping_ratio
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready figures: ``simulation``, ``paper_model``, ``experiment`` (each
+        ``period_s``, ``damping_ratio`` [-]; the analyses also ``damping_ratio_std``,
+        ``period_std_s``, ``peaks_used`` and ``release_time_s``) and ``difference``
+        (``period_s``, ``damping_ratio`` [-], and ``period_relative``,
+        ``damping_ratio_relative`` [-], divided by the experiment's)."""
+
+        def figures(r: Any) -> dict[str, Any]:
+            return {
+                "period_s": r.fit.period,
+                "damping_ratio": r.fit.damping_ratio,
+                "period_std_s": r.fit.period_std,
+                "damping_ratio_std": r.fit.damping_ratio_std,
+                "peaks_used": r.fit.n_peaks,
+                "release_time_s": r.release_time,
+            }
+
+        exp = self.experiment.fit
+        return {
+            "trial": self.experiment.name,
+            "simulation": figures(self.simulation),
+            "paper_model": {
+                "period_s": PAPER_MODEL.period,
+                "damping_ratio": PAPER_MODEL.damping_ratio,
+            },
+            "experiment": figures(self.experiment),
+            "difference": {
+                "period_s": self.period_difference_s,
+                "damping_ratio": self.damping_ratio_difference,
+                "period_relative": self.period_difference_s / exp.period,
+                "damping_ratio_relative": self.damping_ratio_difference / exp.damping_ratio,
+            },
+        }
+
+    def table(self) -> str:
+        """The paper-style table (Table 8): simulation, the paper's model, experiment, and the
+        simulation's difference relative to the experiment [%]."""
+        s = self.summary()
+        rows = [
+            ("damping ratio [%]", "damping_ratio", 100.0, 3, "damping_ratio_relative"),
+            ("period [s]", "period_s", 1.0, 4, "period_relative"),
+        ]
+        lines = [
+            f"free decay against {s['trial']} (Table 8)",
+            f"  {'':20}{'simulation':>12}{'paper model':>13}{'experiment':>12}{'difference':>12}",
+        ]
+        for label, key, scale, digits, rel in rows:
+            lines.append(
+                f"  {label:20}{s['simulation'][key] * scale:12.{digits}f}"
+                f"{s['paper_model'][key] * scale:13.{digits}f}"
+                f"{s['experiment'][key] * scale:12.{digits}f}{s['difference'][rel]:+12.1%}"
+            )
         return "\n".join(lines)
 
 
@@ -210,7 +383,7 @@ def vibrate(
         Step.static("push", activate=["push"], increments=4, lambda_end=2.0),
         Step.dynamic("free", duration=settings.duration, deactivate=["push"], **options),
     ]
-    outputs = Outputs(reactions=((built.clamp, "uz"),))
+    outputs = Outputs(reactions=((built.clamp, "uz"),), field_interval=settings.field_interval)
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
     marker = results.marker_names.index("marker3")
     loaded = results.in_step(0)
