@@ -33,7 +33,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "decays (peaks within --window-mm). Compare with Table 8 of the paper; with "
             "--experiment, with a recorded free decay too, both analysed as 'tapespring trials' "
             "does (the simulation sampled as a trial). At the paper's eta the peaks enter the "
-            "0.4-4 mm window after about 2 s: a fit needs --duration of 3 s or more."
+            "0.4-4 mm window after about 3.5 s: a fit needs --duration 4 or more."
         ),
     )
     p.add_argument(
