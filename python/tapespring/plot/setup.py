@@ -189,7 +189,8 @@ def plot_vibration(sim: Any, experiment: Any | None = None) -> Figure:
         _draw_fit(ax, fit, t0, "0.2", "peaks fitted")
         ax.set_xlim(-0.1, max(float(own.time[-1] - t0), 0.1))
     else:
-        ax.plot(sim.time_s, sim.displacement_m * 1e3, color="tab:red", lw=0.8, label="marker 3")
+        label = "marker 3" if experiment is None else "simulation"
+        ax.plot(sim.time_s, sim.displacement_m * 1e3, color="tab:red", lw=0.8, label=label)
         fit = sim.fit
         if fit is not None:
             _draw_fit(ax, fit, 0.0, "0.2", "peaks fitted")

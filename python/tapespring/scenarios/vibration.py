@@ -158,9 +158,9 @@ class VibrationSimulation:
         -------
         tapespring.trials.Trial
             Markers ``M1``, ``M2`` (rod) and ``M3`` (on the additional weight) [m] in the
-            set-up's frame (the laboratory's: opposite sense, z up); no force plate. The release
-            is at ``hold`` seconds after the trial's start, which is the release's simulation
-            time.
+            set-up's frame (the laboratory's: opposite sense, z up); no force plate. The trial
+            starts at the release's simulation time [s] with the held state, and the release
+            follows `hold` seconds later.
         """
         from tapespring.scenarios.pull import rest_before
         from tapespring.trials.trial import Metadata
