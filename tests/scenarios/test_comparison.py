@@ -155,6 +155,8 @@ def test_decay_against_a_known_oscillator(decay) -> None:
 
 
 def test_pull_command_with_an_experiment(tmp_path, capsys) -> None:
+    from tapespring.trials.c3d import write_c3d
+
     path = write_csv(make_pull_test_trial(), tmp_path / "measured_pull.csv")
     png, pvd = tmp_path / "pull.png", tmp_path / "pull.pvd"
     args = [*PULL_ARGS, "--no-progress", f"--experiment={path}"]
@@ -164,7 +166,9 @@ def test_pull_command_with_an_experiment(tmp_path, capsys) -> None:
     assert png.stat().st_size > 10_000
     # One ParaView file per state of the path.
     assert len(list((tmp_path / "pull").glob("*.vtu"))) >= 10
-    assert main([*args, "--json"]) == 0
+    # The same recording as a C3D file.
+    c3d = write_c3d(make_pull_test_trial(), tmp_path / "measured_pull.c3d")
+    assert main([*PULL_ARGS, "--no-progress", f"--experiment={c3d}", "--json"]) == 0
     c = json.loads(capsys.readouterr().out)["comparison"]
     assert c["trial"] == "measured_pull"
     for part in ("simulation", "paper_model", "experiment"):
@@ -199,11 +203,16 @@ def test_vibrate_command_with_an_experiment(tmp_path, capsys) -> None:
 
 
 @pytest.mark.parametrize("command", ["pull", "vibrate"])
-@pytest.mark.parametrize("problem", ["missing", "corrupt", "wrong test"])
+@pytest.mark.parametrize("problem", ["missing", "corrupt", "truncated c3d", "wrong test"])
 def test_bad_experiment_file_is_named(command, problem, tmp_path, capsys) -> None:
+    from tapespring.trials.c3d import write_c3d
+
     path = tmp_path / f"{problem.replace(' ', '_')}.csv"
     if problem == "corrupt":
         path.write_bytes(b"time [s],M2_x [mm]\n0.0,1.0,\x00\x01\n")
+    elif problem == "truncated c3d":
+        path = write_c3d(make_pull_test_trial(duration=2.0), path.with_suffix(".c3d"))
+        path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     elif problem == "wrong test":
         # A pull test has no free decay; a free decay has no force plate.
         other = make_vibration_trial() if command == "pull" else make_pull_test_trial()
