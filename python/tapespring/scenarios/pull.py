@@ -288,7 +288,8 @@ class PullResult:
         Raises
         ------
         ValueError
-            For a bad `speed` or rate, or a result without its set-up.
+            For a bad `speed` or rate, a result without its set-up, or a run that stopped
+            before the pull.
         """
         import dataclasses
 
@@ -300,7 +301,10 @@ class PullResult:
             raise ValueError("this PullResult has no set-up (it was not made by pull())")
         # Seconds per unit of the path's t: the drive ramps over t = 1 to 2 (setup.drive).
         scale = self.settings.max_displacement / speed
-        start = float(self.results.t[self.results.in_step(1)[0] - 1])
+        in_pull = self.results.in_step(1)
+        if in_pull.size == 0:
+            raise ValueError("the run recorded no state of the pull (it stopped under gravity)")
+        start = float(self.results.t[in_pull[0] - 1])
         trial = self.results.to_trial(
             markers=TRIAL_MARKERS,
             force_nodes=[self.setup.clamp],
