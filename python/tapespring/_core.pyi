@@ -18,6 +18,7 @@ __all__ = [
     "_panic_for_tests",
     "cylindrical_panel_mesh",
     "flat_plate_mesh",
+    "generalized_alpha_decay",
     "run",
     "step_defaults",
     "tape_section_centroid_z",
@@ -170,6 +171,7 @@ def run(
     mode_shapes, effective_masses, residuals, below_shift, equilibrium_residual, matrices),
     stats, step_stats, error, cancelled, steps_completed, settings."""
 
+def generalized_alpha_decay(rho_inf: float, omega_h: float, xi: float = 0.0) -> tuple[float, float]: ...
 def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]: ...
 def tape_spring_mesh(
     length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0

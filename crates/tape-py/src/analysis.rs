@@ -71,6 +71,27 @@ pub fn run<'py>(
     Ok(d)
 }
 
+/// What a free decay computed by the generalised-alpha scheme with spectral radius `rho_inf`
+/// shows of a linear oscillator of damping ratio `xi`, at `omega h` (pulsation [rad/s] times the
+/// time step [s]): `(damping_ratio, period_ratio)`, the apparent damping ratio and the period over
+/// the exact damped period (NaN past the bifurcation of the principal roots).
+#[pyfunction]
+#[pyo3(signature = (rho_inf, omega_h, xi = 0.0))]
+pub fn generalized_alpha_decay(rho_inf: f64, omega_h: f64, xi: f64) -> PyResult<(f64, f64)> {
+    let alpha = to_py(tape_core::solver::alpha::Alpha::new(rho_inf))?;
+    for (name, v) in [("omega_h", omega_h), ("xi", xi)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "{name} must be finite and >= 0 (got {v})"
+            )));
+        }
+    }
+    if xi >= 1.0 {
+        return Err(PyValueError::new_err(format!("xi must be < 1 (got {xi})")));
+    }
+    Ok(alpha.apparent_damping(omega_h, xi))
+}
+
 /// Every option of a step of `kind` with its default value (the flat dict `run` reads).
 #[pyfunction]
 #[pyo3(signature = (kind = "static", control = "load"))]

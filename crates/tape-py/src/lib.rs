@@ -15,7 +15,7 @@ mod _core {
     use pyo3::prelude::*;
 
     #[pymodule_export]
-    use super::analysis::{run, step_defaults};
+    use super::analysis::{generalized_alpha_decay, run, step_defaults};
     #[pymodule_export]
     use super::mesh::{
         _panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_section_centroid_z, tape_spring_mesh,

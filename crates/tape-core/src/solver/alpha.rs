@@ -97,16 +97,29 @@ impl Alpha {
         (self.beta - 1.0 / 6.0).abs()
     }
 
-    /// Amplification matrix of the undamped oscillator `x'' + omega^2 x = 0` at `omega h`, on the
-    /// state `(x, h v, h^2 a)`.
+    /// Amplification matrix of the oscillator `x'' + 2 xi omega x' + omega^2 x = 0` at `omega h`,
+    /// on the state `(x, h v, h^2 a)`: the scheme's step for a linear system (the Lie-group form
+    /// reduces to Chung & Hulbert's on a vector space).
     #[must_use]
-    pub fn amplification(&self, omega_h: f64) -> Matrix3<f64> {
-        // Unknowns (x1, h v1, h^2 a1); the equations of one step, `lhs y1 = rhs y0`.
+    pub fn amplification(&self, omega_h: f64, xi: f64) -> Matrix3<f64> {
+        // Unknowns (x1, h v1, h^2 a1); the equations of one step, `lhs y1 = rhs y0`; the equation
+        // of motion weighted by alpha_f between the step's ends.
         let (b, g, am, af) = (self.beta, self.gamma, self.alpha_m, self.alpha_f);
-        let w2 = omega_h * omega_h;
-        let lhs = Matrix3::new(1.0, 0.0, -b, 0.0, 1.0, -g, (1.0 - af) * w2, 0.0, 1.0 - am);
-        let rhs = Matrix3::new(1.0, 1.0, 0.5 - b, 0.0, 1.0, 1.0 - g, -af * w2, 0.0, -am);
+        let (w2, c) = (omega_h * omega_h, 2.0 * xi * omega_h);
+        let lhs = Matrix3::new(1.0, 0.0, -b, 0.0, 1.0, -g, (1.0 - af) * w2, (1.0 - af) * c, 1.0 - am);
+        let rhs = Matrix3::new(1.0, 1.0, 0.5 - b, 0.0, 1.0, 1.0 - g, -af * w2, -af * c, -am);
         lhs.try_inverse().expect("the step matrix is regular") * rhs
+    }
+
+    /// The principal (oscillating) root of [`Self::amplification`], if the roots are complex.
+    fn principal_root(&self, omega_h: f64, xi: f64) -> (f64, Option<Complex<f64>>) {
+        let eig = self.amplification(omega_h, xi).complex_eigenvalues();
+        let radius = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        let principal = eig.iter().copied().fold(
+            Complex::new(0.0, 0.0),
+            |best: Complex<f64>, l| if l.im > best.im { l } else { best },
+        );
+        (radius, (principal.im > 0.0).then_some(principal))
     }
 
     /// Spectral radius and algorithmic damping ratio of the principal (oscillating) root at
@@ -114,24 +127,25 @@ impl Alpha {
     /// the principal roots into real ones).
     #[must_use]
     pub fn spectral_properties(&self, omega_h: f64) -> (f64, f64) {
-        let eig = self.amplification(omega_h).complex_eigenvalues();
-        let radius = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
-        let principal = eig.iter().copied().fold(
-            Complex::new(0.0, 0.0),
-            |best: Complex<f64>, l| {
-                if l.im > best.im {
-                    l
-                } else {
-                    best
-                }
-            },
-        );
-        let damping = if principal.im > 0.0 {
-            -principal.norm().ln() / principal.arg()
-        } else {
-            f64::NAN
-        };
+        let (radius, principal) = self.principal_root(omega_h, 0.0);
+        let damping = principal.map_or(f64::NAN, |l| -l.norm().ln() / l.arg());
         (radius, damping)
+    }
+
+    /// What a free decay computed with steps `h` shows of an oscillator of pulsation `omega`
+    /// [rad/s] and damping ratio `xi`, at `omega h`: the damping ratio `a / sqrt(a^2 + w_d^2)`
+    /// of the decay rate `a = -ln|lambda| / h` and pulsation `w_d = arg(lambda) / h`, and the
+    /// period over the exact damped period `2 pi / (omega sqrt(1 - xi^2))`. NaN past the
+    /// bifurcation of the principal roots.
+    #[must_use]
+    pub fn apparent_damping(&self, omega_h: f64, xi: f64) -> (f64, f64) {
+        match self.principal_root(omega_h, xi).1 {
+            Some(l) => {
+                let (a, w) = (-l.norm().ln(), l.arg());
+                (a / a.hypot(w), omega_h * (1.0 - xi * xi).sqrt() / w)
+            }
+            None => (f64::NAN, f64::NAN),
+        }
     }
 }
 
@@ -189,6 +203,61 @@ mod tests {
         // rho_inf = 1: no algorithmic damping at all.
         let (r, xi) = Alpha::new(1.0).unwrap().spectral_properties(1.0);
         assert!((r - 1.0).abs() < 1e-12 && xi.abs() < 1e-12);
+    }
+
+    /// The apparent damping of a damped oscillator tends to its own as the step vanishes; without
+    /// physical damping it is the algorithmic damping ratio; at a finite step it grows as rho_inf
+    /// falls, and rho_inf = 1 shows the trapezoidal rule's period error `(omega h)^2 / 12`.
+    #[test]
+    fn apparent_damping_of_a_damped_oscillator() {
+        let xi = 0.005;
+        let mut previous = f64::INFINITY;
+        for rho in [0.0, 0.3, 0.7, 1.0] {
+            let s = Alpha::new(rho).unwrap();
+            let (eps, ratio) = s.apparent_damping(1e-3, xi);
+            assert!((eps / xi - 1.0).abs() < 1e-4, "rho {rho}: {eps} at omega h = 1e-3");
+            assert!((ratio - 1.0).abs() < 1e-5, "rho {rho}: period ratio {ratio}");
+            let (undamped, _) = s.apparent_damping(0.3, 0.0);
+            let (_, algorithmic) = s.spectral_properties(0.3);
+            // a / sqrt(a^2 + w^2) against a / w: they differ by (a / w)^3 / 2.
+            assert!(
+                (undamped - algorithmic).abs() <= 1e-12 + algorithmic.powi(3),
+                "rho {rho}"
+            );
+            let (eps, _) = s.apparent_damping(0.3, xi);
+            assert!(eps < previous, "rho {rho}: {eps}");
+            previous = eps;
+        }
+        let (_, ratio) = Alpha::new(1.0).unwrap().apparent_damping(0.1, 0.0);
+        assert!(
+            (ratio - 1.0 - 0.01 / 12.0).abs() < 1e-6,
+            "trapezoidal period ratio {ratio}"
+        );
+    }
+
+    /// The amplification matrix is the scheme: 50 steps of a damped oscillator with
+    /// [`Alpha::advance`] land where the 50th power of the matrix takes the state.
+    #[test]
+    fn amplification_matrix_is_the_step() {
+        let (w, xi, h) = (2.0_f64, 0.05, 0.2);
+        let s = Alpha::new(0.6).unwrap();
+        let (mut x, mut v) = (1.0_f64, -0.3_f64);
+        let mut dv = -w * w * x - 2.0 * xi * w * v;
+        let mut a = dv;
+        let y0 = nalgebra::Vector3::new(x, h * v, h * h * a);
+        for _ in 0..50 {
+            // The equation of motion at the step's end is affine in the increment D.
+            let f = |d: f64| {
+                let (_, v1, dv1) = s.advance(h, d, v, dv, a);
+                dv1 + 2.0 * xi * w * v1 + w * w * (x + d)
+            };
+            let d = -f(0.0) / (f(1.0) - f(0.0));
+            let (a1, v1, dv1) = s.advance(h, d, v, dv, a);
+            (x, v, dv, a) = (x + d, v1, dv1, a1);
+        }
+        let y = s.amplification(w * h, xi).pow(50) * y0;
+        let got = nalgebra::Vector3::new(x, h * v, h * h * a);
+        assert!((got - y).norm() < 1e-12, "{got} vs {y}");
     }
 
     /// Integrates `x'' = -omega^2 x` with the scheme's own update and returns the error at `t_end`
