@@ -15,10 +15,16 @@ DEFAULT_DURATION = 1.0
 DEFAULT_MESH_TAPE = 5e-3
 DEFAULT_MESH_PLATES = 10e-3
 
+#: Default sample rate with the flexible support [Hz]: steps of at most 0.5 ms, 12 per period of
+#: the support's first mode (164 Hz, ``SetupSpec``), where the motion capture's 800 Hz give 5 and
+#: generalised-alpha damps the mode and stretches its period.
+FLEXIBLE_SAMPLE_RATE = 2000.0
+
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
+    from tapespring.scenarios.setup import SUPPORTS
 
     d = DeploymentSettings()
     p = sub.add_parser(
@@ -34,6 +40,22 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("--sense", choices=("opposite", "equal"), default=d.sense)
+    p.add_argument(
+        "--support",
+        choices=SUPPORTS,
+        default=d.spec.support,
+        help="model of the fixation support: the tapes' ends clamped (rigid, the paper's model) "
+        "or a shell model of the support standing on the force plate (flexible, Fig. 33); the "
+        "clamp force is the vertical force under it",
+    )
+    p.add_argument(
+        "--sample-rate",
+        type=_positive("sample rate"),
+        default=None,
+        help="rate of the recorded histories [Hz]; the time steps land on its multiples "
+        f"(default {d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
+        "resolves the support's vibration at 164 Hz)",
+    )
     p.add_argument(
         "--duration",
         type=_positive("duration"),
@@ -91,9 +113,17 @@ def run(args: argparse.Namespace) -> int:
             return 2
 
     def simulate() -> object:
+        rate = args.sample_rate
+        if rate is None:
+            rate = (
+                FLEXIBLE_SAMPLE_RATE
+                if args.support == "flexible"
+                else DeploymentSettings.sample_rate
+            )
         settings = DeploymentSettings(
-            spec=spec_from_args(args),
+            spec=replace(spec_from_args(args), support=args.support),
             sense=args.sense,
+            sample_rate=rate,
             duration=args.duration,
             rho_inf=args.rho_inf,
             tolerance=args.tolerance,

@@ -24,6 +24,13 @@ measured record uses its tail). Peaks and phases go through the measured records
 :meth:`DeploymentSimulation.to_trial` turns the run into a :class:`tapespring.trials.Trial`
 (markers M1 support, M2 rod, M3 appendix tip; the force plate under the clamp) for the trial
 tool chain.
+
+The support is that of ``spec.support``: ``"rigid"`` (the paper's model: the tapes' clamped ends
+fixed, the clamp force is their reaction) or ``"flexible"`` (the shell model of the support of
+Sec. 6.1, Fig. 33: the clamp force is the sum of the vertical reactions at the support's base on
+the force plate, which also carries the support's own weight and inertia;
+:func:`tapespring.scenarios.setup.add_flexible_support`). Both are read from the set-up's fixed
+``clamp`` node with the same sign.
 """
 
 from __future__ import annotations
@@ -65,7 +72,10 @@ class DeploymentSettings:
     Attributes
     ----------
     spec : SetupSpec
-        The set-up (configuration ``"appendix"``); ``spec.eta`` is the tapes' viscosity.
+        The set-up (configuration ``"appendix"``); ``spec.eta`` is the tapes' viscosity and
+        ``spec.support`` the model of the support (``"rigid"`` or ``"flexible"``). With the
+        flexible support, a `sample_rate` of about 2 kHz resolves its vibration (first natural
+        frequency 164 Hz) in the time steps.
     sense : str
         ``"opposite"`` or ``"equal"``.
     duration : float
@@ -128,7 +138,8 @@ class DeploymentSimulation:
         Bending angle relative to the gravity equilibrium [deg].
     clamp_force_N : ndarray
         Vertical force on the support from the tapes (the force plate's Fz, with the sign the
-        plate measures) [N].
+        plate measures) [N]; with the flexible support, the force under the support's base
+        (which includes the support's weight, ``spec.support_mass * g``, and inertia).
     tip_m : ndarray
         Position of the appendix tip (marker 3) [m], shape (n, 3).
     peaks : tapespring.signals.peaks.Peaks or None
@@ -161,7 +172,8 @@ class DeploymentSimulation:
         """The release and the motion as a :class:`tapespring.trials.Trial`.
 
         Markers M1 (support), M2 (rod), M3 (appendix tip) resampled at `rate_hz` (default: the
-        run's sample rate); one force plate under the clamp (1 kHz).
+        run's sample rate); one force plate under the clamp (1 kHz): the rigid support's clamp,
+        or the flexible support's base (moments about the middle of its base edge).
         """
         from tapespring.trials.trial import Metadata
 
@@ -244,6 +256,7 @@ class DeploymentSimulation:
         )
         return {
             "sense": self.settings.sense,
+            "support": self.settings.spec.support,
             "initial_angle_deg": float(self.angle_deg[0]) if self.angle_deg.size else None,
             "final_angle_deg": float(self.angle_deg[-1]) if self.angle_deg.size else None,
             "peaks": peaks,
@@ -273,7 +286,8 @@ class DeploymentSimulation:
         s = self.summary()
         reached = self.time_s[-1] if self.time_s.size else 0.0
         lines = [
-            f"deployment of the set-up, {self.settings.sense} sense, {s['ndof']} DOFs: "
+            f"deployment of the set-up, {self.settings.sense} sense, {s['support']} support, "
+            f"{s['ndof']} DOFs: "
             f"{reached:.3g} s of motion in {s['steps']} steps ({s['rejected_steps']} rejected, "
             f"{s['newton_iterations']} Newton iterations in all), wall time {self.wall_s:.1f} s",
         ]

@@ -22,11 +22,14 @@ __all__ = [
     "PAPER_SETUP",
     "PAPER_TAPE",
     "SENSES",
+    "SUPPORTS",
+    "FlexibleSupport",
     "PaperResults",
     "IdentificationBounds",
     "SetupModel",
     "SetupSpec",
     "TapeSpring",
+    "add_flexible_support",
     "build_setup",
     "check_number",
     "check_sense",
@@ -175,6 +178,11 @@ CONFIGURATIONS = ("appendix", "bare", "weight")
 #: folded downwards) or the block turned upside down (equal sense).
 SENSES = ("opposite", "equal")
 
+#: Models of the fixation support: the tapes' clamped ends held fixed (the paper's model, Sec. 5:
+#: "the fixation support is not included in the model"), or a shell model of the support
+#: standing on the force plate (the paper's variant of Sec. 6.1, Fig. 33).
+SUPPORTS = ("rigid", "flexible")
+
 
 @dataclass(frozen=True)
 class SetupSpec:
@@ -222,6 +230,38 @@ class SetupSpec:
       dx/dz of the paper's folded equilibrium (0.33 at markers 1-2, 0.39 at marker 3) are
       those of markers about 15-20 mm above the plane rotating about this model's fold; with
       markers in the plane they come out near 0.5.
+    * the support (``support``): ``"rigid"`` by default, the paper's model (Sec. 5: the support
+      is not modelled, the tapes are clamped at the big interfaces); ``"flexible"`` is the
+      paper's variant of Sec. 6.1 (Fig. 33: "a flexible model of the support using a shell
+      finite element mesh"), whose dimensions the paper does not give. Chosen here: an
+      aluminium L-bracket 80 mm wide and 8 mm thick standing on the force plate: a vertical web
+      (the plane x = -100 mm) clamped along its base, 100 mm from its base to a horizontal
+      flange, which reaches forward 100 mm to x = 0 and carries the big interfaces on its top
+      face. Figs. 5 and 8 show a bracket standing on the force plate and holding the big
+      interfaces; 80 mm spans the two 25 mm big interfaces 40 mm apart with a margin; 8 mm is
+      a stock aluminium plate; 100 mm raises the tapes well above the force plate. The
+      proportions are set by what the force plate sees: its vertical force feels a mode of the
+      support through the mode's vertical effective mass. With this flange the first mode of
+      the bracket with its big interfaces (164 Hz on a 10 mm mesh) moves the tapes' clamped
+      ends up and down and has the largest vertical effective mass of all (0.12 kg); with a
+      shorter flange (50 mm) or a vertical plate holding the interfaces on its face, the first
+      mode rocks the clamp along x and the vertical force sees mainly a third mode near 500 Hz
+      to 1 kHz, which steps of 0.5 ms cannot follow. 164 Hz is far above the tapes' motion
+      (below 20 Hz; the folds' forming and vanishing spread the rigid clamp force to about
+      120 Hz) and below the 400 Hz Nyquist frequency of the 800 Hz records. Aluminium: 70 GPa,
+      0.33, 2700 kg/m^3, undamped (a metal's material damping is orders of magnitude below the
+      tapes' equivalent viscosity; the paper's flexible support rings too long, Sec. 6.1).
+    * the big interfaces (flexible support only; the rigid support is them held fixed): two
+      rigid aluminium blocks, 40 g each, 25 mm (x) by 25 mm (y) by 20 mm (z), on the flange's
+      front end, the tapes' clamped sections (their centroid) at mid-height of the blocks
+      ("larger and thicker" than the small ones, Sec. 3.2). Each ties its tape's x = 0 section
+      and the flange's nodes under its footprint (bolted, it holds the flange there). In
+      equal sense the block of tapes is turned upside down on the same support, so in the
+      set-up's frame the support stands on the +z side (the blocks then hang under the
+      flange).
+    * marker 0 with the flexible support: on the middle of the bracket's corner (the top of the
+      fixation support, Sec. 4.1), moving with it; ``support_marker`` places it on the rigid
+      support only.
 
     Every value can be overridden (``dataclasses.replace``).
 
@@ -235,7 +275,8 @@ class SetupSpec:
     tape_spacing : float
         Distance between the two tapes' mid-lines [m].
     mesh_tape, mesh_plates : float
-        Element sizes of the tapes and of the rod and appendix [m] (paper: 2 mm and 3 mm).
+        Element sizes of the tapes and of the rod, appendix and flexible support [m] (paper:
+        2 mm and 3 mm).
     interface_length, interface_width, interface_height : float
         Size of each small interface [m] (x, y, z).
     interface_mass : float
@@ -265,6 +306,26 @@ class SetupSpec:
         Time the folded set-up is held before the release [s] (paper: 5 s).
     pull_rate : float
         Speed of the quasi-static pull [m/s] (paper: 1 mm/s).
+    support : str
+        ``"rigid"`` (the clamped ends fixed) or ``"flexible"`` (the shell model of the support);
+        see :data:`SUPPORTS`.
+    support_height : float
+        Height of the flexible support's web, from its base on the force plate to the flange's
+        mid-surface [m].
+    support_length : float
+        Length of the flange along x, from the web's mid-surface to its front edge under the
+        tapes' clamped sections (x = 0) [m].
+    support_width, support_thickness : float
+        Width (along y) and thickness of the bracket's web and flange [m].
+    support_youngs_modulus, support_poisson, support_density : float
+        Material of the bracket [Pa, -, kg/m^3].
+    support_eta : float
+        Kelvin-Voigt viscosity of the bracket [s] (>= 0).
+    clamp_interface_mass : float
+        Mass of each big interface [kg] (flexible support only).
+    clamp_interface_length, clamp_interface_width, clamp_interface_height : float
+        Size of each big interface [m] (along x, y, z); its footprint on the flange is
+        length by width, and the tapes' clamped sections are at half its height.
     """
 
     tape: TapeSpring = PAPER_TAPE
@@ -298,6 +359,28 @@ class SetupSpec:
     fold_rate: float = 2e-3
     hold: float = 5.0
     pull_rate: float = 1e-3
+    support: str = "rigid"
+    support_height: float = 0.100
+    support_length: float = 0.100
+    support_width: float = 0.080
+    support_thickness: float = 8e-3
+    support_youngs_modulus: float = 70e9
+    support_poisson: float = 0.33
+    support_density: float = 2700.0
+    support_eta: float = 0.0
+    clamp_interface_mass: float = 0.040
+    clamp_interface_length: float = 0.025
+    clamp_interface_width: float = 0.025
+    clamp_interface_height: float = 0.020
+
+    @property
+    def support_mass(self) -> float:
+        """Mass of the flexible support's bracket and the two big interfaces [kg] (what its base
+        carries beyond the rigid support's clamp)."""
+        area = (self.support_height + self.support_length) * self.support_width
+        return (
+            self.support_density * area * self.support_thickness + 2.0 * self.clamp_interface_mass
+        )
 
     @property
     def rod_x(self) -> float:
@@ -340,10 +423,12 @@ class SetupSpec:
             check_number(f"tape.{name}", value, positive=True)
         if not -1.0 < self.tape.poisson < 0.5:
             raise ValueError(f"tape.poisson must lie in (-1, 0.5) (got {self.tape.poisson})")
+        if self.support not in SUPPORTS:
+            raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
-            if name in ("tape", "support_marker"):
+            if name in ("tape", "support_marker", "support"):
                 continue
-            positive = not name.startswith("initial_angle") and name != "eta"
+            positive = not name.startswith("initial_angle") and name not in ("eta", "support_eta")
             check_number(name, value, positive=positive)
         if len(self.support_marker) != 3:
             raise ValueError(f"support_marker must have 3 coordinates (got {self.support_marker})")
@@ -353,6 +438,7 @@ class SetupSpec:
             raise ValueError(f"eta must be >= 0 s (got {self.eta})")
         if not -1.0 < self.plate_poisson < 0.5:
             raise ValueError(f"plate_poisson must lie in (-1, 0.5) (got {self.plate_poisson})")
+        self._validate_support()
         if self.appendix_length <= self.mesh_plates:
             raise ValueError(
                 f"setup_length {self.setup_length} m leaves no room for the appendix beyond the "
@@ -376,6 +462,34 @@ class SetupSpec:
             size = getattr(self, name)
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
+
+    def _validate_support(self) -> None:
+        """Check the flexible support's values: each one always (like every value), against
+        the rest of the set-up only when the support is flexible (a rigid support's spec is
+        accepted as before)."""
+        if self.support_eta < 0.0:
+            raise ValueError(f"support_eta must be >= 0 s (got {self.support_eta})")
+        if not -1.0 < self.support_poisson < 0.5:
+            raise ValueError(f"support_poisson must lie in (-1, 0.5) (got {self.support_poisson})")
+        if self.support != "flexible":
+            return
+        if self.clamp_interface_length > self.support_length - self.support_thickness / 2.0:
+            raise ValueError(
+                f"support_length {self.support_length} m must hold the big interfaces "
+                f"(clamp_interface_length {self.clamp_interface_length} m) in front of the web"
+            )
+        if self.tape_spacing + self.clamp_interface_width > self.support_width:
+            raise ValueError(
+                f"support_width {self.support_width} m must span both big interfaces "
+                f"(>= tape_spacing + clamp_interface_width = "
+                f"{self.tape_spacing + self.clamp_interface_width} m)"
+            )
+        for name in ("support_height", "support_length", "support_width"):
+            if self.mesh_plates > getattr(self, name) / 4.0:
+                raise ValueError(
+                    f"mesh_plates {self.mesh_plates} m is too coarse for {name} (at most a "
+                    "quarter of it)"
+                )
 
 
 def check_sense(sense: str) -> None:
@@ -413,8 +527,9 @@ class SetupModel:
     configuration, sense : str
         See :data:`CONFIGURATIONS` and :data:`SENSES`.
     clamp : int
-        Reference node of the clamped ends (fixed; its reactions are the forces the support
-        feels from the tapes).
+        The fixed node (id ``"clamp"``) whose reactions are the forces of the support on the
+        structure: the reference node of the tapes' clamped ends (rigid support) or of the
+        support's base (flexible support); see the notes.
     interfaces : tuple of int
         Reference nodes of the two small interfaces.
     rod_middle : int
@@ -423,6 +538,18 @@ class SetupModel:
         The node carrying marker 3: the appendix's tip node or the weight's reference node.
     down : float
         Sign of "downwards" along z in this frame: -1 in opposite sense, +1 in equal sense.
+    flexible_support : FlexibleSupport or None
+        The shell model of the support (``spec.support == "flexible"``), else None.
+
+    Notes
+    -----
+    ``clamp`` is the one fixed node of the set-up whatever the support, so the scenarios read
+    the force plate from its reactions alike: with the rigid support it is the reference node
+    of the tapes' clamped ends; with the flexible one it is the reference node of the support's
+    base (on the force plate, in the middle of the base edge), to which every node of the base
+    is tied, so its reactions are the sums of the base nodes' reactions (forces, and moments
+    about it). Reactions ``r`` are the forces of the support on the structure; the force plate
+    measures ``-r`` (:mod:`tapespring.trials.simulated`).
     """
 
     model: Any
@@ -434,11 +561,194 @@ class SetupModel:
     rod_middle: int
     tip: int | None
     down: float
+    flexible_support: FlexibleSupport | None = None
 
     @property
     def gravity_vector(self) -> tuple[float, float, float]:
         """Gravitational acceleration in the set-up's frame [m/s^2]."""
         return (0.0, 0.0, self.down * self.spec.gravity)
+
+
+@dataclass(frozen=True)
+class FlexibleSupport:
+    """The shell model of the fixation support, as built by :func:`add_flexible_support`.
+
+    Attributes
+    ----------
+    base : int
+        Fixed reference node (constraint id ``"clamp"``) in the middle of the web's base edge,
+        to which every base node is tied: its reactions are the base's summed reactions [N,
+        N m] (moments about it).
+    base_nodes : ndarray of int64
+        The web's nodes along its base (tied to `base`).
+    interfaces : tuple of int
+        Reference nodes of the big interfaces (rigid bodies), in the order of the tapes (empty
+        for the plate alone).
+    top : int
+        The web's node in the middle of the bracket's corner (marker 0 of the set-up).
+    part : str
+        Name of the web's part (``"support"``; node sets ``support.base``, ``support.top``,
+        ``support.all``); the flange is ``support_flange`` (``.back``, ``.front``, ``.all``).
+    mass : float
+        Mass of the bracket and of the big interfaces built [kg].
+    """
+
+    base: int
+    base_nodes: NDArray[np.int64]
+    interfaces: tuple[int, ...]
+    top: int
+    part: str
+    mass: float
+
+
+def _breaks(points: list[float], size: float) -> NDArray[np.float64]:
+    """Grid coordinates through every one of the sorted `points`, spaced at most `size`."""
+    out = [points[0]]
+    for a, b in zip(points[:-1], points[1:], strict=True):
+        if b - a > 1e-12:
+            n = _count(b - a, size)
+            out.extend(np.linspace(a, b, n + 1)[1:].tolist())
+    return np.asarray(out)
+
+
+def add_flexible_support(
+    model: Any,
+    spec: SetupSpec = PAPER_SETUP,
+    *,
+    down: float = -1.0,
+    clamped: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
+    interfaces: bool = True,
+) -> FlexibleSupport:
+    """Add the shell model of the fixation support to `model` (paper Sec. 6.1, Fig. 33).
+
+    An L-bracket of ``spec.support_thickness`` shells (the support's material),
+    ``spec.support_width`` wide about ``y = 0``::
+
+               big interfaces (rigid), tapes' clamped sections at x = 0
+                      [==]
+        flange  o-----[==]  z_f   (its front edge at x = 0)
+                |
+                |  web, x = -support_length, height support_height
+                |
+        base  ==+==  clamped on the force plate (tied to the fixed node ``base``)
+
+    The flange (part ``support_flange``) lies in the plane ``z_f`` half a big interface and half
+    a thickness below the tapes' section centroid ``zc`` (along `down`); the web (part
+    ``support``) stands in the plane ``x = -spec.support_length`` from the base,
+    ``spec.support_height`` below the flange, up to it. The corner is welded: each flange node
+    of the fold line is tied to the coincident web node (separate parts, so that each keeps its
+    own normal). The base edge is tied to one reference node, fixed in all six DOFs (id
+    ``"clamp"``: a clamped base). Each big interface is a rigid body (``spec.clamp_interface_mass``,
+    a uniform block standing on the flange) whose reference node, at ``(-length / 2, y, zc)``,
+    ties the flange's nodes under its footprint (from the front edge back by
+    ``spec.clamp_interface_length``, centred on ``y = -/+ spec.tape_spacing / 2``) and its
+    tape's clamped section. Meshes of at most ``spec.mesh_plates``, with grid lines along the
+    footprints and through the middle.
+
+    Parameters
+    ----------
+    model : tapespring.Model
+        The model the support is added to.
+    spec : SetupSpec
+        Dimensions and material (the ``support*`` and ``clamp_interface*`` values).
+    down : float
+        Sign of "downwards" along z (-1 opposite sense, +1 equal sense: the support stands on
+        the floor while the block of tapes is upside down).
+    clamped : pair of int arrays, optional
+        The clamped-section nodes of the two tapes (y < 0 first), tied to the big interfaces.
+    interfaces : bool
+        False: the bracket alone (no big interfaces; `clamped` must be None).
+
+    Returns
+    -------
+    FlexibleSupport
+
+    Raises
+    ------
+    ValueError
+        For a bad spec (validated), or `clamped` without interfaces.
+    """
+    from tapespring import _core
+
+    spec.validate()
+    if clamped is not None and not interfaces:
+        raise ValueError("clamped sections need the big interfaces (interfaces=True)")
+    zc = _core.tape_section_centroid_z(spec.tape.radius, spec.tape.alpha)
+    height, length, width = spec.support_height, spec.support_length, spec.support_width
+    li, wi, hi = (
+        spec.clamp_interface_length,
+        spec.clamp_interface_width,
+        spec.clamp_interface_height,
+    )
+    half = spec.tape_spacing / 2.0
+    z_f = zc + down * (hi / 2.0 + spec.support_thickness / 2.0)
+    z_base = z_f + down * height
+    x_web = -length
+    b = _breaks(
+        sorted({-width / 2.0, -half - wi / 2.0, -half + wi / 2.0, 0.0}
+               | {half - wi / 2.0, half + wi / 2.0, width / 2.0}),
+        spec.mesh_plates,
+    )  # fmt: skip
+    a = _breaks([0.0, height], spec.mesh_plates)  # web: from the base up
+    c = _breaks([0.0, length - li, length], spec.mesh_plates)  # flange: from the web forward
+
+    def grid(u: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        ids = np.arange(u.size * b.size).reshape(u.size, b.size)
+        quads = np.column_stack(
+            [ids[:-1, :-1].ravel(), ids[1:, :-1].ravel(), ids[1:, 1:].ravel(), ids[:-1, 1:].ravel()]
+        )
+        return ids, quads
+
+    section = {
+        "thickness": spec.support_thickness,
+        "youngs_modulus": spec.support_youngs_modulus,
+        "poisson": spec.support_poisson,
+        "density": spec.support_density,
+        "eta": spec.support_eta,
+    }
+    ids, quads = grid(a)
+    aa, bb = np.meshgrid(a, b, indexing="ij")
+    web = np.column_stack([np.full(aa.size, x_web), bb.ravel(), z_base - down * aa.ravel()])
+    sets = {"base": ids[0], "top": ids[-1], "all": ids.ravel()}
+    model.add_part("support", web, quads, node_sets=sets, **section)
+    ids, quads = grid(c)
+    cc, bb = np.meshgrid(c, b, indexing="ij")
+    flange = np.column_stack([x_web + cc.ravel(), bb.ravel(), np.full(cc.size, z_f)])
+    sets = {"back": ids[0], "front": ids[-1], "all": ids.ravel()}
+    model.add_part("support_flange", flange, quads, node_sets=sets, **section)
+    corner_web = model.node_set("support.top")
+    corner_flange = model.node_set("support_flange.back")
+    xyz = model.nodes
+    for i, j in zip(corner_web[np.argsort(xyz[corner_web, 1])],
+                    corner_flange[np.argsort(xyz[corner_flange, 1])], strict=True):  # fmt: skip
+        model.tie([int(j)], int(i))
+    top = int(corner_web[np.argmin(np.abs(xyz[corner_web, 1]))])
+    base_nodes = model.node_set("support.base")
+    base = model.add_node([x_web, 0.0, z_base])
+    model.tie(base_nodes, base)
+    model.fix(base, "all", id="clamp")
+    mass = spec.support_density * (height + length) * width * spec.support_thickness
+    refs: list[int] = []
+    if interfaces:
+        on = model.node_set("support_flange.all")
+        p = xyz[on]
+        for i, y in enumerate((-half, half)):
+            under = on[(np.abs(p[:, 1] - y) <= wi / 2.0 + 1e-9) & (p[:, 0] >= -li - 1e-9)]
+            node = model.add_node([-li / 2.0, y, zc])
+            held = under if clamped is None else np.concatenate([clamped[i], under])
+            model.tie(held, node)
+            inertia = _box_inertia(spec.clamp_interface_mass, li, wi, hi)
+            model.add_rigid_body(node, spec.clamp_interface_mass, inertia=inertia)
+            refs.append(node)
+            mass += spec.clamp_interface_mass
+    return FlexibleSupport(
+        base=base,
+        base_nodes=base_nodes,
+        interfaces=tuple(refs),
+        top=top,
+        part="support",
+        mass=mass,
+    )
 
 
 def _count(length: float, size: float, *, even: bool = False) -> int:
@@ -468,6 +778,11 @@ def build_setup(
     width. The rod (part ``rod``) lies flat in the plane z = 0 of the tapes' mid-line. The
     appendix (part ``appendix``) or the weight (a rigid body) is tied to the rod's far edge
     over its width.
+
+    With ``spec.support == "flexible"`` the clamped sections are tied instead to the big
+    interfaces of the support's shell model (:func:`add_flexible_support`), whose base is the
+    fixed ``clamp`` node; the support and the big interfaces then carry gravity too, and marker
+    0 rides on the middle of the bracket's corner.
 
     Parameters
     ----------
@@ -514,10 +829,16 @@ def build_setup(
         )  # fmt: skip
     zc = _core.tape_section_centroid_z(tape.radius, tape.alpha)
 
-    clamp = model.add_node([0.0, 0.0, zc])
-    ends = np.concatenate([model.node_set("tape0.end0"), model.node_set("tape1.end0")])
-    model.tie(ends, clamp)
-    model.fix(clamp, "all", id="clamp")
+    support: FlexibleSupport | None = None
+    if spec.support == "rigid":
+        clamp = model.add_node([0.0, 0.0, zc])
+        ends = np.concatenate([model.node_set("tape0.end0"), model.node_set("tape1.end0")])
+        model.tie(ends, clamp)
+        model.fix(clamp, "all", id="clamp")
+    else:
+        clamped = (model.node_set("tape0.end0"), model.node_set("tape1.end0"))
+        support = add_flexible_support(model, spec, down=down, clamped=clamped)
+        clamp = support.base
 
     def plate(name: str, lx: float, ly: float, thickness: float, mass: float, x0: float) -> None:
         nx = _count(lx, spec.mesh_plates, even=True)
@@ -582,7 +903,12 @@ def build_setup(
         model.add_rigid_body(tip, spec.weight_mass, centre_of_mass=com, inertia=inertia)
 
     model.set_gravity([0.0, 0.0, down * spec.gravity], function=ramp(0.0, 1.0), id="gravity")
-    model.add_marker("marker0", clamp, offset=np.asarray(spec.support_marker) - [0.0, 0.0, zc])
+    if support is None:
+        offset = np.asarray(spec.support_marker) - [0.0, 0.0, zc]
+        model.add_marker("marker0", clamp, offset=offset)
+    else:
+        # On the middle of the bracket's corner, which moves with the support.
+        model.add_marker("marker0", support.top)
     # Markers sit on the laboratory's upper side, which is -z in the upturned equal-sense block.
     up = -down * spec.marker_height
     model.add_marker("marker1", interfaces[0], offset=[0.0, 0.0, up - zc])
@@ -601,6 +927,7 @@ def build_setup(
         rod_middle=rod_middle,
         tip=tip,
         down=down,
+        flexible_support=support,
     )
 
 
