@@ -171,7 +171,9 @@ def run(
     mode_shapes, effective_masses, residuals, below_shift, equilibrium_residual, matrices),
     stats, step_stats, error, cancelled, steps_completed, settings."""
 
-def generalized_alpha_decay(rho_inf: float, omega_h: float, xi: float = 0.0) -> tuple[float, float]: ...
+def generalized_alpha_decay(
+    rho_inf: float, omega_h: float, xi: float = 0.0
+) -> tuple[float, float]: ...
 def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]: ...
 def tape_spring_mesh(
     length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0
