@@ -169,3 +169,27 @@ def test_bad_inputs_are_refused_with_clear_errors(strip):
     static_only = dataclasses.replace(r, settings={"steps": [{"kind": "static"}]})
     with pytest.raises(ValueError, match="no dynamic step"):
         static_only.to_trial(markers=MARKERS)
+
+
+def test_a_plate_at_a_multiple_of_the_marker_rate_is_stored_per_frame(strip, tmp_path):
+    """With 5 plate samples per marker frame, as a recorder stores them, the trial writes to C3D
+    and reads back; the samples past the last record hold its value."""
+    from tapespring.trials.c3d import read_c3d, write_c3d
+
+    _, clamp, _, r = strip
+    trial = results_to_trial(
+        r, markers=MARKERS, force_nodes=[clamp], rate_hz=800.0, force_rate_hz=4000.0
+    )
+    plate = trial.force_plate()
+    assert plate.time.size == 5 * trial.time.size
+    last = r.n_records - 1
+    past = plate.time >= r.t[last]
+    assert 1 <= past.sum() <= 5
+    np.testing.assert_allclose(plate.force[past, 2], -r.total_reaction("uz")[last])
+    shifted = dataclasses.replace(trial, time=trial.time - trial.time[0])
+    shifted = dataclasses.replace(
+        shifted,
+        force_plates=(dataclasses.replace(plate, time=plate.time - trial.time[0]),),
+    )
+    back = read_c3d(write_c3d(shifted, tmp_path / "sim.c3d"))
+    np.testing.assert_allclose(back.force_plate().force, plate.force, atol=1e-4)

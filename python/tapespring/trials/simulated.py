@@ -73,7 +73,8 @@ def results_to_trial(
     rate_hz : float
         Marker sampling rate [Hz], > 0 (the paper's cameras: 800 Hz).
     force_rate_hz : float
-        Force-plate sampling rate [Hz], > 0.
+        Force-plate sampling rate [Hz], > 0. An integer multiple of `rate_hz` gives that many
+        plate samples per marker frame, as recorders store them and C3D needs.
     steps : sequence of int, optional
         Analysis steps whose records are kept, with the state each of them starts from (the
         record before its first one, at its start time). None: the dynamic steps, when the
@@ -125,6 +126,12 @@ def results_to_trial(
     if force_nodes is not None:
         force, moment = _plate_history(results, force_nodes, origin)
         force_time = _uniform_grid(t[0], t[-1], force_rate_hz, "force_rate_hz")
+        ratio = force_rate_hz / rate_hz
+        if abs(ratio - round(ratio)) < 1e-9:
+            # As a recorder stores them (and C3D requires): `ratio` plate samples per marker
+            # frame, so the last frame's samples run up to one frame past the last record, where
+            # the plate holds its last value.
+            force_time = t[0] + np.arange(time.size * round(ratio)) / force_rate_hz
         plate = np.concatenate([force[records], moment[records]], axis=1)
         sampled = _resample(t, plate, force_time)
         plates = (ForcePlate(force_time, sampled[:, :3], sampled[:, 3:], name="FP1"),)
