@@ -110,7 +110,8 @@ def plot_clamp_forces(
 
     rate = rate_hz or max(rigid.settings.sample_rate, flexible.settings.sample_rate)
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.5, 6.5))
-    runs = (("rigid support", rigid, "tab:red"), ("flexible support", flexible, "tab:green"))
+    # The flexible support's ringing first, the rigid support's force over it.
+    runs = (("flexible support", flexible, "tab:green"), ("rigid support", rigid, "tab:red"))
     for label, sim, color in runs:
         force = tared_force(sim) if tare else np.asarray(sim.clamp_force_N)
         top.plot(sim.time_s, force, color=color, lw=0.8, label=label)

@@ -237,21 +237,22 @@ class SetupSpec:
       aluminium L-bracket 80 mm wide and 8 mm thick standing on the force plate: a vertical web
       (the plane x = -100 mm) clamped along its base, 100 mm from its base to a horizontal
       flange, which reaches forward 100 mm to x = 0 and carries the big interfaces on its top
-      face. Figs. 5 and 8 show a bracket standing on the force plate and holding the big
-      interfaces; 80 mm spans the two 25 mm big interfaces 40 mm apart with a margin; 8 mm is
-      a stock aluminium plate; 100 mm raises the tapes well above the force plate. The
-      proportions are set by what the force plate sees: its vertical force feels a mode of the
-      support through the mode's vertical effective mass. With this flange the first mode of
-      the bracket with its big interfaces (164 Hz on a 10 mm mesh) moves the tapes' clamped
-      ends up and down and has the largest vertical effective mass of all (0.12 kg); with a
-      shorter flange (50 mm) or a vertical plate holding the interfaces on its face, the first
-      mode rocks the clamp along x and the vertical force sees mainly a third mode near 500 Hz
-      to 1 kHz, which steps of 0.5 ms cannot follow. 164 Hz is far above the tapes' motion
-      (below 20 Hz; the folds' forming and vanishing spread the rigid clamp force to about
-      120 Hz) and below the 400 Hz Nyquist frequency of the 800 Hz records. Aluminium: 70 GPa,
-      0.33, 2700 kg/m^3, undamped (a metal's material damping is orders of magnitude below the
-      tapes' equivalent viscosity; the paper's flexible support rings too long, Sec. 6.1).
-    * the big interfaces (flexible support only; the rigid support is them held fixed): two
+      face. The support of Figs. 5 and 8 is a bracket standing on the force plate and holding
+      the big interfaces; 80 mm spans the two 25 mm big interfaces 40 mm apart with a margin;
+      8 mm is a stock aluminium plate. The height and the flange's reach are set by what the
+      force plate sees: its vertical force feels a mode of the support through the mode's
+      vertical effective mass. With these, the first mode of the bracket with its big
+      interfaces (164 Hz, on 10 mm and 3 mm meshes) moves the tapes' clamped ends up and down
+      and has the largest vertical effective mass of its modes (0.12 kg). With a 50 mm flange
+      on a 120 mm web, or a vertical plate holding the interfaces on its face, the first mode
+      rocks the clamp along x, and the vertical force rings instead at a third mode near 500 Hz
+      (flange) or 1 kHz (the interfaces pitching on the plate), which steps of 0.5 ms cannot
+      follow (both were tried). 164 Hz is far above the tapes' motion (below 20 Hz; the folds'
+      forming and vanishing spread the rigid clamp force to about 120 Hz) and below the
+      400 Hz Nyquist frequency of the 800 Hz records. Aluminium: 70 GPa, 0.33, 2700 kg/m^3,
+      undamped (a metal's material damping is orders of magnitude below the tapes' equivalent
+      viscosity; the paper's flexible support rings too long, Sec. 6.1).
+    * the big interfaces (flexible support only; the rigid support holds them fixed): two
       rigid aluminium blocks, 40 g each, 25 mm (x) by 25 mm (y) by 20 mm (z), on the flange's
       front end, the tapes' clamped sections (their centroid) at mid-height of the blocks
       ("larger and thicker" than the small ones, Sec. 3.2). Each ties its tape's x = 0 section
