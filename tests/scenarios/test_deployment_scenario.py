@@ -126,6 +126,16 @@ def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> N
     assert len(c["max_amplitude_deg"]) == 3 and c["max_amplitude_deg"][2] is None
     assert c["initial_angle_deg"]["simulation"] == pytest.approx(95.5, abs=0.05)
     json.dumps(c)
+    # The simulation's first minimum left aside: its second pairs with the experiment's first.
+    aside = opposite.compare(measured, n=3, leave_aside_min=(1,))
+    assert aside["left_aside"] == {"max": [], "min": [1]}
+    if len(opposite.peaks.minima) > 1:
+        second = opposite.peaks.minima.value[1] - measured.peaks.minima.value[0]
+        assert aside["min_amplitude_deg"][0] == pytest.approx(np.degrees(second))
+    else:
+        assert aside["min_amplitude_deg"][0] is None
+    with pytest.raises(ValueError, match="no maximum numbered"):
+        opposite.compare(measured, leave_aside_max=(99,))
 
 
 def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
@@ -137,8 +147,10 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     path = write_csv(trial, tmp_path / "equal.csv")
     png, pvd, snaps = tmp_path / "deploy.png", tmp_path / "run.pvd", tmp_path / "snaps.png"
     args = ["deploy", "--sense=equal", "--duration=0.3", "--json", f"--plot={png}"]
-    assert main([*args, f"--experiment={path}", f"--vtu={pvd}", f"--snapshots={snaps}"]) == 0
+    extra = [f"--vtu={pvd}", f"--snapshots={snaps}", "--leave-aside-max", "1"]
+    assert main([*args, f"--experiment={path}", *extra]) == 0
     out = json.loads(capsys.readouterr().out)
+    assert out["comparison"]["left_aside"] == {"max": [1], "min": []}
     assert out["sense"] == "equal" and out["initial_angle_deg"] == pytest.approx(-91.2, abs=0.05)
     assert out["comparison"]["initial_angle_deg"]["experiment"] < 0
     assert png.stat().st_size > 10_000 and snaps.stat().st_size > 10_000

@@ -134,3 +134,24 @@ def test_head_equals_extracting_fewer_peaks():
         np.testing.assert_array_equal(a.time, b.time)
         np.testing.assert_array_equal(a.value, b.value)
         np.testing.assert_array_equal(a.separation, b.separation)
+
+
+def test_a_peak_left_aside_gives_its_place_to_the_next():
+    """An extra oscillation in one series (a fourth minimum the other lacks, as the paper's
+    equal-sense model has) is left aside: the next minima pair with the other series', and the
+    separation of the one after it runs from the previous peak kept."""
+    t = np.arange(0, 6, 1 / RATE)
+    y = np.exp(-0.2 * t) * np.sin(2 * np.pi * t)
+    p = extract_peaks(t, y, None)
+    q = p.without(minima=(4,))
+    assert len(q.minima) == len(p.minima) - 1 and len(q.maxima) == len(p.maxima)
+    np.testing.assert_array_equal(q.minima.value[3:], p.minima.value[4:])
+    np.testing.assert_array_equal(q.minima.time[:3], p.minima.time[:3])
+    assert q.minima.separation[3] == pytest.approx(p.minima.time[4] - p.minima.time[2])
+    first = p.without(maxima=(1,))
+    assert first.maxima.separation[0] == pytest.approx(p.maxima.time[1] - p.t_ref)
+    np.testing.assert_array_equal(p.without().minima.separation, p.minima.separation)
+    with pytest.raises(ValueError, match="no minimum numbered"):
+        p.without(minima=(0,))
+    with pytest.raises(ValueError, match="no maximum numbered"):
+        p.without(maxima=(len(p.maxima) + 1,))

@@ -75,6 +75,17 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="a recorded deployment (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
         "drawn under the simulation, and its first peaks compared with the simulation's",
     )
+    for kind, word in (("min", "minima"), ("max", "maxima")):
+        p.add_argument(
+            f"--leave-aside-{kind}",
+            type=int,
+            nargs="+",
+            default=[],
+            metavar="K",
+            help=f"with --experiment: the simulation's {word} left aside in the peak-by-peak "
+            "comparison, numbered from 1 (the paper leaves aside the model's extra fourth "
+            "minimum in equal sense: --leave-aside-min 4)",
+        )
     p.add_argument(
         "--vtu",
         metavar="FILE.pvd",
@@ -95,6 +106,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
     input)."""
+    import sys
     from dataclasses import replace
 
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
@@ -107,8 +119,6 @@ def run(args: argparse.Namespace) -> int:
         try:
             measured = analyze_deployment(read_trial(args.experiment))
         except (OSError, ValueError) as exc:
-            import sys
-
             print(f"error: {args.experiment}: {exc}", file=sys.stderr)
             return 2
 
@@ -131,7 +141,16 @@ def run(args: argparse.Namespace) -> int:
         )
         result = deploy(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
-            result = replace(result, comparison=result.compare(measured))
+            try:
+                comparison = result.compare(
+                    measured,
+                    leave_aside_max=tuple(args.leave_aside_max),
+                    leave_aside_min=tuple(args.leave_aside_min),
+                )
+            except ValueError as exc:
+                problems.append(f"no comparison with {args.experiment}: {exc}")
+            else:
+                result = replace(result, comparison=comparison)
         return result
 
     def plot(result: object, path: str) -> None:
@@ -140,8 +159,12 @@ def run(args: argparse.Namespace) -> int:
 
         save_figure(plot_deployment(result, measured), path)
 
+    problems: list[str] = []
+
     def fields(result: object) -> None:
         r = result  # a DeploymentSimulation
+        for problem in problems:
+            print(f"error: {problem}", file=sys.stderr)
         if args.vtu:
             from tapespring.io.vtu import write_pvd
 
@@ -168,4 +191,5 @@ def run(args: argparse.Namespace) -> int:
         r = result
         return {"time_s": r.time_s, "angle_deg": r.angle_deg, "clamp_force_N": r.clamp_force_N}  # type: ignore[attr-defined]
 
-    return finish(args, simulate, columns, plot, extra=fields)
+    code = finish(args, simulate, columns, plot, extra=fields)
+    return 1 if problems and code == 0 else code

@@ -99,6 +99,34 @@ class Peaks:
 
         return Peaks(cut(self.maxima), cut(self.minima), self.prominence, self.noise, self.t_ref)
 
+    def without(self, maxima: Sequence[int] = (), minima: Sequence[int] = ()) -> Peaks:
+        """These peaks with the given ones left aside, numbered from 1 in time order per kind
+        (paper Sec. 6.1: "if that fourth peak is left aside"). The separation of the peak after
+        one left aside runs from the previous peak kept.
+
+        Raises
+        ------
+        ValueError
+            If a number is not that of a peak.
+        """
+
+        def drop(e: Extrema, numbers: Sequence[int], kind: str) -> Extrema:
+            whole = (int, np.integer)
+            bad = [k for k in numbers if not (isinstance(k, whole) and 1 <= k <= len(e))]
+            if bad:
+                raise ValueError(f"no {kind} numbered {bad} (there are {len(e)}, from 1)")
+            keep = np.setdiff1d(np.arange(len(e)), np.asarray(numbers, dtype=int) - 1)
+            time = e.time[keep]
+            return Extrema(time, e.value[keep], np.diff(time, prepend=self.t_ref), e.index[keep])
+
+        return Peaks(
+            drop(self.maxima, maxima, "maximum"),
+            drop(self.minima, minima, "minimum"),
+            self.prominence,
+            self.noise,
+            self.t_ref,
+        )
+
     def sequence(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """All peaks merged in time order.
 
