@@ -186,6 +186,10 @@ def test_results_save_and_load_keep_everything(tmp_path):
     assert disp[tip, 2] > 0
     with pytest.raises(KeyError, match="not kept"):
         back.field(1)
+    # A record past the end is refused, not wrapped round to one that exists.
+    for record in (back.n_records, -back.n_records - 1):
+        with pytest.raises(IndexError, match="out of range"):
+            back.field(record)
     with pytest.raises(KeyError, match="no marker"):
         back.marker("nope")
     with pytest.raises(KeyError, match="no reaction at 'foo'"):

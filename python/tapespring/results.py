@@ -268,10 +268,15 @@ class Results:
 
         Raises
         ------
+        IndexError
+            If there is no record `record`.
         KeyError
             If the fields of that record were not kept.
         """
-        r = int(record) % self.n_records
+        n = self.n_records
+        if not -n <= int(record) < n:
+            raise IndexError(f"record {record} out of range: the results hold {n} records")
+        r = int(record) % n
         hits = np.nonzero(self.field_records == r)[0]
         if hits.size == 0:
             raise KeyError(f"the fields of record {r} were not kept (kept: {self.field_records})")
