@@ -175,6 +175,9 @@ def test_flexible_support_adds_its_vibration_to_the_clamp_force(
     assert flexible.clamp_force_N[0] == pytest.approx(
         rigid.clamp_force_N[0] - FLEXIBLE.support_mass * FLEXIBLE.gravity, rel=1e-6
     )
+    # The trial's force plate is the base's: the same vertical force at the release.
+    plate = flexible.to_trial().force_plates[0]
+    assert plate.force[0, 2] == pytest.approx(flexible.clamp_force_N[0], rel=1e-9)
     s = json.loads(json.dumps(flexible.summary()))
     assert s["support"] == "flexible" and s["settings"]["spec"]["support"] == "flexible"
 
