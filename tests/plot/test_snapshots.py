@@ -25,10 +25,11 @@ def test_snapshots_png_is_written(bent, tmp_path):
     model, r = bent
     ax = plot_snapshots(r, model, [0, 0.5, -1])
     assert ax.get_xlabel() == "x [mm]" and ax.get_ylabel() == "z [mm]"
+    # A static step's records are labelled by their load factor, not as times.
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
-        "t = 0 s",
-        "t = 0.5 s",
-        "t = 1 s",
+        "load factor 0",
+        "load factor 0.5",
+        "load factor 1",
     ]
     # The deformed tip, in mm, is within the drawn limits.
     assert ax.get_ylim()[1] >= 1e3 * r.field(-1)[0][:, 2].max()

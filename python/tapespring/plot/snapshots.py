@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from numbers import Integral
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -101,7 +101,7 @@ def plot_snapshots(
         )
         if isolated.size:
             ax.plot(x[isolated, h], x[isolated, v], "o", ms=2.5, color=colour, zorder=2 + k)
-        handles.append(Line2D([], [], color=colour, lw=2.0, label=f"t = {results.t[r]:.4g} s"))
+        handles.append(Line2D([], [], color=colour, lw=2.0, label=_label(results, r)))
     ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{view[0]} [mm]")
@@ -110,6 +110,15 @@ def plot_snapshots(
     if legend:
         ax.legend(handles=handles, fontsize=8, loc="best")
     return ax
+
+
+def _label(results: Any, record: int) -> str:
+    """The record's time in a dynamic step [s], or its load factor in a static one."""
+    kinds = [s.get("kind") for s in results.settings.get("steps", [])]
+    step = int(results.step[record])
+    if 0 <= step < len(kinds) and kinds[step] != "dynamic":
+        return f"load factor {results.t[record]:.4g}"
+    return f"t = {results.t[record]:.4g} s"
 
 
 def _field_records(results: Results, records_or_times: Sequence[int | float]) -> list[int]:
