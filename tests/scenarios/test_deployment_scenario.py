@@ -158,3 +158,18 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert len(list((tmp_path / "run").glob("*.vtu"))) >= 15
     assert main([*args, f"--experiment={tmp_path / 'missing.csv'}"]) == 2
     assert "missing.csv" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("sense", ["opposite", "equal"])
+def test_trial_force_plate_reads_the_clamp_force_in_both_senses(
+    sense: str, opposite: DeploymentSimulation
+) -> None:
+    """The plate stays on the floor when the block is turned over: its Fz is the clamp force
+    (laboratory up) in both senses, -W and the fold's hold at the release."""
+    run = opposite
+    if sense == "equal":
+        run = deploy(DeploymentSettings(spec=COARSE, sense="equal", duration=0.05))
+    plate = run.to_trial().force_plate()
+    expected = np.interp(plate.time - plate.time[0], run.time_s, run.clamp_force_N)
+    np.testing.assert_allclose(plate.force[:, 2], expected, atol=1e-9 * np.abs(expected).max())
+    assert plate.force[0, 2] < 0.0

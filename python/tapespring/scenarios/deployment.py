@@ -172,9 +172,14 @@ class DeploymentSimulation:
         """The release and the motion as a :class:`tapespring.trials.Trial`.
 
         Markers M1 (support), M2 (rod), M3 (appendix tip) resampled at `rate_hz` (default: the
-        run's sample rate); one force plate under the clamp (1 kHz): the rigid support's clamp,
-        or the flexible support's base (moments about the middle of its base edge).
+        run's sample rate), in the set-up's frame for its sense; one force plate under the clamp
+        (1 kHz): the rigid support's clamp, or the flexible support's base (moments about the
+        middle of its base edge), in the laboratory's frame as a plate reads it whatever the
+        sense (the upturned equal-sense block has y and z reversed), so its Fz is
+        `clamp_force_N`.
         """
+        import dataclasses
+
         from tapespring.trials.trial import Metadata
 
         rate = self.settings.sample_rate if rate_hz is None else rate_hz
@@ -182,13 +187,22 @@ class DeploymentSimulation:
         meta = Metadata(
             name=f"simulated deployment ({self.settings.sense} sense)", sense=self.settings.sense
         )
-        return self.results.to_trial(
+        trial = self.results.to_trial(
             markers=TRIAL_MARKERS,
             force_nodes=[self.setup.clamp],
             rate_hz=rate,
             steps=steps,
             metadata=meta,
         )
+        if self.setup.down < 0:
+            return trial
+        # Equal sense: the block is turned about x, and the plate stays on the floor.
+        turn = np.array([1.0, -1.0, -1.0])
+        plates = tuple(
+            dataclasses.replace(p, force=p.force * turn, moment=p.moment * turn)
+            for p in trial.force_plates
+        )
+        return dataclasses.replace(trial, force_plates=plates)
 
     def compare(
         self,
