@@ -1,7 +1,7 @@
 """The integrator's numerical damping on the small-vibration test (paper Fig. 26).
 
 With a fixed step of about a twentieth of the vibration period, generalised-alpha with
-rho_inf = 0 damps the mode itself by about 1 % of critical more than with rho_inf = 0.7, and
+rho_inf = 0 damps the mode itself by about 0.9 % of critical more than with rho_inf = 0.7, and
 lengthens its period by a few percent. The scheme's amplification matrix predicts both for a linear
 oscillator with the structure's modal period and Kelvin-Voigt damping ratio; the set-up, a
 nonlinear shell structure with several modes, must show the same change.
@@ -23,13 +23,16 @@ from tapespring.scenarios.numerical_damping import (
 from tapespring.scenarios.setup import PAPER_SETUP
 from tapespring.scenarios.vibration import VibrationSettings
 
-# 5 mm meshes, 5 ms steps (omega h = 0.31), 0.5 s of decay from 8 mm: about 10 peaks, fitted
-# from 9 mm down (the paper's 4 mm upper bound is only reached after about 2 s).
+# 5 mm meshes, 5 ms steps (omega h = 0.29), 0.5 s of decay from 3 mm, fitted from 3.5 mm down:
+# about 9 peaks, at amplitudes where the structure is nearly linear (from the paper's 8 mm the
+# period is 3 % longer, and the faster decay at low rho_inf shortens it, masking the scheme's
+# lengthening).
 SETTINGS = VibrationSettings(
     spec=replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=5e-3),
     duration=0.5,
+    initial_displacement=3e-3,
     time_step=5e-3,
-    window=(0.4e-3, 9e-3),
+    window=(0.1e-3, 3.5e-3),
 )
 
 
@@ -40,8 +43,8 @@ def study() -> NumericalDampingStudy:
 
 def test_lowering_rho_inf_adds_the_predicted_damping(study: NumericalDampingStudy) -> None:
     """The rise of the fitted damping ratio from rho_inf = 0.7 to 0 is the linear oscillator's
-    within 10 % (measured: 1.04 against 1.08 % of critical). The absolute values differ more
-    (the fit spans amplitudes up to 9 mm, where the structure is not quite linear), so the test
+    within 10 % (measured: 0.90 against 0.93 % of critical). The absolute values differ more
+    (0.544 against 0.504 % at rho_inf = 0.7: the rod and weight, the other modes), so the test
     compares changes, which that offset leaves alone."""
     assert np.all(np.isfinite(study.damping_ratio)), study.summary()["fit_errors"]
     rise = study.damping_ratio[1] - study.damping_ratio[0]
@@ -51,13 +54,13 @@ def test_lowering_rho_inf_adds_the_predicted_damping(study: NumericalDampingStud
 
 
 def test_lowering_rho_inf_lengthens_the_period(study: NumericalDampingStudy) -> None:
-    """The period grows as the scheme predicts (measured +2.4 % against +2.9 %; the tolerance is
-    wider than for the damping because the faster decay at rho_inf = 0 samples smaller amplitudes,
-    whose period is shorter)."""
+    """The period grows as the scheme predicts (measured +2.39 % against +2.60 %: within 15 %,
+    since what is left of the amplitude dependence acts on the difference), and each period is
+    the oscillator's with the scheme's elongation, within 1 % (measured 0.5 and 0.3 %)."""
     lengthening = study.period_s[1] / study.period_s[0] - 1.0
     predicted = study.predicted_period_s[1] / study.predicted_period_s[0] - 1.0
-    assert lengthening == pytest.approx(predicted, rel=0.3)
-    # Both against the modal period: the transient one is longer by the scheme's elongation.
+    assert lengthening == pytest.approx(predicted, rel=0.15)
+    np.testing.assert_allclose(study.period_s, study.predicted_period_s, rtol=0.01)
     modal = study.summary()["modal_period_s"]
     assert np.all(study.period_s > modal)
 
@@ -72,7 +75,7 @@ def test_the_prediction_is_the_oscillator_without_the_scheme_at_small_steps() ->
 def test_summary_carries_the_figures_and_the_settings(study: NumericalDampingStudy) -> None:
     s = study.summary()
     assert s["rho_inf"] == [0.7, 0.0]
-    assert s["time_step_s"] == 5e-3 and s["settings"]["window"] == (0.4e-3, 9e-3)
+    assert s["time_step_s"] == 5e-3 and s["settings"]["window"] == (0.1e-3, 3.5e-3)
     assert len(s["damping_ratio"]) == len(s["predicted_period_s"]) == 2
     assert s["errors"] == [None, None]
     assert "fixed step 5 ms" in study.describe()
@@ -98,9 +101,11 @@ def test_command_writes_the_study(study: NumericalDampingStudy, tmp_path, capsys
             "5e-3",
             "--duration",
             "0.3",
+            "--initial-displacement",
+            "3e-3",
             "--window-mm",
-            "0.4",
-            "9",
+            "0.1",
+            "3.5",
             "--mesh-tape",
             "5e-3",
             "--mesh-plates",

@@ -217,19 +217,21 @@ class SetupSpec:
       mm from the clamp, 74 mm from the tapes' middle: eq. (1) with the analytical equal-sense
       residual moment of two tapes (0.062 N m) then allows 86 g there, so 77 g deploys in both
       senses, as the set-up was designed to (Sec. 3.1).
-    * the additional weight (Figs. 21, 25): a rigid steel block (50 x 20 x 20 mm) fixed under
-      the rod's middle and reaching beyond it along x, marker 3 at its tip. Its mass, 120 g, is
-      pinned by Table 6: it puts marker 3 of the folded equilibrium
-      (:mod:`tapespring.scenarios.equilibrium`) 113.0 mm below its deployed position on a 3 mm
-      mesh (Table 6: 111.6 mm). The small-vibration period (Table 8) is then a prediction:
-      0.1075 s on the paper's meshes, against the paper's model 0.110 s.
+    * the additional weight (Figs. 21, 25): a rigid steel block (30 x 20 x 20 mm) fixed under
+      the rod's middle and reaching beyond it along x, marker 3 at its tip.
     * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp; marker 1 on top
       of the first small interface; marker 2 on the rod's middle; marker 3 at the tip of the
-      appendix or the weight; markers 1-3 15 mm above the tapes' mid-line plane (an active
-      marker of about 10 mm on a 12 mm interface). The height is pinned by Table 6: the ratios
-      dx/dz of the paper's folded equilibrium (0.33 at markers 1-2, 0.39 at marker 3) are
-      those of markers about 15-20 mm above the plane rotating about this model's fold; with
-      markers in the plane they come out near 0.5.
+      appendix or the weight; markers 1-3 16 mm above the tapes' mid-line plane (an active
+      marker of about 10 mm on a 12 mm interface).
+    * pinned by Table 6 (the paper's model of the folded equilibrium,
+      :mod:`tapespring.scenarios.equilibrium`), by least squares on the paper's meshes: the
+      weight's mass (165 g) and length along x (30 mm) and the markers' height. The four
+      displacements come out 25.76 / 77.99 mm (markers 1-2, x / z) and 43.74 / 110.67 mm
+      (marker 3) against 25.7 / 77.9 and 43.7 / 111.6 (within 0.9 %). These three set the
+      folded geometry: the mass the fold angle (the weight's moment balances the tapes' constant
+      folded moment), the length the ratio of marker 3's drop to markers 1-2's, the height the
+      ratios dx/dz (0.33 and 0.39; markers in the tapes' plane give about 0.5). Every other
+      figure of the paper is a prediction, the small-vibration period (Table 8) among them.
     * the support (``support``): ``"rigid"`` by default, the paper's model (Sec. 5: the support
       is not modelled, the tapes are clamped at the big interfaces); ``"flexible"`` is the
       paper's variant of Sec. 6.1 (Fig. 33: "a flexible model of the support using a shell
@@ -348,12 +350,12 @@ class SetupSpec:
     plate_youngs_modulus: float = 70e9
     plate_poisson: float = 0.33
     setup_length: float = 0.235
-    weight_mass: float = 0.120
-    weight_length: float = 0.050
+    weight_mass: float = 0.165
+    weight_length: float = 0.030
     weight_width: float = 0.020
     weight_height: float = 0.020
     support_marker: tuple[float, float, float] = (-0.030, 0.0, 0.030)
-    marker_height: float = 0.015
+    marker_height: float = 0.016
     gravity: float = 9.81
     initial_angle_opposite_deg: float = 95.5
     initial_angle_equal_deg: float = -91.2
