@@ -190,9 +190,13 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert sign.size >= 1
     k = peak + int(sign[0])
     assert min(u[k], u[k + 1]) <= result.marker3_m[2] <= max(u[k], u[k + 1])
-    # Marker 3 is where the weight's mass was pinned (Table 6: 111.6 mm; 106.5 mm on this
-    # 5 mm mesh, 113.0 mm on 3 mm): within 10 % here.
-    assert result.marker3_m[2] == pytest.approx(PAPER_MODEL.marker3_dz, rel=0.10)
+    # Table 6 pinned the weight and the markers' height on the paper's meshes (within 0.9 %
+    # there); this 5 mm mesh is within 2.5 % of those values (25.2/76.9/43.4/110.0 mm against
+    # 25.76/77.99/43.74/110.67): the issue's 5 % against Table 6 holds here too.
+    p = PAPER_MODEL
+    got = [*result.markers12_m[[0, 2]], *result.marker3_m[[0, 2]]]
+    want = [p.markers12_dx, p.markers12_dz, p.marker3_dx, p.marker3_dz]
+    np.testing.assert_allclose(got, want, rtol=0.05)
     json.dumps(result.summary())
     code = main(["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--json"])
     assert code == 0
