@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 
 from .bend import _positive
-from .scenario_options import add_output_options, add_spec_options, finish, spec_from_args
+from .scenario_options import (
+    add_output_options,
+    add_spec_options,
+    finish,
+    spec_from_args,
+    with_comparison,
+)
 
 __all__ = ["register", "run"]
 
@@ -141,16 +147,15 @@ def run(args: argparse.Namespace) -> int:
         )
         result = deploy(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
-            try:
-                comparison = result.compare(
+
+            def compare() -> object:
+                return result.compare(
                     measured,
                     leave_aside_max=tuple(args.leave_aside_max),
                     leave_aside_min=tuple(args.leave_aside_min),
                 )
-            except ValueError as exc:
-                problems.append(f"no comparison with {args.experiment}: {exc}")
-            else:
-                result = replace(result, comparison=comparison)
+
+            result = with_comparison(result, compare, args.experiment, problems)
         return result
 
     def plot(result: object, path: str) -> None:

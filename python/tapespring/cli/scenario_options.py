@@ -19,6 +19,7 @@ __all__ = [
     "analyze_experiment",
     "finish",
     "spec_from_args",
+    "with_comparison",
     "write_vtu",
 ]
 
@@ -163,6 +164,21 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
             message = f"{path}: {message}"
         print(f"error: {message}", file=sys.stderr)
         return None
+
+
+def with_comparison(
+    result: Any, compare: Callable[[], Any], experiment: str, problems: list[str]
+) -> Any:
+    """`result` with ``comparison=compare()``; if the comparison cannot be made (ValueError), the
+    result unchanged and the reason appended to `problems` (the command prints it after its
+    outputs and exits with 1)."""
+    from dataclasses import replace
+
+    try:
+        return replace(result, comparison=compare())
+    except ValueError as exc:
+        problems.append(f"no comparison with {experiment}: {exc}")
+        return result
 
 
 def write_vtu(args: argparse.Namespace, results: Any, model: Any) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 from typing import Any
 
 from .bend import _positive
@@ -13,6 +14,7 @@ from .scenario_options import (
     analyze_experiment,
     finish,
     spec_from_args,
+    with_comparison,
     write_vtu,
 )
 
@@ -93,7 +95,6 @@ def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring vibrate``; returns the exit code (0, 1 stopped early or no
     comparison, 2 bad input or experiment file)."""
     import sys
-    from dataclasses import replace
 
     from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
@@ -124,10 +125,8 @@ def run(args: argparse.Namespace) -> int:
         )
         result = vibrate(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
-            try:
-                result = replace(result, comparison=result.compare(measured))
-            except ValueError as exc:
-                problems.append(f"no comparison with {args.experiment}: {exc}")
+            compare = functools.partial(result.compare, measured)
+            result = with_comparison(result, compare, args.experiment, problems)
         return result
 
     def plot(result: object, path: str) -> None:
