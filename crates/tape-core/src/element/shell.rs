@@ -104,6 +104,13 @@ pub struct Viscous {
     /// `d(velocity)/d(displacement)` of the time integrator [1/s]: the damping matrix
     /// `eta K_material` enters the tangent times this factor.
     pub gamma_prime: f64,
+    /// Per node, what the velocities' Jacobian with respect to the node's spatial rotation
+    /// increment `theta_a` adds to `gamma'`: `[d v_a / d theta_a, d w_a / d theta_a - gamma' I]`
+    /// [m/s, 1/s] (zero: `v_a` does not depend on `theta_a` and `d w_a = gamma' d theta_a`).
+    /// A time integrator on the rotation vector `D` of the step has `d w = gamma' T^-T(D) d theta`,
+    /// and a node tied at lever `l` to a moving node has `v = v_r + w_r x l` (see
+    /// [`crate::assembly::System::rates`]).
+    pub rotation_jacobian: [[Matrix3<f64>; 2]; 4],
 }
 
 impl Viscous {
@@ -791,6 +798,28 @@ impl ShellElement {
             if rate_tangent {
                 // Material part with viscosity: (1 + eta gamma') B^T C B + eta B^T C d(B v)/dq
                 // = Bt^T (s Bt + eta Bt'), not symmetric: every entry by a contiguous dot product.
+                // Rotation columns of the velocities' Jacobian beyond gamma' I: the damping matrix
+                // times it, Bt J.
+                for (a, [jv, jw]) in viscous
+                    .map_or([[Matrix3::zeros(); 2]; 4], |v| v.rotation_jacobian)
+                    .iter()
+                    .enumerate()
+                {
+                    if jv.iter().chain(jw.iter()).all(|&v| v == 0.0) {
+                        continue;
+                    }
+                    let c = 6 * a;
+                    for col in 0..3 {
+                        for r in 0..N_ROWS {
+                            let mut v = 0.0;
+                            for kk in 0..3 {
+                                v += btil[(c + kk) * N_ROWS + r] * jv[(kk, col)]
+                                    + btil[(c + 3 + kk) * N_ROWS + r] * jw[(kk, col)];
+                            }
+                            bdot[(c + 3 + col) * N_ROWS + r] += v;
+                        }
+                    }
+                }
                 for (bd, b) in bdot.iter_mut().zip(&btil) {
                     *bd = material_scale * b + eta * *bd;
                 }
@@ -1322,6 +1351,7 @@ mod tests {
             w: [spin; 4],
             eta: 0.01,
             gamma_prime: 0.0,
+            rotation_jacobian: Default::default(),
         };
         let mut f = ElementVector::zeros();
         let (_, power) = e.compute_viscous_into(&x, &mats(&q), &sec, &rigid, &mut f, None);
@@ -1358,6 +1388,7 @@ mod tests {
             ],
             eta,
             gamma_prime,
+            rotation_jacobian: Default::default(),
         }
     }
 
@@ -1378,11 +1409,15 @@ mod tests {
             let force = |sign: f64| {
                 let (xp, qp) = perturb(x, q, j, sign * h);
                 let mut v = *viscous;
+                let (a, c) = (j / 6, j % 6);
                 let rate = sign * h * viscous.gamma_prime;
-                if j % 6 < 3 {
-                    v.v[j / 6][j % 6] += rate;
+                if c < 3 {
+                    v.v[a][c] += rate;
                 } else {
-                    v.w[j / 6][j % 6 - 3] += rate;
+                    let [jv, jw] = viscous.rotation_jacobian[a];
+                    v.w[a][c - 3] += rate;
+                    v.v[a] += sign * h * jv.column(c - 3);
+                    v.w[a] += sign * h * jw.column(c - 3);
                 }
                 let mut fp = ElementVector::zeros();
                 e.compute_viscous_into(&xp, &mats(&qp), &sec, &v, &mut fp, None);
@@ -1400,7 +1435,8 @@ mod tests {
     /// The tangent of the Kelvin-Voigt force of a moving, curved, distorted element is its
     /// derivative in the configuration at fixed velocities and angular velocities (`gamma' = 0`:
     /// only the geometric part of the total stresses and `B^T C eta d(B v)/dq` remain besides the
-    /// elastic tangent), and with `gamma' > 0` the damping matrix joins. Central differences with
+    /// elastic tangent), and with `gamma' > 0` the damping matrix joins, times the velocities'
+    /// rotation Jacobian when it is not `gamma' I`. Central differences with
     /// steps 1e-8 m / 1e-6 rad: truncation and round-off ~1e-8 of the scaled entries (the error
     /// stays there from steps 1e-9 m to 1e-7 m); without `d(B v)/dq` it is 2.
     #[test]
@@ -1410,13 +1446,22 @@ mod tests {
         let sec = section();
         let (mut f, mut k, mut k_el) = (ElementVector::zeros(), ElementMatrix::zeros(), ElementMatrix::zeros());
         e.compute_into(&x, &mats(&q), &sec, &mut f, Some(&mut k_el));
-        for gamma_prime in [0.0, 800.0] {
-            let viscous = moving(2e-3, gamma_prime);
+        // Velocities that also depend on the rotation increments beyond gamma' (as those of a
+        // Lie-group integrator and of tied nodes do).
+        let mut jacobians = moving(2e-3, 800.0);
+        for (a, jac) in jacobians.rotation_jacobian.iter_mut().enumerate() {
+            #[allow(clippy::cast_precision_loss)]
+            let s = a as f64 + 1.0;
+            jac[0] = Matrix3::new(0.1, -0.3, 0.2, 0.4, 0.0, -0.1, -0.2, 0.3, 0.1) * s;
+            jac[1] = Matrix3::new(30.0, -50.0, 10.0, 20.0, -40.0, 60.0, -10.0, 70.0, 50.0) * s;
+        }
+        for viscous in [moving(2e-3, 0.0), moving(2e-3, 800.0), jacobians] {
             e.compute_viscous_into(&x, &mats(&q), &sec, &viscous, &mut f, Some(&mut k));
             let worst = viscous_tangent_error(&e, &x, &q, &viscous, &k);
             assert!(
                 worst < 1e-7,
-                "gamma' = {gamma_prime}: max relative tangent error {worst:e}"
+                "gamma' = {}: max relative tangent error {worst:e}",
+                viscous.gamma_prime
             );
         }
         // The configuration derivative of the strain rates is not negligible here: the viscous

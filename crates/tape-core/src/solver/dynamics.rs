@@ -9,7 +9,11 @@
 //! tangent operator, in the inertia Jacobian). The
 //! iteration matrix is `K + gamma' C + beta' M` assembled as:
 //!
-//! * the elements' tangent, their Kelvin-Voigt material part scaled by `1 + eta gamma'`;
+//! * the elements' tangent with Kelvin-Voigt damping: the material part scaled by
+//!   `1 + eta gamma'`, the strain rates' derivative in the configuration at fixed velocities,
+//!   the geometric part of the total stresses, and the velocities' own dependence on the rotation
+//!   increments (`d w = gamma' T^-T(D) d theta`, tied nodes' `v_r + w_r x l`; see
+//!   [`System::rates`](crate::assembly::System::rates));
 //! * each node's 6 x 6 inertia Jacobian (mass, rotary inertia, gyroscopic and centripetal terms,
 //!   see [`crate::inertia`]).
 //!
@@ -24,7 +28,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{Matrix6, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
@@ -332,7 +336,16 @@ impl Integrator<'_> {
     /// Assembles residual and iteration matrix at `state`; returns (residual norm, reference).
     fn assemble(&mut self, start: &State, state: &State, h: f64, r: &mut Vec<f64>) -> (f64, f64) {
         let t = Instant::now();
-        let rates = self.system.rates(state, self.alpha.gamma_prime(h));
+        // `d D = T^-T(D) d theta` per node: the angular velocities' Jacobian over gamma'.
+        let tangents: Vec<Matrix3<f64>> = (0..state.x.len())
+            .map(|i| match self.system.dofs.master[i] {
+                Some(_) => Matrix3::identity(),
+                None => tangent_inverse(&-self.increment(start, state, i)[1]),
+            })
+            .collect();
+        let rates = self
+            .system
+            .rates(state, self.alpha.gamma_prime(h), &tangents);
         let stress = self.stress_valid.then_some(self.stress.as_slice());
         self.system
             .assemble_dynamic(state, &rates, stress, &mut self.asm);
@@ -391,6 +404,10 @@ impl Integrator<'_> {
         for it in 0..=params.newton.max_iterations {
             let (res, reference) = self.assemble(start, state, h, &mut r);
             residual = res;
+            log::debug!(
+                "t = {}, step {h:e} s: iteration {it}, residual {res:e} (reference {reference:e})",
+                start.t
+            );
             if !res.is_finite() {
                 return Attempt::Failed {
                     iterations: it,
@@ -487,7 +504,7 @@ impl Integrator<'_> {
     /// Consistent accelerations of `state` (velocities given): `M dv = f_ext - f_int - g(v)` node
     /// by node (the mass matrix is block diagonal), constrained DOFs held at zero acceleration.
     fn initial_accelerations(&mut self, state: &mut State) -> Result<()> {
-        let rates = self.system.rates(state, 0.0);
+        let rates = self.system.rates(state, 0.0, &[]);
         self.system
             .assemble_dynamic(state, &rates, None, &mut self.asm);
         for i in 0..state.x.len() {
@@ -629,7 +646,7 @@ pub fn solve_dynamic(
     // Energy bookkeeping from the step's start.
     let mut path = DynamicPath::default();
     let mut balance = EnergyBalance::default();
-    let rates = integ.system.rates(state, 0.0);
+    let rates = integ.system.rates(state, 0.0, &[]);
     integ
         .system
         .assemble_dynamic(state, &rates, None, &mut integ.asm);
