@@ -81,6 +81,8 @@ pub struct Rates {
     /// Per node, the velocities' Jacobians with respect to the node's rotation increment beyond
     /// `gamma'` (see [`Viscous::rotation_jacobian`]); empty: none.
     pub rotation_jacobian: Vec<[Matrix3<f64>; 2]>,
+    /// The consistent viscous tangent (see [`Viscous::consistent`]).
+    pub consistent: bool,
 }
 
 impl Assembled {
@@ -615,7 +617,9 @@ impl System {
     /// Nodal rates of every node from the velocities of the independent nodes in `state` (tied
     /// nodes move rigidly with their reference node), for a time integrator whose velocities
     /// move by `d v = gamma' d u` and `d w = gamma' p_i d theta` at independent node `i`
-    /// (`rotation_tangent[i] = p_i`; empty: the identity).
+    /// (`rotation_tangent[i] = p_i`), for the consistent viscous tangent; empty: the tangent
+    /// without the strain rates' configuration derivative and the rotation Jacobians (see
+    /// [`Viscous::consistent`]).
     ///
     /// The Jacobians beyond `gamma'` follow: `d w_i = gamma' (p_i - I) d theta_i` more at an
     /// independent node, and at a node tied at lever `l = x_s - x_r`, whose velocity
@@ -636,17 +640,21 @@ impl System {
                 .get(i)
                 .map_or_else(Matrix3::zeros, |p| (p - Matrix3::identity()) * gamma_prime)
         };
-        let mut rotation_jacobian = vec![[Matrix3::zeros(); 2]; n];
+        let consistent = !rotation_tangent.is_empty();
+        let mut rotation_jacobian = vec![[Matrix3::zeros(); 2]; if consistent { n } else { 0 }];
         for (s, m) in self.dofs.master.iter().enumerate() {
             match *m {
                 Some(r) => {
                     let lever = state.x[s] - state.x[r];
                     w[s] = w[r];
                     v[s] = v[r] + w[r].cross(&lever);
-                    let (sl, dw) = (skew(&lever), extra(r));
-                    rotation_jacobian[s] = [-sl * dw - skew(&w[r]) * sl, dw];
+                    if consistent {
+                        let (sl, dw) = (skew(&lever), extra(r));
+                        rotation_jacobian[s] = [-sl * dw - skew(&w[r]) * sl, dw];
+                    }
                 }
-                None => rotation_jacobian[s][1] = extra(s),
+                None if consistent => rotation_jacobian[s][1] = extra(s),
+                None => {}
             }
         }
         Rates {
@@ -654,6 +662,7 @@ impl System {
             w,
             gamma_prime,
             rotation_jacobian,
+            consistent,
         }
     }
 
@@ -709,6 +718,7 @@ impl System {
                 rotation_jacobian: e
                     .nodes
                     .map(|n| r.rotation_jacobian.get(n).copied().unwrap_or_default()),
+                consistent: r.consistent,
             });
             *en = match (stress, &viscous) {
                 (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg),

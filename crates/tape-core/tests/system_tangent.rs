@@ -214,7 +214,9 @@ fn dynamic_tangent_with_moving_ties_is_derivative_of_residual() -> Result<()> {
     let gamma_prime = 800.0;
     let residual = |system: &mut System, state: &State| {
         let mut a = Assembled::default();
-        let rates = system.rates(state, gamma_prime, &[]);
+        // The consistent viscous tangent, the rotation tangents taken as the identity.
+        let identity = vec![nalgebra::Matrix3::identity(); state.x.len()];
+        let rates = system.rates(state, gamma_prime, &identity);
         system.assemble_dynamic(state, &rates, None, &mut a);
         a
     };

@@ -111,6 +111,10 @@ pub struct Viscous {
     /// and a node tied at lever `l` to a moving node has `v = v_r + w_r x l` (see
     /// [`crate::assembly::System::rates`]).
     pub rotation_jacobian: [[Matrix3<f64>; 2]; 4],
+    /// The consistent tangent: `eta B^T C d(B v)/dq` and the rotation Jacobians, and in the
+    /// mixed iteration the viscous stresses in the geometric part (false: neither, the tangent
+    /// of the strain rates at fixed `B`; Newton converges linearly at a rate ~ `eta |grad v|`).
+    pub consistent: bool,
 }
 
 impl Viscous {
@@ -476,8 +480,9 @@ impl ShellElement {
     }
 
     /// Internal force of the Kelvin-Voigt material, elastic plus viscous stresses
-    /// `C (eps + eta B v)`, and, if `k` is given, its consistent tangent for a time integrator
-    /// whose velocities move by `gamma'` times the increments:
+    /// `C (eps + eta B v)`, and, if `k` is given, its tangent for a time integrator whose
+    /// velocities move by `gamma'` times the increments; with `viscous.consistent` the exact one
+    /// (the velocities' rotation Jacobians `viscous.rotation_jacobian` included):
     ///
     /// ```text
     /// k = (1 + eta gamma') B^T C B  +  eta B^T C d(B v)/dq  +  geometric part of C (eps + eta B v)
@@ -486,7 +491,8 @@ impl ShellElement {
     /// (stiffness plus damping matrix; the derivative of the strain rates in the configuration at
     /// fixed nodal velocities and angular velocities, not symmetric, of relative order
     /// `eta |grad v|`; the geometric part of the total stresses). Returns the strain energy [J]
-    /// and the dissipated power `eta rate . C rate` [W].
+    /// and the dissipated power `eta rate . C rate` [W]. Without `viscous.consistent` the middle
+    /// term is left out (linear convergence at a rate of order `eta |grad v|`).
     pub fn compute_viscous_into(
         &self,
         x: &[Vector3<f64>; 4],
@@ -500,10 +506,10 @@ impl ShellElement {
     }
 
     /// As [`Self::compute_viscous_into`], with the geometric part of the tangent from the elastic
-    /// `stress` of the mixed iteration (see [`Self::compute_mixed_into`]) plus the current viscous
-    /// stresses (which follow the velocities, not the linearised kinematics: with them the
-    /// tangent is the consistent one once `stress` has converged). `f_geo` receives the force of
-    /// the geometric stresses.
+    /// `stress` of the mixed iteration (see [`Self::compute_mixed_into`]), plus, with
+    /// `viscous.consistent`, the current viscous stresses (which follow the velocities, not the
+    /// linearised kinematics: with them the tangent is the consistent one once `stress` has
+    /// converged). `f_geo` receives the force of the geometric stresses.
     #[allow(clippy::too_many_arguments)]
     pub fn compute_viscous_mixed_into(
         &self,
@@ -560,7 +566,8 @@ impl ShellElement {
         let mut n_rows = 0;
         // With viscous stresses and a tangent, the same rows of `d(B v)/dq` at fixed nodal
         // velocities (the strain rates' own configuration derivative), for `B^T C eta d(B v)/dq`.
-        let rate_tangent = tangent && eta > 0.0;
+        let consistent = viscous.is_some_and(|v| v.consistent);
+        let rate_tangent = tangent && eta > 0.0 && consistent;
         let mut bdot = [0.0; DOFS_PER_ELEMENT * N_ROWS];
         let (vv, ww) = viscous.map_or(([Vector3::zeros(); 4], [Vector3::zeros(); 4]), |v| (v.v, v.w));
         // Director rates `w_a x d_a`.
@@ -602,8 +609,10 @@ impl ShellElement {
                         Vector3::from(st.bending[gp_index]),
                     );
                     // The viscous stresses are the current ones (they follow the velocities).
-                    n += nv;
-                    m += mv;
+                    if consistent {
+                        n += nv;
+                        m += mv;
+                    }
                     add_gauss_forces(&g.dn, &xs, &ds, &n, &m, &mut gf_x, &mut gf_d);
                     (n, m)
                 }
@@ -665,7 +674,9 @@ impl ShellElement {
         let qv = match mixed {
             Some(st) => {
                 let mut qg = Vector4::from(st.shear);
-                qg += qd;
+                if consistent {
+                    qg += qd;
+                }
                 self.add_shear_forces(&qg, &gt, &dt, &mut gf_x, &mut gf_d);
                 qg
             }
@@ -730,7 +741,7 @@ impl ShellElement {
             }
             f_t1[a] += 0.5 * big_psi * u;
             f_t2[a] -= 0.5 * big_psi * v;
-            let geo_psi = mixed.map_or(big_psi, |st| st.drilling[a] + psi_v);
+            let geo_psi = mixed.map_or(big_psi, |st| st.drilling[a] + if consistent { psi_v } else { 0.0 });
             if mixed.is_some() {
                 gf_t1[a] += 0.5 * geo_psi * u;
                 gf_t2[a] -= 0.5 * geo_psi * v;
@@ -1352,6 +1363,7 @@ mod tests {
             eta: 0.01,
             gamma_prime: 0.0,
             rotation_jacobian: Default::default(),
+            consistent: false,
         };
         let mut f = ElementVector::zeros();
         let (_, power) = e.compute_viscous_into(&x, &mats(&q), &sec, &rigid, &mut f, None);
@@ -1389,6 +1401,7 @@ mod tests {
             eta,
             gamma_prime,
             rotation_jacobian: Default::default(),
+            consistent: true,
         }
     }
 
