@@ -78,6 +78,11 @@ pub struct Rates {
     pub w: Vec<Vector3<f64>>,
     /// `d(velocity)/d(displacement)` of the time integrator [1/s].
     pub gamma_prime: f64,
+    /// Per node, the velocities' Jacobians with respect to the node's rotation increment beyond
+    /// `gamma'` (see [`Viscous::rotation_jacobian`]); empty: none.
+    pub rotation_jacobian: Vec<[Matrix3<f64>; 2]>,
+    /// The consistent viscous tangent (see [`Viscous::consistent`]).
+    pub consistent: bool,
 }
 
 impl Assembled {
@@ -610,18 +615,55 @@ impl System {
     }
 
     /// Nodal rates of every node from the velocities of the independent nodes in `state` (tied
-    /// nodes move rigidly with their reference node).
+    /// nodes move rigidly with their reference node), for a time integrator whose velocities
+    /// move by `d v = gamma' d u` and `d w = gamma' p_i d theta` at independent node `i`
+    /// (`rotation_tangent[i] = p_i`), for the consistent viscous tangent; empty: the tangent
+    /// without the strain rates' configuration derivative and the rotation Jacobians (see
+    /// [`Viscous::consistent`]).
+    ///
+    /// The Jacobians beyond `gamma'` follow: `d w_i = gamma' (p_i - I) d theta_i` more at an
+    /// independent node, and at a node tied at lever `l = x_s - x_r`, whose velocity
+    /// `v_r + w_r x l` also turns with the lever and whose increments are `d u_s = d u_r -
+    /// [l]x d theta_r`, `d theta_s = d theta_r`: `d v_s / d theta_s = -gamma' [l]x (p_r - I) -
+    /// [w_r]x [l]x` beyond `gamma'` (see [`Viscous::rotation_jacobian`]).
+    ///
+    /// # Panics
+    /// If `rotation_tangent` is neither empty nor one matrix per node.
     #[must_use]
-    pub fn rates(&self, state: &State, gamma_prime: f64) -> Rates {
+    pub fn rates(&self, state: &State, gamma_prime: f64, rotation_tangent: &[Matrix3<f64>]) -> Rates {
+        let n = state.x.len();
+        assert!(rotation_tangent.is_empty() || rotation_tangent.len() == n);
         let mut w = state.w.clone();
         let mut v = state.v.clone();
+        let extra = |i: usize| {
+            rotation_tangent
+                .get(i)
+                .map_or_else(Matrix3::zeros, |p| (p - Matrix3::identity()) * gamma_prime)
+        };
+        let consistent = !rotation_tangent.is_empty();
+        let mut rotation_jacobian = vec![[Matrix3::zeros(); 2]; if consistent { n } else { 0 }];
         for (s, m) in self.dofs.master.iter().enumerate() {
-            if let Some(r) = *m {
-                w[s] = w[r];
-                v[s] = v[r] + w[r].cross(&(state.x[s] - state.x[r]));
+            match *m {
+                Some(r) => {
+                    let lever = state.x[s] - state.x[r];
+                    w[s] = w[r];
+                    v[s] = v[r] + w[r].cross(&lever);
+                    if consistent {
+                        let (sl, dw) = (skew(&lever), extra(r));
+                        rotation_jacobian[s] = [-sl * dw - skew(&w[r]) * sl, dw];
+                    }
+                }
+                None if consistent => rotation_jacobian[s][1] = extra(s),
+                None => {}
             }
         }
-        Rates { v, w, gamma_prime }
+        Rates {
+            v,
+            w,
+            gamma_prime,
+            rotation_jacobian,
+            consistent,
+        }
     }
 
     #[allow(clippy::too_many_lines)]
@@ -673,6 +715,10 @@ impl System {
                 w: e.nodes.map(|n| r.w[n]),
                 eta,
                 gamma_prime: r.gamma_prime,
+                rotation_jacobian: e
+                    .nodes
+                    .map(|n| r.rotation_jacobian.get(n).copied().unwrap_or_default()),
+                consistent: r.consistent,
             });
             *en = match (stress, &viscous) {
                 (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg),

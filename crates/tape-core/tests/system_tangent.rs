@@ -180,3 +180,89 @@ fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
     }
     Ok(())
 }
+
+/// Kelvin-Voigt damping with moving ties: the assembled dynamic tangent is the derivative of the
+/// residual when the independent nodes' velocities move by `gamma'` times the increments (as the
+/// time integrator's do, its rotation tangent taken as the identity here). The tied end sections'
+/// velocities `v_r + w_r x l` turn with the reference node's rotation (the lever term of
+/// [`System::rates`]), and the strain rates' own configuration derivative enters every element.
+/// The velocities are a smooth field with strain rates ~ 10/s and the reference node spins at
+/// 20 rad/s; eta = 2e-3 s makes the viscous stresses a few percent of the elastic ones.
+/// Measured: column errors below 2e-9 (without the lever term, 4e-2 at the reference node).
+#[test]
+fn dynamic_tangent_with_moving_ties_is_derivative_of_residual() -> Result<()> {
+    use nalgebra::Vector3;
+    use tape_core::Dof;
+    let tb = TapeBending {
+        mesh_size: 4e-3,
+        ..TapeBending::default()
+    };
+    let mut bm = tb.build()?;
+    bm.model.constraints.retain(|c| c.node != bm.driven_node);
+    bm.model.add_load(bm.driven_node, Dof::Ry, 0.05)?;
+    for part in &mut bm.model.parts {
+        part.section.eta = 2e-3;
+    }
+    let mut system = System::try_new(&bm.model)?;
+    let mut state = deformed(&system, 0.1, 1e-4, std::f64::consts::FRAC_PI_2, 0.5);
+    for (i, x) in system.reference.x.iter().enumerate() {
+        let s = (70.0 * x.x + 0.3 * i as f64).sin();
+        state.v[i] = Vector3::new(0.02 * s, -0.01, 0.05 * s);
+        state.w[i] = Vector3::new(3.0 * s, -5.0, 2.0 * s);
+    }
+    state.w[bm.driven_node] = Vector3::new(-4.0, 20.0, 6.0);
+    let gamma_prime = 800.0;
+    let residual = |system: &mut System, state: &State| {
+        let mut a = Assembled::default();
+        // The consistent viscous tangent, the rotation tangents taken as the identity.
+        let identity = vec![nalgebra::Matrix3::identity(); state.x.len()];
+        let rates = system.rates(state, gamma_prime, &identity);
+        system.assemble_dynamic(state, &rates, None, &mut a);
+        a
+    };
+    let a = residual(&mut system, &state);
+    let n = system.n_free();
+    let mut cols: Vec<usize> = (0..n)
+        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
+        .collect();
+    assert_eq!(cols.len(), 6);
+    cols.extend((0..n).step_by(97));
+    for &j in &cols {
+        let (node, dof) = system.dofs.free_dofs[j];
+        let h = if dof.is_rotation() { 1e-6 } else { 1e-7 };
+        let moved = |system: &mut System, h: f64| {
+            let mut e = vec![0.0; n];
+            e[j] = h;
+            let mut s = state.clone();
+            system.update(&mut s, &e, 0.0);
+            let k = dof.index();
+            if k < 3 {
+                s.v[node][k] += gamma_prime * h;
+            } else {
+                s.w[node][k - 3] += gamma_prime * h;
+            }
+            residual(system, &s).residual()
+        };
+        let (rp, rm) = (moved(&mut system, h), moved(&mut system, -h));
+        let fd: Vec<f64> = rp
+            .iter()
+            .zip(&rm)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
+        let mut col = vec![0.0; n];
+        let pat = &system.pattern_ff;
+        for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
+            col[pat.row_idx[p]] = a.k_ff[p];
+        }
+        let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let err = fd
+            .iter()
+            .zip(&col)
+            .map(|(f, c)| (f - c) * (f - c))
+            .sum::<f64>()
+            .sqrt()
+            / norm;
+        assert!(err < 1e-6, "column {j} ({node}, {dof:?}): relative error {err:e}");
+    }
+    Ok(())
+}
