@@ -73,6 +73,10 @@ def test_dynamic_step_options_and_errors():
         run(model, [Step.dynamic(duration=0.01, rho_inf=1.5)])
     with pytest.raises(ValueError, match="do not apply to a dynamic step"):
         run(model, [Step.dynamic(duration=0.01, control="arc-length")])
+    # Newton's line search is no dynamic option: asked for, it is refused, not ignored.
+    with pytest.raises(ValueError, match="'line_search' does not apply to a dynamic step"):
+        run(model, [Step.dynamic(duration=0.01, line_search=True)])
+    run(model, [Step.dynamic(duration=1e-4, line_search=False)])
     massless = Model(*flat_plate_mesh(L, B, 4, 1)[:2], thickness=T, youngs_modulus=E, poisson=0.0)
     massless.fix(0, "all")
     massless.fix(5, "all")

@@ -19,8 +19,8 @@
 //!   see [`crate::inertia`]).
 //!
 //! The inertia forces are added to the internal forces, so the residual is `f_int + f_inertia -
-//! f_ext` and the reactions at constrained DOFs are the forces the supports feel (inertia
-//! included).
+//! f_ext` and the reactions at constrained DOFs are the forces the supports apply to the
+//! structure, inertia included (a force plate under a support reads their opposite).
 //!
 //! Step control: the local error of the displacements is estimated as `|beta - 1/6| h^2
 //! |dv_{n+1} - dv_n|` per node (rotations times the node's radius of gyration) and kept below the
@@ -156,6 +156,14 @@ impl DynamicParams {
     /// [`Error::InvalidParameter`] for a bad value or an option that is not a dynamic step's.
     pub fn from_options(mut o: Options) -> Result<Self> {
         let d = Self::default();
+        // Accepted only as false: a dynamic step's Newton takes full corrections.
+        if o.take::<bool>("line_search")? == Some(true) {
+            return Err(Error::InvalidParameter(
+                "dynamic step options: 'line_search' does not apply to a dynamic step (its Newton \
+                 iteration takes full corrections; cut-backs of the time step stand for it)"
+                    .into(),
+            ));
+        }
         let mut newton = NewtonParams::read(&mut o)?;
         newton.line_search = false;
         let p = Self {
