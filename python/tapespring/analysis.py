@@ -103,7 +103,9 @@ def dynamic_step_options() -> dict[str, Any]:
     ``max_step``, ``min_step`` [s] (0: ``duration/1000``, ``duration/20``, ``1e-12 duration``);
     ``adaptive`` (time steps from the local error estimate); ``tolerance`` [m] (local error per
     step; 0: 1e-5 times the model's characteristic length); ``output_interval`` [s] (steps land on
-    its multiples; 0: none); ``max_steps``; ``max_cutbacks``; and the Newton options.
+    its multiples; 0: none); ``max_steps``; ``max_cutbacks``; ``viscous_tangent`` (the exact
+    Kelvin-Voigt tangent: quadratic Newton when eta > 0, but a non-symmetric iteration matrix;
+    off by default, see docs/dynamics.md); and the Newton options (``line_search`` excepted).
     """
     options = dict(_core.step_defaults("dynamic"))
     for key in ("name", "kind", "activate", "deactivate"):
