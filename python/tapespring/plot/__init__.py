@@ -15,6 +15,11 @@ bending
 
 release
     The free motion of a released tape spring: end angle and energy balance (returns a Figure).
+
+setup, max_mass, numerical_damping, support, snapshots
+    The paper's tests on the set-up (deployment, pull, vibration; Figs. 27-34), the maximum mass
+    (Fig. 7), the numerical damping study (Fig. 26), the flexible support's clamp force (Fig.
+    33) and side views of the deformed model (Fig. 13). Some return a Figure rather than axes.
 """
 
 from tapespring._lazy import lazy_exports
@@ -22,23 +27,45 @@ from tapespring._lazy import lazy_exports
 __all__ = [
     "plot_angle_histories",
     "plot_bending",
+    "plot_clamp_forces",
     "plot_damping_series",
+    "plot_deployment",
     "plot_force_and_angle",
     "plot_free_decay",
+    "plot_max_mass",
+    "plot_numerical_damping",
     "plot_peak_differences",
+    "plot_pull",
     "plot_pull_test",
     "plot_release",
     "plot_series_comparison",
+    "plot_snapshots",
     "plot_tip_trajectory",
     "plot_variation_coefficients",
+    "plot_vibration",
 ]
 
 __getattr__, __dir__ = lazy_exports(
     __name__,
     __all__,
     {
-        "trials": [n for n in __all__ if n not in ("plot_bending", "plot_release")],
+        "trials": [
+            "plot_angle_histories",
+            "plot_damping_series",
+            "plot_force_and_angle",
+            "plot_free_decay",
+            "plot_peak_differences",
+            "plot_pull_test",
+            "plot_series_comparison",
+            "plot_tip_trajectory",
+            "plot_variation_coefficients",
+        ],
         "bending": ["plot_bending"],
         "release": ["plot_release"],
+        "setup": ["plot_deployment", "plot_pull", "plot_vibration"],
+        "max_mass": ["plot_max_mass"],
+        "numerical_damping": ["plot_numerical_damping"],
+        "support": ["plot_clamp_forces"],
+        "snapshots": ["plot_snapshots"],
     },
 )
