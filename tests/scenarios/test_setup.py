@@ -175,6 +175,20 @@ def test_pull_command_writes_json_csv_and_plot(tmp_path, capsys) -> None:
     assert png.stat().st_size > 10_000
 
 
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"tolerance": -1e-4}, "tolerance must be >= 0"),
+        ({"time_step": -5e-3}, "time_step must be >= 0"),
+        ({"modes": 0}, "modes must be an integer >= 1"),
+        ({"field_interval": True}, "field_interval must be an integer >= 0"),
+    ],
+)
+def test_bad_vibration_settings_are_named(change: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        VibrationSettings(**change).validate()
+
+
 def test_commands_refuse_bad_input(capsys) -> None:
     assert main(["pull", "--mesh-tape=1.0", "--no-progress"]) == 2
     assert "mesh_tape" in capsys.readouterr().err

@@ -50,6 +50,7 @@ from tapespring.scenarios.setup import (
     SetupSpec,
     buckling_step,
     build_setup,
+    check_count,
     check_number,
     check_sense,
     drive,
@@ -118,12 +119,8 @@ class DeploymentSettings:
             raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
         if not (math.isfinite(self.tolerance) and self.tolerance >= 0.0):
             raise ValueError(f"tolerance must be finite and >= 0 (got {self.tolerance})")
-        if not (isinstance(self.field_interval, int) and self.field_interval >= 0):
-            raise ValueError(
-                f"field_interval must be an integer >= 0 (got {self.field_interval!r})"
-            )
-        if not (isinstance(self.n_peaks, int) and self.n_peaks >= 1):
-            raise ValueError(f"n_peaks must be an integer >= 1 (got {self.n_peaks!r})")
+        check_count("field_interval", self.field_interval, minimum=0)
+        check_count("n_peaks", self.n_peaks, minimum=1)
 
 
 @dataclass(frozen=True)

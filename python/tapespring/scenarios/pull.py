@@ -34,6 +34,7 @@ from tapespring.scenarios.setup import (
     SetupSpec,
     buckling_step,
     build_setup,
+    check_count,
     drive,
     gravity_step,
     raise_if_stopped,
@@ -74,9 +75,7 @@ class PullSettings:
         d = self.max_displacement
         if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0.0 < d < 0.1:
             raise ValueError(f"max_displacement must lie in (0, 0.1) m (got {d!r})")
-        k = self.field_interval
-        if isinstance(k, bool) or not isinstance(k, int) or k < 0:
-            raise ValueError(f"field_interval must be an integer >= 0 (got {k!r})")
+        check_count("field_interval", self.field_interval, minimum=0)
 
 
 def rest_before(trial: Any, duration: float) -> Any:

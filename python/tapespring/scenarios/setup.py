@@ -31,6 +31,7 @@ __all__ = [
     "TapeSpring",
     "add_flexible_support",
     "build_setup",
+    "check_count",
     "check_number",
     "check_sense",
 ]
@@ -501,14 +502,23 @@ def check_sense(sense: str) -> None:
         raise ValueError(f"sense must be one of {SENSES} (got {sense!r})")
 
 
-def check_number(name: str, value: object, *, positive: bool) -> None:
-    """Raise ValueError naming `name` unless `value` is a finite number (and > 0 if `positive`)."""
+def check_number(name: str, value: object, *, positive: bool, zero: bool = False) -> None:
+    """Raise ValueError naming `name` unless `value` is a finite number, > 0 if `positive`
+    (>= 0 with `zero` too, for settings where 0 means "the default")."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{name} must be a number (got {value!r})")
     if not math.isfinite(value):
         raise ValueError(f"{name} must be finite (got {value})")
-    if positive and value <= 0.0:
+    if positive and zero and value < 0.0:
+        raise ValueError(f"{name} must be >= 0 (got {value})")
+    if positive and not zero and value <= 0.0:
         raise ValueError(f"{name} must be > 0 (got {value})")
+
+
+def check_count(name: str, value: object, *, minimum: int) -> None:
+    """Raise ValueError naming `name` unless `value` is an integer >= `minimum`."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum} (got {value!r})")
 
 
 #: The set-up with the paper's figures and this project's choices.

@@ -38,6 +38,7 @@ from tapespring.scenarios.setup import (
     PAPER_SETUP,
     SetupSpec,
     build_setup,
+    check_count,
     check_number,
     drive,
     dynamic_options,
@@ -103,15 +104,12 @@ class VibrationSettings:
         if not 0.0 <= self.rho_inf <= 1.0:
             raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
         for name in ("tolerance", "time_step"):
-            check_number(name, getattr(self, name), positive=False)
+            check_number(name, getattr(self, name), positive=True, zero=True)
         lo, hi = self.window
         if not 0.0 <= lo < hi:
             raise ValueError(f"window must satisfy 0 <= low < high (got {self.window})")
-        if not (isinstance(self.modes, int) and self.modes >= 1):
-            raise ValueError(f"modes must be an integer >= 1 (got {self.modes!r})")
-        k = self.field_interval
-        if isinstance(k, bool) or not isinstance(k, int) or k < 0:
-            raise ValueError(f"field_interval must be an integer >= 0 (got {k!r})")
+        check_count("modes", self.modes, minimum=1)
+        check_count("field_interval", self.field_interval, minimum=0)
 
 
 @dataclass(frozen=True)
