@@ -105,7 +105,9 @@ def dynamic_step_options() -> dict[str, Any]:
     step; 0: 1e-5 times the model's characteristic length); ``output_interval`` [s] (steps land on
     its multiples; 0: none); ``max_steps``; ``max_cutbacks``; ``viscous_tangent`` (the exact
     Kelvin-Voigt tangent: quadratic Newton when eta > 0, but a non-symmetric iteration matrix;
-    off by default, see docs/dynamics.md); and the Newton options (``line_search`` excepted).
+    off by default, see docs/dynamics.md); ``reuse_factorisation`` (modified Newton: a factorised
+    iteration matrix kept while the residual contracts fast, on by default, see docs/dynamics.md);
+    and the Newton options (``line_search`` excepted).
     """
     options = dict(_core.step_defaults("dynamic"))
     for key in ("name", "kind", "activate", "deactivate"):

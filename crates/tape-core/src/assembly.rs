@@ -614,6 +614,12 @@ impl System {
         self.assemble_with(state, true, stress, Some(rates), out);
     }
 
+    /// The pieces of [`Self::assemble_dynamic`] without the tangent (`k_ff` and `k_fc` keep what
+    /// they held): the residual of an iteration that reuses a factorised iteration matrix.
+    pub fn assemble_dynamic_residual(&mut self, state: &State, rates: &Rates, out: &mut Assembled) {
+        self.assemble_with(state, false, None, Some(rates), out);
+    }
+
     /// Nodal rates of every node from the velocities of the independent nodes in `state` (tied
     /// nodes move rigidly with their reference node), for a time integrator whose velocities
     /// move by `d v = gamma' d u` and `d w = gamma' p_i d theta` at independent node `i`

@@ -1,6 +1,7 @@
 //! Transient dynamics: the Lie-group generalised-alpha scheme ([`super::alpha`]) on the nodal
 //! configuration space (translations times rotations), Newton's method per step with the
-//! consistent iteration matrix, and adaptive time steps.
+//! consistent iteration matrix (kept factorised across iterations and steps while the residual
+//! contracts fast: [`DynamicParams::reuse_factorisation`]), and adaptive time steps.
 //!
 //! Each Newton iteration works on the spatial increments of the statics (`Q <- exp(theta^) Q`);
 //! the step's rotation vector `D = log(R R_n^T)` of each node (spatial, the right-invariant form of
@@ -89,6 +90,14 @@ pub struct DynamicParams {
     /// (linear convergence at a rate of order `eta |grad v|`).
     #[serde(default)]
     pub viscous_tangent: bool,
+    /// Keep the factorised iteration matrix across iterations and steps while Newton contracts
+    /// the residual by at least [`REUSE_CONTRACTION`] per iteration and the step size stays
+    /// within [`REUSE_STEP_CHANGE`] of the one it was built for (modified Newton): an iteration
+    /// then costs a residual assembly and two triangular solves instead of a tangent assembly and
+    /// a factorisation. The converged states are those of full Newton to the convergence
+    /// tolerance. False: a fresh iteration matrix at every iteration.
+    #[serde(default = "default_true")]
+    pub reuse_factorisation: bool,
     /// Record nodal fields (set by the analysis runner).
     #[serde(skip)]
     pub record_fields: bool,
@@ -112,10 +121,27 @@ impl Default for DynamicParams {
                 ..NewtonParams::default()
             },
             viscous_tangent: false,
+            reuse_factorisation: true,
             record_fields: false,
         }
     }
 }
+
+fn default_true() -> bool {
+    true
+}
+
+/// Largest residual ratio of two successive iterations at which a reused iteration matrix is kept
+/// (modified Newton, [`DynamicParams::reuse_factorisation`]): slower contraction refreshes it.
+pub const REUSE_CONTRACTION: f64 = 0.05;
+
+/// Largest relative change of the time step for which an iteration matrix built for another step
+/// is reused: its mass part scales as `1 / h^2`, so 10 % in `h` is about 20 % in that part.
+pub const REUSE_STEP_CHANGE: f64 = 0.1;
+
+/// Largest predictor residual, over the reference force of the last converged step, at which the
+/// first correction of a step reuses the iteration matrix.
+pub const REUSE_PREDICTOR: f64 = 1.0;
 
 impl DynamicParams {
     /// Checks every setting.
@@ -179,6 +205,7 @@ impl DynamicParams {
             max_cutbacks: o.take_or("max_cutbacks", d.max_cutbacks)?,
             newton,
             viscous_tangent: o.take_or("viscous_tangent", d.viscous_tangent)?,
+            reuse_factorisation: o.take_or("reuse_factorisation", d.reuse_factorisation)?,
             record_fields: false,
         };
         let statics = super::static_option_names();
@@ -202,6 +229,7 @@ impl DynamicParams {
         m.insert("max_steps".into(), self.max_steps.into());
         m.insert("max_cutbacks".into(), self.max_cutbacks.into());
         m.insert("viscous_tangent".into(), self.viscous_tangent.into());
+        m.insert("reuse_factorisation".into(), self.reuse_factorisation.into());
         self.newton.write(&mut m);
         m.remove("line_search");
         m
@@ -259,6 +287,12 @@ struct Integrator<'a> {
     /// Element stresses of the mixed iteration (linearised from the last iterate) when valid.
     stress: Vec<ElementStress>,
     stress_valid: bool,
+    /// Step size of the iteration matrix held factorised by the linear solver, while it may be
+    /// reused ([`DynamicParams::reuse_factorisation`]).
+    factor_h: Option<f64>,
+    /// Reference force of the last converged step [N]: a predictor residual far above it marks a
+    /// step too violent for a reused iteration matrix.
+    last_reference: f64,
 }
 
 /// Outcome of one attempted time step.
@@ -360,8 +394,9 @@ impl Integrator<'_> {
         }
     }
 
-    /// Assembles residual and iteration matrix at `state`; returns (residual norm, reference).
-    fn assemble(&mut self, start: &State, state: &State, h: f64, r: &mut Vec<f64>) -> (f64, f64) {
+    /// Assembles the residual and, with `tangent`, the iteration matrix at `state`; returns
+    /// (residual norm, reference).
+    fn assemble(&mut self, start: &State, state: &State, h: f64, tangent: bool, r: &mut Vec<f64>) -> (f64, f64) {
         let t = Instant::now();
         let gamma_prime = self.alpha.gamma_prime(h);
         let rates = if self.viscous_tangent {
@@ -377,10 +412,15 @@ impl Integrator<'_> {
             self.system.rates(state, gamma_prime, &[])
         };
         let stress = self.stress_valid.then_some(self.stress.as_slice());
-        self.system
-            .assemble_dynamic(state, &rates, stress, &mut self.asm);
+        if tangent {
+            self.system
+                .assemble_dynamic(state, &rates, stress, &mut self.asm);
+        } else {
+            self.system
+                .assemble_dynamic_residual(state, &rates, &mut self.asm);
+        }
         let f_int = System::force_norm(&self.asm.f_int, &self.weights);
-        let inertia = self.add_inertia(start, state, h, true);
+        let inertia = self.add_inertia(start, state, h, tangent);
         self.asm.residual_into(r);
         self.stats.assembly_s += t.elapsed().as_secs_f64();
         let reference = System::force_norm(&self.asm.f_ext, &self.weights)
@@ -431,13 +471,33 @@ impl Integrator<'_> {
         let mut residual = f64::NAN;
         let mut stall = Stall::new(params.newton.stall_iterations);
         let mut a_new = self.kinematics(start, state, h, a);
+        // Residual before the last correction, whether that correction came from a matrix built
+        // at an earlier iterate (modified Newton), and the iterate it started from.
+        let mut previous = f64::INFINITY;
+        let mut stale = false;
+        let mut backup: Option<(State, Vec<ElementStress>, Vec<Pair>)> = None;
         for it in 0..=params.newton.max_iterations {
-            let (res, reference) = self.assemble(start, state, h, &mut r);
-            residual = res;
+            // Modified Newton: the factorised matrix of an earlier iterate (or step) serves while
+            // the residual contracts fast enough; otherwise a fresh one is built at this iterate.
+            let reusable = self
+                .factor_h
+                .is_some_and(|fh| (fh - h).abs() <= REUSE_STEP_CHANGE * h);
+            let (mut res, mut reference) = self.assemble(start, state, h, !reusable, &mut r);
             log::debug!(
-                "t = {}, step {h:e} s: iteration {it}, residual {res:e} (reference {reference:e})",
-                start.t
+                "t = {}, step {h:e} s: iteration {it}, residual {res:e} (reference {reference:e}){}",
+                start.t,
+                if reusable { ", reused matrix" } else { "" }
             );
+            if stale && (res > previous || res.is_nan()) {
+                // A correction from an outdated matrix made things worse: back to the iterate it
+                // started from, where a fresh matrix takes over (full Newton's step from there).
+                let (s0, st0, a0) = backup.take().expect("a stale correction keeps its start");
+                log::debug!("  diverging with a reused matrix: back to the previous iterate");
+                (*state, self.stress, a_new) = (s0, st0, a0);
+                self.factor_h = None;
+                (res, reference) = self.assemble(start, state, h, true, &mut r);
+            }
+            residual = res;
             if !res.is_finite() {
                 return Attempt::Failed {
                     iterations: it,
@@ -452,6 +512,7 @@ impl Integrator<'_> {
                 ..self.conv
             };
             if it > 0 && conv.test(res, reference, None) {
+                self.last_reference = reference;
                 let error = self.error_estimate(start, state, h, params);
                 return Attempt::Converged {
                     iterations: it,
@@ -473,16 +534,44 @@ impl Integrator<'_> {
                 };
             }
             let t = Instant::now();
-            if let Err(e) = self.system.linear.factorize(&self.asm.k_ff) {
-                return Attempt::Failed {
-                    iterations: it,
-                    residual,
-                    why: e.to_string(),
-                };
+            // A fresh matrix when the last correction contracted the residual too little, or at
+            // a predictor far off the last step's equilibrium (a violent step, where corrections
+            // from an outdated matrix send a thin shell's membrane strains astray).
+            let slow = if it == 0 {
+                res > REUSE_PREDICTOR * self.last_reference
+            } else {
+                res > REUSE_CONTRACTION * previous
+            };
+            let fresh = !reusable || self.factor_h.is_none() || slow;
+            if fresh {
+                if reusable && self.factor_h.is_some() {
+                    // The same residual, now with the iteration matrix.
+                    self.assemble(start, state, h, true, &mut r);
+                }
+                self.factor_h = None;
+                if let Err(e) = self.system.linear.factorize(&self.asm.k_ff) {
+                    return Attempt::Failed {
+                        iterations: it,
+                        residual,
+                        why: e.to_string(),
+                    };
+                }
+                self.factor_h = params.reuse_factorisation.then_some(h);
+                self.stats.factorisations += 1;
             }
-            self.stats.factorisations += 1;
+            previous = res;
+            // The next correction is stale unless it comes from a matrix built at this iterate.
+            stale = !fresh;
+            if stale {
+                backup = Some((state.clone(), self.stress.clone(), a_new.clone()));
+            }
             let mut delta: Vec<f64> = r.iter().map(|v| -v).collect();
-            if let Err(e) = self.system.linear.solve_in_place(&mut delta) {
+            let solved = if params.reuse_factorisation {
+                self.system.linear.solve_approx_in_place(&mut delta)
+            } else {
+                self.system.linear.solve_in_place(&mut delta)
+            };
+            if let Err(e) = solved {
                 return Attempt::Failed {
                     iterations: it,
                     residual,
@@ -649,6 +738,8 @@ pub fn solve_dynamic(
         viscous_tangent: params.viscous_tangent,
         stress: Vec::new(),
         stress_valid: false,
+        factor_h: None,
+        last_reference: 0.0,
     };
     let lc = integ.system.char_length;
     integ.inertia_round_off = f64::EPSILON
@@ -762,6 +853,7 @@ pub fn solve_dynamic(
                 residual,
                 why,
             } => {
+                integ.factor_h = None;
                 integ.stats.cutbacks += 1;
                 cutbacks += 1;
                 log::debug!(
