@@ -61,11 +61,11 @@ pub struct Assembled {
     pub k_ff: Vec<f64>,
     /// Values of the free x constrained tangent, in [`System::pattern_fc`] order.
     pub k_fc: Vec<f64>,
-    /// Strain energy [J].
+    /// Strain energy \[J\].
     pub energy: f64,
-    /// Potential energy of gravity `-sum m g(t) . x` [J].
+    /// Potential energy of gravity `-sum m g(t) . x` \[J\].
     pub gravity_energy: f64,
-    /// Power dissipated by Kelvin-Voigt damping [W] (dynamic assemblies).
+    /// Power dissipated by Kelvin-Voigt damping \[W\] (dynamic assemblies).
     pub dissipation: f64,
 }
 
@@ -129,14 +129,14 @@ pub struct System {
     /// Active gravity: acceleration [m/s^2] and time function.
     pub gravity: Option<(Vector3<f64>, TimeFunction)>,
     /// Shell mass lumped at each node with the consistent weights of a uniform body force,
-    /// `rho t int N_a dA` [kg].
+    /// `rho t int N_a dA` \[kg\].
     pub node_mass: Vec<f64>,
     /// Rigid bodies and point masses.
     pub bodies: Vec<RigidBody>,
     /// Inertia carried by each independent node: its own lumped shell mass and rotary inertia,
     /// its tied nodes' and its rigid bodies' (zero for tied nodes); see [`crate::inertia`].
     pub inertia: Vec<NodeInertia>,
-    /// Kelvin-Voigt viscosity of each part [s].
+    /// Kelvin-Voigt viscosity of each part \[s\].
     eta: Vec<f64>,
     /// Markers.
     pub markers: Vec<Marker>,
@@ -149,7 +149,7 @@ pub struct System {
     pub pattern_fc: Pattern,
     /// Linear solver of the free x free tangent (symbolic analysis done once per numbering).
     pub linear: LinearSolver,
-    /// Characteristic length [m] used to weigh rotations against translations in norms.
+    /// Characteristic length \[m\] used to weigh rotations against translations in norms.
     pub char_length: f64,
     /// Direction of travel in time (+1 or -1): selects the one-sided slopes of time functions.
     pub time_direction: f64,
@@ -503,7 +503,7 @@ impl System {
     }
 
     /// Norm of a force vector at the free equations in the metric dual to [`Self::free_weights`]
-    /// (moments divided by `L_c`) [N]: the residual norm of the convergence tests.
+    /// (moments divided by `L_c`) \[N\]: the residual norm of the convergence tests.
     #[must_use]
     pub fn force_norm(f: &[f64], weights: &[f64]) -> f64 {
         f.iter()
@@ -986,7 +986,7 @@ impl System {
         out
     }
 
-    /// Positions [m] of the markers in `state`.
+    /// Positions \[m\] of the markers in `state`.
     #[must_use]
     pub fn marker_positions(&self, state: &State) -> Vec<Vector3<f64>> {
         self.markers
@@ -995,7 +995,7 @@ impl System {
             .collect()
     }
 
-    /// Rotation vectors [rad] of the markers (of their nodes) from the reference configuration.
+    /// Rotation vectors \[rad\] of the markers (of their nodes) from the reference configuration.
     #[must_use]
     pub fn marker_rotations(&self, state: &State) -> Vec<Vector3<f64>> {
         self.markers
@@ -1023,7 +1023,7 @@ impl System {
             .collect()
     }
 
-    /// Nodal displacements [m] and rotation vectors [rad] of `state` from the reference
+    /// Nodal displacements \[m\] and rotation vectors \[rad\] of `state` from the reference
     /// configuration (the fields of a record).
     #[must_use]
     pub fn fields(&self, state: &State) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
@@ -1038,7 +1038,7 @@ impl System {
         )
     }
 
-    /// Residual norm reachable in floating point [N]: element forces are sums of terms of size
+    /// Residual norm reachable in floating point \[N\]: element forces are sums of terms of size
     /// `E t |x|` that cancel, so the residual cannot go below a few ulps of them (measured: about
     /// `eps E t |x|` per node; 2e-8 N on a 0.2 m x 2 mm steel plate where this gives 2e-7 N).
     #[must_use]
@@ -1054,13 +1054,13 @@ impl System {
         f64::EPSILON * self.membrane_stiffness() * (x_max + self.char_length) * n
     }
 
-    /// Smallest reference force of the convergence tests [N] (a model without loads).
+    /// Smallest reference force of the convergence tests \[N\] (a model without loads).
     #[must_use]
     pub fn force_floor(&self) -> f64 {
         1e-13 * self.membrane_stiffness() * self.char_length
     }
 
-    /// Kinetic energy [J] of `state` (every independent node carries its tied nodes' inertia).
+    /// Kinetic energy \[J\] of `state` (every independent node carries its tied nodes' inertia).
     #[must_use]
     pub fn kinetic_energy(&self, state: &State) -> f64 {
         (0..state.x.len())
@@ -1075,7 +1075,7 @@ impl System {
             .sum()
     }
 
-    /// Total mass [kg] carried by the system (lumped shell mass and rigid bodies).
+    /// Total mass \[kg\] carried by the system (lumped shell mass and rigid bodies).
     #[must_use]
     pub fn total_mass(&self) -> f64 {
         self.node_mass.iter().sum::<f64>() + self.bodies.iter().map(|b| b.mass).sum::<f64>()

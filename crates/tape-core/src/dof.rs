@@ -1,8 +1,8 @@
 //! The six nodal degrees of freedom and their names: the one home of both.
 //!
-//! Order within a node: translations `u_x, u_y, u_z` [m], then the components of the spatial
-//! incremental rotation vector `theta_x, theta_y, theta_z` [rad] (see [`crate::rotation`]).
-//! Forces conjugate to them are forces [N] and moments [N m] along the global axes.
+//! Order within a node: translations `u_x, u_y, u_z` \[m\], then the components of the spatial
+//! incremental rotation vector `theta_x, theta_y, theta_z` \[rad\] (see [`crate::rotation`]).
+//! Forces conjugate to them are forces \[N\] and moments [N m] along the global axes.
 
 use serde::{Deserialize, Serialize};
 
@@ -12,17 +12,17 @@ use crate::error::{Error, Result};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Dof {
-    /// Translation along x [m].
+    /// Translation along x \[m\].
     Ux = 0,
-    /// Translation along y [m].
+    /// Translation along y \[m\].
     Uy = 1,
-    /// Translation along z [m].
+    /// Translation along z \[m\].
     Uz = 2,
-    /// Rotation about x [rad].
+    /// Rotation about x \[rad\].
     Rx = 3,
-    /// Rotation about y [rad].
+    /// Rotation about y \[rad\].
     Ry = 4,
-    /// Rotation about z [rad].
+    /// Rotation about z \[rad\].
     Rz = 5,
 }
 

@@ -2,8 +2,8 @@
 //! force vector and tangent into fixed-size arrays from the current nodal positions and triads,
 //! with no allocation.
 //!
-//! Degrees of freedom of a node, in this order: three translations `u` [m] and three components of
-//! the *spatial* incremental rotation vector `theta` [rad] (see [`crate::rotation`]). The tangent is
+//! Degrees of freedom of a node, in this order: three translations `u` \[m\] and three components of
+//! the *spatial* incremental rotation vector `theta` \[rad\] (see [`crate::rotation`]). The tangent is
 //! the exact derivative of the internal force under the multiplicative update
 //! `Q <- exp(theta^) Q`, which is not symmetric away from equilibrium.
 

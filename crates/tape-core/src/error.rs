@@ -24,7 +24,7 @@ pub enum Error {
         t: f64,
         /// Newton iterations spent on the last failed attempt.
         iterations: usize,
-        /// Residual norm at the last iteration of that attempt [N] (NaN if it had none).
+        /// Residual norm at the last iteration of that attempt \[N\] (NaN if it had none).
         residual: f64,
         /// What was tried and why it failed.
         detail: String,

@@ -34,7 +34,7 @@ use crate::rotation::skew;
 /// Mass properties of a rigid body about a node, in its body frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct NodeInertia {
-    /// Mass m [kg].
+    /// Mass m \[kg\].
     pub mass: f64,
     /// Static moment `s = m c` about the node [kg m].
     pub moment: Vector3<f64>,
@@ -56,7 +56,7 @@ pub struct Motion<'a> {
 }
 
 impl NodeInertia {
-    /// Adds a body of mass `mass` [kg] whose centre of mass is at `offset` [m] from the node, with
+    /// Adds a body of mass `mass` \[kg\] whose centre of mass is at `offset` \[m\] from the node, with
     /// inertia tensor `inertia` [kg m^2] about its centre of mass (parallel-axis theorem).
     pub fn add(&mut self, mass: f64, offset: &Vector3<f64>, inertia: &Matrix3<f64>) {
         self.mass += mass;
@@ -70,7 +70,7 @@ impl NodeInertia {
         self.mass == 0.0 && self.inertia == Matrix3::zeros()
     }
 
-    /// Radius of gyration about the node [m], `sqrt(tr(J) / 3m)`: the length that turns the
+    /// Radius of gyration about the node \[m\], `sqrt(tr(J) / 3m)`: the length that turns the
     /// node's rotation into the displacement of its mass (`None` for a massless node).
     #[must_use]
     pub fn radius_of_gyration(&self) -> Option<f64> {
@@ -98,7 +98,7 @@ impl NodeInertia {
         m
     }
 
-    /// Kinetic energy [J] at velocity `v` and angular velocity `w` (spatial).
+    /// Kinetic energy \[J\] at velocity `v` and angular velocity `w` (spatial).
     #[must_use]
     pub fn kinetic_energy(&self, r: &Matrix3<f64>, v: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
         let (s, j) = self.spatial(r);

@@ -3,8 +3,8 @@
 //! Geometrically nonlinear shell finite elements for tape springs and deployable structures.
 //!
 //! Units are SI throughout (m, kg, s, N, Pa, rad). Each node has six degrees of freedom, in
-//! this order: translations `u_x, u_y, u_z` [m] and the spatial incremental rotation vector
-//! `theta_x, theta_y, theta_z` [rad]. Nodal orientations are stored as unit quaternions and updated
+//! this order: translations `u_x, u_y, u_z` \[m\] and the spatial incremental rotation vector
+//! `theta_x, theta_y, theta_z` \[rad\]. Nodal orientations are stored as unit quaternions and updated
 //! multiplicatively (`Q <- exp(theta^) Q`), so rotations of any size are exact.
 //!
 //! * [`mesh`]: nodes, quadrilaterals, node sets and generators (plate, cylinder, tape spring);

@@ -23,16 +23,16 @@ use crate::error::{check_positive, Error, Result};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShellSection {
-    /// Thickness t [m], > 0.
+    /// Thickness t \[m\], > 0.
     pub thickness: f64,
-    /// Young's modulus E [Pa], > 0.
+    /// Young's modulus E \[Pa\], > 0.
     pub youngs_modulus: f64,
     /// Poisson's ratio nu, in (-1, 0.5).
     pub poisson: f64,
     /// Mass density [kg/m^3], >= 0 (default 0: massless).
     #[serde(default)]
     pub density: f64,
-    /// Kelvin-Voigt viscosity eta [s], >= 0 (default 0).
+    /// Kelvin-Voigt viscosity eta \[s\], >= 0 (default 0).
     #[serde(default)]
     pub eta: f64,
     /// Transverse shear correction factor k_s, > 0 (default 5/6).
@@ -73,8 +73,8 @@ pub struct SectionStiffness {
 }
 
 impl ShellSection {
-    /// A homogeneous elastic section of thickness `thickness` [m], Young's modulus
-    /// `youngs_modulus` [Pa] and Poisson's ratio `poisson`, without mass or damping; shear factor
+    /// A homogeneous elastic section of thickness `thickness` \[m\], Young's modulus
+    /// `youngs_modulus` \[Pa\] and Poisson's ratio `poisson`, without mass or damping; shear factor
     /// 5/6, drilling factor 1e-3.
     #[must_use]
     pub fn new(thickness: f64, youngs_modulus: f64, poisson: f64) -> Self {

@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 /// Name of the environment variable that sets the memory limit.
 pub const LIMIT_VARIABLE: &str = "TAPESPRING_MEMORY_LIMIT";
 
-/// Limit used where the available memory cannot be read (not Linux): 8 GiB [bytes].
+/// Limit used where the available memory cannot be read (not Linux): 8 GiB \[bytes\].
 pub const FALLBACK_LIMIT: u64 = 8 << 30;
 
 /// Bytes per entry of the tangent's pattern held by the assembly and the linear solver: row index
@@ -49,7 +49,7 @@ pub struct MemoryEstimate {
     pub matrix_entries: f64,
     /// Entries of the sparse factor (typical fill of a shell mesh, or the exact count).
     pub factor_entries: f64,
-    /// Total [bytes].
+    /// Total \[bytes\].
     pub bytes: f64,
 }
 
@@ -193,7 +193,7 @@ fn human(bytes: f64) -> String {
     format!("{v:.1} {}", UNITS[u])
 }
 
-/// The memory limit [bytes] and where it comes from; `None` if the check is disabled
+/// The memory limit \[bytes\] and where it comes from; `None` if the check is disabled
 /// (`TAPESPRING_MEMORY_LIMIT=none`).
 ///
 /// # Errors
@@ -251,7 +251,7 @@ fn parse_limit(text: &str) -> Result<Option<u64>> {
     Ok(Some((value * scale as f64).min(u64::MAX as f64) as u64))
 }
 
-/// Memory available to this process [bytes]: `MemAvailable` of `/proc/meminfo`, and the room
+/// Memory available to this process \[bytes\]: `MemAvailable` of `/proc/meminfo`, and the room
 /// left under the cgroup's limit (`memory.max - memory.current`, cgroup v2) if smaller; `None`
 /// where neither can be read.
 #[must_use]

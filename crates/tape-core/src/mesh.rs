@@ -25,27 +25,27 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
-/// Largest admissible coordinate magnitude [m]: the element computations form products of up to
+/// Largest admissible coordinate magnitude \[m\]: the element computations form products of up to
 /// four lengths, which stay far inside the range of `f64` (1e308) below this.
 pub const MAX_COORDINATE: f64 = 1e50;
-/// Smallest admissible element size (largest edge) [m], for the same reason (1e-308).
+/// Smallest admissible element size (largest edge) \[m\], for the same reason (1e-308).
 pub const MIN_LENGTH: f64 = 1e-50;
 /// Smallest admissible element size relative to its distance from the origin: coordinates carry
 /// a round-off of `1e-16` of their magnitude, so such an element's shape is known to `1e-8`.
 pub const MIN_RELATIVE_SIZE: f64 = 1e-8;
 
-/// A rigid placement `x -> R x + translation`, with `R = exp(rotation^)` (rotation vector [rad]).
+/// A rigid placement `x -> R x + translation`, with `R = exp(rotation^)` (rotation vector \[rad\]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Placement {
-    /// Rotation vector [rad] (axis times angle), applied first, about the origin.
+    /// Rotation vector \[rad\] (axis times angle), applied first, about the origin.
     pub rotation: Vector3<f64>,
-    /// Translation [m], applied after the rotation.
+    /// Translation \[m\], applied after the rotation.
     pub translation: Vector3<f64>,
 }
 
 impl Placement {
-    /// The placed position of `x` [m].
+    /// The placed position of `x` \[m\].
     #[must_use]
     pub fn apply(&self, x: &Vector3<f64>) -> Vector3<f64> {
         UnitQuaternion::from_scaled_axis(self.rotation) * x + self.translation
@@ -73,11 +73,11 @@ impl Placement {
     }
 }
 
-/// A shell mesh: coordinates [m], quadrilateral connectivity and named node sets.
+/// A shell mesh: coordinates \[m\], quadrilateral connectivity and named node sets.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mesh {
-    /// Node coordinates in the reference configuration [m].
+    /// Node coordinates in the reference configuration \[m\].
     pub nodes: Vec<Vector3<f64>>,
     /// Quadrilaterals, four node indices each, counter-clockwise about the outward normal.
     pub quads: Vec<[usize; 4]>,
@@ -222,7 +222,7 @@ impl Mesh {
         Ok(())
     }
 
-    /// Smallest element edge length [m]; `None` for a mesh without elements.
+    /// Smallest element edge length \[m\]; `None` for a mesh without elements.
     #[must_use]
     pub fn min_edge_length(&self) -> Option<f64> {
         self.quads
@@ -231,7 +231,7 @@ impl Mesh {
             .min_by(f64::total_cmp)
     }
 
-    /// Diagonal of the bounding box of the nodes [m].
+    /// Diagonal of the bounding box of the nodes \[m\].
     #[must_use]
     pub fn bounding_box_diagonal(&self) -> f64 {
         let mut lo = Vector3::repeat(f64::INFINITY);
@@ -294,7 +294,7 @@ impl Mesh {
         }
     }
 
-    /// Index of the node nearest to `p` [m] (the lowest index among equally near nodes); `None`
+    /// Index of the node nearest to `p` \[m\] (the lowest index among equally near nodes); `None`
     /// for a mesh without nodes.
     #[must_use]
     pub fn nearest_node(&self, p: &Vector3<f64>) -> Option<usize> {
@@ -306,7 +306,7 @@ impl Mesh {
         })
     }
 
-    /// Nodes inside the axis-aligned box `[lo, hi]` [m] (bounds included), in index order.
+    /// Nodes inside the axis-aligned box `[lo, hi]` \[m\] (bounds included), in index order.
     #[must_use]
     pub fn nodes_in_box(&self, lo: &Vector3<f64>, hi: &Vector3<f64>) -> Vec<usize> {
         (0..self.nodes.len())
@@ -326,10 +326,10 @@ impl Mesh {
         (0..self.nodes.len()).filter(|&i| count[i] == 1).collect()
     }
 
-    /// The node nearest to each of `points` [m].
+    /// The node nearest to each of `points` \[m\].
     ///
     /// # Errors
-    /// [`Error::InvalidModel`] if a point is farther than `tolerance` [m] from every node, or the
+    /// [`Error::InvalidModel`] if a point is farther than `tolerance` \[m\] from every node, or the
     /// mesh has no node.
     pub fn nodes_at(&self, points: &[Vector3<f64>], tolerance: f64) -> Result<Vec<usize>> {
         points

@@ -12,7 +12,7 @@
 //!   [`TimeFunction`]; `value = 0` holds it). For a rotation, the spatial rotation increments about
 //!   the global axis follow that law (exact for a rotation about a fixed axis with the other two
 //!   rotation components held, which is how bending is driven).
-//! * **Loads**: nodal forces [N] and moments [N m] of fixed direction, `value * f(t)`.
+//! * **Loads**: nodal forces \[N\] and moments [N m] of fixed direction, `value * f(t)`.
 //! * **Gravity**: an acceleration [m/s^2] acting on all mass (shell density and rigid bodies),
 //!   `g * f(t)`, with consistent nodal loads.
 //! * **Markers**: named points rigidly attached to a node, whose positions and rotations are
@@ -52,9 +52,9 @@ pub struct Part {
 pub struct RigidBody {
     /// Reference node (its rotation is the body's rotation).
     pub node: usize,
-    /// Mass [kg], >= 0.
+    /// Mass \[kg\], >= 0.
     pub mass: f64,
-    /// Centre of mass relative to the reference node, in the reference configuration [m]; it
+    /// Centre of mass relative to the reference node, in the reference configuration \[m\]; it
     /// rotates with the node.
     #[serde(default = "Vector3::zeros")]
     pub centre_of_mass: Vector3<f64>,
@@ -105,7 +105,7 @@ pub struct Load {
     pub id: Option<String>,
     /// Node index.
     pub node: usize,
-    /// Force component (`Ux..Uz`, [N]) or moment component (`Rx..Rz`, [N m]).
+    /// Force component (`Ux..Uz`, \[N\]) or moment component (`Rx..Rz`, [N m]).
     pub dof: Dof,
     /// Amplitude.
     pub value: f64,
@@ -142,7 +142,7 @@ pub struct Marker {
     pub name: String,
     /// Node it follows.
     pub node: usize,
-    /// Position relative to the node in the reference configuration [m]; rotates with the node.
+    /// Position relative to the node in the reference configuration \[m\]; rotates with the node.
     #[serde(default = "Vector3::zeros")]
     pub offset: Vector3<f64>,
 }
@@ -297,7 +297,7 @@ impl Model {
         }
     }
 
-    /// Adds a node (e.g. a reference node for a rigid tie) at `x` [m]; returns its index.
+    /// Adds a node (e.g. a reference node for a rigid tie) at `x` \[m\]; returns its index.
     ///
     /// # Errors
     /// [`Error::InvalidModel`] for a non-finite coordinate.
@@ -401,7 +401,7 @@ impl Model {
         Ok(())
     }
 
-    /// Adds a nodal force [N] (translation DOF) or moment [N m] (rotation DOF) proportional to
+    /// Adds a nodal force \[N\] (translation DOF) or moment [N m] (rotation DOF) proportional to
     /// the load factor (`value` at load factor 1).
     ///
     /// # Errors
@@ -643,7 +643,7 @@ impl Model {
         Ok(())
     }
 
-    /// Total mass [kg]: shells (density times thickness times reference area) and rigid bodies.
+    /// Total mass \[kg\]: shells (density times thickness times reference area) and rigid bodies.
     #[must_use]
     pub fn total_mass(&self) -> f64 {
         let shells: f64 = self

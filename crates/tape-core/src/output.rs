@@ -57,9 +57,9 @@ impl Outputs {
 pub struct Fields {
     /// Index of the record (row of the history).
     pub record: usize,
-    /// Nodal displacements [m].
+    /// Nodal displacements \[m\].
     pub displacements: Vec<[f64; 3]>,
-    /// Nodal rotation vectors from the reference configuration [rad].
+    /// Nodal rotation vectors from the reference configuration \[rad\].
     pub rotations: Vec<[f64; 3]>,
 }
 
@@ -69,12 +69,12 @@ pub struct Fields {
 pub struct History {
     /// Index of the analysis step of each record (0 for the initial state).
     pub step: Vec<usize>,
-    /// Time [s], the load factor in static steps.
+    /// Time \[s\], the load factor in static steps.
     pub t: Vec<f64>,
     /// Newton iterations spent on each state (0 for the initial state, a jump or a located one
     /// found in the step).
     pub iterations: Vec<usize>,
-    /// Weighted residual norm of each state [N].
+    /// Weighted residual norm of each state \[N\].
     pub residual: Vec<f64>,
     /// Negative eigenvalues of the tangent (-1: not computed).
     pub negative_eigenvalues: Vec<i64>,
@@ -82,28 +82,28 @@ pub struct History {
     pub jump: Vec<bool>,
     /// The event a state marks (located limit point, extremum of the monitored reaction).
     pub event: Vec<Option<Event>>,
-    /// Strain energy [J].
+    /// Strain energy \[J\].
     pub strain_energy: Vec<f64>,
-    /// Potential energy of gravity `-sum m g . x` [J].
+    /// Potential energy of gravity `-sum m g . x` \[J\].
     pub gravity_energy: Vec<f64>,
-    /// Kinetic energy [J] (0 in static steps).
+    /// Kinetic energy \[J\] (0 in static steps).
     pub kinetic_energy: Vec<f64>,
-    /// Work of the nodal loads since the start of the record's dynamic step [J] (NaN in static
+    /// Work of the nodal loads since the start of the record's dynamic step \[J\] (NaN in static
     /// steps).
     pub work_loads: Vec<f64>,
-    /// Work of the prescribed motions since the start of the dynamic step [J] (NaN in static steps).
+    /// Work of the prescribed motions since the start of the dynamic step \[J\] (NaN in static steps).
     pub work_prescribed: Vec<f64>,
-    /// Energy dissipated by Kelvin-Voigt damping since the start of the dynamic step [J] (NaN in
+    /// Energy dissipated by Kelvin-Voigt damping since the start of the dynamic step \[J\] (NaN in
     /// static steps).
     pub viscous_dissipation: Vec<f64>,
     /// Energy dissipated by the time integrator since the start of the dynamic step: the remainder
-    /// of the balance [J] (NaN in static steps).
+    /// of the balance \[J\] (NaN in static steps).
     pub numerical_dissipation: Vec<f64>,
     /// Marker names, in model order.
     pub marker_names: Vec<String>,
-    /// Marker positions [m], `record x marker` rows of 3.
+    /// Marker positions \[m\], `record x marker` rows of 3.
     pub marker_positions: Vec<[f64; 3]>,
-    /// Marker rotation vectors [rad], `record x marker` rows of 3.
+    /// Marker rotation vectors \[rad\], `record x marker` rows of 3.
     pub marker_rotations: Vec<[f64; 3]>,
     /// The (node, DOF) of each reaction column.
     pub reaction_dofs: Vec<(usize, Dof)>,
@@ -179,7 +179,7 @@ impl History {
         Some((0..self.len()).map(|i| self.reactions[i * n + k]).collect())
     }
 
-    /// Position history of the marker `name` [m], if it exists.
+    /// Position history of the marker `name` \[m\], if it exists.
     #[must_use]
     pub fn marker(&self, name: &str) -> Option<Vec<[f64; 3]>> {
         let k = self.marker_names.iter().position(|m| m == name)?;

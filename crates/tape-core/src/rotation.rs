@@ -1,5 +1,5 @@
 //! Finite rotations: the nodal triads live on SO(3) and are updated multiplicatively,
-//! `Q <- exp(theta^) Q`, with `theta` a *spatial* incremental rotation vector [rad].
+//! `Q <- exp(theta^) Q`, with `theta` a *spatial* incremental rotation vector \[rad\].
 //!
 //! With this parametrisation the variation of a rotated vector is `delta v = theta x v`, and the
 //! second-order term of `f . exp(theta^) v` is `theta . (H theta) / 2` with

@@ -35,13 +35,13 @@ pub struct TapeBending {
     pub geometry: TapeGeometry,
     /// Shell section (thickness, material).
     pub section: ShellSection,
-    /// Element size [m].
+    /// Element size \[m\].
     pub mesh_size: f64,
-    /// Final bending angle [rad], non-zero.
+    /// Final bending angle \[rad\], non-zero.
     pub theta_max: f64,
     /// Also unload back to zero.
     pub unload: bool,
-    /// Twist imperfection amplitude [rad] (sections rotated about x by `a sin(pi x / L)`).
+    /// Twist imperfection amplitude \[rad\] (sections rotated about x by `a sin(pi x / L)`).
     pub imperfection: f64,
     /// Load-factor increment of the first arc-length step, in (0, 1).
     pub initial_increment: f64,
@@ -88,7 +88,7 @@ pub struct BendingModel {
 /// One point of a bending curve.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BendingPoint {
-    /// Bending angle [rad].
+    /// Bending angle \[rad\].
     pub theta: f64,
     /// Bending moment [N m].
     pub moment: f64,
@@ -224,7 +224,7 @@ impl TapeBending {
     }
 
     /// Traces the bending curve (and the unloading branch if asked) with [`run`], calling
-    /// `progress` with the current angle [rad] after each converged step (return `false` to stop).
+    /// `progress` with the current angle \[rad\] after each converged step (return `false` to stop).
     /// The points are the converged states after the initial one.
     ///
     /// # Errors

@@ -456,11 +456,11 @@ pub struct Stats {
     pub lu_fallbacks: usize,
     /// Symbolic analyses (one per numbering of the unknowns).
     pub symbolic_analyses: usize,
-    /// Time in assembly [s].
+    /// Time in assembly \[s\].
     pub assembly_s: f64,
-    /// Time in factorisation and solves [s].
+    /// Time in factorisation and solves \[s\].
     pub solve_s: f64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_s: f64,
 }
 
@@ -504,23 +504,23 @@ pub struct StaticStep {
     pub lambda: f64,
     /// Newton iterations used.
     pub iterations: usize,
-    /// Final weighted residual norm [N].
+    /// Final weighted residual norm \[N\].
     pub residual: f64,
-    /// Strain energy [J].
+    /// Strain energy \[J\].
     pub energy: f64,
-    /// Potential energy of gravity [J].
+    /// Potential energy of gravity \[J\].
     pub gravity_energy: f64,
     /// Reactions at the constrained DOFs, in [`crate::constraint::DofMap::constrained`] order [N, N m].
     pub reactions: Vec<f64>,
     /// Negative eigenvalues of the tangent (0 = stable), if requested.
     pub negative_eigenvalues: Option<usize>,
-    /// Nodal displacements [m] (empty unless fields are recorded).
+    /// Nodal displacements \[m\] (empty unless fields are recorded).
     pub displacements: Vec<[f64; 3]>,
-    /// Nodal rotation vectors [rad] (empty unless fields are recorded).
+    /// Nodal rotation vectors \[rad\] (empty unless fields are recorded).
     pub rotations: Vec<[f64; 3]>,
-    /// Positions of the model's markers [m].
+    /// Positions of the model's markers \[m\].
     pub markers: Vec<[f64; 3]>,
-    /// Rotation vectors of the model's markers from the reference configuration [rad].
+    /// Rotation vectors of the model's markers from the reference configuration \[rad\].
     pub marker_rotations: Vec<[f64; 3]>,
     /// Nodal forces `f_int - f_ext` at the DOFs of [`crate::assembly::System::probes`] [N, N m]:
     /// the reaction where the DOF is constrained, the (vanishing) residual where it is free, NaN

@@ -11,9 +11,9 @@ use serde::{Deserialize, Serialize};
 /// `dQ/dt = [w]x Q`. Static steps leave them at zero.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct State {
-    /// Time [s] in dynamic steps; the load factor in static steps.
+    /// Time \[s\] in dynamic steps; the load factor in static steps.
     pub t: f64,
-    /// Nodal positions [m].
+    /// Nodal positions \[m\].
     pub x: Vec<Vector3<f64>>,
     /// Nodal triads (orientation of `[t1, t2, d]`), updated multiplicatively `Q <- exp(theta^) Q`.
     pub q: Vec<UnitQuaternion<f64>>,
@@ -56,13 +56,13 @@ impl State {
         }
     }
 
-    /// Displacement of node `i` from `reference` [m].
+    /// Displacement of node `i` from `reference` \[m\].
     #[must_use]
     pub fn displacement(&self, reference: &State, i: usize) -> Vector3<f64> {
         self.x[i] - reference.x[i]
     }
 
-    /// Rotation vector of node `i` relative to `reference` [rad]: `log(Q Q0^T)`, norm in `[0, pi]`.
+    /// Rotation vector of node `i` relative to `reference` \[rad\]: `log(Q Q0^T)`, norm in `[0, pi]`.
     #[must_use]
     pub fn rotation(&self, reference: &State, i: usize) -> Vector3<f64> {
         (self.q[i] * reference.q[i].inverse()).scaled_axis()

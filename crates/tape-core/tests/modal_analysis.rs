@@ -154,7 +154,7 @@ fn cantilever_strip_first_frequency_is_euler_bernoulli() -> Result<()> {
 }
 
 /// A strip simply supported at both ends (uz = 0 on the end edges, ux at x = 0, uy at one node),
-/// loaded axially at x = L by `p` [N] (> 0 tension), then a modal step at the loaded state.
+/// loaded axially at x = L by `p` \[N\] (> 0 tension), then a modal step at the loaded state.
 fn prestressed_first_frequency(p: f64, l: f64) -> Result<f64> {
     let mut section = common::section(T, E, 0.0);
     section.density = RHO;

@@ -11,8 +11,8 @@ use tape_core::assembly::Assembled;
 use tape_core::samples::TapeBending;
 use tape_core::{Result, State, System};
 
-/// `system`'s reference state moved by a smooth field of free increments (`rot` [rad] on
-/// rotations, `disp` [m] on translations, phase `phase`) and the load factor `lambda`.
+/// `system`'s reference state moved by a smooth field of free increments (`rot` \[rad\] on
+/// rotations, `disp` \[m\] on translations, phase `phase`) and the load factor `lambda`.
 fn deformed(system: &System, rot: f64, disp: f64, phase: f64, lambda: f64) -> State {
     let mut state = system.initial_state();
     let dq: Vec<f64> = system

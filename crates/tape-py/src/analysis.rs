@@ -73,7 +73,7 @@ pub fn run<'py>(
 
 /// What a free decay computed by the generalised-alpha scheme with spectral radius `rho_inf`
 /// shows of a linear oscillator of damping ratio `xi`, at `omega h` (pulsation [rad/s] times the
-/// time step [s]): `(damping_ratio, period_ratio)`, the apparent damping ratio and the period over
+/// time step \[s\]): `(damping_ratio, period_ratio)`, the apparent damping ratio and the period over
 /// the exact damped period (NaN past the bifurcation of the principal roots).
 #[pyfunction]
 #[pyo3(signature = (rho_inf, omega_h, xi = 0.0))]

@@ -234,7 +234,7 @@ pub fn active_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     flag(obj, "active")
 }
 
-/// The `tolerance` argument of `nodes_at` [m] (for `from_py_with`).
+/// The `tolerance` argument of `nodes_at` \[m\] (for `from_py_with`).
 ///
 /// # Errors
 /// See [`float`].

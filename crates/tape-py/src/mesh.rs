@@ -26,7 +26,7 @@ fn mesh_tuple<'py>(
 }
 
 /// Tape-spring mesh: `(nodes, quads, node_sets)` with sets end0, end1, side0, side1, midline, all;
-/// `twist` [rad] rotates the sections about x by `twist sin(pi x / L)` (an imperfection).
+/// `twist` \[rad\] rotates the sections about x by `twist sin(pi x / L)` (an imperfection).
 #[pyfunction]
 #[pyo3(signature = (length, radius, alpha, mesh_size, *, twist = 0.0))]
 pub fn tape_spring_mesh<'py>(
@@ -59,7 +59,7 @@ pub fn tape_spring_mesh<'py>(
     })
 }
 
-/// The `twist` argument [rad] (for `from_py_with`).
+/// The `twist` argument \[rad\] (for `from_py_with`).
 fn twist_arg(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
     convert::float(obj, "twist")
 }
@@ -106,7 +106,7 @@ pub fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
     py.detach(|| guard(|| -> PyResult<()> { panic!("deliberate panic for the test-suite") }))
 }
 
-/// Height of the centroid of a tape spring's cross-section arc above the arc's middle point [m]:
+/// Height of the centroid of a tape spring's cross-section arc above the arc's middle point \[m\]:
 /// `R (1 - sin(alpha/2) / (alpha/2))`.
 #[pyfunction]
 pub fn tape_section_centroid_z(radius: &Bound<'_, PyAny>, alpha: &Bound<'_, PyAny>) -> PyResult<f64> {

@@ -132,8 +132,8 @@ impl PyModel {
         Ok(model)
     }
 
-    /// Adds a part: the mesh `(nodes, quads)` moved by `rotation` (a rotation vector [rad]) then
-    /// `translation` [m], with the section of the keyword arguments; returns the part's index.
+    /// Adds a part: the mesh `(nodes, quads)` moved by `rotation` (a rotation vector \[rad\]) then
+    /// `translation` \[m\], with the section of the keyword arguments; returns the part's index.
     #[pyo3(signature = (name, nodes, quads, *, rotation = None, translation = None, node_sets = None, **section_kwargs))]
     #[allow(clippy::too_many_arguments)]
     fn add_part(
@@ -166,7 +166,7 @@ impl PyModel {
         self.inner.mesh.quads.len()
     }
 
-    /// Node coordinates, shape (n_nodes, 3) [m] (a copy).
+    /// Node coordinates, shape (n_nodes, 3) \[m\] (a copy).
     #[getter]
     fn nodes<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         convert::nodes_to_numpy(py, &self.inner.mesh)
@@ -195,13 +195,13 @@ impl PyModel {
         convert::to_py_object(py, &part.section)
     }
 
-    /// Total mass [kg]: shells (density x thickness x area) and rigid bodies.
+    /// Total mass \[kg\]: shells (density x thickness x area) and rigid bodies.
     #[getter]
     fn total_mass(&self) -> f64 {
         self.inner.total_mass()
     }
 
-    /// Adds a node at `xyz` [m] (e.g. the reference node of a rigid tie); returns its index.
+    /// Adds a node at `xyz` \[m\] (e.g. the reference node of a rigid tie); returns its index.
     fn add_node(&mut self, xyz: &Bound<'_, PyAny>) -> PyResult<usize> {
         let x = convert::vector3(xyz, "xyz")?;
         to_py(self.inner.add_node(x))
@@ -226,7 +226,7 @@ impl PyModel {
         self.inner.mesh.node_sets.keys().cloned().collect()
     }
 
-    /// Index of the node nearest to `point` [m].
+    /// Index of the node nearest to `point` \[m\].
     fn nearest_node(&self, point: &Bound<'_, PyAny>) -> PyResult<usize> {
         let p = convert::vector3(point, "point")?;
         self.inner
@@ -235,7 +235,7 @@ impl PyModel {
             .ok_or_else(|| PyValueError::new_err("the model has no node"))
     }
 
-    /// Nodes inside the axis-aligned box `[lo, hi]` [m], in index order.
+    /// Nodes inside the axis-aligned box `[lo, hi]` \[m\], in index order.
     fn nodes_in_box<'py>(
         &self,
         py: Python<'py>,
@@ -252,7 +252,7 @@ impl PyModel {
     }
 
     /// The node nearest to each of `points` (shape (n, 3)); `ValueError` if one is farther than
-    /// `tolerance` [m].
+    /// `tolerance` \[m\].
     #[pyo3(signature = (points, tolerance = 1e-6))]
     fn nodes_at<'py>(
         &self,
@@ -340,7 +340,7 @@ impl PyModel {
         to_py(self.inner.tie(&nodes, reference))
     }
 
-    /// Adds a nodal force [N] (ux, uy, uz) or moment [N m] (rx, ry, rz): `value * f(t)` while
+    /// Adds a nodal force \[N\] (ux, uy, uz) or moment [N m] (rx, ry, rz): `value * f(t)` while
     /// active (`function` defaults to the load factor itself).
     #[pyo3(signature = (node, dof, value, *, function = None, id = None, active = true))]
     fn add_load(
@@ -363,7 +363,7 @@ impl PyModel {
         }))
     }
 
-    /// Puts a rigid body on `node`: `mass` [kg], `centre_of_mass` relative to the node [m] (in the
+    /// Puts a rigid body on `node`: `mass` \[kg\], `centre_of_mass` relative to the node \[m\] (in the
     /// reference configuration; it rotates with the node), `inertia` about the centre of mass
     /// [kg m^2] (3 x 3, global axes; zero for a point mass).
     #[pyo3(signature = (node, mass, *, centre_of_mass = None, inertia = None))]
@@ -400,7 +400,7 @@ impl PyModel {
         }))
     }
 
-    /// Puts a point mass [kg] on `node` (a rigid body without inertia or offset).
+    /// Puts a point mass \[kg\] on `node` (a rigid body without inertia or offset).
     fn add_point_mass(&mut self, node: &Bound<'_, PyAny>, mass: &Bound<'_, PyAny>) -> PyResult<()> {
         self.add_rigid_body(node, mass, None, None)
     }
@@ -444,7 +444,7 @@ impl PyModel {
         }))
     }
 
-    /// Adds a marker `name` following `node`, at `offset` [m] from it (rotating with it).
+    /// Adds a marker `name` following `node`, at `offset` \[m\] from it (rotating with it).
     #[pyo3(signature = (name, node, *, offset = None))]
     fn add_marker(
         &mut self,

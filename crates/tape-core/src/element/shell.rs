@@ -67,9 +67,9 @@ pub struct ShellStrains {
     pub membrane: [[f64; 3]; 4],
     /// Bending strains `[k11, k22, 2 k12]` [1/m] at each Gauss point.
     pub bending: [[f64; 3]; 4],
-    /// Covariant transverse shear strains at the tying points B, D, A, C [m].
+    /// Covariant transverse shear strains at the tying points B, D, A, C \[m\].
     pub shear: [f64; 4],
-    /// Drilling strains at the nodes [rad].
+    /// Drilling strains at the nodes \[rad\].
     pub drilling: [f64; 4],
 }
 
@@ -99,7 +99,7 @@ pub struct Viscous {
     pub v: [Vector3<f64>; 4],
     /// Nodal angular velocities, spatial [rad/s].
     pub w: [Vector3<f64>; 4],
-    /// Viscosity eta [s].
+    /// Viscosity eta \[s\].
     pub eta: f64,
     /// `d(velocity)/d(displacement)` of the time integrator [1/s]: the damping matrix
     /// `eta K_material` enters the tangent times this factor.
@@ -192,7 +192,7 @@ fn cartesian(x: &[Vector3<f64>; 4], xi: f64, eta: f64) -> Option<([[f64; 2]; 4],
 }
 
 impl ShellElement {
-    /// Precomputes the reference geometry from the nodal reference positions `x` [m] and the
+    /// Precomputes the reference geometry from the nodal reference positions `x` \[m\] and the
     /// reference nodal triads `q` (columns `t1, t2, D`).
     ///
     /// # Errors
@@ -367,7 +367,7 @@ impl ShellElement {
         (c0 * xc[1] - s0 * xc[0], c0 * xc[0] + s0 * xc[1])
     }
 
-    /// Strain energy [J] in the configuration `(x, q)`.
+    /// Strain energy \[J\] in the configuration `(x, q)`.
     #[must_use]
     pub fn energy(&self, x: &[Vector3<f64>; 4], q: &[Matrix3<f64>; 4], sec: &SectionStiffness) -> f64 {
         let s = self.strains(x, q);
@@ -384,7 +384,7 @@ impl ShellElement {
     }
 
     /// Stresses `C (eps + B delta)` of the strains linearised at `(x, q)` in the direction of the
-    /// nodal increments `dx` [m] and spatial rotation increments `dtheta` [rad] (zero increments give
+    /// nodal increments `dx` \[m\] and spatial rotation increments `dtheta` \[rad\] (zero increments give
     /// the stresses of the configuration). This is the stress update of the mixed Newton iteration:
     /// the stresses follow the linearised kinematics, so the large spurious membrane stresses that
     /// a displacement predictor or correction produces in a thin shell do not enter the next
@@ -445,7 +445,7 @@ impl ShellElement {
     }
 
     /// Internal force `f` (gradient of the strain energy) and, if `k` is given, the consistent
-    /// tangent, in the configuration `(x, q)`; returns the strain energy [J].
+    /// tangent, in the configuration `(x, q)`; returns the strain energy \[J\].
     ///
     /// Layout of `f` and `k`: node-major, `[u_x, u_y, u_z, theta_x, theta_y, theta_z]` per node.
     pub fn compute_into(
@@ -490,8 +490,8 @@ impl ShellElement {
     ///
     /// (stiffness plus damping matrix; the derivative of the strain rates in the configuration at
     /// fixed nodal velocities and angular velocities, not symmetric, of relative order
-    /// `eta |grad v|`; the geometric part of the total stresses). Returns the strain energy [J]
-    /// and the dissipated power `eta rate . C rate` [W]. Without `viscous.consistent` the middle
+    /// `eta |grad v|`; the geometric part of the total stresses). Returns the strain energy \[J\]
+    /// and the dissipated power `eta rate . C rate` \[W\]. Without `viscous.consistent` the middle
     /// term is left out (linear convergence at a rate of order `eta |grad v|`).
     pub fn compute_viscous_into(
         &self,

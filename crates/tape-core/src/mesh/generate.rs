@@ -53,7 +53,7 @@ pub fn flat_plate(lx: f64, ly: f64, nx: usize, ny: usize) -> Result<Mesh> {
 }
 
 /// Cylindrical panel of radius `radius` about the x axis: points `(x, R sin(phi), R cos(phi))`
-/// for `x` in `[0, length]` and `phi` in `[phi0, phi1]` [rad]; normals point away from the axis.
+/// for `x` in `[0, length]` and `phi` in `[phi0, phi1]` \[rad\]; normals point away from the axis.
 ///
 /// Node sets: `x0`, `x1` (curved edges), `phi0`, `phi1` (straight edges), `all`.
 ///
@@ -72,15 +72,15 @@ pub fn cylindrical_panel(radius: f64, length: f64, phi0: f64, phi1: f64, n_axial
 }
 
 /// Geometry of a tape spring: a straight strip of length `length` along x whose cross-section is a
-/// circular arc of radius `radius` subtending `alpha` [rad] in the y-z plane, symmetric about z,
+/// circular arc of radius `radius` subtending `alpha` \[rad\] in the y-z plane, symmetric about z,
 /// with its centre of curvature on the +z side (at `z = radius`); the arc's middle lies on the x axis.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TapeGeometry {
-    /// Length L [m].
+    /// Length L \[m\].
     pub length: f64,
-    /// Transverse radius of curvature R [m].
+    /// Transverse radius of curvature R \[m\].
     pub radius: f64,
-    /// Subtended angle alpha [rad].
+    /// Subtended angle alpha \[rad\].
     pub alpha: f64,
 }
 
@@ -109,7 +109,7 @@ impl TapeGeometry {
     }
 
     /// Centroid of the cross-section arc, relative to the arc's middle point: `(0, 0, z_c)` with
-    /// `z_c = R (1 - sin(alpha/2) / (alpha/2))` [m].
+    /// `z_c = R (1 - sin(alpha/2) / (alpha/2))` \[m\].
     #[must_use]
     pub fn section_centroid_z(&self) -> f64 {
         let h = 0.5 * self.alpha;
@@ -117,7 +117,7 @@ impl TapeGeometry {
     }
 }
 
-/// Tape-spring mesh with elements of size about `h` [m] (the arc count is rounded up to an even
+/// Tape-spring mesh with elements of size about `h` \[m\] (the arc count is rounded up to an even
 /// number so that a line of nodes lies on the symmetry plane).
 ///
 /// Node sets: `end0` (x = 0), `end1` (x = L), `side0`, `side1` (the free edges), `midline`
@@ -148,7 +148,7 @@ pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
     Ok(mesh)
 }
 
-/// Twists the sections of a tape spring about the x axis by `amplitude * sin(pi x / L)` [rad], a
+/// Twists the sections of a tape spring about the x axis by `amplitude * sin(pi x / L)` \[rad\], a
 /// geometric imperfection that selects one branch at the equal-sense bifurcation.
 pub fn apply_twist_imperfection(mesh: &mut Mesh, length: f64, amplitude: f64) {
     for x in &mut mesh.nodes {

@@ -49,24 +49,24 @@ use crate::state::State;
 /// Settings of a dynamic step.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DynamicParams {
-    /// Duration of the step [s], > 0.
+    /// Duration of the step \[s\], > 0.
     pub duration: f64,
     /// Spectral radius at infinite frequency of the generalised-alpha scheme, in [0, 1]: 1 has no
     /// numerical dissipation, smaller values damp high frequencies more (default 0.7, the paper's).
     pub rho_inf: f64,
-    /// First time step [s] (0: `duration / 1000`).
+    /// First time step \[s\] (0: `duration / 1000`).
     pub initial_step: f64,
-    /// Largest time step [s] (0: `duration / 20`).
+    /// Largest time step \[s\] (0: `duration / 20`).
     pub max_step: f64,
-    /// Smallest time step [s] before the step gives up (0: `1e-12 duration`).
+    /// Smallest time step \[s\] before the step gives up (0: `1e-12 duration`).
     pub min_step: f64,
     /// Adapt the time step to the local error estimate (false: fixed steps, cut back only when
     /// Newton fails).
     pub adaptive: bool,
-    /// Local error tolerance of the displacements per step [m] (0: `1e-5` times the model's
+    /// Local error tolerance of the displacements per step \[m\] (0: `1e-5` times the model's
     /// characteristic length, half its bounding-box diagonal).
     pub tolerance: f64,
-    /// Steps land exactly on every multiple of this interval from the step's start [s] (0: none).
+    /// Steps land exactly on every multiple of this interval from the step's start \[s\] (0: none).
     pub output_interval: f64,
     /// Largest number of accepted steps.
     pub max_steps: usize,
@@ -236,7 +236,7 @@ impl DynamicParams {
     }
 }
 
-/// Energy terms of a dynamic record, cumulated from the start of its step [J].
+/// Energy terms of a dynamic record, cumulated from the start of its step \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyBalance {
     /// Kinetic energy.
@@ -290,7 +290,7 @@ struct Integrator<'a> {
     /// Step size of the iteration matrix held factorised by the linear solver, while it may be
     /// reused ([`DynamicParams::reuse_factorisation`]).
     factor_h: Option<f64>,
-    /// Reference force of the last converged step [N]: a predictor residual far above it marks a
+    /// Reference force of the last converged step \[N\]: a predictor residual far above it marks a
     /// step too violent for a reused iteration matrix.
     last_reference: f64,
 }

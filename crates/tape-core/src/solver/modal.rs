@@ -16,7 +16,7 @@
 //!
 //! The eigenpairs nearest a shift `sigma` [rad^2/s^2] are computed by [`crate::eigen`] with the
 //! LDL^T of `K - sigma M` ([`crate::linalg::LinearSolver`]). The shift is given as a signed
-//! frequency `f_s` [Hz], `sigma = sign(f_s) (2 pi f_s)^2`; by default it is negative,
+//! frequency `f_s` \[Hz\], `sigma = sign(f_s) (2 pi f_s)^2`; by default it is negative,
 //! `sigma = -1e-6 min_i K_ii / M_ii`, below the rigid-body modes (`omega = 0`, where
 //! `K - sigma M` would be singular) and below the lowest frequencies of a stable state, so that
 //! the lowest modes are found. (`K_ii / M_ii` is the Rayleigh quotient of a unit vector, an upper
@@ -28,7 +28,7 @@
 //! eigenvalue `omega^2`, frequency `sign(omega^2) sqrt(|omega^2|) / (2 pi)` (negative for an
 //! unstable state's divergent modes), period, nodal shape (tied nodes follow their reference node
 //! rigidly, constrained DOFs are 0), and the effective masses `(phi^T M r_d)^2` of the six rigid
-//! motions `r_d` (translations along x, y, z [kg]; rotations about the axes through
+//! motions `r_d` (translations along x, y, z \[kg\]; rotations about the axes through
 //! [`ModalParams::reference_point`] [kg m^2]), restricted to the free DOFs: for each direction,
 //! their sum over all modes is the mass (inertia) the free DOFs carry.
 
@@ -58,14 +58,14 @@ const AUTO_SHIFT_FACTOR: f64 = 1e-6;
 pub struct ModalParams {
     /// Number of modes (those nearest the shift: the lowest ones with the default shift), >= 0.
     pub modes: usize,
-    /// Shift as a signed frequency `f_s` [Hz]: `sigma = sign(f_s) (2 pi f_s)^2` [rad^2/s^2];
+    /// Shift as a signed frequency `f_s` \[Hz\]: `sigma = sign(f_s) (2 pi f_s)^2` [rad^2/s^2];
     /// `None`: automatic, negative (see the module doc). It must not be an eigenvalue (0 is one
     /// where rigid-body motions are free).
     pub shift: Option<f64>,
     /// Convergence of the eigenpairs: relative residual of the shift-inverted problem, in
     /// (0, 1e-2] (default 1e-8; the frequencies are then exact to round-off).
     pub tolerance: f64,
-    /// Point [m] about which the rotational effective masses are taken (default the origin).
+    /// Point \[m\] about which the rotational effective masses are taken (default the origin).
     pub reference_point: [f64; 3],
     /// Record the free x free tangent stiffness and mass matrices with the modes.
     pub matrices: bool,
@@ -167,20 +167,20 @@ pub struct Modes {
     pub name: String,
     /// Index of the history record of the state analysed (the last record before the step).
     pub record: usize,
-    /// Time of that state [s] (the load factor after a static step).
+    /// Time of that state \[s\] (the load factor after a static step).
     pub t: f64,
     /// The shift used, `sigma` [rad^2/s^2].
     pub shift: f64,
     /// Eigenvalues `omega^2` [rad^2/s^2], increasing.
     pub eigenvalues: Vec<f64>,
-    /// Frequencies `sign(omega^2) sqrt(|omega^2|) / (2 pi)` [Hz].
+    /// Frequencies `sign(omega^2) sqrt(|omega^2|) / (2 pi)` \[Hz\].
     pub frequencies_hz: Vec<f64>,
-    /// Periods `1 / f` [s] (infinite where `omega^2 <= 0`).
+    /// Periods `1 / f` \[s\] (infinite where `omega^2 <= 0`).
     pub periods_s: Vec<f64>,
     /// Nodal mode shapes `[ux, uy, uz, rx, ry, rz]`, `M`-normalised [m/sqrt(kg), rad/sqrt(kg)],
     /// `mode x node` rows (every node of the mesh; largest free component positive).
     pub mode_shapes: Vec<[f64; 6]>,
-    /// Effective masses of each mode for the rigid motions along x, y, z [kg] and about the axes
+    /// Effective masses of each mode for the rigid motions along x, y, z \[kg\] and about the axes
     /// through the reference point [kg m^2], one row per mode.
     pub effective_masses: Vec<[f64; 6]>,
     /// Relative residual of each eigenpair (see [`ModalParams::tolerance`]).
@@ -188,7 +188,7 @@ pub struct Modes {
     /// Number of eigenvalues below the shift (Sturm count; 0 with the default shift at a stable
     /// state).
     pub below_shift: usize,
-    /// Weighted residual norm of the state analysed [N] (small at an equilibrium).
+    /// Weighted residual norm of the state analysed \[N\] (small at an equilibrium).
     pub equilibrium_residual: f64,
     /// The free x free stiffness and mass, if asked for.
     pub matrices: Option<SystemMatrices>,
@@ -295,13 +295,13 @@ impl Pencil for FePencil<'_> {
     }
 }
 
-/// The eigenvalue shift [rad^2/s^2] of a shift frequency [Hz]: `sign(f) (2 pi f)^2`.
+/// The eigenvalue shift [rad^2/s^2] of a shift frequency \[Hz\]: `sign(f) (2 pi f)^2`.
 #[must_use]
 pub fn shift_from_hz(f: f64) -> f64 {
     f.signum() * (2.0 * std::f64::consts::PI * f).powi(2)
 }
 
-/// The frequency [Hz] of an eigenvalue [rad^2/s^2]: `sign(l) sqrt(|l|) / (2 pi)`.
+/// The frequency \[Hz\] of an eigenvalue [rad^2/s^2]: `sign(l) sqrt(|l|) / (2 pi)`.
 #[must_use]
 pub fn frequency_hz(eigenvalue: f64) -> f64 {
     eigenvalue.signum() * eigenvalue.abs().sqrt() / (2.0 * std::f64::consts::PI)

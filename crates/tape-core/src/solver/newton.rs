@@ -115,7 +115,7 @@ impl NewtonParams {
 pub(crate) struct Convergence {
     pub tol_force: f64,
     pub tol_energy: f64,
-    /// Residual norm reachable in floating point [N]: a few ulps of the element forces.
+    /// Residual norm reachable in floating point \[N\]: a few ulps of the element forces.
     pub round_off: f64,
 }
 

@@ -33,7 +33,7 @@ pub(super) struct Switch {
     /// The last stable state located before the bifurcation, recorded with its event.
     pub critical: Option<(State, StaticStep)>,
     /// Potential energy of the stable state reached on the chosen branch (the driver's state on
-    /// return) [J].
+    /// return) \[J\].
     pub energy: f64,
 }
 

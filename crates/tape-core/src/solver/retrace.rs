@@ -5,7 +5,7 @@
 //! a shallow roof pulled far past a limit point, which then went back through the origin and up
 //! the other way until the step limit) or closes a loop. Either way continuing would only repeat
 //! the shapes already recorded. So the converged states are remembered as points `z = u` (the
-//! nodal displacements [m]: the shape), and a state is found to be on the old path when it lies
+//! nodal displacements \[m\]: the shape), and a state is found to be on the old path when it lies
 //! near a segment between two remembered states that is far behind it along the path, and its own
 //! increment is parallel (a loop) or antiparallel (a retrace) to that segment. Rotations are left
 //! out: the nodes' rotations about their normals (drilling) are nearly free, and on that roof the

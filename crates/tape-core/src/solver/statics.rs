@@ -20,7 +20,7 @@
 //! The driver is a loop of *propose* (the next increment from the [`StepController`]), *attempt*
 //! (the Newton iteration), then *accept* (record the state, adapt the increment) or *reject* (restore
 //! the last converged state, halve the increment). An increment is rejected for the reasons of
-//! [`Rejection`]; after `max_cutbacks` successive halvings, or once the increment is below
+//! `Rejection`; after `max_cutbacks` successive halvings, or once the increment is below
 //! round-off, the analysis stops with [`Error::NotConverged`] and the path so far.
 //!
 //! On an arc-length path, limit points of the load factor and extrema of a monitored reaction
@@ -508,7 +508,7 @@ impl Driver<'_> {
         })
     }
 
-    /// Weighted distance between two configurations (translations [m], rotations times `L_c`).
+    /// Weighted distance between two configurations (translations \[m\], rotations times `L_c`).
     pub fn distance(&self, a: &State, b: &State) -> f64 {
         let lc2 = self.system.char_length.powi(2);
         a.x.iter()
@@ -1251,7 +1251,7 @@ impl<'a, 'b> Walk<'a, 'b> {
 }
 
 /// The error that ends a path whose increment could not be made to converge.
-/// `force` is the reference force of the convergence test [N].
+/// `force` is the reference force of the convergence test \[N\].
 fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams, force: f64) -> Error {
     let (iterations, residual) = last.newton();
     let how = match why {

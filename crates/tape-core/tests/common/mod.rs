@@ -121,7 +121,7 @@ pub fn rate(e1: f64, e2: f64, h1: f64, h2: f64) -> f64 {
 }
 
 /// Quarter of a hemisphere of radius `radius` centred at the origin, pole on +z, with a polar hole
-/// of half-angle `hole` [rad]: polar angle in `[hole, pi/2]` (`n_polar` elements, from the hole to
+/// of half-angle `hole` \[rad\]: polar angle in `[hole, pi/2]` (`n_polar` elements, from the hole to
 /// the equator) and azimuth in `[0, pi/2]` (`n_azimuth` elements, from the x-z plane to the y-z
 /// plane). Normals point outward.
 ///
@@ -296,9 +296,9 @@ pub fn value_at_load(lambdas: &[f64], values: &[f64], level: f64, first: bool) -
 }
 
 /// Quarter model of the hinged cylindrical roof (Sze et al. 2004): a panel of radius `r` and
-/// half-length `half_length`, opening `theta` [rad] from the crown, `n x n` elements, symmetric at
+/// half-length `half_length`, opening `theta` \[rad\] from the crown, `n x n` elements, symmetric at
 /// the middle (`x1`) and the crown (`phi0`), hinged along the straight edge (`phi1`), with a
-/// quarter of the load `p` [N] pushing the crown's centre down. Returns the model and that node.
+/// quarter of the load `p` \[N\] pushing the crown's centre down. Returns the model and that node.
 pub fn hinged_roof_quarter(
     r: f64,
     half_length: f64,
@@ -336,14 +336,14 @@ pub mod strip {
     pub const B: f64 = 0.02;
     pub const T: f64 = 2e-3;
 
-    /// `f = c^2 / (2 pi) sqrt(E I / (rho A L^4))` [Hz] of the strip as a beam of modulus
-    /// `modulus` [Pa] and length `l` [m].
+    /// `f = c^2 / (2 pi) sqrt(E I / (rho A L^4))` \[Hz\] of the strip as a beam of modulus
+    /// `modulus` \[Pa\] and length `l` \[m\].
     pub fn beam_frequency(c: f64, modulus: f64, l: f64) -> f64 {
         c * c / (2.0 * std::f64::consts::PI) * (modulus * T * T / (12.0 * RHO) / l.powi(4)).sqrt()
     }
 
-    /// The clamped strip of length `length` [m] with Poisson's ratio `poisson` and Kelvin-Voigt
-    /// `eta` [s].
+    /// The clamped strip of length `length` \[m\] with Poisson's ratio `poisson` and Kelvin-Voigt
+    /// `eta` \[s\].
     pub fn clamped(length: f64, poisson: f64, eta: f64) -> Result<Model> {
         let mut section = super::section(T, E, poisson);
         section.density = RHO;
@@ -375,8 +375,8 @@ pub mod strip {
         })
     }
 
-    /// A static step applying the push, then a dynamic step of fixed steps `h` [s] releasing it
-    /// for `duration` [s] (Newton to 1e-10).
+    /// A static step applying the push, then a dynamic step of fixed steps `h` \[s\] releasing it
+    /// for `duration` \[s\] (Newton to 1e-10).
     pub fn bend_then_release(rho_inf: f64, h: f64, duration: f64) -> Vec<Step> {
         let bend = Step::new_static(
             "bend",
