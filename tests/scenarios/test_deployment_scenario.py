@@ -55,15 +55,17 @@ def test_swings_through_straight_and_peaks_near_half_a_second(
 
 
 def test_clamp_force_peaks_when_the_angle_crosses_zero(opposite: DeploymentSimulation) -> None:
-    t, a, f = opposite.time_s, opposite.angle_deg, opposite.clamp_force_N
-    crossings = t[:-1][np.sign(a[:-1]) != np.sign(a[1:])]
-    assert crossings.size >= 2
-    # The largest force changes (folds forming and vanishing) happen within 30 ms of a
-    # crossing: the half-period of the swing is about 0.25 s.
-    g = np.abs(f - f[0])
-    top = t[np.argsort(g)[-3:]]
-    for instant in top:
-        assert np.min(np.abs(crossings - instant)) < 0.03
+    # Sec. 6.1: a large peak of the clamp force each time the angle crosses zero in phases I and
+    # II (the folds vanish and form again). At each crossing the force's largest deviation
+    # within a quarter of a half-cycle is at least twice the largest in the rest of the flanking
+    # half-cycles (measured here: 2.5 and 4.8; on the paper's meshes 3.3 to 6.8 in phases I-II).
+    x = opposite.clamp_force_at_crossings()
+    assert x.time.size >= 2
+    assert np.all(x.ratio >= 2.0), x.ratio
+    # ... and close to the crossing: the swing's half-period is about 0.2 s.
+    assert np.all(np.abs(x.peak_time - x.time) < 0.015)
+    s = opposite.summary()["clamp_force_at_crossings"]
+    assert s["time_s"] == pytest.approx(x.time.tolist())
 
 
 def test_energy_only_decreases(opposite: DeploymentSimulation) -> None:

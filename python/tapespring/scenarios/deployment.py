@@ -259,6 +259,18 @@ class DeploymentSimulation:
             "min_separation_s": listed(c.min_separation, 1.0),
         }
 
+    def clamp_force_at_crossings(self) -> Any:
+        """The clamp force's peak at each zero crossing of the bending angle in phases I and II
+        (up to the start of phase III, or the end of the run), against the rest of the flanking
+        half-cycles (:func:`tapespring.signals.crossings.force_at_crossings`; Sec. 6.1: a large
+        peak at each crossing)."""
+        from tapespring.signals.crossings import force_at_crossings
+
+        end = None if self.phases is None else self.phases.phase_iii_start
+        return force_at_crossings(
+            self.time_s, self.angle_deg, self.clamp_force_N, start=0.0, end=end
+        )
+
     def summary(self) -> dict[str, Any]:
         """The figures as JSON-ready values, with the settings."""
         r = self.results
@@ -288,6 +300,9 @@ class DeploymentSimulation:
             if self.clamp_force_N.size
             else None,
             "max_lateral_tip_displacement_m": lateral,
+            "clamp_force_at_crossings": self.clamp_force_at_crossings().as_dict()
+            if self.time_s.size >= 2
+            else None,
             "time_s": self.time_s.tolist(),
             "angle_deg": self.angle_deg.tolist(),
             "clamp_force_N": self.clamp_force_N.tolist(),
@@ -337,6 +352,16 @@ class DeploymentSimulation:
         )
         if s["max_clamp_force_N"] is not None:
             lines.append(f"  largest vertical clamp force {s['max_clamp_force_N']:.2f} N")
+        x = s["clamp_force_at_crossings"]
+        if x is not None and x["time_s"]:
+            items = ", ".join(
+                f"{p:.1f} N at {t:.3f} s ({r:.1f}x)" if r is not None else f"{p:.1f} N at {t:.3f} s"
+                for t, p, r in zip(x["time_s"], x["peak_N"], x["ratio"], strict=True)
+            )
+            lines.append(
+                "  clamp force at the angle's zero crossings before phase III (deviation from "
+                f"{x['baseline_N']:+.2f} N; its ratio to the rest of the half-cycles): {items}"
+            )
         c = self.comparison
         if c is not None:
             amp = [abs(v) for v in c["max_amplitude_deg"] + c["min_amplitude_deg"] if v is not None]

@@ -22,6 +22,8 @@ damping
     Damped-oscillator fit of a free decay (eqs. 5-6).
 phases
     Deployment phases I, II and III from the peaks of the bending angle.
+crossings
+    The force's peak at each zero crossing of the bending angle (`force_at_crossings`).
 circle
     Circle fit of the tip trajectory, lateral excursion.
 pull
@@ -37,6 +39,7 @@ from tapespring._lazy import lazy_exports
 
 __all__ = [
     "CircleFit",
+    "CrossingPeaks",
     "DampingFit",
     "Extrema",
     "PeakComparison",
@@ -55,6 +58,7 @@ __all__ = [
     "fit_circle",
     "fit_damping",
     "fit_motion_frame",
+    "force_at_crossings",
     "max_lateral_displacement",
     "noise_std",
     "parse_frame",
@@ -73,6 +77,7 @@ __getattr__, __dir__ = lazy_exports(
     {
         "angle": ["bending_angle"],
         "circle": ["CircleFit", "fit_circle", "max_lateral_displacement"],
+        "crossings": ["CrossingPeaks", "force_at_crossings"],
         "damping": ["DampingFit", "fit_damping", "select_window_peaks"],
         "frame": ["fit_motion_frame", "parse_frame", "to_frame"],
         "levels": ["equilibrium_value", "release_index"],
