@@ -88,7 +88,14 @@ impl NewtonParams {
     /// # Errors
     /// A value of the wrong type.
     pub fn read(options: &mut Options) -> Result<Self> {
-        let d = Self::default();
+        Self::read_or(options, Self::default())
+    }
+
+    /// Reads the Newton options of a flat option map, `d`'s values for those absent.
+    ///
+    /// # Errors
+    /// A value of the wrong type.
+    pub fn read_or(options: &mut Options, d: Self) -> Result<Self> {
         Ok(Self {
             max_iterations: options.take_or("max_iterations", d.max_iterations)?,
             tol_force: options.take_or("tol_force", d.tol_force)?,
