@@ -15,8 +15,9 @@ __all__ = ["plot_deployment", "plot_pull", "plot_vibration"]
 
 def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     """Bending angle [deg] with its peaks, and the clamp's vertical force [N], against time from
-    the release [s]; a measured deployment (a `DeploymentResult` of the trial analysis) drawn
-    under the simulation if given."""
+    the release [s], the angle's zero crossings before phase III dotted and the force's peak at
+    each circled; a measured deployment (a `DeploymentResult` of the trial analysis) drawn under
+    the simulation if given."""
     import matplotlib.pyplot as plt
 
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6.0))
@@ -45,6 +46,23 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
             lw=0.6,
         )
     bottom.plot(sim.time_s, sim.clamp_force_N, color="tab:red", lw=0.8)
+    if sim.time_s.size >= 2:
+        # The angle's zero crossings before phase III and the clamp force's peak at each (Sec. 6.1).
+        x = sim.clamp_force_at_crossings()
+        for ax in (top, bottom):
+            for c in x.time:
+                ax.axvline(c, color="0.5", lw=0.6, ls=":")
+        bottom.plot(
+            x.peak_time,
+            np.interp(x.peak_time, sim.time_s, sim.clamp_force_N),
+            "o",
+            mfc="none",
+            color="k",
+            ms=5,
+            label="peak at a zero crossing (phases I-II)",
+        )
+        if x.time.size:
+            bottom.legend(loc="lower right", frameon=False, fontsize="small")
     bottom.set_ylabel("clamp force $F_z$ [N]")
     bottom.set_xlabel("time from release [s]")
     for ax in (top, bottom):
