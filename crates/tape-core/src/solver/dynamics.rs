@@ -96,10 +96,11 @@ pub struct DynamicParams {
     /// within [`REUSE_STEP_CHANGE`] of the one the matrix was built for, and a step's predictor
     /// residual stays within [`REUSE_PREDICTOR`] times the last step's reference force; a
     /// correction from a kept matrix that raises the residual is undone, and a fresh matrix is
-    /// built where it started. A kept matrix costs a residual assembly and one triangular solve
-    /// (the LDL^T of its symmetric part) per iteration, instead of a tangent assembly, a
-    /// factorisation and GMRES sweeps. The converged states are those of full Newton to the
-    /// convergence tolerance. False: a fresh iteration matrix at every iteration.
+    /// built where it started. Every solve then uses the LDL^T of the matrix's symmetric part
+    /// (one triangular solve, no GMRES sweeps), so an iteration with a kept matrix costs a
+    /// residual assembly and that solve instead of a tangent assembly and a factorisation. The
+    /// converged states are those of full Newton to the convergence tolerance. False: a fresh
+    /// iteration matrix at every iteration, solved exactly.
     #[serde(default = "default_true")]
     pub reuse_factorisation: bool,
     /// Record nodal fields (set by the analysis runner).
@@ -495,7 +496,9 @@ impl Integrator<'_> {
             let reusable = self
                 .factor_h
                 .is_some_and(|fh| (fh - h).abs() <= REUSE_STEP_CHANGE * h);
-            let (mut res, mut reference) = self.assemble(start, state, h, !reusable, &mut r);
+            // Whether the iteration matrix is assembled at this iterate.
+            let mut with_tangent = !reusable;
+            let (mut res, mut reference) = self.assemble(start, state, h, with_tangent, &mut r);
             log::debug!(
                 "t = {}, step {h:e} s: iteration {it}, residual {res:e} (reference {reference:e}){}",
                 start.t,
@@ -504,11 +507,13 @@ impl Integrator<'_> {
             if stale && (res > previous || res.is_nan()) {
                 // A correction from an outdated matrix made things worse: back to the iterate it
                 // started from, where a fresh matrix takes over (full Newton's step from there).
-                let (s0, st0, a0) = backup.take().expect("a stale correction keeps its start");
+                let (s0, st0, a0) = backup.as_mut().expect("a stale correction keeps its start");
                 log::debug!("  diverging with a reused matrix: back to the previous iterate");
-                (*state, self.stress, a_new) = (s0, st0, a0);
-                self.factor_h = None;
-                (res, reference) = self.assemble(start, state, h, true, &mut r);
+                std::mem::swap(state, s0);
+                std::mem::swap(&mut self.stress, st0);
+                std::mem::swap(&mut a_new, a0);
+                with_tangent = true;
+                (res, reference) = self.assemble(start, state, h, with_tangent, &mut r);
             }
             residual = res;
             if !res.is_finite() {
@@ -555,9 +560,9 @@ impl Integrator<'_> {
             } else {
                 res > REUSE_CONTRACTION * previous
             };
-            let fresh = !reusable || self.factor_h.is_none() || slow;
+            let fresh = with_tangent || slow;
             if fresh {
-                if reusable && self.factor_h.is_some() {
+                if !with_tangent {
                     // The same residual, now with the iteration matrix.
                     self.assemble(start, state, h, true, &mut r);
                 }
@@ -576,7 +581,15 @@ impl Integrator<'_> {
             // The next correction is stale unless it comes from a matrix built at this iterate.
             stale = !fresh;
             if stale {
-                backup = Some((state.clone(), self.stress.clone(), a_new.clone()));
+                // Into the buffers of an earlier backup of this step, if any.
+                match &mut backup {
+                    Some((s0, st0, a0)) => {
+                        s0.clone_from(state);
+                        st0.clone_from(&self.stress);
+                        a0.clone_from(&a_new);
+                    }
+                    None => backup = Some((state.clone(), self.stress.clone(), a_new.clone())),
+                }
             }
             let mut delta: Vec<f64> = r.iter().map(|v| -v).collect();
             let solved = if params.reuse_factorisation {
