@@ -32,6 +32,49 @@ fn deformed(system: &System, rot: f64, disp: f64, phase: f64, lambda: f64) -> St
     state
 }
 
+/// `|fd - approx| / |fd|`.
+fn relative_error(fd: &[f64], approx: &[f64]) -> f64 {
+    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
+    fd.iter()
+        .zip(approx)
+        .map(|(f, c)| (f - c) * (f - c))
+        .sum::<f64>()
+        .sqrt()
+        / norm
+}
+
+/// Column `j` of the free-DOF matrix `k_ff` (in `system`'s pattern), dense.
+fn column(system: &System, k_ff: &[f64], j: usize) -> Vec<f64> {
+    let mut col = vec![0.0; system.n_free()];
+    let pat = &system.pattern_ff;
+    for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
+        col[pat.row_idx[p]] = k_ff[p];
+    }
+    col
+}
+
+/// The tape (4 mm mesh) with the driven end's reference node released from its constraints and
+/// loaded by a moment about y (0.05 N m), so that it rotates freely; returns the model and the
+/// node.
+fn freed_driven_end() -> Result<(tape_core::Model, usize)> {
+    let tb = TapeBending {
+        mesh_size: 4e-3,
+        ..TapeBending::default()
+    };
+    let mut bm = tb.build()?;
+    bm.model.constraints.retain(|c| c.node != bm.driven_node);
+    bm.model
+        .add_load(bm.driven_node, tape_core::Dof::Ry, 0.05)?;
+    Ok((bm.model, bm.driven_node))
+}
+
+/// The free equations of `node`.
+fn node_columns(system: &System, node: usize) -> Vec<usize> {
+    (0..system.n_free())
+        .filter(|&i| system.dofs.free_dofs[i].0 == node)
+        .collect()
+}
+
 /// Relative error of column `j` of the assembled tangent `k_ff` against central differences of
 /// the residual under the multiplicative update (steps 1e-7 m / 1e-6 rad).
 fn fd_column_error(system: &mut System, state: &State, k_ff: &[f64], j: usize) -> f64 {
@@ -56,18 +99,7 @@ fn fd_column_error(system: &mut System, state: &State, k_ff: &[f64], j: usize) -
         .zip(&am.residual())
         .map(|(p, m)| (p - m) / (2.0 * h))
         .collect();
-    let mut col = vec![0.0; n];
-    let pat = &system.pattern_ff;
-    for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
-        col[pat.row_idx[p]] = k_ff[p];
-    }
-    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-    fd.iter()
-        .zip(&col)
-        .map(|(f, c)| (f - c) * (f - c))
-        .sum::<f64>()
-        .sqrt()
-        / norm
+    relative_error(&fd, &column(system, k_ff, j))
 }
 
 #[test]
@@ -84,9 +116,7 @@ fn assembled_tangent_is_derivative_of_residual_with_rigid_ties() -> Result<()> {
     system.assemble(&state, true, &mut a);
     let k = a.k_ff.clone();
     // Columns to check: the driven reference node's free DOFs and a spread of shell DOFs.
-    let driven: Vec<usize> = (0..n)
-        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
-        .collect();
+    let driven = node_columns(&system, bm.driven_node);
     let mut cols = driven.clone();
     cols.extend((0..n).step_by(97));
     for &j in &cols {
@@ -136,14 +166,7 @@ fn coupling_to_prescribed_dofs_is_derivative_of_residual() -> Result<()> {
         .zip(&am.residual())
         .map(|(p, m)| (p - m) / (2.0 * h))
         .collect();
-    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let err = fd
-        .iter()
-        .zip(&pred)
-        .map(|(f, c)| (f - c) * (f - c))
-        .sum::<f64>()
-        .sqrt()
-        / norm;
+    let err = relative_error(&fd, &pred);
     assert!(err < 1e-5, "relative error of dr/dlambda {err:e}");
     Ok(())
 }
@@ -152,23 +175,13 @@ fn coupling_to_prescribed_dofs_is_derivative_of_residual() -> Result<()> {
 /// non-symmetric rotation terms of the reference node are checked.
 #[test]
 fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
-    use tape_core::Dof;
-    let tb = TapeBending {
-        mesh_size: 4e-3,
-        ..TapeBending::default()
-    };
-    let mut bm = tb.build()?;
-    bm.model.constraints.retain(|c| c.node != bm.driven_node);
-    bm.model.add_load(bm.driven_node, Dof::Ry, 0.05)?;
-    bm.model.add_load(bm.driven_node, Dof::Uz, -0.3)?;
-    let mut system = System::try_new(&bm.model)?;
+    let (mut model, driven) = freed_driven_end()?;
+    model.add_load(driven, tape_core::Dof::Uz, -0.3)?;
+    let mut system = System::try_new(&model)?;
     let state = deformed(&system, 0.1, 1e-4, std::f64::consts::FRAC_PI_2, 0.5);
-    let n = system.n_free();
     let mut a = Assembled::default();
     system.assemble(&state, true, &mut a);
-    let cols: Vec<usize> = (0..n)
-        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
-        .collect();
+    let cols = node_columns(&system, driven);
     assert_eq!(cols.len(), 6);
     for &j in &cols {
         let err = fd_column_error(&mut system, &state, &a.k_ff, j);
@@ -192,25 +205,18 @@ fn tangent_with_free_tie_rotations_is_derivative_of_residual() -> Result<()> {
 #[test]
 fn dynamic_tangent_with_moving_ties_is_derivative_of_residual() -> Result<()> {
     use nalgebra::Vector3;
-    use tape_core::Dof;
-    let tb = TapeBending {
-        mesh_size: 4e-3,
-        ..TapeBending::default()
-    };
-    let mut bm = tb.build()?;
-    bm.model.constraints.retain(|c| c.node != bm.driven_node);
-    bm.model.add_load(bm.driven_node, Dof::Ry, 0.05)?;
-    for part in &mut bm.model.parts {
+    let (mut model, driven) = freed_driven_end()?;
+    for part in &mut model.parts {
         part.section.eta = 2e-3;
     }
-    let mut system = System::try_new(&bm.model)?;
+    let mut system = System::try_new(&model)?;
     let mut state = deformed(&system, 0.1, 1e-4, std::f64::consts::FRAC_PI_2, 0.5);
     for (i, x) in system.reference.x.iter().enumerate() {
         let s = (70.0 * x.x + 0.3 * i as f64).sin();
         state.v[i] = Vector3::new(0.02 * s, -0.01, 0.05 * s);
         state.w[i] = Vector3::new(3.0 * s, -5.0, 2.0 * s);
     }
-    state.w[bm.driven_node] = Vector3::new(-4.0, 20.0, 6.0);
+    state.w[driven] = Vector3::new(-4.0, 20.0, 6.0);
     let gamma_prime = 800.0;
     let residual = |system: &mut System, state: &State| {
         let mut a = Assembled::default();
@@ -222,9 +228,7 @@ fn dynamic_tangent_with_moving_ties_is_derivative_of_residual() -> Result<()> {
     };
     let a = residual(&mut system, &state);
     let n = system.n_free();
-    let mut cols: Vec<usize> = (0..n)
-        .filter(|&i| system.dofs.free_dofs[i].0 == bm.driven_node)
-        .collect();
+    let mut cols = node_columns(&system, driven);
     assert_eq!(cols.len(), 6);
     cols.extend((0..n).step_by(97));
     for &j in &cols {
@@ -249,19 +253,7 @@ fn dynamic_tangent_with_moving_ties_is_derivative_of_residual() -> Result<()> {
             .zip(&rm)
             .map(|(p, m)| (p - m) / (2.0 * h))
             .collect();
-        let mut col = vec![0.0; n];
-        let pat = &system.pattern_ff;
-        for p in pat.col_ptr[j]..pat.col_ptr[j + 1] {
-            col[pat.row_idx[p]] = a.k_ff[p];
-        }
-        let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let err = fd
-            .iter()
-            .zip(&col)
-            .map(|(f, c)| (f - c) * (f - c))
-            .sum::<f64>()
-            .sqrt()
-            / norm;
+        let err = relative_error(&fd, &column(&system, &a.k_ff, j));
         assert!(err < 1e-6, "column {j} ({node}, {dof:?}): relative error {err:e}");
     }
     Ok(())
