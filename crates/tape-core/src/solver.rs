@@ -512,7 +512,10 @@ pub struct StaticStep {
     pub gravity_energy: f64,
     /// Reactions at the constrained DOFs, in [`crate::constraint::DofMap::constrained`] order [N, N m].
     pub reactions: Vec<f64>,
-    /// Negative eigenvalues of the tangent (0 = stable), if requested.
+    /// Negative eigenvalues of the tangent (0 = stable), if requested. With branch switching, a
+    /// state found unstable only along a neutral mode (a fold free to slide along its plateau,
+    /// whose eigenvalue is zero to round-off and may come out negative) does not count it; so do
+    /// states reached by relaxation. Other states count every negative pivot of the LDL^T.
     pub negative_eigenvalues: Option<usize>,
     /// Nodal displacements \[m\] (empty unless fields are recorded).
     pub displacements: Vec<[f64; 3]>,

@@ -126,10 +126,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--switch-branches",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
+        default=None,
         help=(
-            "with --path jump: at a bifurcation (the path loses stability while the angle keeps "
-            "growing, as the perfect tape in equal sense), follow the stable branch leaving it"
+            "with --path jump: where the path loses stability while the angle keeps growing (a "
+            "bifurcation, as the perfect tape's in equal sense, or a limit point stepped over), "
+            "close in on it and follow the stable branch leaving it (default: on with --path jump)"
         ),
     )
     p.add_argument(
@@ -160,13 +162,14 @@ def run(args: argparse.Namespace) -> int:
     if imperfection is None:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.
         imperfection = 0.1 if args.theta_max < 0 else 0.0
+    jump = (args.path or ("jump" if args.theta_max < 0 else "full")) == "jump"
     setup = BendingSetup(
         **tape_fields(args),
         theta_max_deg=args.theta_max,
         unload=args.unload,
         imperfection_deg=imperfection,
-        jump=(args.path or ("jump" if args.theta_max < 0 else "full")) == "jump",
-        switch_branches=args.switch_branches,
+        jump=jump,
+        switch_branches=jump if args.switch_branches is None else args.switch_branches,
     )
     try:
         result = bend(setup, progress=not (args.no_progress or args.json))
@@ -219,7 +222,8 @@ def run(args: argparse.Namespace) -> int:
             f" = {s.m_star_analytical:+.4f} N m ({rel:+.1%})",
         ]
         if s.theta_snap_deg is not None:
-            lines.append(f"  snap (fold forms) at theta = {s.theta_snap_deg:+.2f} deg")
+            what = "fold forms" if sense == "opposite" else "first snap: the tape twists"
+            lines.append(f"  snap ({what}) at theta = {s.theta_snap_deg:+.2f} deg")
         if s.theta_heel_deg is not None:
             lines.append(f"  fold disappears on unloading at theta = {s.theta_heel_deg:+.2f} deg")
         if args.csv:

@@ -28,6 +28,16 @@ use crate::state::State;
 /// measure -4e-14 and beyond, its neutral sliding modes -7e-16).
 const NEUTRAL: f64 = 100.0 * f64::EPSILON;
 
+/// Relative potential energy an unstable state must lose, relaxed from a push along its critical
+/// mode, to count as left. On the 2 mm equal-sense tape: the snaps release 1.3e-4 (the heel) to
+/// 0.14 (the fold); a fold slid along its neutral mode changes it by 1e-12 to 5e-8, and by up to
+/// 1.2e-6 where it slips from one element to the next.
+const NEUTRAL_ENERGY: f64 = 1e-5;
+
+/// Largest translation of a trial push along a critical mode, as a fraction of the model's
+/// characteristic length (half its bounding box's diagonal: 1 mm on the 100 mm tape).
+const PUSH: f64 = 0.02;
+
 /// The outcome of a branch switch at a bifurcation.
 pub(super) struct Switch {
     /// The last stable state located before the bifurcation, recorded with its event.
@@ -75,33 +85,36 @@ impl Driver<'_> {
         })
     }
 
+    /// Whether the unstable equilibrium `state` (its tangent factorised) is one a slow test leaves:
+    /// pushed along the critical mode (see [`Driver::push_amount`]) and relaxed, the state must go
+    /// at least half the push away and lose more than [`NEUTRAL_ENERGY`] of its potential energy. A
+    /// neutral mode (a fold free to slide) or a pivot at round-off level fails the test. `state` is
+    /// unchanged; the driver's pieces are those of the trial (assemble again).
+    ///
+    /// # Errors
+    /// A failure of the linear algebra.
+    pub fn leaves(&mut self, state: &State) -> Result<bool> {
+        let mode = self.inverse_iteration()?;
+        let energy = self.asm.energy + self.asm.gravity_energy;
+        let mut trial = state.clone();
+        let push = self.push_amount(&mode);
+        self.push_along(&mut trial, &mode, push);
+        if self.relax(&mut trial, state.t).is_err() || self.distance(&trial, state) < 0.5 * push {
+            self.invalidate();
+            return Ok(false);
+        }
+        let relaxed = self.asm.energy + self.asm.gravity_energy;
+        self.invalidate();
+        Ok(relaxed < energy - NEUTRAL_ENERGY * energy.abs())
+    }
+
     /// Between the stable converged state `stable` and the unstable one `unstable` reached from it
-    /// without a limit point, locates the bifurcation, and moves `state` to a stable equilibrium
-    /// on the branch leaving it (see the module notes). `None` if the unstable state's instability
-    /// is not one a push along the critical mode leaves (both pushes relax back onto the path
-    /// itself, within `ds / 10`): the path is then kept.
+    /// without a limit point (and left, see [`Driver::leaves`]), locates the bifurcation, and moves
+    /// `state` to a stable equilibrium on the branch leaving it (see the module notes).
     ///
     /// # Errors
     /// A failure of the linear algebra, or no stable equilibrium found either way.
-    pub fn switch_branch(
-        &mut self,
-        state: &mut State,
-        stable: &State,
-        unstable: &State,
-        ds: f64,
-    ) -> Result<Option<Switch>> {
-        // Is the instability real? Pushed along the critical mode, the unstable state must relax
-        // away from the path.
-        let mode = self.critical_mode(unstable)?;
-        let mut trial = unstable.clone();
-        self.push_along(&mut trial, &mode, 0.2 * ds);
-        let away = self.relax(&mut trial, unstable.t).is_ok() && self.distance(&trial, unstable) >= 0.1 * ds;
-        if !away {
-            // Back where it started: the path's own state is stable after all (a pivot at
-            // round-off level, not an instability).
-            self.invalidate();
-            return Ok(None);
-        }
+    pub fn switch_branch(&mut self, state: &mut State, stable: &State, unstable: &State) -> Result<Switch> {
         // The bifurcation, by bisection along the path between the stable and unstable states.
         // Near it the tangent is nearly singular along the critical mode, which the hyperplane
         // does not fix: a solve that fails there counts as past it.
@@ -136,6 +149,7 @@ impl Driver<'_> {
             .as_ref()
             .map_or_else(|| stable.clone(), |f| f.state.clone());
         let mode = self.critical_mode(&start)?;
+        let push = self.push_amount(&mode);
         let mut best: Option<(State, f64)> = None;
         // Past a limit point the path comes back in load factor: the switch is never behind the
         // last stable state (it is then the jump of a limit point).
@@ -150,8 +164,8 @@ impl Driver<'_> {
             }
             for sign in [1.0, -1.0] {
                 let mut trial = start.clone();
-                self.push_along(&mut trial, &mode, sign * 0.2 * ds);
-                if self.relax(&mut trial, t_switch).is_err() || self.distance(&trial, &start) < 0.1 * ds {
+                self.push_along(&mut trial, &mode, sign * push);
+                if self.relax(&mut trial, t_switch).is_err() || self.distance(&trial, &start) < 0.5 * push {
                     continue;
                 }
                 let energy = self.asm.energy + self.asm.gravity_energy;
@@ -179,7 +193,7 @@ impl Driver<'_> {
         *state = switched;
         self.invalidate();
         self.assemble(state);
-        Ok(Some(Switch { critical, energy }))
+        Ok(Switch { critical, energy })
     }
 
     /// The eigenvector of the tangent's eigenvalue nearest zero at `at` (inverse iteration with
@@ -224,7 +238,7 @@ impl Driver<'_> {
     ///
     /// # Errors
     /// No factorisation, or a failed solve.
-    fn negative_eigenvalues(&mut self) -> Result<usize> {
+    pub fn negative_eigenvalues(&mut self) -> Result<usize> {
         self.factorise()?;
         let count = self.system.linear.negative_eigenvalues()?;
         if count != 1 {
@@ -247,6 +261,28 @@ impl Driver<'_> {
             .map(|p| self.asm.k_ff[p].abs())
             .fold(0.0, f64::max);
         num / den / diag
+    }
+
+    /// How far to push along the unit `mode` (weighted norm) to try whether a state leaves it: so
+    /// far that the largest translation is [`PUSH`] of the model's characteristic length. Just past
+    /// a bifurcation the potential is flat along the mode to second order: a push scaled on the
+    /// path's steps (which close in on it) would stay within the relaxation's tolerance.
+    fn push_amount(&self, mode: &[f64]) -> f64 {
+        let largest = self
+            .system
+            .dofs
+            .free_dofs
+            .iter()
+            .zip(mode)
+            .filter(|((_, dof), _)| !dof.is_rotation())
+            .map(|(_, v)| v.abs())
+            .fold(0.0, f64::max);
+        let lc = self.system.char_length;
+        if largest > 0.0 {
+            PUSH * lc / largest
+        } else {
+            PUSH * lc
+        }
     }
 
     /// Moves `state` by `amount` (weighted norm) along the unit `mode`, at fixed load factor.

@@ -532,6 +532,10 @@ impl Driver<'_> {
     }
 }
 
+/// A step from a stable state onto an unstable one is retried shorter until it is at most the
+/// first arc-length step over this, before the instability is taken for a bifurcation.
+const CLOSE_IN: f64 = 16.0;
+
 /// The driver's bookkeeping of one path, between propose, attempt, accept and reject.
 struct PathState {
     control: StepController,
@@ -553,6 +557,11 @@ struct PathState {
     restart: Option<f64>,
     /// Arc-length only: the states followed so far, to stop a path that returns onto itself.
     memory: Option<PathMemory>,
+    /// The state of the increment being tried is unstable only by a neutral mode (see
+    /// [`Driver::leaves`]): it is recorded without it.
+    neutral_reached: bool,
+    /// Steps are being shortened towards an instability found real (see `CLOSE_IN`).
+    closing_in: bool,
 }
 
 /// What the driver does after a stage of an increment.
@@ -775,6 +784,8 @@ impl<'a, 'b> Walk<'a, 'b> {
                 last_negative: None,
                 restart: None,
                 memory: arc_control.then(PathMemory::new),
+                neutral_reached: false,
+                closing_in: false,
             },
             path: StaticPath::default(),
             progress,
@@ -890,6 +901,7 @@ impl<'a, 'b> Walk<'a, 'b> {
         *state = saved;
         self.s.invalidate();
         self.s.stats.cutbacks += 1;
+        self.p.neutral_reached = false;
         log::debug!("increment rejected at t = {}: {rejection}; cutting back", state.t);
         let params = self.s.params;
         if let Err(why) = self.p.control.reject() {
@@ -983,7 +995,10 @@ impl<'a, 'b> Walk<'a, 'b> {
         let forward = self
             .lambda_end
             .is_some_and(|end| (state.t - saved.t) * (end - saved.t) > 0.0);
-        if !(self.s.params.switch_branches && self.arc_control && forward && self.p.last_negative == Some(0)) {
+        // A state unstable only by a neutral mode was recorded as stable: a further negative
+        // pivot is tested too.
+        let was_stable = self.p.last_negative == Some(0);
+        if !(self.s.params.switch_branches && self.arc_control && forward && was_stable) {
             return None;
         }
         match self
@@ -998,17 +1013,45 @@ impl<'a, 'b> Walk<'a, 'b> {
                 return Some(Flow::Stop);
             }
         }
-        let reached = state.clone();
         let ds = self.p.control.size.abs();
-        let switch = match self.s.switch_branch(state, saved, &reached, ds) {
-            Ok(Some(switch)) => switch,
-            Ok(None) => {
-                // A round-off pivot: keep the converged state (its pieces, changed by the trial
-                // relaxations, are assembled again).
-                *state = reached;
+        // Closing in on an instability found real, the retried states are not tested again.
+        let real = if self.p.closing_in {
+            Ok(true)
+        } else {
+            self.s.leaves(state)
+        };
+        match real {
+            Ok(true) => {}
+            Ok(false) => {
+                // A neutral mode (a fold free to slide on its plateau) or a pivot at round-off
+                // level: the path goes on, its state recorded with the plain count.
+                self.p.neutral_reached = true;
                 self.s.assemble(state);
                 return None;
             }
+            Err(e) => {
+                log::debug!("no instability test at t = {}: {e}; following the path", state.t);
+                self.s.invalidate();
+                self.s.assemble(state);
+                return None;
+            }
+        }
+        // A long step may have jumped over a limit point onto another branch rather than met a
+        // bifurcation: close in with shorter steps first (a limit point then shows as a turn in
+        // load factor, and a bifurcation is located from nearby).
+        if let Some(ds0) = self.p.arc_ds {
+            if ds > ds0 / CLOSE_IN && self.p.control.reject().is_ok() {
+                *state = saved.clone();
+                self.s.invalidate();
+                self.s.stats.cutbacks += 1;
+                self.p.closing_in = true;
+                return Some(Flow::Next);
+            }
+        }
+        self.p.closing_in = false;
+        let reached = state.clone();
+        let switch = match self.s.switch_branch(state, saved, &reached) {
+            Ok(switch) => switch,
             Err(e) => {
                 // No stable branch found: the path itself is followed, its states recorded with
                 // their stability.
@@ -1022,6 +1065,14 @@ impl<'a, 'b> Walk<'a, 'b> {
         // Arc positions run from the last converged state, through the located bifurcation, to
         // the state on the new branch.
         let mut from = saved;
+        if switch.critical.is_none() {
+            // The steps closed in on the bifurcation within the location's tolerance: the last
+            // recorded state is the last stable one.
+            let arc = self.p.arc;
+            if let Some(last) = self.path.steps.iter_mut().rev().find(|st| st.arc == arc) {
+                last.event.get_or_insert(Event::Bifurcation);
+            }
+        }
         if let Some((critical, step)) = &switch.critical {
             let mut step = step.clone();
             step.arc = self.p.arc + self.s.distance(critical, saved);
@@ -1085,6 +1136,7 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// A converged increment along the path: record it, adapt the next increment.
     fn accept(&mut self, state: &State, saved: &State, out: Outcome) -> Flow {
         self.p.restart = None;
+        self.p.closing_in = false;
         self.s.strict_turns = true;
         self.s.tangent_predictor = true;
         let Some(keep_going) = self.record_step(state, &out) else {
@@ -1150,6 +1202,9 @@ impl<'a, 'b> Walk<'a, 'b> {
                 return None;
             }
         };
+        if std::mem::take(&mut self.p.neutral_reached) {
+            step.negative_eigenvalues = step.negative_eigenvalues.map(|n| n.saturating_sub(1));
+        }
         self.p.arc += self.s.arc_norm(&out.dq, out.dlambda);
         step.arc = self.p.arc;
         self.s.stats.steps += 1;
@@ -1199,6 +1254,16 @@ impl<'a, 'b> Walk<'a, 'b> {
                 return false;
             }
         };
+        // Relaxation ends where the tangent is positive definite but for a neutral mode.
+        if st.negative_eigenvalues == Some(1) {
+            match self.s.negative_eigenvalues() {
+                Ok(n) => st.negative_eigenvalues = Some(n),
+                Err(e) => {
+                    self.path.error = Some(e);
+                    return false;
+                }
+            }
+        }
         st.jump = relaxed.jump;
         st.event = relaxed.event;
         self.p.arc += relaxed.distance;
@@ -1212,6 +1277,8 @@ impl<'a, 'b> Walk<'a, 'b> {
             m.restart(state, &self.s.system.reference);
         }
         self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
+        self.p.neutral_reached = false;
+        self.p.closing_in = false;
         self.p.control.cutbacks = 0;
         self.p.history.clear();
         if self.locate {
