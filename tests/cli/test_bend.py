@@ -96,3 +96,23 @@ def test_bad_value_exits_non_zero_with_a_message(option, value, message, capsys)
     assert code != 0
     assert message in captured.err
     assert captured.out == ""
+
+
+@pytest.mark.parametrize(
+    ("extra", "jump", "switch"),
+    [
+        ([], True, True),  # equal sense: a slow test's path, branches switched
+        (["--no-switch-branches"], True, False),
+        (["--path", "full"], False, False),
+    ],
+)
+def test_equal_sense_switches_branches_by_default_on_the_jump_path(
+    extra, jump, switch, tmp_path, capsys
+):
+    csv_path = tmp_path / "eq.csv"
+    args = ["bend", "--mesh-size", "0.004", "--theta-max=-1", "--no-progress"]
+    code = main([*args, "--csv", str(csv_path), *extra])
+    capsys.readouterr()
+    assert code == 0
+    setup = json.loads(csv_path.read_text().splitlines()[0][len("# tapespring bend: ") :])
+    assert (setup["jump"], setup["switch_branches"]) == (jump, switch)

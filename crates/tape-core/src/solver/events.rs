@@ -176,6 +176,33 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
     Ok(())
 }
 
+/// Before a jump from the limit point the path reached at `history`'s last state, the step to
+/// `turned` having come back in load factor: locates the limit point between the state before,
+/// the last one and `turned` (a point off the recorded path), inserting it into `path`. The
+/// driver's state is unchanged on return.
+pub(super) fn before_jump(s: &mut Driver, history: &[Point], turned: Point, path: &mut StaticPath) -> Result<()> {
+    let n = history.len();
+    if n < 2 || !s.params.locate_limit_points {
+        return Ok(());
+    }
+    let (a, b) = (&history[n - 2], &history[n - 1]);
+    let g = [a.state.t, b.state.t, turned.state.t];
+    if (g[1] - g[0]) * (g[2] - g[1]) >= 0.0 {
+        return Ok(());
+    }
+    let saved = s.save();
+    let found = search(
+        s,
+        (a, b, &turned),
+        Event::LimitPoint,
+        (g[1] - g[0]).signum(),
+        s.monitor_index(),
+    );
+    s.restore(saved)?;
+    insert(s, path, found, Event::LimitPoint, b);
+    Ok(())
+}
+
 /// Records the located event: the best state found. If the search found nothing better than the
 /// converged state in the middle, that state is the best estimate; it stays a plain step of the
 /// path (the path's states are never relabelled) and the event is not recorded.

@@ -35,7 +35,7 @@
 use std::time::Instant;
 
 use super::control::{GiveUp, StepController};
-use super::events::{after_step, Point};
+use super::events::{after_step, before_jump, Point};
 use super::newton::{Convergence, Stall};
 use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
@@ -963,6 +963,22 @@ impl<'a, 'b> Walk<'a, 'b> {
             return None;
         }
         let turned = state.clone();
+        if self.locate {
+            // The limit point itself, not the last state before it, is what the jump leaves from.
+            let monitor = self
+                .monitor
+                .map_or(0.0, |i| self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i]);
+            let arc = self.p.arc + self.s.distance(&turned, saved);
+            let point = Point {
+                state: turned.clone(),
+                arc,
+                monitor,
+            };
+            if let Err(e) = before_jump(&mut self.s, &self.p.history, point, &mut self.path) {
+                self.path.error = Some(e);
+                return Some(Flow::Stop);
+            }
+        }
         if let Err(e) = self
             .s
             .jump(state, saved, travel, self.p.last_dlambda, self.p.control.size.abs())
