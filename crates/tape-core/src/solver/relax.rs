@@ -108,6 +108,22 @@ impl Driver<'_> {
         Ok(relaxed < energy - NEUTRAL_ENERGY * energy.abs())
     }
 
+    /// A stable equilibrium at load factor `lambda`, relaxed from `from`; `state` ends there, with
+    /// its pieces assembled.
+    ///
+    /// # Errors
+    /// [`Error::NotConverged`] if no stable equilibrium is found (`state` is then `from`).
+    pub fn relax_at(&mut self, state: &mut State, from: &State, lambda: f64) -> Result<()> {
+        *state = from.clone();
+        if let Err(e) = self.relax(state, lambda) {
+            *state = from.clone();
+            return Err(e);
+        }
+        self.invalidate();
+        self.assemble(state);
+        Ok(())
+    }
+
     /// Between the stable converged state `stable` and the unstable one `unstable` reached from it
     /// without a limit point (and left, see [`Driver::leaves`]), locates the bifurcation, and moves
     /// `state` to a stable equilibrium on the branch leaving it (see the module notes).

@@ -916,7 +916,18 @@ impl<'a, 'b> Walk<'a, 'b> {
                 (true, Some(end), Some(ds)) => {
                     let from = state.clone();
                     let travel = (end - from.t).signum();
-                    match self.s.jump(state, &from, travel, self.p.last_dlambda, ds) {
+                    // Past a limit point, else (the neutral mode keeps every relaxed state near
+                    // this one) on along the same stable branch, one first step further.
+                    let further = match &params.control {
+                        Control::ArcLength { initial_increment, .. } => initial_increment.abs(),
+                        _ => 0.0,
+                    };
+                    let t_next = from.t + travel * further.min((end - from.t).abs());
+                    match self
+                        .s
+                        .jump(state, &from, travel, self.p.last_dlambda, ds)
+                        .or_else(|_| self.s.relax_at(state, &from, t_next))
+                    {
                         Ok(()) => true,
                         Err(e) => {
                             log::debug!("no relaxation past t = {}: {e}", from.t);
@@ -937,6 +948,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 jump: false,
                 event: None,
             };
+            log::debug!("path continued by relaxation to t = {}", state.t);
             if !self.push_relaxed(state, relaxed) {
                 return Flow::Stop;
             }
