@@ -536,6 +536,10 @@ impl Driver<'_> {
 /// first arc-length step over this, before the instability is taken for a bifurcation.
 const CLOSE_IN: f64 = 16.0;
 
+/// On the path of a slowly driven test, a step over which the monitored reaction changes by more
+/// than this many times `refine_change` is retried shorter (see `Walk::too_coarse`).
+const COARSE: f64 = 4.0;
+
 /// The driver's bookkeeping of one path, between propose, attempt, accept and reject.
 struct PathState {
     control: StepController,
@@ -631,6 +635,9 @@ pub fn solve_static(
                 Flow::Stop => break,
             },
         };
+        if w.too_coarse(state, &saved) {
+            continue;
+        }
         let flow = match w.jump_at_limit(state, &saved) {
             Some(flow) => flow,
             None => match w.switch_at_bifurcation(state, &saved) {
@@ -961,6 +968,33 @@ impl<'a, 'b> Walk<'a, 'b> {
         // length, which turns at the limit.
         self.p.restart = None;
         Flow::Next
+    }
+
+    /// On the path of a slowly driven test, a converged step over which the monitored reaction
+    /// changes by more than [`COARSE`] times `refine_change` (and the load factor by more than
+    /// `refine_span`): it may have stepped over a limit point, whose jump would then be missed,
+    /// and refinement along its chord cannot recover a path that turned in between. It is rolled
+    /// back to `saved` with half the increment (`true`), while half the cut-backs remain.
+    fn too_coarse(&mut self, state: &mut State, saved: &State) -> bool {
+        let params = self.s.params;
+        let (true, Some(i), Some(last)) = (
+            params.jump_at_limit_points && self.arc_control && self.locate,
+            self.monitor,
+            self.p.history.last(),
+        ) else {
+            return false;
+        };
+        let m = self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i];
+        let dm = (m - last.monitor).abs();
+        let coarse = (state.t - saved.t).abs() > params.refine_span
+            && dm > COARSE * params.refine_change * m.abs().max(last.monitor.abs());
+        if !coarse || self.p.control.cutbacks >= params.max_cutbacks / 2 || self.p.control.reject().is_err() {
+            return false;
+        }
+        *state = saved.clone();
+        self.s.invalidate();
+        self.s.stats.cutbacks += 1;
+        true
     }
 
     /// A converged arc-length increment that went back in load factor, on the path of a slowly
