@@ -168,7 +168,19 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
     }
     if n >= 2 && needs_refinement(s, &history[n - 2], &history[n - 1]) {
         let saved = s.save();
-        let found = refine(s, &history[n - 2], &history[n - 1], monitor, 0);
+        let mut found = refine(s, &history[n - 2], &history[n - 1], monitor, 0);
+        if s.params.switch_branches {
+            // On a path that switches branches, a neutral mode (a fold free to slide) is not
+            // counted, as at the path's own states.
+            for f in found
+                .iter_mut()
+                .filter(|f| f.step.negative_eigenvalues == Some(1))
+            {
+                s.invalidate();
+                s.assemble(&f.state);
+                f.step.negative_eigenvalues = Some(s.negative_eigenvalues()?);
+            }
+        }
         s.restore(saved)?;
         s.stats.steps += found.len();
         path.steps.extend(found.into_iter().map(|f| f.step));

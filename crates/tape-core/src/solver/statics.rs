@@ -536,6 +536,12 @@ impl Driver<'_> {
 /// first arc-length step over this, before the instability is taken for a bifurcation.
 const CLOSE_IN: f64 = 16.0;
 
+/// Accepted steps that each move the load factor by less than this fraction of the first step's
+/// are crawling (see `Walk::crawling`), once there are [`CRAWL_STEPS`] in a row.
+const CRAWL: f64 = 1e-3;
+/// See [`CRAWL`].
+const CRAWL_STEPS: usize = 5;
+
 /// On the path of a slowly driven test, a step over which the monitored reaction changes by more
 /// than this many times `refine_change` is retried shorter (see `Walk::too_coarse`).
 const COARSE: f64 = 4.0;
@@ -566,6 +572,8 @@ struct PathState {
     neutral_reached: bool,
     /// Steps are being shortened towards an instability found real (see `CLOSE_IN`).
     closing_in: bool,
+    /// Accepted steps in a row that crawled (see `Walk::crawling`).
+    crawl: usize,
 }
 
 /// What the driver does after a stage of an increment.
@@ -644,7 +652,16 @@ pub fn solve_static(
                 Some(flow) => flow,
                 None => match w.land(state, saved.clone()) {
                     Some(flow) => flow,
-                    None => w.accept(state, &saved, out),
+                    None => {
+                        let dlambda = out.dlambda;
+                        match w.accept(state, &saved, out) {
+                            Flow::Next if w.crawling(dlambda) => {
+                                w.p.crawl = 0;
+                                w.relax_onward(state).unwrap_or(Flow::Next)
+                            }
+                            flow => flow,
+                        }
+                    }
                 },
             },
         };
@@ -793,6 +810,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 memory: arc_control.then(PathMemory::new),
                 neutral_reached: false,
                 closing_in: false,
+                crawl: 0,
             },
             path: StaticPath::default(),
             progress,
@@ -915,52 +933,14 @@ impl<'a, 'b> Walk<'a, 'b> {
             // On the stable path of a slowly driven test, a state whose tangent does not define
             // the path (a neutral mode: a fold free to slide) can still be left by relaxing at a
             // larger load factor.
-            let relaxed = match (
-                params.jump_at_limit_points && self.arc_control,
-                self.lambda_end,
-                self.p.arc_ds,
-            ) {
-                (true, Some(end), Some(ds)) => {
-                    let from = state.clone();
-                    let travel = (end - from.t).signum();
-                    // Past a limit point, else (the neutral mode keeps every relaxed state near
-                    // this one) on along the same stable branch, one first step further.
-                    let further = match &params.control {
-                        Control::ArcLength { initial_increment, .. } => initial_increment.abs(),
-                        _ => 0.0,
-                    };
-                    let t_next = from.t + travel * further.min((end - from.t).abs());
-                    match self
-                        .s
-                        .jump(state, &from, travel, self.p.last_dlambda, ds)
-                        .or_else(|_| self.s.relax_at(state, &from, t_next))
-                    {
-                        Ok(()) => true,
-                        Err(e) => {
-                            log::debug!("no relaxation past t = {}: {e}", from.t);
-                            *state = from;
-                            false
-                        }
-                    }
+            return match self.relax_onward(state) {
+                Some(flow) => flow,
+                None => {
+                    let force = self.s.reference_force();
+                    self.path.error = Some(give_up(&self.p, why, rejection, state, params, force));
+                    Flow::Stop
                 }
-                _ => false,
             };
-            if !relaxed {
-                let force = self.s.reference_force();
-                self.path.error = Some(give_up(&self.p, why, rejection, state, params, force));
-                return Flow::Stop;
-            }
-            let relaxed = Relaxed {
-                distance: self.p.arc_ds.unwrap_or(0.0),
-                jump: false,
-                event: None,
-            };
-            log::debug!("path continued by relaxation to t = {}", state.t);
-            if !self.push_relaxed(state, relaxed) {
-                return Flow::Stop;
-            }
-            self.p.control.size = self.p.arc_ds.unwrap_or(self.p.control.size);
-            return Flow::Next;
         }
         self.s.strict_turns = self.p.control.cutbacks < params.max_cutbacks / 2;
         self.s.tangent_predictor = false;
@@ -968,6 +948,68 @@ impl<'a, 'b> Walk<'a, 'b> {
         // length, which turns at the limit.
         self.p.restart = None;
         Flow::Next
+    }
+
+    /// On the path of a slowly driven test, from the converged `state` where the arc length gets
+    /// nowhere: a relaxation past a limit point (a jump), else at the load factor one first step
+    /// further (a fold's neutral mode keeps every relaxed state near this one: the path goes on
+    /// along the same stable branch). `None` if neither finds a stable equilibrium (`state`
+    /// unchanged) or the path is not such a path.
+    fn relax_onward(&mut self, state: &mut State) -> Option<Flow> {
+        let params = self.s.params;
+        let (true, Some(end), Some(ds), Control::ArcLength { initial_increment, .. }) = (
+            params.jump_at_limit_points && self.arc_control,
+            self.lambda_end,
+            self.p.arc_ds,
+            &params.control,
+        ) else {
+            return None;
+        };
+        let from = state.clone();
+        let travel = (end - from.t).signum();
+        let t_next = from.t + travel * initial_increment.abs().min((end - from.t).abs());
+        let relaxed = self
+            .s
+            .jump(state, &from, travel, self.p.last_dlambda, ds)
+            .or_else(|_| self.s.relax_at(state, &from, t_next));
+        if let Err(e) = relaxed {
+            log::debug!("no relaxation past t = {}: {e}", from.t);
+            *state = from;
+            return None;
+        }
+        log::debug!("path continued by relaxation from t = {} to t = {}", from.t, state.t);
+        let relaxed = Relaxed {
+            distance: self.s.distance(state, &from),
+            jump: false,
+            event: None,
+        };
+        if !self.push_relaxed(state, relaxed) {
+            return Some(Flow::Stop);
+        }
+        self.p.control.size = ds;
+        Some(Flow::Next)
+    }
+
+    /// Branches are switched on this path (a slowly driven test with branch switching).
+    fn switching(&self) -> bool {
+        let params = self.s.params;
+        params.switch_branches && params.jump_at_limit_points && self.arc_control
+    }
+
+    /// On the path of a slowly driven test with branch switching, the accepted steps crawl: the
+    /// last [`CRAWL_STEPS`] each moved the load factor by less than [`CRAWL`] of the first step's
+    /// (a fold's neutral mode takes up their arc length). The path then goes on by relaxation.
+    fn crawling(&mut self, dlambda: f64) -> bool {
+        let first = match &self.s.params.control {
+            Control::ArcLength { initial_increment, .. } => initial_increment.abs(),
+            _ => return false,
+        };
+        if !self.switching() || dlambda.abs() >= CRAWL * first {
+            self.p.crawl = 0;
+            return false;
+        }
+        self.p.crawl += 1;
+        self.p.crawl >= CRAWL_STEPS
     }
 
     /// On the path of a slowly driven test, a converged step over which the monitored reaction
