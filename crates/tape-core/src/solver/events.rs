@@ -190,17 +190,23 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
 
 /// Before a jump from the limit point the path reached at `history`'s last state, the step to
 /// `turned` having come back in load factor: locates the limit point between the state before,
-/// the last one and `turned` (a point off the recorded path), inserting it into `path`. The
-/// driver's state is unchanged on return.
-pub(super) fn before_jump(s: &mut Driver, history: &[Point], turned: Point, path: &mut StaticPath) -> Result<()> {
+/// the last one and `turned` (a point off the recorded path), inserting it into `path`; returns
+/// its arc position, which the state jumped to must lie beyond. The driver's state is unchanged
+/// on return.
+pub(super) fn before_jump(
+    s: &mut Driver,
+    history: &[Point],
+    turned: Point,
+    path: &mut StaticPath,
+) -> Result<Option<f64>> {
     let n = history.len();
     if n < 2 || !s.params.locate_limit_points {
-        return Ok(());
+        return Ok(None);
     }
     let (a, b) = (&history[n - 2], &history[n - 1]);
     let g = [a.state.t, b.state.t, turned.state.t];
     if (g[1] - g[0]) * (g[2] - g[1]) >= 0.0 {
-        return Ok(());
+        return Ok(None);
     }
     let saved = s.save();
     let found = search(
@@ -211,8 +217,9 @@ pub(super) fn before_jump(s: &mut Driver, history: &[Point], turned: Point, path
         s.monitor_index(),
     );
     s.restore(saved)?;
+    let limit = found.as_ref().map(|f| f.step.arc);
     insert(s, path, found, Event::LimitPoint, b);
-    Ok(())
+    Ok(limit)
 }
 
 /// Records the located event: the best state found. If the search found nothing better than the

@@ -968,10 +968,17 @@ impl<'a, 'b> Walk<'a, 'b> {
         let from = state.clone();
         let travel = (end - from.t).signum();
         let t_next = from.t + travel * initial_increment.abs().min((end - from.t).abs());
+        let switching = self.switching();
         let relaxed = self
             .s
             .jump(state, &from, travel, self.p.last_dlambda, ds)
-            .or_else(|_| self.s.relax_at(state, &from, t_next));
+            .or_else(|e| {
+                if switching {
+                    self.s.relax_at(state, &from, t_next)
+                } else {
+                    Err(e)
+                }
+            });
         if let Err(e) = relaxed {
             log::debug!("no relaxation past t = {}: {e}", from.t);
             *state = from;
@@ -979,7 +986,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         }
         log::debug!("path continued by relaxation from t = {} to t = {}", from.t, state.t);
         let relaxed = Relaxed {
-            distance: self.s.distance(state, &from),
+            // Paths that switch branches record how far the state moved.
+            distance: if switching { self.s.distance(state, &from) } else { ds },
             jump: false,
             event: None,
         };
@@ -1019,11 +1027,7 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// back to `saved` with half the increment (`true`), while half the cut-backs remain.
     fn too_coarse(&mut self, state: &mut State, saved: &State) -> bool {
         let params = self.s.params;
-        let (true, Some(i), Some(last)) = (
-            params.jump_at_limit_points && self.arc_control && self.locate,
-            self.monitor,
-            self.p.history.last(),
-        ) else {
+        let (true, Some(i), Some(last)) = (self.switching() && self.locate, self.monitor, self.p.history.last()) else {
             return false;
         };
         let m = self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i];
@@ -1051,7 +1055,8 @@ impl<'a, 'b> Walk<'a, 'b> {
             return None;
         }
         let turned = state.clone();
-        if self.locate {
+        let mut limit = None;
+        if self.locate && self.switching() {
             // The limit point itself, not the last state before it, is what the jump leaves from.
             let monitor = self
                 .monitor
@@ -1062,9 +1067,12 @@ impl<'a, 'b> Walk<'a, 'b> {
                 arc,
                 monitor,
             };
-            if let Err(e) = before_jump(&mut self.s, &self.p.history, point, &mut self.path) {
-                self.path.error = Some(e);
-                return Some(Flow::Stop);
+            match before_jump(&mut self.s, &self.p.history, point, &mut self.path) {
+                Ok(found) => limit = found,
+                Err(e) => {
+                    self.path.error = Some(e);
+                    return Some(Flow::Stop);
+                }
             }
         }
         if let Err(e) = self
@@ -1080,8 +1088,10 @@ impl<'a, 'b> Walk<'a, 'b> {
             self.s.assemble(state);
             return None;
         }
+        // The state jumped to lies beyond the located limit point along the path.
+        let to_limit = limit.map_or(0.0, |arc| arc - self.p.arc);
         let relaxed = Relaxed {
-            distance: self.s.distance(state, saved),
+            distance: self.s.distance(state, saved).max(1.001 * to_limit),
             jump: true,
             event: None,
         };
@@ -1359,7 +1369,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             }
         };
         // Relaxation ends where the tangent is positive definite but for a neutral mode.
-        if st.negative_eigenvalues == Some(1) {
+        if st.negative_eigenvalues == Some(1) && self.switching() {
             match self.s.negative_eigenvalues() {
                 Ok(n) => st.negative_eigenvalues = Some(n),
                 Err(e) => {
