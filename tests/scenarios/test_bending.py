@@ -350,7 +350,7 @@ def test_equal_sense_peak_is_lower_than_opposite_and_residual_moment_matches(to_
     change = np.abs(np.diff(m)) / np.maximum(np.abs(m[:-1]), np.abs(m[1:]))
     bad = np.nonzero(same & wide & (change > 0.05) & ~result.jump[1:])[0]
     assert bad.size == 0, [(th[i], th[i + 1], m[i], m[i + 1]) for i in bad]
-    # Unstable only at located limit points (measured: 3 of 211 states).
+    # Unstable only at located limit points (measured: 1 of 211 states).
     assert not (~result.stable & ~limit).any()
 
 

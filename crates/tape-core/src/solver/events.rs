@@ -159,10 +159,7 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
                 _ => true,
             };
             if prominent && (g[1] - g[0]) * (g[2] - g[1]) < 0.0 {
-                let saved = s.save();
-                let found = search(s, (a, b, c), kind, sense, monitor);
-                s.restore(saved)?;
-                insert(s, path, found, kind, b);
+                locate(s, (a, b, c), kind, sense, path)?;
             }
         }
     }
@@ -208,18 +205,25 @@ pub(super) fn before_jump(
     if (g[1] - g[0]) * (g[2] - g[1]) >= 0.0 {
         return Ok(None);
     }
+    locate(s, (a, b, &turned), Event::LimitPoint, (g[1] - g[0]).signum(), path)
+}
+
+/// Locates the event `kind` between `a` and `c` (see [`search`]), the driver's state saved around
+/// the search, and records it (see [`insert`]); returns its arc position if one was found.
+fn locate(
+    s: &mut Driver,
+    (a, b, c): (&Point, &Point, &Point),
+    kind: Event,
+    sense: f64,
+    path: &mut StaticPath,
+) -> Result<Option<f64>> {
     let saved = s.save();
-    let found = search(
-        s,
-        (a, b, &turned),
-        Event::LimitPoint,
-        (g[1] - g[0]).signum(),
-        s.monitor_index(),
-    );
+    let monitor = s.monitor_index();
+    let found = search(s, (a, b, c), kind, sense, monitor);
     s.restore(saved)?;
-    let limit = found.as_ref().map(|f| f.step.arc);
-    insert(s, path, found, Event::LimitPoint, b);
-    Ok(limit)
+    let arc = found.as_ref().map(|f| f.step.arc);
+    insert(s, path, found, kind, b);
+    Ok(arc)
 }
 
 /// Records the located event: the best state found. If the search found nothing better than the

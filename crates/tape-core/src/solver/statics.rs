@@ -652,16 +652,7 @@ pub fn solve_static(
                 Some(flow) => flow,
                 None => match w.land(state, saved.clone()) {
                     Some(flow) => flow,
-                    None => {
-                        let dlambda = out.dlambda;
-                        match w.accept(state, &saved, out) {
-                            Flow::Next if w.crawling(dlambda) => {
-                                w.p.crawl = 0;
-                                w.relax_onward(state).unwrap_or(Flow::Next)
-                            }
-                            flow => flow,
-                        }
-                    }
+                    None => w.accept(state, &saved, out),
                 },
             },
         };
@@ -956,18 +947,17 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// along the same stable branch). `None` if neither finds a stable equilibrium (`state`
     /// unchanged) or the path is not such a path.
     fn relax_onward(&mut self, state: &mut State) -> Option<Flow> {
-        let params = self.s.params;
-        let (true, Some(end), Some(ds), Control::ArcLength { initial_increment, .. }) = (
-            params.jump_at_limit_points && self.arc_control,
+        let (true, Some(end), Some(ds), Some(first)) = (
+            self.s.params.jump_at_limit_points && self.arc_control,
             self.lambda_end,
             self.p.arc_ds,
-            &params.control,
+            self.first_increment(),
         ) else {
             return None;
         };
         let from = state.clone();
         let travel = (end - from.t).signum();
-        let t_next = from.t + travel * initial_increment.abs().min((end - from.t).abs());
+        let t_next = from.t + travel * first.min((end - from.t).abs());
         let switching = self.switching();
         let relaxed = self
             .s
@@ -1008,16 +998,27 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// last [`CRAWL_STEPS`] each moved the load factor by less than [`CRAWL`] of the first step's
     /// (a fold's neutral mode takes up their arc length). The path then goes on by relaxation.
     fn crawling(&mut self, dlambda: f64) -> bool {
-        let first = match &self.s.params.control {
-            Control::ArcLength { initial_increment, .. } => initial_increment.abs(),
-            _ => return false,
+        let Some(first) = self.first_increment().filter(|_| self.switching()) else {
+            return false;
         };
-        if !self.switching() || dlambda.abs() >= CRAWL * first {
+        if dlambda.abs() >= CRAWL * first {
             self.p.crawl = 0;
             return false;
         }
         self.p.crawl += 1;
-        self.p.crawl >= CRAWL_STEPS
+        if self.p.crawl < CRAWL_STEPS {
+            return false;
+        }
+        self.p.crawl = 0;
+        true
+    }
+
+    /// The load-factor increment of an arc-length path's first step (`initial_increment`).
+    fn first_increment(&self) -> Option<f64> {
+        match &self.s.params.control {
+            Control::ArcLength { initial_increment, .. } => Some(initial_increment.abs()),
+            _ => None,
+        }
     }
 
     /// On the path of a slowly driven test, a converged step over which the monitored reaction
@@ -1138,7 +1139,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             Ok(true) => {}
             Ok(false) => {
                 // A neutral mode (a fold free to slide on its plateau) or a pivot at round-off
-                // level: the path goes on, its state recorded with the plain count.
+                // level: the path goes on, its state recorded without it.
                 self.p.neutral_reached = true;
                 self.s.assemble(state);
                 return None;
@@ -1247,8 +1248,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         Some(Flow::Next)
     }
 
-    /// A converged increment along the path: record it, adapt the next increment.
-    fn accept(&mut self, state: &State, saved: &State, out: Outcome) -> Flow {
+    /// A converged increment along the path: record it, adapt the next increment (or, where the
+    /// steps crawl, go on by relaxation).
+    fn accept(&mut self, state: &mut State, saved: &State, out: Outcome) -> Flow {
         self.p.restart = None;
         self.p.closing_in = false;
         self.s.strict_turns = true;
@@ -1302,6 +1304,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             return Flow::Stop;
         }
         self.p.steps_left = self.p.steps_left.saturating_sub(1);
+        if self.crawling(out.dlambda) {
+            return self.relax_onward(state).unwrap_or(Flow::Next);
+        }
         Flow::Next
     }
 
