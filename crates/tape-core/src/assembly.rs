@@ -43,6 +43,8 @@ use crate::state::State;
 use crate::time_function::TimeFunction;
 
 const NONE: u32 = u32::MAX;
+/// Entries per parallel task when the two halves of the scattered tangent are added.
+const ADD_CHUNK: usize = 1 << 15;
 
 /// The pieces of one assembly, condensed onto the independent nodes.
 #[derive(Clone, Debug, Default)]
@@ -697,9 +699,8 @@ impl System {
             v.resize(n_con, 0.0);
         }
         if tangent {
-            out.k_ff.clear();
+            // Zeroed by `scatter_tangent`, each buffer in its own task.
             out.k_ff.resize(nnz_ff, 0.0);
-            out.k_fc.clear();
             out.k_fc.resize(self.pattern_fc.nnz(), 0.0);
         }
 
@@ -894,12 +895,12 @@ impl System {
         let nnz_ff = self.pattern_ff.nnz();
         let n_el = self.elements.len();
         let half = n_el / 2;
-        self.k_scratch_ff.clear();
         self.k_scratch_ff.resize(nnz_ff, 0.0);
-        self.k_scratch_fc.clear();
         self.k_scratch_fc.resize(self.pattern_fc.nnz(), 0.0);
         let (slots, k_buf) = (&self.slots, &self.k_buf);
         let scatter = |range: std::ops::Range<usize>, ff: &mut [f64], fc: &mut [f64]| {
+            ff.fill(0.0);
+            fc.fill(0.0);
             for e in range {
                 for (s, v) in slots[e * 576..(e + 1) * 576]
                     .iter()
@@ -927,8 +928,16 @@ impl System {
             scatter(0..half, &mut out.k_ff, &mut out.k_fc);
             scatter(half..n_el, sff, sfc);
         }
-        for (a, b) in out.k_ff.iter_mut().zip(sff.iter()) {
-            *a += b;
+        if self.parallel {
+            out.k_ff
+                .par_chunks_mut(ADD_CHUNK)
+                .zip(sff.par_chunks(ADD_CHUNK))
+                .for_each(|(a, b)| a.iter_mut().zip(b).for_each(|(a, b)| *a += b));
+        } else {
+            out.k_ff
+                .iter_mut()
+                .zip(sff.iter())
+                .for_each(|(a, b)| *a += b);
         }
         for (a, b) in out.k_fc.iter_mut().zip(sfc.iter()) {
             *a += b;
