@@ -3,6 +3,7 @@ keeps its energy, and its results round-trip through save/load with the energy b
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -62,7 +63,44 @@ def test_released_strip_period_and_energy(tmp_path):
     assert abs(r.numerical_dissipation[-1]) < 1e-3 * released
     back = Results.load(r.save(tmp_path / "strip"))
     np.testing.assert_array_equal(back.kinetic_energy, r.kinetic_energy)
+    np.testing.assert_array_equal(back.factorisations, r.factorisations)
+    np.testing.assert_array_equal(back.wall_s, r.wall_s)
     assert back.settings["steps"][1]["kind"] == "dynamic"
+
+
+def test_per_record_costs_add_up_to_the_step_stats():
+    model, _ = strip_model()
+    steps = [
+        Step.static("bend", control="load", increments=2),
+        # Adaptive steps from a first step far too long: some are rejected, and their
+        # factorisations are charged to the record that follows.
+        Step.dynamic("release", duration=0.02, deactivate=["push"], initial_step=5e-3),
+    ]
+    r = run(model, steps, outputs=Outputs())
+    static, free = r.in_step(0), r.in_step(1)
+    assert np.all(r.factorisations[static] == -1) and np.all(np.isnan(r.wall_s[static]))
+    stats = r.step_stats[1]
+    assert stats["cutbacks"] > 0
+    assert int(r.factorisations[free].sum()) == stats["factorisations"]
+    assert np.all(r.factorisations[free] >= 0) and np.all(r.wall_s[free] > 0.0)
+    # The records' wall times are the step's, less what comes before the first step (the
+    # consistent accelerations) and after the last record.
+    assert r.wall_s[free].sum() <= stats["wall_s"]
+    assert r.wall_s[free].sum() > 0.5 * stats["wall_s"]
+
+
+def test_files_without_per_record_costs_load_as_not_recorded(tmp_path):
+    model, _ = strip_model()
+    r = run(model, [Step.dynamic("free", duration=1e-3)])
+    with np.load(r.save(tmp_path / "new.npz"), allow_pickle=False) as f:
+        arrays = {k: f[k] for k in f.files if k not in ("factorisations", "wall_s")}
+    meta = json.loads(str(arrays["meta"]))
+    meta["version"] = 3
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez(tmp_path / "old.npz", **arrays)
+    back = Results.load(tmp_path / "old.npz")
+    assert np.all(back.factorisations == -1) and np.all(np.isnan(back.wall_s))
+    np.testing.assert_array_equal(back.t, r.t)
 
 
 def test_dynamic_step_options_and_errors():

@@ -163,12 +163,13 @@ def run(
     outputs: Mapping[str, Any] | None = None,
     progress: Callable[[int, str, float], bool | None] | None = None,
 ) -> dict[str, Any]:
-    """Run the steps; keys: step, t, iterations, residual, negative_eigenvalues, jump, event,
-    strain_energy, gravity_energy, kinetic_energy, work_loads, work_prescribed,
-    viscous_dissipation, numerical_dissipation, marker_names, marker_positions, marker_rotations,
-    reaction_dofs, reactions, field_records, displacements, rotations, ndof, modes (one dict per
-    modal step: step, name, record, t, shift, eigenvalues, frequencies_hz, periods_s,
-    mode_shapes, effective_masses, residuals, below_shift, equilibrium_residual, matrices),
+    """Run the steps; keys: step, t, iterations, factorisations, wall_s, residual,
+    negative_eigenvalues, jump, event, strain_energy, gravity_energy, kinetic_energy, work_loads,
+    work_prescribed, viscous_dissipation, numerical_dissipation, marker_names, marker_positions,
+    marker_rotations, reaction_dofs, reactions, field_records, displacements, rotations, ndof,
+    modes (one dict per modal step: step, name, record, t, shift, eigenvalues, frequencies_hz,
+    periods_s, mode_shapes, effective_masses, residuals, below_shift, equilibrium_residual,
+    matrices),
     stats, step_stats, error, cancelled, steps_completed, settings."""
 
 def generalized_alpha_decay(

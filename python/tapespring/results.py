@@ -23,8 +23,8 @@ if TYPE_CHECKING:
 __all__ = ["Results"]
 
 _FORMAT = "tapespring.Results"
-# 3: modal steps' results (``modes``).
-_VERSION = 3
+# 3: modal steps' results (``modes``); 4: per-record costs (``factorisations``, ``wall_s``).
+_VERSION = 4
 # Arrays of each modal step, saved as ``modes<i>_<name>``.
 _MODE_ARRAYS = (
     "eigenvalues",
@@ -41,6 +41,8 @@ _ARRAYS: dict[str, Any] = {
     "t": float,
     "step": np.int64,
     "iterations": np.int64,
+    "factorisations": np.int64,
+    "wall_s": float,
     "residual": float,
     "negative_eigenvalues": np.int64,
     "jump": bool,
@@ -73,6 +75,12 @@ class Results:
         Index of the analysis step of each record (0 for the initial state).
     iterations : ndarray of int, shape (n,)
         Newton iterations spent on each state.
+    factorisations : ndarray of int, shape (n,)
+        Factorisations of the iteration matrix spent on each record of a dynamic step since the
+        previous record, rejected attempts included (-1 in static steps).
+    wall_s : ndarray, shape (n,)
+        Wall time spent on each record of a dynamic step since the previous record, rejected
+        attempts included [s] (NaN in static steps).
     residual : ndarray, shape (n,)
         Weighted residual norm of each state [N].
     negative_eigenvalues : ndarray of int, shape (n,)
@@ -123,6 +131,8 @@ class Results:
     t: NDArray[np.float64]
     step: NDArray[np.int64]
     iterations: NDArray[np.int64]
+    factorisations: NDArray[np.int64]
+    wall_s: NDArray[np.float64]
     residual: NDArray[np.float64]
     negative_eigenvalues: NDArray[np.int64]
     jump: NDArray[np.bool_]
@@ -380,8 +390,12 @@ class Results:
                     f"{path} was written by a newer tapespring (format {meta['version']})"
                 )
             n = f["t"].shape[0]
-            # Files of format 1 have no energy balance.
-            d = {k: f[k] if k in f else np.full(n, np.nan) for k in _ARRAYS}
+            # Files of format 1 have no energy balance, files before format 4 no per-record
+            # costs (-1 for the counts, NaN for the rest: "not recorded").
+            d = {
+                k: f[k] if k in f else np.full(n, -1 if dt is np.int64 else np.nan)
+                for k, dt in _ARRAYS.items()
+            }
             # Files of formats 1 and 2 have no modes.
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.pop("modes", []))]
         d.update(meta)

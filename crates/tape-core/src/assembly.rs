@@ -928,7 +928,7 @@ impl System {
             scatter(0..half, &mut out.k_ff, &mut out.k_fc);
             scatter(half..n_el, sff, sfc);
         }
-        if self.parallel {
+        if self.parallel && nnz_ff >= 4 * ADD_CHUNK {
             out.k_ff
                 .par_chunks_mut(ADD_CHUNK)
                 .zip(sff.par_chunks(ADD_CHUNK))

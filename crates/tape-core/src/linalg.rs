@@ -322,21 +322,26 @@ impl LinearSolver {
         // the time of `f64::max` chains, which the NaN rules make long), and finiteness for free.
         // In parallel chunks: the transposed reads are scattered and latency-bound, so two
         // threads overlap their cache misses (the maxima do not depend on the order).
-        let (max_bits, skew_bits) = self
-            .sym
-            .par_chunks_mut(SYM_CHUNK)
-            .zip(self.src.par_chunks(SYM_CHUNK))
-            .map(|(sym, src)| {
-                let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
-                for (s, &[p, t]) in sym.iter_mut().zip(src) {
-                    let (v, vt) = (values[p], values[t]);
-                    max_bits = max_bits.max(v.abs().to_bits().max(vt.abs().to_bits()));
-                    skew_bits = skew_bits.max((v - vt).abs().to_bits());
-                    *s = 0.5 * (v + vt);
-                }
-                (max_bits, skew_bits)
-            })
-            .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+        let pass = |(sym, src): (&mut [f64], &[[usize; 2]])| {
+            let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
+            for (s, &[p, t]) in sym.iter_mut().zip(src) {
+                let (v, vt) = (values[p], values[t]);
+                max_bits = max_bits.max(v.abs().to_bits().max(vt.abs().to_bits()));
+                skew_bits = skew_bits.max((v - vt).abs().to_bits());
+                *s = 0.5 * (v + vt);
+            }
+            (max_bits, skew_bits)
+        };
+        // Small matrices in one go: waking the pool would cost more than it saves.
+        let (max_bits, skew_bits) = if self.sym.len() < 4 * SYM_CHUNK {
+            pass((&mut self.sym, &self.src))
+        } else {
+            self.sym
+                .par_chunks_mut(SYM_CHUNK)
+                .zip(self.src.par_chunks(SYM_CHUNK))
+                .map(pass)
+                .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)))
+        };
         let (max, skew) = (f64::from_bits(max_bits), f64::from_bits(skew_bits));
         if max_bits >= f64::INFINITY.to_bits() {
             let p = values.iter().position(|v| !v.is_finite()).unwrap_or(0);

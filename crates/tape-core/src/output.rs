@@ -74,6 +74,14 @@ pub struct History {
     /// Newton iterations spent on each state (0 for the initial state, a jump or a located one
     /// found in the step).
     pub iterations: Vec<usize>,
+    /// Factorisations of the iteration matrix spent on each record of a dynamic step since the
+    /// previous record, rejected attempts included (-1 in static steps).
+    #[serde(default)]
+    pub factorisations: Vec<i64>,
+    /// Wall time spent on each record of a dynamic step since the previous record \[s\] (NaN in
+    /// static steps).
+    #[serde(default)]
+    pub wall_s: Vec<f64>,
     /// Weighted residual norm of each state \[N\].
     pub residual: Vec<f64>,
     /// Negative eigenvalues of the tangent (-1: not computed).
@@ -138,6 +146,11 @@ impl History {
         self.step.push(step);
         self.t.push(s.lambda);
         self.iterations.push(s.iterations);
+        self.factorisations.push(
+            s.factorisations
+                .map_or(-1, |n| i64::try_from(n).unwrap_or(i64::MAX)),
+        );
+        self.wall_s.push(s.wall_s.unwrap_or(f64::NAN));
         self.residual.push(s.residual);
         self.negative_eigenvalues.push(
             s.negative_eigenvalues

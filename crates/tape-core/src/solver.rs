@@ -538,6 +538,14 @@ pub struct StaticStep {
     pub arc: f64,
     /// Energy balance of a dynamic step's state (`None` in static steps).
     pub balance: Option<dynamics::EnergyBalance>,
+    /// Factorisations of the iteration matrix since the previous record, those of rejected
+    /// attempts included (`None` in static steps).
+    #[serde(default)]
+    pub factorisations: Option<usize>,
+    /// Wall time since the previous record, rejected attempts included \[s\] (`None` in static
+    /// steps).
+    #[serde(default)]
+    pub wall_s: Option<f64>,
 }
 
 /// The equilibrium path followed by a static analysis.

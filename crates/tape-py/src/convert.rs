@@ -564,6 +564,8 @@ pub fn history_to_dict<'py>(py: Python<'py>, h: &History, n_nodes: usize) -> PyR
     d.set_item("step", counts_to_numpy(py, h.step.iter().copied()))?;
     d.set_item("t", vec_to_numpy(py, h.t.clone()))?;
     d.set_item("iterations", counts_to_numpy(py, h.iterations.iter().copied()))?;
+    d.set_item("factorisations", h.factorisations.clone().into_pyarray(py))?;
+    d.set_item("wall_s", vec_to_numpy(py, h.wall_s.clone()))?;
     d.set_item("residual", vec_to_numpy(py, h.residual.clone()))?;
     d.set_item("negative_eigenvalues", h.negative_eigenvalues.clone().into_pyarray(py))?;
     d.set_item("jump", numpy::PyArray1::from_iter(py, h.jump.iter().copied()))?;

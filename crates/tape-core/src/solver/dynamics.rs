@@ -806,6 +806,8 @@ pub fn solve_dynamic(
     let mut cutbacks = 0;
     let mut retry = false;
     let mut scratch = state.clone();
+    // Factorisations and wall time at the last record, for the per-record costs.
+    let mut recorded = (integ.stats.factorisations, Instant::now());
     while state.t < t_end - eps_t {
         if path.steps.len() >= params.max_steps {
             path.error = Some(Error::StepLimit {
@@ -949,7 +951,10 @@ pub fn solve_dynamic(
             - (now.kinetic + now.strain + now.gravity - mech0);
         std::mem::swap(state, &mut scratch);
         integ.stats.steps += 1;
-        let record = record(&integ, state, asm, iterations, balance, params.record_fields);
+        let mut record = record(&integ, state, asm, iterations, balance, params.record_fields);
+        record.factorisations = Some(integ.stats.factorisations - recorded.0);
+        record.wall_s = Some(recorded.1.elapsed().as_secs_f64());
+        recorded = (integ.stats.factorisations, Instant::now());
         last = now;
         let go_on = progress(&record, &integ.stats);
         path.steps.push(record);

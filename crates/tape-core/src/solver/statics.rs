@@ -504,7 +504,7 @@ impl Driver<'_> {
             jump: false,
             event: None,
             arc: 0.0,
-            balance: None,
+            ..StaticStep::default()
         })
     }
 
