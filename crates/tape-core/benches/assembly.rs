@@ -62,6 +62,35 @@ fn element_kernel(c: &mut Criterion) {
     });
 }
 
+/// The factorisation of a small model (the 4 mm tape, ~1k DOFs), where faer's automatic choice
+/// would be the simplicial factorisation: the supernodal one that `LinearSolver` always takes
+/// against it.
+fn small_factorisation(c: &mut Criterion) {
+    for mesh_mm in [4.0, 8.0, 16.0] {
+        let bm = TapeBending {
+            mesh_size: mesh_mm * 1e-3,
+            ..TapeBending::default()
+        }
+        .build()
+        .expect("model");
+        let mut system = System::try_new(&bm.model).expect("system");
+        let state = system.initial_state();
+        let mut out = Assembled::default();
+        system.assemble(&state, true, &mut out);
+        let n = system.n_free();
+        let mut solver = LinearSolver::try_new(&system.pattern_ff).expect("symbolic");
+        c.bench_function(
+            &format!("numeric factorisation {mesh_mm} mm tape, {n} DOFs (default)"),
+            |b| b.iter(|| solver.factorize(&out.k_ff).expect("factor")),
+        );
+        let mut solver = LinearSolver::with_simplicial(&system.pattern_ff).expect("symbolic");
+        c.bench_function(
+            &format!("numeric factorisation {mesh_mm} mm tape, {n} DOFs (simplicial)"),
+            |b| b.iter(|| solver.factorize(&out.k_ff).expect("factor")),
+        );
+    }
+}
+
 fn assembly_and_solve(c: &mut Criterion) {
     let (mut system, state) = deformed_system();
     let mut out = Assembled::default();
@@ -83,6 +112,7 @@ fn assembly_and_solve(c: &mut Criterion) {
         b.iter(|| solver.factorize(&out.k_ff).expect("factor"))
     });
     solver.factorize(&out.k_ff).expect("factor");
+    small_factorisation(c);
     let rhs = out.residual();
     // This out-of-equilibrium state has a strongly indefinite symmetric part: GMRES does not
     // converge at the first solve, and the iterations time the LU fallback.

@@ -22,8 +22,12 @@ use tape_core::solver::{Control, NewtonParams, StaticParams};
 use tape_core::{run, Dof, Model, Outputs, Result, Step, TimeFunction};
 
 /// The pre-refactor curves are reproduced point by point: same number of equilibria, same angles
-/// and moments to 1e-9 relative (the arithmetic is the same; only the order of a few sums of
-/// zero external loads could differ).
+/// and moments to 1e-9 relative on loading (the same arithmetic but for the factorisation; only
+/// the order of a few sums of zero external loads could differ). The reference was computed with
+/// faer's simplicial LDL^T, which the solver then chose at this size; it now always takes the
+/// supernodal one, whose round-off differs, and the unloading's snap amplifies that: measured
+/// 5e-11 on loading and 7e-8 on unloading, hence 1e-6 there (a path that changed would differ by
+/// percents: an equilibrium missed or added shifts every point after it).
 #[test]
 fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
     let reference = common::reference("bending_paths.json");
@@ -35,19 +39,20 @@ fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
             ..TapeBending::default()
         };
         let ours = tb.run(&mut |_| true)?;
+        let tol = if unload { 1e-6 } else { 1e-9 };
         assert!(ours.error.is_none(), "{name}: {:?}", ours.error);
         let theta = common::nums(&curve["theta_rad"]);
         let moment = common::nums(&curve["moment"]);
         assert_eq!(ours.points.len(), theta.len(), "{name}: number of equilibria");
         for (i, p) in ours.points.iter().enumerate() {
             assert!(
-                (p.theta - theta[i]).abs() <= 1e-9 * tb.theta_max,
+                (p.theta - theta[i]).abs() <= tol * tb.theta_max,
                 "{name} point {i}: theta {} vs {}",
                 p.theta,
                 theta[i]
             );
             assert!(
-                (p.moment - moment[i]).abs() <= 1e-9 * moment[i].abs().max(1e-3),
+                (p.moment - moment[i]).abs() <= tol * moment[i].abs().max(1e-3),
                 "{name} point {i}: moment {} vs {}",
                 p.moment,
                 moment[i]

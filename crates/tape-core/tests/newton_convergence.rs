@@ -8,8 +8,10 @@
 //! (assemble, factorise, solve, multiplicative update) are recorded. Quadratic convergence of the
 //! Newton corrections: `c_{k+1} <= C c_k^2` with a constant C that stays bounded while the
 //! corrections fall by more than six orders of magnitude, and the convergence order
-//! `log(c_{k+1}/c_k) / log(c_k/c_{k-1})` is about 2 at the end (above round-off). The residual
-//! norm, which mixes forces and moments, is not monotone before the asymptotic range.
+//! `log(c_{k+1}/c_k) / log(c_k/c_{k-1})` is about 2 at the end (above round-off), for the mixed
+//! iteration; the standard one converges superlinearly, its quadratic range cut short by
+//! round-off (see its test). The residual norm, which mixes forces and moments, is not monotone
+//! before the asymptotic range.
 
 use std::f64::consts::PI;
 
@@ -127,14 +129,39 @@ fn assert_quadratic(corr: &[f64], res: &[f64], min_run: usize) {
     );
 }
 
+/// The standard iteration on the same problem reaches its quadratic range only one iteration
+/// before round-off: measured corrections 3.2, 0.069, 0.0028, 0.0069, 3.4e-6, 5.2e-9, then 9e-14
+/// at the floor (the thin strip's membrane stresses make its pre-asymptotic range long, which
+/// is why the mixed iteration exists). The order over the last three corrections was therefore
+/// decided by the round-off of the last one: 1.75 with the simplicial LDL^T, 1.69 with the
+/// supernodal one. Asserted instead, on the corrections above the round-off floor: the last step
+/// contracts superlinearly, `c_(k+1) / c_k < 1e-2` (measured 1.5e-3) with `c_(k+1) <= C c_k^2`,
+/// `C <= 1e3` (measured 450; linear convergence at that rate would need `C` = 1.5e-3 / 3.4e-6).
+/// Quadratic convergence with this non-symmetric tangent is shown by the mixed iteration below.
 #[test]
-fn newton_converges_quadratically_with_the_nonsymmetric_tangent() -> Result<()> {
+fn newton_with_the_nonsymmetric_tangent_converges_superlinearly() -> Result<()> {
     let (corr, res, nonsymmetric, m_max) = newton_corrections(false)?;
     assert!(
         nonsymmetric > 1e-3 * m_max,
         "the tangent should be non-symmetric here: {nonsymmetric}"
     );
-    assert_quadratic(&corr, &res, 4);
+    let floor = corr.iter().copied().fold(f64::INFINITY, f64::min);
+    let above: Vec<f64> = corr
+        .iter()
+        .copied()
+        .take_while(|&c| c >= 1e3 * floor)
+        .collect();
+    let n = above.len();
+    assert!(n >= 3 && above[n - 1] < 1e-8 * above[0], "corrections {corr:?}");
+    let (last, before) = (above[n - 1], above[n - 2]);
+    assert!(
+        last < 1e-2 * before && last <= 1e3 * before * before,
+        "corrections {corr:?}"
+    );
+    assert!(
+        *res.last().expect("residuals") < 1e-9 * res[0],
+        "residual did not converge: {res:?}"
+    );
     Ok(())
 }
 

@@ -39,6 +39,11 @@ use super::events::{after_step, before_jump, Point};
 use super::newton::{Convergence, Stall};
 use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
+
+/// Largest response of a node to the load per unit load factor under load control, in radians
+/// or characteristic lengths, before the tangent counts as singular along the load (see
+/// `Driver::load_carried`).
+const SINGULAR_RESPONSE: f64 = 1e6;
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
@@ -131,6 +136,35 @@ impl Driver<'_> {
         }
         self.system.update_with(state, dq, &dc);
         state.t += dlambda;
+    }
+
+    /// Rejects load control on a tangent that is singular along the load: `dq_b`, the tangent's
+    /// response to the load per unit load factor, turns a node by more than
+    /// [`SINGULAR_RESPONSE`] rad or moves it by more than that many characteristic lengths, so
+    /// that a millionth of a unit increment would already turn it by a radian. That is a
+    /// mechanism the load drives (its pivot is round-off: faer's supernodal LDL^T does not report
+    /// it as zero), or a limit point hit to within round-off; either way the increment's Newton
+    /// iteration would carry the structure to an arbitrary remote equilibrium (a plate turning
+    /// about two pinned points jumped to its unstable hanging position). Rejected at every size,
+    /// the increment is cut back to round-off and the step reports it. Displacement and
+    /// arc-length control pass limit points by design and are not checked.
+    fn load_carried(&self, dq_b: &[f64]) -> std::result::Result<(), Rejection> {
+        let lc = self.system.char_length;
+        for (v, (node, dof)) in dq_b.iter().zip(&self.system.dofs.free_dofs) {
+            let (size, unit) = if dof.is_rotation() {
+                (v.abs(), "rad")
+            } else {
+                (v.abs() / lc, "characteristic lengths")
+            };
+            if size > SINGULAR_RESPONSE || size.is_nan() {
+                return Err(Rejection::Singular(format!(
+                    "the tangent is singular along the load: per unit load factor, {} of node \
+                     {node} moves by {size:.3e} {unit} (a mechanism the load drives?)",
+                    dof.name()
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Forgets everything computed at the current state (after it was replaced).
@@ -269,7 +303,10 @@ impl Driver<'_> {
             _ => {
                 let (dq_r, dq_b) = self.solve_pair()?;
                 let (dlambda0, mut dq) = match inc {
-                    Increment::Load(dl) => (*dl, dq_r),
+                    Increment::Load(dl) => {
+                        self.load_carried(&dq_b)?;
+                        (*dl, dq_r)
+                    }
                     Increment::Displacement { eq, delta } => {
                         if dq_b[*eq].abs() < 1e-300 {
                             return Err(Rejection::NoResponse);
