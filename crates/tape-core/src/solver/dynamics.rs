@@ -307,6 +307,8 @@ struct Integrator<'a> {
     /// Reference force of the last converged step \[N\]: a predictor residual far above it marks a
     /// step too violent for a reused iteration matrix.
     last_reference: f64,
+    /// [`Self::node_blocks`].
+    node_blocks: Vec<[usize; 36]>,
 }
 
 /// Outcome of one attempted time step.
@@ -392,20 +394,34 @@ impl Integrator<'_> {
     }
 
     fn add_node_matrix(&mut self, i: usize, jac: &Matrix6<f64>) {
-        let slots = &self.system.dofs.slots[i];
-        for r in 0..6 {
-            let Slot::Free(row) = slots[r] else { continue };
-            for c in 0..6 {
-                if let Slot::Free(col) = slots[c] {
-                    let p = self
-                        .system
-                        .pattern_ff
-                        .find(row, col)
-                        .expect("node blocks are in the pattern");
-                    self.asm.k_ff[p] += jac[(r, c)];
-                }
+        for (k, &p) in self.node_blocks[i].iter().enumerate() {
+            if p != usize::MAX {
+                self.asm.k_ff[p] += jac[(k % 6, k / 6)];
             }
         }
+    }
+
+    /// Positions in the free tangent of each independent node's 6 x 6 block, column-major
+    /// (`usize::MAX` where a row or column is not free, and for tied nodes): the inertia Jacobians are added at every tangent assembly,
+    /// where searching the pattern cost about a tenth of the assembly on the set-up.
+    fn node_blocks(system: &System) -> Vec<[usize; 36]> {
+        system
+            .dofs
+            .slots
+            .iter()
+            .zip(&system.dofs.master)
+            .map(|(slots, master)| {
+                std::array::from_fn(|k| match (slots[k % 6], slots[k / 6]) {
+                    // Tied nodes carry their inertia to their reference node, not here.
+                    _ if master.is_some() => usize::MAX,
+                    (Slot::Free(row), Slot::Free(col)) => system
+                        .pattern_ff
+                        .find(row, col)
+                        .expect("node blocks are in the pattern"),
+                    _ => usize::MAX,
+                })
+            })
+            .collect()
     }
 
     /// Assembles the residual and, with `tangent`, the iteration matrix at `state`; returns
@@ -746,6 +762,7 @@ pub fn solve_dynamic(
     let alpha = Alpha::new(params.rho_inf)?;
     let weights = system.free_weights();
     let n_nodes = state.x.len();
+    let node_blocks = Integrator::node_blocks(system);
     let mut integ = Integrator {
         force_floor: system.force_floor(),
         conv: Convergence {
@@ -766,6 +783,7 @@ pub fn solve_dynamic(
         stress_valid: false,
         factor_h: None,
         last_reference: 0.0,
+        node_blocks,
     };
     let lc = integ.system.char_length;
     integ.inertia_round_off = f64::EPSILON
