@@ -347,3 +347,34 @@ def test_huge_meshes_are_refused_in_a_child_process(counts):
     assert proc.returncode == 0, proc.stderr[-2000:]
     outcomes = json.loads(proc.stdout.splitlines()[-1])
     assert all(o.startswith("MemoryError: ") and "elements" in o for o in outcomes), outcomes
+
+
+@_examples(ci=10, long=100)
+@given(
+    scale=_log_uniform(1e-2, 1e2),
+    rotation=st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),
+    load=_log_uniform(1e-3, 1e3),
+    sign=st.sampled_from([-1.0, 1.0]),
+    across=st.floats(0.1, 1.0),
+)
+def test_a_loaded_mechanism_is_reported_not_solved(scale, rotation, load, sign, across):
+    # A plate pinned (translations only) at the two corners of one short edge turns freely about
+    # the line through them; a load normal to the plate anywhere off that line drives the turn.
+    # The factorisation's pivot along that turn is round-off, not zero, so the first increment
+    # would carry the plate to an arbitrary equilibrium: load control must refuse it, naming it.
+    r = _rotation(rotation)
+    nodes = NODES * scale @ r.T
+    local = NODES
+    edge = np.flatnonzero(np.isclose(local[:, 0], 0.0))
+    pins = [int(edge[np.argmin(local[edge, 1])]), int(edge[np.argmax(local[edge, 1])])]
+    far = np.flatnonzero(np.isclose(local[:, 0], local[:, 0].max()))
+    loaded = int(far[min(int(across * len(far)), len(far) - 1)])
+    model = Model(nodes, QUADS, node_sets=SETS, **SECTION)
+    for p in pins:
+        model.fix(p, ["ux", "uy", "uz"])
+    normal = r[:, 2] * sign * load
+    for dof, value in zip(("ux", "uy", "uz"), normal, strict=True):
+        if value != 0.0:
+            model.add_load(loaded, dof, float(value))
+    with pytest.raises(ConvergenceError, match="singular along the load"):
+        run(model, [Step.static("s", max_cutbacks=60)])
