@@ -93,6 +93,15 @@ fn newton_corrections(mixed: bool) -> Result<(Vec<f64>, Vec<f64>, f64, f64)> {
     Ok((corr, res, nonsymmetric, m_max))
 }
 
+/// The corrections before the first one at the round-off floor (within 1e3 of the smallest).
+fn above_round_off(corr: &[f64]) -> Vec<f64> {
+    let floor = corr.iter().copied().fold(f64::INFINITY, f64::min);
+    corr.iter()
+        .copied()
+        .take_while(|&c| c >= 1e3 * floor)
+        .collect()
+}
+
 /// Checks quadratic convergence of the correction norms `corr` over an asymptotic run of at least
 /// `min_run` (>= 3) corrections, and convergence of `res`.
 fn assert_quadratic(corr: &[f64], res: &[f64], min_run: usize) {
@@ -145,12 +154,7 @@ fn newton_with_the_nonsymmetric_tangent_converges_superlinearly() -> Result<()> 
         nonsymmetric > 1e-3 * m_max,
         "the tangent should be non-symmetric here: {nonsymmetric}"
     );
-    let floor = corr.iter().copied().fold(f64::INFINITY, f64::min);
-    let above: Vec<f64> = corr
-        .iter()
-        .copied()
-        .take_while(|&c| c >= 1e3 * floor)
-        .collect();
+    let above = above_round_off(&corr);
     let n = above.len();
     assert!(n >= 3 && above[n - 1] < 1e-8 * above[0], "corrections {corr:?}");
     let (last, before) = (above[n - 1], above[n - 2]);
@@ -172,14 +176,8 @@ fn newton_with_the_nonsymmetric_tangent_converges_superlinearly() -> Result<()> 
 fn mixed_stress_newton_converges_quadratically() -> Result<()> {
     let (corr, res, _, _) = newton_corrections(true)?;
     // It reaches round-off an iteration earlier, by a jump from 1e-8 that a quadratic step would take
-    // to 1e-17: drop the corrections at the round-off floor (within 1e3 of the smallest one).
-    let floor = corr.iter().copied().fold(f64::INFINITY, f64::min);
-    let above: Vec<f64> = corr
-        .iter()
-        .copied()
-        .take_while(|&c| c >= 1e3 * floor)
-        .collect();
-    assert_quadratic(&above, &res, 4);
+    // to 1e-17: drop the corrections at the round-off floor.
+    assert_quadratic(&above_round_off(&corr), &res, 4);
     let (corr_std, _, _, _) = newton_corrections(false)?;
     assert!(corr.len() <= corr_std.len(), "mixed {corr:?}, standard {corr_std:?}");
     Ok(())

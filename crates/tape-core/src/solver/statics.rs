@@ -151,12 +151,9 @@ impl Driver<'_> {
     /// step reports it. Displacement and arc-length control pass limit points by design and are
     /// not checked.
     fn load_carried(&self, dq_b: &[f64]) -> std::result::Result<(), Rejection> {
-        let lc = self.system.char_length;
         let dofs = &self.system.dofs.free_dofs;
-        let scale: Vec<f64> = dofs
-            .iter()
-            .map(|(_, d)| if d.is_rotation() { lc } else { 1.0 })
-            .collect();
+        // The arc-length metric's lengths: 1 for translations, L_c for rotations.
+        let scale: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
         let p = &self.system.pattern_ff;
         let mut k_max: f64 = 0.0;
         for j in 0..p.nrows {
