@@ -6,9 +6,12 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use tape_core::assembly::Assembled;
-use tape_core::element::shell::{ElementMatrix, ElementVector};
+use tape_core::element::shell::{ElementMatrix, ElementVector, Viscous};
+use tape_core::inertia::{Motion, NodeInertia};
 use tape_core::linalg::LinearSolver;
+use tape_core::rotation::tangent_inverse;
 use tape_core::samples::TapeBending;
+use tape_core::solver::alpha::Alpha;
 use tape_core::{State, System};
 
 /// The 2 mm tape-spring system in a deformed state (a small bending rotation of every node).
@@ -58,6 +61,73 @@ fn element_kernel(c: &mut Criterion) {
                 Some(&mut k),
                 Some(&mut fg),
             )
+        });
+    });
+}
+
+/// What dynamics adds to the element kernel (issue 8: under 20 % of it): the Kelvin-Voigt
+/// stresses and damping matrix in the element (the default tangent, and the consistent one), and
+/// the inertia forces and 6 x 6 Jacobian of a node (about one node per element in a shell mesh).
+fn dynamic_terms(c: &mut Criterion) {
+    let (system, state) = deformed_system();
+    let e = &system.elements[137];
+    let x = e.nodes.map(|n| state.x[n]);
+    let q: [Matrix3<f64>; 4] = e
+        .nodes
+        .map(|n| state.q[n].to_rotation_matrix().into_inner());
+    let mut f = ElementVector::zeros();
+    let mut k = ElementMatrix::zeros();
+    // A step of 1e-4 s at rho_inf = 0.7 and the paper's eta, with velocities of a deploying tape.
+    let alpha = Alpha::new(0.7).expect("rho_inf");
+    let h = 1e-4;
+    let mut viscous = Viscous {
+        v: std::array::from_fn(|a| Vector3::new(0.1, -0.2 + 0.05 * a as f64, 0.3)),
+        w: std::array::from_fn(|a| Vector3::new(1.0, 2.0 * a as f64, -0.5)),
+        eta: 1.73e-4,
+        gamma_prime: alpha.gamma_prime(h),
+        ..Viscous::default()
+    };
+    c.bench_function("element internal force + tangent, Kelvin-Voigt", |b| {
+        b.iter(|| e.compute_viscous_into(&x, &q, system.section(137), &viscous, &mut f, Some(&mut k)));
+    });
+    let stress = e.linearised_stress(
+        &x,
+        &q,
+        system.section(137),
+        &[Vector3::zeros(); 4],
+        &[Vector3::zeros(); 4],
+    );
+    let mut fg = ElementVector::zeros();
+    c.bench_function("element internal force + mixed tangent, Kelvin-Voigt", |b| {
+        b.iter(|| {
+            e.compute_viscous_mixed_into(&x, &q, system.section(137), &viscous, &stress, &mut f, &mut k, &mut fg)
+        });
+    });
+    viscous.consistent = true;
+    c.bench_function("element internal force + tangent, Kelvin-Voigt (consistent)", |b| {
+        b.iter(|| e.compute_viscous_into(&x, &q, system.section(137), &viscous, &mut f, Some(&mut k)));
+    });
+    let node = e.nodes[0];
+    let body: NodeInertia = system.inertia[node];
+    let r = state.q[node].to_rotation_matrix().into_inner();
+    let (a, w, dw) = (
+        Vector3::new(50.0, -20.0, 100.0),
+        Vector3::new(1.0, 20.0, -3.0),
+        Vector3::new(1e3, -2e3, 5e2),
+    );
+    let motion = Motion {
+        r: &r,
+        a: &a,
+        w: &w,
+        dw: &dw,
+    };
+    let d = Vector3::new(1e-3, 2e-3, -1e-3);
+    let (beta_p, gamma_p) = (alpha.beta_prime(h), alpha.gamma_prime(h));
+    c.bench_function("node inertia forces + Jacobian", |b| {
+        b.iter(|| {
+            let forces = body.forces(&motion);
+            let p = tangent_inverse(&-d);
+            (forces, body.jacobian(&motion, beta_p, gamma_p, &p))
         });
     });
 }
@@ -148,6 +218,6 @@ fn assembly_and_solve(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2)).warm_up_time(std::time::Duration::from_millis(500));
-    targets = element_kernel, assembly_and_solve
+    targets = element_kernel, dynamic_terms, assembly_and_solve
 }
 criterion_main!(benches);
