@@ -23,7 +23,12 @@ import pytest
 from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from tapespring import Model, Step, run, shell
-from tapespring.analysis import ConvergenceError, step_options
+from tapespring.analysis import (
+    ConvergenceError,
+    dynamic_step_options,
+    modal_step_options,
+    step_options,
+)
 from tapespring.scenarios.bending import BendingSetup
 
 LONG = os.environ.get("HYPOTHESIS_PROFILE") == "long"
@@ -271,6 +276,98 @@ def test_options_run_or_are_refused_by_name(control, options):
         pass  # admissible values that the path cannot meet (one iteration, tight tolerances ...)
     else:
         assert np.isfinite(results.t).all() and np.isfinite(results.reactions).all()
+
+
+DYNAMIC_NAMES = sorted(dynamic_step_options())
+MODAL_NAMES = sorted(modal_step_options())
+#: Records after which a generated dynamic run is stopped through the progress callback: a
+#: valid but long request (a duration of 1e300 s, ten million steps) would otherwise run for
+#: hours, which is what was asked, not a hang.
+RECORD_BUDGET = 300
+
+
+def _strip_with_mass() -> Model:
+    model = Model(NODES, QUADS, node_sets=SETS, density=7850.0, **SECTION)
+    model.fix("x0")
+    for n in model.node_set("x1"):
+        model.add_load(int(n), "uz", 10.0)
+    return model
+
+
+@_examples(ci=60, long=1000)
+@given(
+    duration=st.one_of(st.just(1e-3), OPTION_VALUES),
+    options=st.dictionaries(
+        st.one_of(st.sampled_from(DYNAMIC_NAMES), st.sampled_from(["control", "steps"])),
+        OPTION_VALUES,
+        max_size=3,
+    ),
+)
+# Found by the long profile: a min_step above the default max_step (duration / 20) made the step
+# controller panic instead of naming the option.
+@example(duration=1e-3, options={"min_step": 1})
+def test_dynamic_options_run_or_are_refused_by_name(duration, options):
+    """Any value of any dynamic option: a run with finite records (complete, stopped by the
+    record budget, or stopped early with a ConvergenceError keeping its records), or a
+    ValueError / TypeError naming an option, before anything runs."""
+    options = {k: v for k, v in options.items() if k != "duration"}
+    model = _strip_with_mass()
+    records = 0
+
+    def budget(step: int, name: str, t: float) -> bool:
+        nonlocal records
+        records += 1
+        assert math.isfinite(t), t
+        return records < RECORD_BUDGET
+
+    try:
+        step = Step.dynamic("d", duration=duration, **options)
+        results = run(model, [step], progress=budget)
+    except (ValueError, TypeError) as exc:
+        message = str(exc)
+        assert any(key in message for key in ["duration", *options]), (duration, options, message)
+        return
+    except ConvergenceError as exc:
+        results = exc.result
+    assert np.isfinite(results.t).all() and np.isfinite(results.reactions).all()
+    assert np.isfinite(results.marker_positions).all()
+    assert np.all(np.diff(results.t) > 0.0), "time goes forward"
+
+
+@_examples(ci=40, long=500)
+@given(
+    options=st.dictionaries(
+        st.one_of(st.sampled_from(MODAL_NAMES), st.sampled_from(["duration", "nodes"])),
+        st.one_of(OPTION_VALUES, st.sampled_from([[0.0, 1.0], [1.0, 2.0, math.nan], [1, 2, 3]])),
+        max_size=2,
+    ),
+)
+# Found by this test: a shift whose squared pulsation overflows was refused without naming it;
+# as many modes as free DOFs (a full Krylov basis, exact but with round-off residuals above the
+# tolerance for the modes far from the shift) ran 1000 block iterations and failed; more modes
+# than that failed the same way instead of saying why.
+@example(options={"shift": 1e300})
+@example(options={"modes": 24})
+@example(options={"modes": 25})
+def test_modal_options_run_or_are_refused_by_name(options):
+    """Any value of any modal option: as many finite, positive frequencies of the clamped plate
+    as asked for, or an error naming the option (a ValueError / TypeError before the run, or a
+    stop for more modes than the 24 free DOFs have)."""
+    model = _strip_with_mass()
+    try:
+        results = run(model, [Step.modal("m", **options)])
+    except (ValueError, TypeError) as exc:
+        message = str(exc)
+        assert any(key in message for key in options), (options, message)
+        return
+    except ConvergenceError as exc:
+        message = str(exc)
+        assert "modes" in options and "exceeds the model's 24 free DOFs" in message, message
+        return
+    (frequencies,) = results.frequencies_hz
+    requested = options.get("modes")  # None: the default
+    assert frequencies.size == (modal_step_options()["modes"] if requested is None else requested)
+    assert np.isfinite(frequencies).all() and (frequencies > 0.0).all()
 
 
 # -- the bending set-up --------------------------------------------------------------------------

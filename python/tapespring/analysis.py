@@ -227,7 +227,7 @@ class Step:
             "modal",
             tuple(activate),
             tuple(deactivate),
-            {"modes": int(modes), "shift": shift, "matrices": bool(matrices), **options},
+            {"modes": modes, "shift": shift, "matrices": matrices, **options},
         )
 
     def to_dict(self) -> dict[str, Any]:

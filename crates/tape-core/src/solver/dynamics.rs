@@ -198,6 +198,22 @@ impl DynamicParams {
         if self.max_steps == 0 {
             return Err(Error::InvalidParameter("max_steps must be >= 1".into()));
         }
+        let max_step = if self.max_step > 0.0 {
+            self.max_step
+        } else {
+            self.duration / 20.0
+        };
+        if self.min_step > max_step {
+            return Err(Error::InvalidParameter(format!(
+                "min_step [s] ({}) must not exceed max_step ({max_step}{})",
+                self.min_step,
+                if self.max_step > 0.0 {
+                    ""
+                } else {
+                    ", by default duration / 20"
+                }
+            )));
+        }
         if self.max_cutbacks > 1000 {
             return Err(Error::InvalidParameter(format!(
                 "max_cutbacks must lie in [0, 1000] (got {})",

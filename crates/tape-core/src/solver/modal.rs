@@ -93,6 +93,11 @@ impl ModalParams {
             if !s.is_finite() {
                 return Err(Error::InvalidParameter(format!("shift [Hz] must be finite (got {s})")));
             }
+            if !shift_from_hz(s).is_finite() {
+                return Err(Error::InvalidParameter(format!(
+                    "shift [Hz] = {s:e} is too large: its squared pulsation overflows"
+                )));
+            }
         }
         if !(self.tolerance > 0.0 && self.tolerance <= 1e-2) {
             return Err(Error::InvalidParameter(format!(
@@ -316,6 +321,13 @@ pub fn frequency_hz(eigenvalue: f64) -> f64 {
 pub fn solve_modal(system: &mut System, state: &State, params: &ModalParams) -> Result<(Modes, Stats)> {
     let start = Instant::now();
     params.validate()?;
+    if params.modes > system.n_free() {
+        return Err(Error::InvalidParameter(format!(
+            "modes = {} exceeds the model's {} free DOFs (it has no more modes than that)",
+            params.modes,
+            system.n_free()
+        )));
+    }
     let mut stats = Stats::default();
     let mut asm = Assembled::default();
     system.assemble(state, true, &mut asm);
