@@ -327,7 +327,7 @@ def test_contour_plot_draws_both_fields(opposite, equal):
         ({"youngs_moduli": 1e11}, "youngs_moduli must be a sequence"),
         ({"youngs_moduli": ("stiff",)}, "youngs_moduli must hold numbers"),
         ({"senses": "equal"}, "senses must be a sequence"),
-        ({"senses": ("upward",)}, "each sense must be one of"),
+        ({"senses": ("upward",)}, "each of senses must be one of"),
         ({"senses": ("equal", "equal")}, "senses must not repeat"),
         ({"senses": ()}, "senses must name at least one"),
         ({"mesh_size": 0.0}, "mesh_size"),

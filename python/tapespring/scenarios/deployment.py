@@ -52,6 +52,7 @@ from tapespring.scenarios.setup import (
     build_setup,
     check_count,
     check_number,
+    check_rho_inf,
     check_sense,
     drive,
     dynamic_options,
@@ -113,12 +114,9 @@ class DeploymentSettings:
         check_sense(self.sense)
         for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
-        if not (math.isfinite(self.settle) and self.settle >= 0.0):
-            raise ValueError(f"settle must be finite and >= 0 s (got {self.settle})")
-        if not 0.0 <= self.rho_inf <= 1.0:
-            raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
-        if not (math.isfinite(self.tolerance) and self.tolerance >= 0.0):
-            raise ValueError(f"tolerance must be finite and >= 0 (got {self.tolerance})")
+        check_number("settle", self.settle, positive=True, zero=True)
+        check_rho_inf(self.rho_inf)
+        check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_count("field_interval", self.field_interval, minimum=0)
         check_count("n_peaks", self.n_peaks, minimum=1)
 

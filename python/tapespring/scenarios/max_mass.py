@@ -208,7 +208,7 @@ class MaxMassSettings:
             raise ValueError(f"senses must name at least one of {SENSES}")
         for s in self.senses:
             if s not in SENSES:
-                raise ValueError(f"each sense must be one of {SENSES} (got {s!r})")
+                raise ValueError(f"each of senses must be one of {SENSES} (got {s!r})")
         if len(set(self.senses)) != len(self.senses):
             raise ValueError(f"senses must not repeat (got {tuple(self.senses)})")
         if not isinstance(self.tape, TapeSpring):

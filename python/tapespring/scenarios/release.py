@@ -9,7 +9,6 @@ end in the x-z plane), and the tape deploys freely for ``duration`` seconds.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import asdict, dataclass, replace
 from typing import Any
@@ -18,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.bending import BendingSetup, bending_model, bending_steps
+from tapespring.scenarios.setup import check_number, check_rho_inf
 
 __all__ = ["ReleaseResult", "ReleaseSetup", "release", "release_model", "release_steps"]
 
@@ -81,19 +81,14 @@ class ReleaseSetup:
             Naming the bad value.
         """
         for name in ("density", "tip_mass", "tip_inertia", "duration", "eta", "tolerance"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{name} must be a number (got {value!r})")
-            if not math.isfinite(value) or value < 0.0:
-                raise ValueError(f"{name} must be finite and >= 0 (got {value})")
+            check_number(name, getattr(self, name), positive=True, zero=True)
         if self.duration <= 0.0:
             raise ValueError(f"duration must be > 0 s (got {self.duration})")
         if self.tip_mass <= 0.0 or self.tip_inertia <= 0.0:
             raise ValueError("tip_mass and tip_inertia must be > 0 (the free end needs inertia)")
-        if not 0.0 <= self.rho_inf <= 1.0:
-            raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
-        if not math.isfinite(self.gravity):
-            raise ValueError(f"gravity must be finite (got {self.gravity})")
+        check_rho_inf(self.rho_inf)
+        check_number("gravity", self.gravity, positive=False)
+        check_number("fold_deg", self.fold_deg, positive=False)
         if not 0.0 < abs(self.fold_deg) < 180.0:
             raise ValueError(
                 f"fold_deg must be non-zero and within (-180, 180) (got {self.fold_deg})"

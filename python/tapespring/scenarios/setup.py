@@ -434,8 +434,10 @@ class SetupSpec:
                 continue
             positive = not name.startswith("initial_angle") and name not in ("eta", "support_eta")
             check_number(name, value, positive=positive)
-        if len(self.support_marker) != 3:
-            raise ValueError(f"support_marker must have 3 coordinates (got {self.support_marker})")
+        if not isinstance(self.support_marker, tuple | list) or len(self.support_marker) != 3:
+            raise ValueError(
+                f"support_marker must have 3 coordinates (got {self.support_marker!r})"
+            )
         for value in self.support_marker:
             check_number("support_marker", value, positive=False)
         if self.eta < 0.0:
@@ -446,7 +448,8 @@ class SetupSpec:
         if self.appendix_length <= self.mesh_plates:
             raise ValueError(
                 f"setup_length {self.setup_length} m leaves no room for the appendix beyond the "
-                f"rod, which ends at x = {self.appendix_x} m"
+                f"rod, which ends at x = {self.appendix_x} m (tape.length + interface_length + "
+                f"rod_width), for at least one element of mesh_plates = {self.mesh_plates} m"
             )
         chord = 2.0 * self.tape.radius * math.sin(self.tape.alpha / 2.0)
         if self.tape_spacing <= chord:
@@ -513,6 +516,13 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
         raise ValueError(f"{name} must be >= 0 (got {value})")
     if positive and not zero and value <= 0.0:
         raise ValueError(f"{name} must be > 0 (got {value})")
+
+
+def check_rho_inf(value: float) -> None:
+    """Raise ValueError unless `value` is a spectral radius at infinity, a number in [0, 1]."""
+    check_number("rho_inf", value, positive=False)
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"rho_inf must lie in [0, 1] (got {value})")
 
 
 def check_count(name: str, value: object, *, minimum: int) -> None:

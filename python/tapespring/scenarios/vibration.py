@@ -40,6 +40,7 @@ from tapespring.scenarios.setup import (
     build_setup,
     check_count,
     check_number,
+    check_rho_inf,
     drive,
     dynamic_options,
     gravity_step,
@@ -101,10 +102,13 @@ class VibrationSettings:
         self.spec.validate()
         for name in ("initial_displacement", "duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
-        if not 0.0 <= self.rho_inf <= 1.0:
-            raise ValueError(f"rho_inf must lie in [0, 1] (got {self.rho_inf})")
+        check_rho_inf(self.rho_inf)
         for name in ("tolerance", "time_step"):
             check_number(name, getattr(self, name), positive=True, zero=True)
+        if not isinstance(self.window, tuple | list) or len(self.window) != 2:
+            raise ValueError(f"window must be a pair (low, high) [m] (got {self.window!r})")
+        for value in self.window:
+            check_number("window", value, positive=False)
         lo, hi = self.window
         if not 0.0 <= lo < hi:
             raise ValueError(f"window must satisfy 0 <= low < high (got {self.window})")
