@@ -11,7 +11,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
+from pathlib import Path
 from typing import Any
 
 __all__ = ["add_tape_options", "register", "run", "tape_fields"]
@@ -31,6 +33,22 @@ def _positive(name: str, *, zero: bool = False):
         return value
 
     return parse
+
+
+def _output_file(text: str) -> str:
+    """An argparse type: a file the command will write, in a folder that exists (checked before
+    anything runs, so that a mistyped path does not cost the run)."""
+    path = Path(text)
+    if text == "" or path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is not a file name")
+    folder = path.parent
+    if not folder.is_dir():
+        raise argparse.ArgumentTypeError(f"cannot write {text}: no folder {str(folder)!r}")
+    if not os.access(folder, os.W_OK):
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text}: folder {str(folder)!r} is not writable"
+        )
+    return text
 
 
 def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
@@ -135,9 +153,11 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         ),
     )
     p.add_argument(
-        "--csv", help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file"
+        "--csv",
+        type=_output_file,
+        help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file",
     )
-    p.add_argument("--plot", help="write the curve as a PNG (paper Fig. 4)")
+    p.add_argument("--plot", type=_output_file, help="write the curve as a PNG (paper Fig. 4)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)

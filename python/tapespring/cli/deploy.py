@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .bend import _positive
+from .bend import _output_file, _positive
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -94,12 +94,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         )
     p.add_argument(
         "--vtu",
+        type=_output_file,
         metavar="FILE.pvd",
         help="write the deformed set-up as a ParaView series (every 16th record: 50 Hz at 800 Hz "
         "samples; needs meshio)",
     )
     p.add_argument(
         "--snapshots",
+        type=_output_file,
         metavar="FILE.png",
         help="draw the set-up from the side at the release and every --duration/5 s (Fig. 13)",
     )

@@ -15,7 +15,7 @@ import json
 import math
 import sys
 
-from .bend import _positive
+from .bend import _output_file, _positive
 
 __all__ = ["register", "run"]
 
@@ -135,9 +135,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--csv",
+        type=_output_file,
         help="write one row per (sense, t, E): moments, masses (FE and analytical), ratio",
     )
-    p.add_argument("--plot", help="write a contour plot of m_max [g] like the paper's Fig. 7 (PNG)")
+    p.add_argument(
+        "--plot",
+        type=_output_file,
+        help="write a contour plot of m_max [g] like the paper's Fig. 7 (PNG)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)

@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from .bend import _positive, add_tape_options, tape_fields
+from .bend import _output_file, _positive, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
 
@@ -88,8 +88,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="local error tolerance of the time steps [m] (0: the solver's default)",
     )
     add_tape_options(p, d.tape)
-    p.add_argument("--csv", help="write time_s, theta_deg, moment_Nm and the energies to this CSV")
-    p.add_argument("--plot", help="write the angle and energy histories as a PNG")
+    p.add_argument(
+        "--csv",
+        type=_output_file,
+        help="write time_s, theta_deg, moment_Nm and the energies to this CSV",
+    )
+    p.add_argument(
+        "--plot", type=_output_file, help="write the angle and energy histories as a PNG"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)

@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .bend import _positive
+from .bend import _output_file, _positive
 
 __all__ = [
     "add_comparison_options",
@@ -74,8 +74,8 @@ def spec_from_args(args: argparse.Namespace) -> Any:
 
 def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
     """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
-    p.add_argument("--csv", help=f"write {csv_what} to this CSV file")
-    p.add_argument("--plot", help="write the figure to this PNG file")
+    p.add_argument("--csv", type=_output_file, help=f"write {csv_what} to this CSV file")
+    p.add_argument("--plot", type=_output_file, help="write the figure to this PNG file")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -141,6 +141,7 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
     )
     p.add_argument(
         "--vtu",
+        type=_output_file,
         metavar="FILE.pvd",
         help=f"write the deformed set-up as a ParaView series ({vtu}; needs meshio)",
     )
