@@ -13,6 +13,8 @@ import pickle
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from tapespring import Model, Outputs, Results, Step, run, shell
 from tapespring.analysis import ConvergenceError, ramp, step_options, table
 
@@ -194,6 +196,44 @@ def test_results_save_and_load_keep_everything(tmp_path):
         back.marker("nope")
     with pytest.raises(KeyError, match="no reaction at 'foo'"):
         back.total_reaction("foo")
+
+
+@pytest.fixture(scope="module")
+def saved_results(tmp_path_factory):
+    model, tip = strip()
+    model.add_load(tip, "uz", 5.0)
+    model.add_marker("tip", tip)
+    results = run(model, [Step.static("s", increments=2)], outputs=Outputs(field_interval=1))
+    path = results.save(tmp_path_factory.mktemp("saved") / "r")
+    return results, path.read_bytes()
+
+
+@settings(max_examples=40, derandomize=True, database=None, deadline=None)
+@given(
+    cut=st.floats(0.0, 1.0, exclude_max=True),
+    flips=st.lists(
+        st.tuples(st.floats(0.0, 1.0, exclude_max=True), st.integers(1, 255)), max_size=4
+    ),
+)
+def test_a_corrupted_results_file_is_refused_naming_it(saved_results, tmp_path_factory, cut, flips):
+    """A saved file truncated and/or with bytes changed either loads the same results (the
+    change hit bytes the reader does not use) or raises a ValueError naming the file; never
+    another exception, never different numbers."""
+    results, blob = saved_results
+    data = bytearray(blob)
+    for where, xor in flips:
+        data[int(where * len(data))] ^= xor
+    if cut > 0.0:
+        data = data[: int((1.0 - cut) * len(data))]
+    path = tmp_path_factory.mktemp("corrupt") / "r.npz"
+    path.write_bytes(bytes(data))
+    try:
+        back = Results.load(path)
+    except ValueError as exc:
+        assert str(path) in str(exc)
+        return
+    for name in ("t", "reactions", "marker_positions", "displacements"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(results, name))
 
 
 def test_convergence_error_names_the_step_and_keeps_the_results():

@@ -7,6 +7,7 @@ state (time 0, before the first step). Units are SI (m, N, N m, J, rad).
 from __future__ import annotations
 
 import json
+import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -376,10 +377,33 @@ class Results:
 
         Raises
         ------
+        FileNotFoundError
+            If there is no such file.
         ValueError
-            If the file is not a saved `Results`, or is of a newer format.
+            If the file is not a saved `Results` (another file, or one truncated or corrupted:
+            the message names the file and what failed), or is of a newer format.
         """
-        with np.load(Path(path), allow_pickle=False) as f:
+        try:
+            return cls._read(Path(path))
+        except (FileNotFoundError, IsADirectoryError, PermissionError):
+            raise
+        except ValueError as exc:
+            if str(path) in str(exc):
+                raise
+            # NumPy reads what is neither .npz nor .npy as a pickle, which it refuses.
+            reason = "not a NumPy .npz archive" if "pickled" in str(exc) else str(exc)
+            message = f"{path} is not a readable saved tapespring Results ({reason})"
+            raise ValueError(message) from exc
+        except (OSError, EOFError, KeyError, TypeError, zipfile.BadZipFile) as exc:
+            raise ValueError(
+                f"{path} is not a readable saved tapespring Results (truncated or corrupted: "
+                f"{type(exc).__name__}: {exc})"
+            ) from exc
+
+    @classmethod
+    def _read(cls, path: Path) -> Results:
+        # The file is opened here, not by np.load, which leaves it open when it fails.
+        with path.open("rb") as handle, _npz(np.load(handle, allow_pickle=False), path) as f:
             if "meta" not in f:
                 raise ValueError(f"{path} is not a saved tapespring Results")
             meta = json.loads(str(f["meta"]))
@@ -401,6 +425,13 @@ class Results:
         d.update(meta)
         d["modes"] = modes
         return cls.from_dict(d)
+
+
+def _npz(loaded: Any, path: Path) -> Any:
+    """`loaded` if np.load read an archive (a .npy array is not a saved `Results`)."""
+    if not isinstance(loaded, np.lib.npyio.NpzFile):
+        raise ValueError(f"{path} is not a saved tapespring Results (not a .npz archive)")
+    return loaded
 
 
 def _load_modes(f: Any, i: int, entry: Mapping[str, Any]) -> Modes:
