@@ -27,35 +27,45 @@ fn deformed_system() -> (System, State) {
     (system, state)
 }
 
+/// The element timed alone (an interior one of the 2 mm tape).
+const BENCH_ELEMENT: usize = 137;
+
+/// Nodal positions and rotation matrices of [`BENCH_ELEMENT`] in `state`.
+fn element_configuration(system: &System, state: &State) -> ([Vector3<f64>; 4], [Matrix3<f64>; 4]) {
+    let e = &system.elements[BENCH_ELEMENT];
+    (
+        e.nodes.map(|n| state.x[n]),
+        e.nodes
+            .map(|n| state.q[n].to_rotation_matrix().into_inner()),
+    )
+}
+
 fn element_kernel(c: &mut Criterion) {
     let (system, state) = deformed_system();
-    let e = &system.elements[137];
-    let x = e.nodes.map(|n| state.x[n]);
-    let q: [Matrix3<f64>; 4] = e
-        .nodes
-        .map(|n| state.q[n].to_rotation_matrix().into_inner());
+    let e = &system.elements[BENCH_ELEMENT];
+    let (x, q) = element_configuration(&system, &state);
     let mut f = ElementVector::zeros();
     let mut k = ElementMatrix::zeros();
     c.bench_function("element internal force + tangent", |b| {
-        b.iter(|| e.compute_into(&x, &q, system.section(137), &mut f, Some(&mut k)));
+        b.iter(|| e.compute_into(&x, &q, system.section(BENCH_ELEMENT), &mut f, Some(&mut k)));
     });
     c.bench_function("element internal force only", |b| {
-        b.iter(|| e.compute_into(&x, &q, system.section(137), &mut f, None));
+        b.iter(|| e.compute_into(&x, &q, system.section(BENCH_ELEMENT), &mut f, None));
     });
     let zero = [Vector3::zeros(); 4];
     let dx = [Vector3::new(1e-6, 2e-6, -1e-6); 4];
     let dth = [Vector3::new(1e-3, -2e-3, 1e-3); 4];
     c.bench_function("element linearised stress", |b| {
-        b.iter(|| e.linearised_stress(&x, &q, system.section(137), &dx, &dth));
+        b.iter(|| e.linearised_stress(&x, &q, system.section(BENCH_ELEMENT), &dx, &dth));
     });
-    let stress = e.linearised_stress(&x, &q, system.section(137), &zero, &dth);
+    let stress = e.linearised_stress(&x, &q, system.section(BENCH_ELEMENT), &zero, &dth);
     let mut fg = ElementVector::zeros();
     c.bench_function("element internal force + mixed tangent", |b| {
         b.iter(|| {
             e.compute_mixed_into(
                 &x,
                 &q,
-                system.section(137),
+                system.section(BENCH_ELEMENT),
                 Some(&stress),
                 &mut f,
                 Some(&mut k),
@@ -70,11 +80,8 @@ fn element_kernel(c: &mut Criterion) {
 /// the inertia forces and 6 x 6 Jacobian of a node (about one node per element in a shell mesh).
 fn dynamic_terms(c: &mut Criterion) {
     let (system, state) = deformed_system();
-    let e = &system.elements[137];
-    let x = e.nodes.map(|n| state.x[n]);
-    let q: [Matrix3<f64>; 4] = e
-        .nodes
-        .map(|n| state.q[n].to_rotation_matrix().into_inner());
+    let e = &system.elements[BENCH_ELEMENT];
+    let (x, q) = element_configuration(&system, &state);
     let mut f = ElementVector::zeros();
     let mut k = ElementMatrix::zeros();
     // A step of 1e-4 s at rho_inf = 0.7 and the paper's eta, with velocities of a deploying tape.
@@ -88,24 +95,33 @@ fn dynamic_terms(c: &mut Criterion) {
         ..Viscous::default()
     };
     c.bench_function("element internal force + tangent, Kelvin-Voigt", |b| {
-        b.iter(|| e.compute_viscous_into(&x, &q, system.section(137), &viscous, &mut f, Some(&mut k)));
+        b.iter(|| e.compute_viscous_into(&x, &q, system.section(BENCH_ELEMENT), &viscous, &mut f, Some(&mut k)));
     });
     let stress = e.linearised_stress(
         &x,
         &q,
-        system.section(137),
+        system.section(BENCH_ELEMENT),
         &[Vector3::zeros(); 4],
         &[Vector3::zeros(); 4],
     );
     let mut fg = ElementVector::zeros();
     c.bench_function("element internal force + mixed tangent, Kelvin-Voigt", |b| {
         b.iter(|| {
-            e.compute_viscous_mixed_into(&x, &q, system.section(137), &viscous, &stress, &mut f, &mut k, &mut fg)
+            e.compute_viscous_mixed_into(
+                &x,
+                &q,
+                system.section(BENCH_ELEMENT),
+                &viscous,
+                &stress,
+                &mut f,
+                &mut k,
+                &mut fg,
+            )
         });
     });
     viscous.consistent = true;
     c.bench_function("element internal force + tangent, Kelvin-Voigt (consistent)", |b| {
-        b.iter(|| e.compute_viscous_into(&x, &q, system.section(137), &viscous, &mut f, Some(&mut k)));
+        b.iter(|| e.compute_viscous_into(&x, &q, system.section(BENCH_ELEMENT), &viscous, &mut f, Some(&mut k)));
     });
     let node = e.nodes[0];
     let body: NodeInertia = system.inertia[node];
