@@ -32,7 +32,7 @@ import numpy as np
 from .c3d_check import check_c3d
 from .c3d_worker import DEFAULT_TIMEOUT, WorkerFailure, read_raw, read_raw_isolated
 from .common import FORCE, FP_CHANNELS, LENGTH, META_KEYS, MOMENT, check_durations, unit_scale
-from .trial import ForcePlate, Metadata, Trial, TrialError
+from .trial import SENSES, ForcePlate, Metadata, Trial, TrialError
 
 # ezc3d is imported inside the functions that touch a C3D file, so that loading CSV trials (or
 # just importing the trials) does not pay for it.
@@ -132,19 +132,27 @@ def read_c3d(
         t_plate = (raw["analog_first_frame"] + np.arange(m)) / raw["analog_rate"]
         f_scale = unit_scale(pf["unit_force"], FORCE, path, "force")
         m_scale = unit_scale(pf["unit_moment"], MOMENT, path, "moment")
-        plates.append(
-            ForcePlate(
+        try:
+            plate = ForcePlate(
                 time=t_plate,
                 force=pf["force"].T * f_scale,
                 moment=pf["moment"].T * m_scale,
                 name=f"FP{k + 1}",
             )
-        )
+        except TrialError as exc:  # the plate has no source of its own: name the file
+            raise TrialError(path, exc.problem) from exc
+        plates.append(plate)
     stored = {}
     for key in META_KEYS:
         value = raw["meta"].get(key.upper(), "").strip()
         if value:
             stored[key] = value
+    if stored.get("sense") not in (None, *SENSES) and sense is None:
+        raise TrialError(
+            path,
+            f"parameter TAPESPRING:SENSE must be one of {SENSES} (got {stored['sense']!r}; "
+            "give the sense to override it)",
+        )
     overrides = {"sense": sense, "tape_pair": tape_pair, "session": session}
     stored.update({k: v for k, v in overrides.items() if v is not None})
     units = {"markers": unit}
