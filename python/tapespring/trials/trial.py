@@ -78,6 +78,14 @@ def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
     mean_dt = (time[-1] - time[0]) / (time.size - 1)
     if mean_dt <= 0 or np.any(dt <= 0):
         raise TrialError(source, f"{what} time vector is not strictly increasing")
+    # A step that the times cannot resolve, or whose rate overflows, is no sampling.
+    span = max(abs(time[0]), abs(time[-1]))
+    if mean_dt <= 1.0 / np.finfo(float).max or mean_dt <= 16 * np.finfo(float).eps * span:
+        raise TrialError(
+            source,
+            f"{what} time vector: steps of {mean_dt:.3g} s are below the resolution of its times "
+            "(no finite sampling rate)",
+        )
     worst = np.max(np.abs(dt - mean_dt)) / mean_dt
     if worst > _RATE_RTOL:
         raise TrialError(
