@@ -198,11 +198,7 @@ impl DynamicParams {
         if self.max_steps == 0 {
             return Err(Error::InvalidParameter("max_steps must be >= 1".into()));
         }
-        let max_step = if self.max_step > 0.0 {
-            self.max_step
-        } else {
-            self.duration / 20.0
-        };
+        let max_step = self.largest_step();
         if self.min_step > max_step {
             return Err(Error::InvalidParameter(format!(
                 "min_step [s] ({}) must not exceed max_step ({max_step}{})",
@@ -221,6 +217,16 @@ impl DynamicParams {
             )));
         }
         self.newton.validate()
+    }
+
+    /// The largest time step \[s\]: `max_step`, or `duration / 20` when it is 0.
+    #[must_use]
+    pub fn largest_step(&self) -> f64 {
+        if self.max_step > 0.0 {
+            self.max_step
+        } else {
+            self.duration / 20.0
+        }
     }
 
     /// Reads a flat option map (defaults for the options absent).
@@ -838,7 +844,7 @@ pub fn solve_dynamic(
     let t0 = state.t;
     let t_end = t0 + params.duration;
     let default_or = |v: f64, d: f64| if v > 0.0 { v } else { d };
-    let max_step = default_or(params.max_step, params.duration / 20.0);
+    let max_step = params.largest_step();
     let min_step = default_or(params.min_step, 1e-12 * params.duration.max(t_end.abs()));
     let mut h = default_or(params.initial_step, params.duration / 1000.0).min(max_step);
     integ.h_gen = h;
