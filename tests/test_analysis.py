@@ -13,8 +13,9 @@ import pickle
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from property_settings import examples
 from tapespring import Model, Outputs, Results, Step, run, shell
 from tapespring.analysis import ConvergenceError, ramp, step_options, table
 
@@ -208,7 +209,7 @@ def saved_results(tmp_path_factory):
     return results, path.read_bytes()
 
 
-@settings(max_examples=40, derandomize=True, database=None, deadline=None)
+@examples(ci=40, long=400)
 @given(
     cut=st.floats(0.0, 1.0, exclude_max=True),
     flips=st.lists(

@@ -20,8 +20,9 @@ import textwrap
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, example, given, settings
+from hypothesis import assume, example, given
 from hypothesis import strategies as st
+from property_settings import examples
 from tapespring import Model, Step, run, shell
 from tapespring.analysis import (
     ConvergenceError,
@@ -30,18 +31,6 @@ from tapespring.analysis import (
     step_options,
 )
 from tapespring.scenarios.bending import BendingSetup
-
-LONG = os.environ.get("HYPOTHESIS_PROFILE") == "long"
-
-
-def _examples(ci: int, long: int) -> settings:
-    return settings(
-        max_examples=long if LONG else ci,
-        derandomize=not LONG,
-        database=None,
-        deadline=None,
-        suppress_health_check=[HealthCheck.too_slow],
-    )
 
 
 def _log_uniform(lo: float, hi: float):
@@ -66,7 +55,7 @@ def _rotation(v):
 # -- valid models: finite results in equilibrium ------------------------------------------------
 
 
-@_examples(ci=20, long=300)
+@examples(ci=20, long=300)
 @given(
     lx=_log_uniform(1e-3, 1e2),
     aspect=_log_uniform(0.1, 10.0),
@@ -183,7 +172,7 @@ BAD_ARRAYS = st.sampled_from(
 )
 
 
-@_examples(ci=15, long=100)
+@examples(ci=15, long=100)
 @given(case=BAD_ARRAYS, scale=_log_uniform(1e-3, 1e3))
 def test_a_bad_mesh_is_refused_naming_the_problem(case, scale):
     _, change, exc, message = case
@@ -192,7 +181,7 @@ def test_a_bad_mesh_is_refused_naming_the_problem(case, scale):
         Model(nodes, quads, **SECTION)
 
 
-@_examples(ci=12, long=100)
+@examples(ci=12, long=100)
 @given(
     key=st.sampled_from(["thickness", "youngs_modulus", "poisson", "density", "eta"]),
     value=st.sampled_from([0.0, -1.0, math.nan, math.inf, -math.inf, 0.5, 1.0, -1.0, "1", [1.0]]),
@@ -219,7 +208,7 @@ INDEX_CALLS = {
 }
 
 
-@_examples(ci=40, long=400)
+@examples(ci=40, long=400)
 @given(
     call=st.sampled_from(sorted(INDEX_CALLS)),
     index=st.one_of(
@@ -249,7 +238,7 @@ OPTION_VALUES = st.one_of(
 )
 
 
-@_examples(ci=80, long=1000)
+@examples(ci=80, long=1000)
 @given(
     control=st.sampled_from(["load", "displacement", "arc-length"]),
     options=st.dictionaries(
@@ -278,7 +267,7 @@ def test_options_run_or_are_refused_by_name(control, options):
         assert np.isfinite(results.t).all() and np.isfinite(results.reactions).all()
 
 
-DYNAMIC_NAMES = sorted(dynamic_step_options())
+DYNAMIC_NAMES = sorted(set(dynamic_step_options()) - {"duration"})  # drawn on its own
 MODAL_NAMES = sorted(modal_step_options())
 #: Records after which a generated dynamic run is stopped through the progress callback: a
 #: valid but long request (a duration of 1e300 s, ten million steps) would otherwise run for
@@ -294,7 +283,7 @@ def _strip_with_mass() -> Model:
     return model
 
 
-@_examples(ci=60, long=1000)
+@examples(ci=60, long=1000)
 @given(
     duration=st.one_of(st.just(1e-3), OPTION_VALUES),
     options=st.dictionaries(
@@ -310,7 +299,6 @@ def test_dynamic_options_run_or_are_refused_by_name(duration, options):
     """Any value of any dynamic option: a run with finite records (complete, stopped by the
     record budget, or stopped early with a ConvergenceError keeping its records), or a
     ValueError / TypeError naming an option, before anything runs."""
-    options = {k: v for k, v in options.items() if k != "duration"}
     model = _strip_with_mass()
     records = 0
 
@@ -334,7 +322,7 @@ def test_dynamic_options_run_or_are_refused_by_name(duration, options):
     assert np.all(np.diff(results.t) > 0.0), "time goes forward"
 
 
-@_examples(ci=40, long=500)
+@examples(ci=40, long=500)
 @given(
     options=st.dictionaries(
         st.one_of(st.sampled_from(MODAL_NAMES), st.sampled_from(["duration", "nodes"])),
@@ -385,7 +373,7 @@ FIELDS = {
 }
 
 
-@_examples(ci=15, long=200)
+@examples(ci=15, long=200)
 @given(
     values=st.fixed_dictionaries({k: st.floats(*r) for k, r in FIELDS.items()}),
     across=st.integers(4, 8),
@@ -406,7 +394,7 @@ def test_a_valid_bending_setup_builds_its_model(values, across):
     assert all(np.isfinite(model.nodes).all() for _ in [0])
 
 
-@_examples(ci=30, long=300)
+@examples(ci=30, long=300)
 @given(
     field=st.sampled_from([*FIELDS, "mesh_size", "unload", "jump", "switch_branches"]),
     value=st.sampled_from([math.nan, math.inf, -math.inf, None, "1", [1.0], 0.0, -1.0, 1e9]),
@@ -429,7 +417,7 @@ def test_a_bad_bending_field_is_refused_naming_it(field, value):
 # -- sizes that aborted the interpreter: in a child process --------------------------------------
 
 
-@_examples(ci=2, long=20)
+@examples(ci=2, long=20)
 @given(
     counts=st.lists(
         st.tuples(st.integers(10**5, 10**12), st.integers(10**5, 10**12)), min_size=3, max_size=3
@@ -462,7 +450,7 @@ def test_huge_meshes_are_refused_in_a_child_process(counts):
     assert all(o.startswith("MemoryError: ") and "elements" in o for o in outcomes), outcomes
 
 
-@_examples(ci=10, long=100)
+@examples(ci=10, long=100)
 @given(
     scale=_log_uniform(1e-2, 1e2),
     rotation=st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),

@@ -7,29 +7,16 @@ Example counts: a fixed small number in CI, many with ``HYPOTHESIS_PROFILE=long`
 import argparse
 import json
 import math
-import os
 import tempfile
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from property_settings import examples
 from tapespring.cli import trials as cli
 from tapespring.trials import write_csv
 from tapespring.trials.samples import make_deployment_trial
-
-LONG = os.environ.get("HYPOTHESIS_PROFILE") == "long"
-CHECKS = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
-
-
-def _examples(ci: int, long: int) -> settings:
-    return settings(
-        max_examples=long if LONG else ci,
-        derandomize=not LONG,
-        database=None,
-        deadline=None,
-        suppress_health_check=CHECKS,
-    )
 
 
 def _run(argv):
@@ -62,7 +49,7 @@ def folder(tmp_path_factory):
     return out
 
 
-@_examples(ci=4, long=40)
+@examples(ci=4, long=40)
 @given(
     senses=st.lists(st.sampled_from(["opposite", "equal"]), min_size=1, max_size=3),
     seed=st.integers(0, 10**6),
@@ -106,7 +93,7 @@ bad_options = st.one_of(
 )
 
 
-@_examples(ci=14, long=200)
+@examples(ci=14, long=200)
 @given(option=bad_options)
 def test_generated_invalid_options_exit_non_zero_naming_the_option(
     folder, tmp_path, option, capsys

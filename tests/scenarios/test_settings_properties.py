@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 from dataclasses import replace
 
-from hypothesis import HealthCheck, assume, example, given, settings
+from hypothesis import assume, example, given
 from hypothesis import strategies as st
+from property_settings import examples
 from tapespring.scenarios.deployment import DeploymentSettings
 from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
@@ -22,8 +22,6 @@ from tapespring.scenarios.pull import PullSettings
 from tapespring.scenarios.release import ReleaseSetup
 from tapespring.scenarios.setup import CONFIGURATIONS, PAPER_SETUP, SetupSpec, build_setup
 from tapespring.scenarios.vibration import VibrationSettings
-
-LONG = os.environ.get("HYPOTHESIS_PROFILE") == "long"
 
 SETTINGS = {
     cls.__name__: cls
@@ -45,16 +43,6 @@ VALUES = st.one_of(
 )
 
 
-def _examples(ci: int, long: int) -> settings:
-    return settings(
-        max_examples=long if LONG else ci,
-        derandomize=not LONG,
-        database=None,
-        deadline=None,
-        suppress_health_check=[HealthCheck.too_slow],
-    )
-
-
 def _fields(cls) -> list[str]:
     return [f.name for f in dataclasses.fields(cls) if f.name not in NESTED]
 
@@ -69,7 +57,7 @@ def _assert_named(obj, name: str) -> None:
 PAIRS = [(c, f) for c, cls in sorted(SETTINGS.items()) for f in _fields(cls)]
 
 
-@_examples(ci=80, long=2000)
+@examples(ci=80, long=2000)
 @given(pair=st.sampled_from(PAIRS), value=VALUES)
 # Found by this test: a rho_inf, tolerance or settle of the wrong type raised a TypeError from a
 # comparison; a window that is not a pair failed to unpack.
@@ -80,14 +68,14 @@ def test_a_scenario_setting_is_accepted_or_refused_by_name(pair, value):
     _assert_named(replace(SETTINGS[cls_name](), **{name: value}), name)
 
 
-@_examples(ci=60, long=1500)
+@examples(ci=60, long=1500)
 @given(name=st.sampled_from(_fields(SetupSpec)), value=VALUES)
 @example(name="support_marker", value=0.0)
 def test_a_setup_dimension_is_accepted_or_refused_by_name(name, value):
     _assert_named(replace(PAPER_SETUP, **{name: value}), name)
 
 
-@_examples(ci=10, long=200)
+@examples(ci=10, long=200)
 @given(
     name=st.sampled_from(_fields(SetupSpec)),
     factor=st.sampled_from([0.5, 0.8, 1.25, 2.0]),
