@@ -81,6 +81,24 @@ def test_invalid_section_is_a_value_error_naming_the_parameter(key, value, match
         core.Model(nodes, quads, **{**SECTION, key: value})
 
 
+def test_errors_name_the_part_or_step_once_with_one_category():
+    # The context (part, step, element) comes first and the category ("invalid parameter: ...")
+    # once, however deep the check that failed.
+    model = core.Model()
+    nodes, quads = square()
+    with pytest.raises(ValueError) as part:
+        model.add_part("web", nodes, quads, **{**SECTION, "thickness": 0.0})
+    assert str(part.value).startswith("invalid parameter: part 'web': thickness")
+    model = core.Model(nodes, quads, **SECTION)
+    model.fix([0, 3], "all")
+    with pytest.raises(ValueError) as step:
+        core.run(model, [{"name": "drop", "kind": "dynamic", "duration": 1.0, "rho_inf": 2.0}])
+    message = str(step.value)
+    assert message.startswith("invalid parameter: step 'drop': rho_inf")
+    for text in (str(part.value), message):
+        assert text.count("invalid") == 1, text
+
+
 def test_section_parameters_are_keyword_only_and_required():
     nodes, quads = square()
     with pytest.raises(TypeError):

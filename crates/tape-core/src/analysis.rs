@@ -109,15 +109,13 @@ impl Step {
         let activate: Vec<String> = o.take_or("activate", Vec::new())?;
         let deactivate: Vec<String> = o.take_or("deactivate", Vec::new())?;
         let kind = match kind.as_str() {
-            "static" => StepKind::Static(
-                StaticParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
-            ),
-            "dynamic" => StepKind::Dynamic(
-                DynamicParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
-            ),
-            "modal" => StepKind::Modal(
-                ModalParams::from_options(o).map_err(|e| Error::InvalidParameter(format!("step '{name}': {e}")))?,
-            ),
+            "static" => {
+                StepKind::Static(StaticParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?)
+            }
+            "dynamic" => {
+                StepKind::Dynamic(DynamicParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?)
+            }
+            "modal" => StepKind::Modal(ModalParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?),
             other => {
                 return Err(Error::InvalidParameter(format!(
                     "step '{name}': unknown kind '{other}' (expected 'static', 'dynamic' or 'modal')"
@@ -407,6 +405,13 @@ pub fn run(
         if let StepKind::Modal(p) = &step.kind {
             match solve_modal(&mut system, &state, p) {
                 Ok((mut modes, mut stats)) => {
+                    log::info!(
+                        "{context}: {} modes, lowest {:.6e} Hz, {} factorisations, {:.3} s",
+                        modes.frequencies_hz.len(),
+                        modes.frequencies_hz.first().copied().unwrap_or(f64::NAN),
+                        stats.factorisations,
+                        stats.wall_s
+                    );
                     modes.step = k;
                     modes.name.clone_from(&step.name);
                     modes.record = history.len() - 1;
@@ -464,6 +469,22 @@ pub fn run(
             StepKind::Modal(_) => unreachable!("modal steps are handled above"),
         };
         stats.symbolic_analyses = std::mem::take(&mut symbolic);
+        log::info!(
+            "{context}: {} increments ({} cut back), {} Newton iterations, {} factorisations, {} DOFs, \
+             reached {} = {:.6e}, {:.3} s",
+            stats.steps,
+            stats.cutbacks,
+            stats.iterations,
+            stats.factorisations,
+            system.n_free(),
+            if matches!(step.kind, StepKind::Dynamic(_)) {
+                "t"
+            } else {
+                "load factor"
+            },
+            state.t,
+            stats.wall_s
+        );
         result.stats.add(&stats);
         result.step_stats.push(stats);
         if let Some(last) = records.last() {

@@ -32,7 +32,7 @@ use crate::constraint::{Activity, DofMap, Slot};
 use crate::dof::Dof;
 use crate::element::shell::{ElementMatrix, ElementStress, ElementVector, Viscous};
 use crate::element::ShellElement;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::inertia::NodeInertia;
 use crate::linalg::LinearSolver;
 pub use crate::linalg::Pattern;
@@ -300,7 +300,7 @@ impl System {
             .map(|(e, quad)| {
                 let x = quad.map(|i| model.mesh.nodes[i]);
                 let q = quad.map(|i| triads[i].to_rotation_matrix().into_inner());
-                ShellElement::try_new(*quad, &x, &q).map_err(|err| Error::InvalidMesh(format!("element {e}: {err}")))
+                ShellElement::try_new(*quad, &x, &q).map_err(|err| err.context(&format!("element {e}")))
             })
             .collect::<Result<Vec<_>>>()?;
         let n_nodes = model.mesh.n_nodes();

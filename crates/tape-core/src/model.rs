@@ -221,10 +221,10 @@ impl Model {
     pub fn add_part(&mut self, name: &str, mesh: Mesh, section: ShellSection, placement: &Placement) -> Result<usize> {
         section
             .validate()
-            .map_err(|e| Error::InvalidParameter(format!("part '{name}': {e}")))?;
+            .map_err(|e| e.context(&format!("part '{name}'")))?;
         placement.validate()?;
         mesh.validate()
-            .map_err(|e| Error::InvalidMesh(format!("part '{name}': {e}")))?;
+            .map_err(|e| e.context(&format!("part '{name}'")))?;
         if mesh.quads.is_empty() {
             return Err(Error::InvalidMesh(format!("part '{name}': the mesh has no element")));
         }
@@ -559,7 +559,7 @@ impl Model {
         for p in &self.parts {
             p.section
                 .validate()
-                .map_err(|e| Error::InvalidParameter(format!("part '{}': {e}", p.name)))?;
+                .map_err(|e| e.context(&format!("part '{}'", p.name)))?;
             if p.elements.start != next || p.elements.end < p.elements.start {
                 return Err(Error::InvalidModel(format!(
                     "part '{}': its elements {:?} do not follow the previous part's",

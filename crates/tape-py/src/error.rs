@@ -83,6 +83,7 @@ impl Ticker<'_> {
     /// Returns `false` to stop the computation. Must be called without the GIL held.
     pub fn tick(&mut self, call: impl for<'py> FnOnce(Python<'py>, &Py<PyAny>) -> PyResult<Bound<'py, PyAny>>) -> bool {
         Python::attach(|py| {
+            crate::logging::forward(py);
             if let Err(e) = py.check_signals() {
                 self.error = Some(e);
                 return false;
@@ -101,7 +102,8 @@ impl Ticker<'_> {
 
 /// The one way the binding runs tape-core: with the GIL released (other Python threads keep
 /// running), panics turned into `TapeError`, and a [`Ticker`] for progress and Ctrl-C; an
-/// exception raised by the callback or a signal handler is re-raised after `f` returns.
+/// exception raised by the callback or a signal handler is re-raised after `f` returns; the
+/// core's log records go to Python's `logging` at every tick and at the end ([`crate::logging`]).
 ///
 /// # Errors
 /// The error of `f`, of the callback, or a `ValueError` if `callback` is not callable.
@@ -115,8 +117,10 @@ pub fn run_detached<T: Send>(
             return Err(PyValueError::new_err("progress must be callable or None"));
         }
     }
+    crate::logging::sync_level(py);
     let mut ticker = Ticker { callback, error: None };
     let out = py.detach(|| guard(|| f(&mut ticker)));
+    crate::logging::forward(py);
     if let Some(e) = ticker.error {
         return Err(e);
     }

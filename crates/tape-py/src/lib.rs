@@ -6,6 +6,7 @@
 mod analysis;
 mod convert;
 mod error;
+mod logging;
 mod mesh;
 mod model;
 
@@ -30,6 +31,7 @@ mod _core {
         m.add("ConvergenceError", py.get_type::<super::error::ConvergenceError>())?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("DOFS", tape_core::Dof::NAMES.to_vec())?;
+        super::logging::install(py);
         Ok(())
     }
 }

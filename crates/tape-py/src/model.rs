@@ -48,7 +48,6 @@ fn section(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ShellSection> {
             "section: {e} (thickness [m], youngs_modulus [Pa] and poisson are required; density [kg/m^3], eta [s], shear_factor and drilling_factor are optional)"
         ))
     })?;
-    to_py(s.validate())?;
     Ok(s)
 }
 
@@ -150,6 +149,11 @@ impl PyModel {
         let name = name.as_str();
         let mesh = mesh_of(nodes, quads, node_sets)?;
         let section = section(section_kwargs)?;
+        // Named after the part, except the one part of `Model(nodes, quads, ...)`.
+        to_py(section.validate().map_err(|e| match name {
+            "" => e,
+            _ => e.context(&format!("part '{name}'")),
+        }))?;
         let placement = placement(rotation, translation)?;
         to_py(self.inner.add_part(name, mesh, section, &placement))
     }

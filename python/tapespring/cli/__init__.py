@@ -18,6 +18,10 @@ deploy, pull, vibrate, equilibrium
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
+``tapespring -v <command>`` prints the solver's messages on stderr (one line per analysis step;
+``-vv`` every time step and Newton iteration, ``-vvv`` the static Newton iterations too): the
+Python logger ``tapespring.core``, which a script configures with :mod:`logging` as usual.
+
 Each command lives in its own module, with a ``register`` function that adds its parser. The
 parsers are built without importing scipy, matplotlib, ezc3d or the native extension (a command
 imports what it needs when it runs), so ``tapespring --help`` answers at once.
@@ -41,6 +45,14 @@ def build_parser() -> argparse.ArgumentParser:
         prog="tapespring",
         description="Nonlinear shell simulation and experimental analysis of tape springs.",
     )
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="solver messages on stderr: -v one line per analysis step, -vv every time step and "
+        "Newton iteration, -vvv the static Newton iterations too (before the command)",
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     bend.register(sub)
     release.register(sub)
@@ -57,4 +69,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``tapespring`` command; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.verbose:
+        import logging
+
+        # The solver's messages (logger "tapespring.core"), read at the start of every run.
+        level = {1: logging.INFO, 2: logging.DEBUG}.get(args.verbose, 5)
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(name)s: %(message)s"))
+        core = logging.getLogger("tapespring.core")
+        core.addHandler(handler)
+        core.setLevel(level)
     return int(args.func(args))

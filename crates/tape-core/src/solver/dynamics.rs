@@ -556,7 +556,7 @@ impl Integrator<'_> {
             let mut with_tangent = !reusable;
             let (mut res, mut reference) = self.assemble(start, state, h, with_tangent, &mut r);
             log::debug!(
-                "t = {}, step {h:e} s: iteration {it}, residual {res:e} (reference {reference:e}){}",
+                "t = {:.6e} s, step {h:.3e} s: iteration {it}, residual {res:.3e} N (reference {reference:.3e} N){}",
                 start.t,
                 if reusable { ", reused matrix" } else { "" }
             );
@@ -935,6 +935,10 @@ pub fn solve_dynamic(
                     }
                     (iterations, true)
                 } else {
+                    log::debug!(
+                        "t = {:.6e} s: step {step_h:.3e} s rejected by the error estimate ({error:.3} times the tolerance)",
+                        state.t
+                    );
                     integ.stats.cutbacks += 1;
                     h = step_h * factor.min(0.9);
                     (iterations, false)
@@ -949,7 +953,7 @@ pub fn solve_dynamic(
                 integ.stats.cutbacks += 1;
                 cutbacks += 1;
                 log::debug!(
-                    "t = {}: step {step_h:e} s rejected after {iterations} iterations (residual {residual:e}): {why}",
+                    "t = {:.6e} s: step {step_h:.3e} s rejected after {iterations} iterations (residual {residual:.3e} N): {why}",
                     state.t
                 );
                 h = step_h * 0.25;

@@ -366,7 +366,7 @@ impl Driver<'_> {
             self.assemble(state);
             let (ok, r) = self.converged(energy_first);
             res = r;
-            log::trace!("Newton iteration {it}: t {:.6}, residual {res:.3e}", state.t);
+            log::trace!("t = {:.6e}: Newton iteration {it}, residual {res:.3e}", state.t);
             if !res.is_finite() {
                 return Err(Rejection::NonFinite);
             }
