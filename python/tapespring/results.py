@@ -387,9 +387,9 @@ class Results:
             return cls._read(Path(path))
         except (FileNotFoundError, IsADirectoryError, PermissionError):
             raise
+        except _NotResults:
+            raise
         except ValueError as exc:
-            if str(path) in str(exc):
-                raise
             # NumPy reads what is neither .npz nor .npy as a pickle, which it refuses.
             reason = "not a NumPy .npz archive" if "pickled" in str(exc) else str(exc)
             message = f"{path} is not a readable saved tapespring Results ({reason})"
@@ -405,12 +405,12 @@ class Results:
         # The file is opened here, not by np.load, which leaves it open when it fails.
         with path.open("rb") as handle, _npz(np.load(handle, allow_pickle=False), path) as f:
             if "meta" not in f:
-                raise ValueError(f"{path} is not a saved tapespring Results")
+                raise _NotResults(f"{path} is not a saved tapespring Results")
             meta = json.loads(str(f["meta"]))
             if meta.get("format") != _FORMAT:
-                raise ValueError(f"{path} is not a saved tapespring Results")
+                raise _NotResults(f"{path} is not a saved tapespring Results")
             if meta.get("version", 0) > _VERSION:
-                raise ValueError(
+                raise _NotResults(
                     f"{path} was written by a newer tapespring (format {meta['version']})"
                 )
             n = f["t"].shape[0]
@@ -427,10 +427,14 @@ class Results:
         return cls.from_dict(d)
 
 
+class _NotResults(ValueError):
+    """A readable file that is not a saved `Results`: its message names the file already."""
+
+
 def _npz(loaded: Any, path: Path) -> Any:
     """`loaded` if np.load read an archive (a .npy array is not a saved `Results`)."""
     if not isinstance(loaded, np.lib.npyio.NpzFile):
-        raise ValueError(f"{path} is not a saved tapespring Results (not a .npz archive)")
+        raise _NotResults(f"{path} is not a saved tapespring Results (not a .npz archive)")
     return loaded
 
 

@@ -80,12 +80,11 @@ class ReleaseSetup:
         ValueError
             Naming the bad value.
         """
-        for name in ("density", "tip_mass", "tip_inertia", "duration", "eta", "tolerance"):
+        for name in ("density", "eta", "tolerance"):
             check_number(name, getattr(self, name), positive=True, zero=True)
-        if self.duration <= 0.0:
-            raise ValueError(f"duration must be > 0 s (got {self.duration})")
-        if self.tip_mass <= 0.0 or self.tip_inertia <= 0.0:
-            raise ValueError("tip_mass and tip_inertia must be > 0 (the free end needs inertia)")
+        # The free end needs inertia: a massless tip body leaves its rotations without mass.
+        for name in ("tip_mass", "tip_inertia", "duration"):
+            check_number(name, getattr(self, name), positive=True)
         check_rho_inf(self.rho_inf)
         check_number("gravity", self.gravity, positive=False)
         check_number("fold_deg", self.fold_deg, positive=False)
