@@ -122,9 +122,13 @@ def test_pull_starts_at_the_cantilever_stiffness_and_buckles() -> None:
 
 def test_pull_maximum_against_the_papers_model() -> None:
     # The paper's meshes are 2 mm and 3 mm; on 3 mm everywhere the maximum force is 7.64 N
-    # (Table 9's model: 7.6 N; 2 mm tapes give 7.16 N): within 5 %, the mesh's own spread.
+    # (Table 9's model: 7.6 N; 2 mm tapes give 7.24 N): within 5 %, the mesh's own spread.
+    # With the command's default pull (20 mm) a path state falls just short of the maximum, by
+    # less than the monitor's 1 % prominence; the maximum is located all the same (it was once
+    # left as the sampled state beyond it: 7.55 N at 12.3 mm instead of 7.64 N at 11.4 mm).
     spec = replace(PAPER_SETUP, mesh_tape=3e-3, mesh_plates=3e-3)
-    result = pull(PullSettings(spec=spec, max_displacement=0.016))
+    result = pull(PullSettings(spec=spec))
+    assert result.located
     assert result.max_force_N == pytest.approx(PAPER_MODEL.pull_max_force, rel=0.05)
     # Its displacement is reported (11.4 mm against 10.1 mm), not asserted beyond the band of
     # the experiments (Table 2: 10.8 mm, spread 4.6 mm).

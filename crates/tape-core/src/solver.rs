@@ -120,8 +120,9 @@ pub struct StaticParams {
     /// Tolerance of located limit points and extrema, in load factor (> 0).
     pub event_tolerance: f64,
     /// An extremum of the monitored reaction is located only if the reaction changes by more than
-    /// this fraction of its magnitude on both sides of it, over the converged steps that bracket it
-    /// (in [0, 1)): the extrema of a plateau are not events.
+    /// this fraction of its magnitude on both sides of it (in [0, 1)): over the monotonic run of
+    /// converged steps that leads to it, and to the converged step after it. The extrema of a
+    /// plateau are not events.
     pub monitor_prominence: f64,
     /// With a monitor: a converged step longer than `refine_span` in load factor over which the
     /// monitored reaction changes by more than this fraction of its magnitude is refined by extra

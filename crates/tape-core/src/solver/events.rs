@@ -150,11 +150,14 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
         for (kind, g) in kinds {
             let sense = (g[1] - g[0]).signum();
             // An extremum of the monitor on a plateau (a change on either side below
-            // `monitor_prominence` of its magnitude) is noise, not an event: not located.
+            // `monitor_prominence` of its magnitude) is noise, not an event: not located. The
+            // change before it is the whole monotonic run that leads to it, not the last step's:
+            // a state just short of a sharp maximum would otherwise hide it.
             let prominent = match kind {
                 Event::MonitorExtremum => {
                     let scale = g[1].abs() * s.params.monitor_prominence;
-                    (g[1] - g[0]).abs() > scale && (g[1] - g[2]).abs() > scale
+                    let rise = g[1] - run_start(&history[..n - 1], sense);
+                    rise.abs() > scale && (g[1] - g[2]).abs() > scale
                 }
                 _ => true,
             };
@@ -183,6 +186,16 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
         path.steps.extend(found.into_iter().map(|f| f.step));
     }
     Ok(())
+}
+
+/// The monitored reaction where the monotonic run (in `sense`) ending at `points`' last point
+/// began.
+fn run_start(points: &[Point], sense: f64) -> f64 {
+    let mut j = points.len() - 1;
+    while j > 0 && (points[j].monitor - points[j - 1].monitor) * sense > 0.0 {
+        j -= 1;
+    }
+    points[j].monitor
 }
 
 /// Before a jump from the limit point the path reached at `history`'s last state, the step to
