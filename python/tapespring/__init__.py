@@ -4,7 +4,7 @@ Sub-modules
 -----------
 analysis
     The model, analysis steps and `run`: one call to the native solver (also exported here as
-    `Model`, `Step`, `Outputs`, `run`).
+    `Model`, `Step`, `Outputs`, `run`, and its errors `ConvergenceError` and `TapeError`).
 results
     `Results`: everything an analysis recorded, saved and loaded with its settings.
 modes
@@ -13,7 +13,8 @@ modes
 shell
     Shell meshes, and static equilibrium paths in one call.
 scenarios
-    The paper's set-up and tests as ready-made simulations (pure bending of a tape spring).
+    The paper's set-up and tests as ready-made simulations (pure bending of a tape spring, the
+    deployment, pull, vibration and equilibrium tests, the maximum mass, the release).
 signals
     Signal analyses on plain arrays, for measured and simulated series alike: bending angle,
     smoothing, peaks, statistics, damping fit, phases, circle fit, pull-test maximum.
@@ -40,10 +41,12 @@ from typing import Any
 __version__ = "0.1.0"
 
 __all__ = [
+    "ConvergenceError",
     "Model",
     "Outputs",
     "Results",
     "Step",
+    "TapeError",
     "__version__",
     "analysis",
     "cli",
@@ -61,6 +64,8 @@ __all__ = [
 
 
 _FROM = {
+    "ConvergenceError": "analysis",
+    "TapeError": "analysis",
     "Model": "analysis",
     "Outputs": "analysis",
     "Step": "analysis",

@@ -38,8 +38,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="fold the set-up with its appendix, release it and follow the deployment",
         description=(
             "The set-up with the dummy appendix sags under gravity, is folded downwards by "
-            "pulling the middle of its rod (static, past the buckling of the tapes) and "
-            "released; it deploys against gravity for --duration seconds (generalised-alpha, "
+            "turning its small interfaces about y to the paper's initial bending angle (static, "
+            "past the buckling of the tapes) and released; it deploys against gravity for "
+            "--duration seconds (generalised-alpha, "
             "adaptive steps). Prints the bending angle's peaks and phases; --plot draws the "
             "angle and the clamp force. The defaults are a coarse, short run; the paper's is "
             "--mesh-tape 2e-3 --mesh-plates 3e-3 --duration 10."
@@ -89,8 +90,13 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             default=[],
             metavar="K",
             help=f"with --experiment: the simulation's {word} left aside in the peak-by-peak "
-            "comparison, numbered from 1 (the paper leaves aside the model's extra fourth "
-            "minimum in equal sense: --leave-aside-min 4)",
+            "comparison, numbered from 1"
+            + (
+                " (the paper leaves aside the model's extra fourth minimum in equal sense: "
+                "--leave-aside-min 4)"
+                if kind == "min"
+                else ""
+            ),
         )
     p.add_argument(
         "--vtu",

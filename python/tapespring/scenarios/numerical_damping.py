@@ -108,6 +108,10 @@ class NumericalDampingStudy:
             period, period_p = self.period_s[k], self.predicted_period_s[k]
             row = f"  {rho:7.2f}  {eps:12.3%}  {eps_p:9.3%}   {period:9.4f}  {period_p:9.4f}"
             lines.append(row)
+        for rho, run in zip(self.rho_inf, self.runs, strict=True):
+            for what, why in (("no fit", run.fit_error), ("stopped", run.results.error)):
+                if why:
+                    lines.append(f"  rho_inf {rho:g}: {what}: {why}")
         lines.append(f"  wall time {self.wall_s:.1f} s")
         return "\n".join(lines)
 
