@@ -117,6 +117,15 @@ def test_dynamic_step_options_and_errors():
     with pytest.raises(ValueError, match="'line_search' does not apply to a dynamic step"):
         run(model, [Step.dynamic(duration=0.01, line_search=True)])
     run(model, [Step.dynamic(duration=1e-4, line_search=False)])
+    # Requests that could only end at max_steps, or that the time cannot resolve, are refused
+    # at once, with short numbers.
+    with pytest.raises(ValueError, match=r"\(1e300\) over output_interval .* max_steps \(100000\)"):
+        run(model, [Step.dynamic(duration=1e300, output_interval=1e-3)])
+    with pytest.raises(ValueError, match="needs 2.000e5 steps, more than max_steps"):
+        run(model, [Step.dynamic(duration=2.0, initial_step=1e-5, adaptive=False)])
+    pushed = [Step.static("push", activate=["push"], increments=1)]
+    with pytest.raises(ValueError, match=r"duration \[s\] \(1e-300\) is below the resolution"):
+        run(model, [*pushed, Step.dynamic(duration=1e-300, deactivate=["push"])])
     massless = Model(*flat_plate_mesh(L, B, 4, 1)[:2], thickness=T, youngs_modulus=E, poisson=0.0)
     massless.fix(0, "all")
     massless.fix(5, "all")

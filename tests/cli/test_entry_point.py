@@ -43,3 +43,44 @@ def test_an_output_path_that_cannot_be_written_is_refused_before_the_run(
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert f"argument {option}" in err and problem in err
+
+
+@pytest.mark.parametrize(
+    ("command", "option"),
+    [
+        ("bend", "--plot"),
+        ("release", "--plot"),
+        ("deploy", "--snapshots"),
+        ("vibrate", "--plot"),
+        ("max-mass", "--plot"),
+    ],
+)
+def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
+    command, option, tmp_path, capsys
+):
+    with pytest.raises(SystemExit) as exc:
+        main([command, option, str(tmp_path / "figure.xyz")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument {option}" in err and "'.xyz' is not an image format" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "code", "message"),
+    [
+        # The solver's own errors (TapeError): a tangent that overflows.
+        (["bend", "--mesh-size", "4.5e-3", "--thickness=1e300", "--no-progress"], 1, "non-finite"),
+        # A ValueError found by the solver, not the parser.
+        (["max-mass", "--mesh-size=1e-300", "--n-thickness", "1", "--n-modulus", "1"], 2, "counts"),
+        # A model larger than memory.
+        (["bend", "--length", "1e3", "--no-progress"], 1, "not enough memory"),
+        # A failure in a scenario's first (static) step, which has no scenario result to show.
+        (["vibrate", "--duration", "0.02", "--thickness=1e300", "--no-progress"], 1, "gravity"),
+    ],
+)
+def test_errors_found_while_running_are_messages_not_tracebacks(argv, code, message, capsys):
+    assert main(argv) == code
+    err = capsys.readouterr().err
+    # After the progress bar's last line, if any.
+    last = err.replace("\r", "\n").strip().splitlines()[-1]
+    assert last.startswith("error: ") and message in last

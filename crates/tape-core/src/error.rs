@@ -103,7 +103,33 @@ pub(crate) fn check_positive(name: &str, value: f64) -> Result<()> {
         Ok(())
     } else {
         Err(Error::InvalidParameter(format!(
-            "{name} must be finite and > 0 (got {value})"
+            "{name} must be finite and > 0 (got {})",
+            shown(value)
         )))
+    }
+}
+
+/// A number for a message: as written for ordinary magnitudes, in scientific notation for very
+/// large or small ones (`{}` would print 1e300 with all its 301 digits).
+pub(crate) fn shown(value: f64) -> String {
+    let magnitude = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e9).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(shown(0.25), "0.25");
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-1e-300), "-1e-300");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(0.0), "0");
     }
 }

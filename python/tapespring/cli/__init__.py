@@ -30,6 +30,7 @@ imports what it needs when it runs), so ``tapespring --help`` answers at once.
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Sequence
 
 __all__ = ["build_parser", "main"]
@@ -79,4 +80,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         core = logging.getLogger("tapespring.core")
         core.addHandler(handler)
         core.setLevel(level)
-    return int(args.func(args))
+    try:
+        return int(args.func(args))
+    except (ValueError, MemoryError, OSError) as exc:
+        # What a command did not report itself: bad input found by the solver, a model larger
+        # than memory, an output that cannot be written. A message, not a traceback.
+        print(f"error: {exc}", file=sys.stderr)
+        return 2 if isinstance(exc, ValueError) else 1
+    except Exception as exc:
+        core_module = sys.modules.get("tapespring._core")
+        if core_module is not None and isinstance(exc, core_module.TapeError):
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+        raise

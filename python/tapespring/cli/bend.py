@@ -51,6 +51,23 @@ def _output_file(text: str) -> str:
     return text
 
 
+def _image_file(text: str) -> str:
+    """An argparse type: an image file the command will write (as `_output_file`), in a format
+    matplotlib writes, given by its extension (none: PNG)."""
+    _output_file(text)
+    suffix = Path(text).suffix.lower().lstrip(".")
+    if suffix:
+        from matplotlib.backend_bases import FigureCanvasBase
+
+        formats = FigureCanvasBase.get_supported_filetypes()
+        if suffix not in formats:
+            raise argparse.ArgumentTypeError(
+                f"cannot write {text}: '.{suffix}' is not an image format matplotlib writes "
+                f"({', '.join(sorted(formats))})"
+            )
+    return text
+
+
 def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     """Add the tape's geometry, material and mesh options (defaults from the `BendingSetup` `d`).
 
@@ -157,7 +174,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_output_file,
         help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file",
     )
-    p.add_argument("--plot", type=_output_file, help="write the curve as a PNG (paper Fig. 4)")
+    p.add_argument("--plot", type=_image_file, help="write the curve as a PNG (paper Fig. 4)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .bend import _output_file, _positive
+from .bend import _image_file, _output_file, _positive
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -107,7 +107,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--snapshots",
-        type=_output_file,
+        type=_image_file,
         metavar="FILE.png",
         help="draw the set-up from the side at the release and every --duration/5 s (Fig. 13)",
     )

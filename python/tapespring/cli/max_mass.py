@@ -15,7 +15,7 @@ import json
 import math
 import sys
 
-from .bend import _output_file, _positive
+from .bend import _image_file, _output_file, _positive
 
 __all__ = ["register", "run"]
 
@@ -140,7 +140,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--plot",
-        type=_output_file,
+        type=_image_file,
         help="write a contour plot of m_max [g] like the paper's Fig. 7 (PNG)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")

@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from .bend import _output_file, _positive, add_tape_options, tape_fields
+from .bend import _image_file, _output_file, _positive, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
 
@@ -93,9 +93,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_output_file,
         help="write time_s, theta_deg, moment_Nm and the energies to this CSV",
     )
-    p.add_argument(
-        "--plot", type=_output_file, help="write the angle and energy histories as a PNG"
-    )
+    p.add_argument("--plot", type=_image_file, help="write the angle and energy histories as a PNG")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)

@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .bend import _output_file, _positive
+from .bend import _image_file, _output_file, _positive
 
 __all__ = [
     "add_comparison_options",
@@ -75,7 +75,7 @@ def spec_from_args(args: argparse.Namespace) -> Any:
 def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
     """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
     p.add_argument("--csv", type=_output_file, help=f"write {csv_what} to this CSV file")
-    p.add_argument("--plot", type=_output_file, help="write the figure to this PNG file")
+    p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -102,8 +102,10 @@ def finish(
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except ConvergenceError as exc:
+        # The scenario's partial result, if the run got that far (a failure in an earlier step
+        # carries the raw analysis results, which have no summary).
         result = getattr(exc, "result", None)
-        if result is None:
+        if result is None or not hasattr(result, "describe"):
             print(f"error: {exc}", file=sys.stderr)
             return 1
         failure = str(exc)

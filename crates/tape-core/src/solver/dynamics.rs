@@ -42,7 +42,7 @@ use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
-use crate::error::{check_positive, Error, Result};
+use crate::error::{check_positive, shown, Error, Result};
 use crate::inertia::Motion;
 use crate::options::Options;
 use crate::rotation::tangent_inverse;
@@ -191,7 +191,8 @@ impl DynamicParams {
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::InvalidParameter(format!(
-                    "{name} must be finite and >= 0 (0: default) (got {v})"
+                    "{name} must be finite and >= 0 (0: default) (got {})",
+                    shown(v)
                 )));
             }
         }
@@ -209,6 +210,27 @@ impl DynamicParams {
                     ", by default duration / 20"
                 }
             )));
+        }
+        // Every output time is a step (and every fixed step one): a request beyond `max_steps`
+        // would only stop there, after a long run.
+        let needed = if self.output_interval > 0.0 {
+            Some(("output_interval [s]", self.output_interval))
+        } else if !self.adaptive && self.initial_step > 0.0 {
+            Some(("the fixed step (initial_step) [s]", self.initial_step))
+        } else {
+            None
+        };
+        if let Some((name, every)) = needed {
+            let steps = self.duration / every;
+            if steps > self.max_steps as f64 {
+                return Err(Error::InvalidParameter(format!(
+                    "duration [s] ({}) over {name} ({}) needs {steps:.3e} steps, more than \
+                     max_steps ({}): shorten the duration or raise max_steps",
+                    shown(self.duration),
+                    shown(every),
+                    self.max_steps
+                )));
+            }
         }
         if self.max_cutbacks > 1000 {
             return Err(Error::InvalidParameter(format!(
@@ -798,6 +820,13 @@ pub fn solve_dynamic(
 ) -> Result<DynamicPath> {
     let start_time = Instant::now();
     params.validate()?;
+    if params.duration <= 1e-12 * (state.t + params.duration).abs() {
+        return Err(Error::InvalidParameter(format!(
+            "duration [s] ({}) is below the resolution of the time at the step's start ({} s)",
+            shown(params.duration),
+            shown(state.t)
+        )));
+    }
     let linear_counts = (system.linear.refinement_sweeps, system.linear.lu_fallbacks);
     let alpha = Alpha::new(params.rho_inf)?;
     let weights = system.free_weights();
