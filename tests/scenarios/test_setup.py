@@ -226,3 +226,15 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert code == 0
     out = json.loads(capsys.readouterr().out)
     assert out["marker_displacements_m"]["marker3_dz_m"] == pytest.approx(result.marker3_m[2])
+
+
+def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:
+    from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+
+    # 10 mm does not buckle the tapes: the force never changes sign after a maximum, and the
+    # reference state's round-off force is not that maximum (it once gave zero displacements).
+    result = equilibrium(EquilibriumSettings(spec=COARSE, push=0.01))
+    assert not result.found
+    assert np.isnan(result.marker3_m).all() and result.unstable_modes == -1
+    argv = ["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--push=0.01", "--json"]
+    assert main(argv) == 1

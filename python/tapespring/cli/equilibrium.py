@@ -32,8 +32,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring equilibrium``; returns the exit code (0, 1 stopped early, 2 bad
-    input)."""
+    """Handler of ``tapespring equilibrium``; returns the exit code (0, 1 stopped early or no
+    folded equilibrium on the push path, 2 bad input)."""
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
     def simulate() -> object:
@@ -58,4 +58,12 @@ def run(args: argparse.Namespace) -> int:
     def columns(result: object) -> dict:
         return {"push_m": result.push_m, "force_N": result.force_N}  # type: ignore[attr-defined]
 
-    return finish(args, simulate, columns, plot)
+    found: list[bool] = []
+
+    def extra(result: object) -> None:
+        found.append(bool(result.found))  # type: ignore[attr-defined]
+
+    code = finish(args, simulate, columns, plot, extra=extra)
+    # Asked for an equilibrium, the command fails when the push path has none (the summary says
+    # so; the path is still written).
+    return 1 if code == 0 and found == [False] else code
