@@ -68,8 +68,8 @@ def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
 @pytest.mark.parametrize(
     ("argv", "code", "message"),
     [
-        # The solver's own errors (TapeError): a tangent that overflows.
-        (["bend", "--mesh-size", "4.5e-3", "--thickness=1e300", "--no-progress"], 1, "non-finite"),
+        # The solver's own errors (TapeError): a tangent that underflows.
+        (["bend", "--mesh-size", "4.5e-3", "-E", "1e-300", "--no-progress"], 1, "factorisation"),
         # A ValueError found by the solver, not the parser.
         (["max-mass", "--mesh-size=1e-300", "--n-thickness", "1", "--n-modulus", "1"], 2, "counts"),
         # A model larger than memory.
@@ -84,3 +84,11 @@ def test_errors_found_while_running_are_messages_not_tracebacks(argv, code, mess
     # After the progress bar's last line, if any.
     last = err.replace("\r", "\n").strip().splitlines()[-1]
     assert last.startswith("error: ") and message in last
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "x"])
+def test_a_peak_left_aside_is_numbered_from_one_before_the_run(value, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["deploy", "--leave-aside-min", value])
+    assert exc.value.code == 2
+    assert "argument --leave-aside-min" in capsys.readouterr().err

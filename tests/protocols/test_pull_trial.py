@@ -11,3 +11,15 @@ def test_pull_trial_recovers_maximum_force_and_displacement():
     # 800 Hz interpolated at the force instants).
     assert result.test.max_force == pytest.approx(9.8, abs=0.26)
     assert result.test.displacement_at_max == pytest.approx(10.8e-3, abs=0.3e-3 + 5 * MARKER_SD)
+
+
+def test_a_smoothing_span_longer_than_the_record_is_refused():
+    # smooth() would shrink the window to the whole record and report its mean as the maximum.
+    from tapespring.trials import TrialError
+
+    trial = make_pull_test_trial(seed=3)
+    n = trial.force_plate(0).force.shape[0]
+    with pytest.raises(TrialError, match=f"span \\({n + 1} samples\\) is longer than the force"):
+        analyze_pull_trial(trial, span=n + 1)
+    with pytest.raises(TrialError, match="is longer than the force record"):
+        analyze_pull_trial(trial, span_time=1e3)

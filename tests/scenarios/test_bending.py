@@ -428,6 +428,8 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
         ({"mesh_size": 38e-3}, "too coarse for a tape 18.96 mm wide"),
         ({"mesh_size": 1000.0}, "too coarse"),
         ({"mesh_size": float("nan")}, "mesh_size must be finite"),
+        # As thick as the section is curved: no thin shell (it once ran, 85 % off eq. (2)).
+        ({"thickness": 0.02}, "is not thin against the radius"),
         ({"alpha_deg": [1.0]}, r"alpha_deg must be a number \(got \[1.0\]\)"),
         ({"theta_max_deg": None}, r"theta_max_deg must be a number \(got None\)"),
     ],

@@ -8,12 +8,25 @@ from .bend import _image_file, _output_file, _positive
 from .scenario_options import (
     add_output_options,
     add_spec_options,
+    analyze_experiment,
     finish,
     spec_from_args,
     with_comparison,
 )
 
 __all__ = ["register", "run"]
+
+
+def _peak_number(text: str) -> int:
+    """An argparse type: a peak's number, counted from 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a peak number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"peaks are numbered from 1 (got {value})")
+    return value
+
 
 #: Defaults of the command: a coarse mesh and a short motion, so that it answers in well under a
 #: minute; the paper's run is ``--mesh-tape 2e-3 --mesh-plates 3e-3 --duration 10``.
@@ -85,7 +98,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     for kind, word in (("min", "minima"), ("max", "maxima")):
         p.add_argument(
             f"--leave-aside-{kind}",
-            type=int,
+            type=_peak_number,
             nargs="+",
             default=[],
             metavar="K",
@@ -128,12 +141,9 @@ def run(args: argparse.Namespace) -> int:
     measured = None
     if args.experiment:
         from tapespring.protocols.deployment import analyze_deployment
-        from tapespring.trials.load import read_trial
 
-        try:
-            measured = analyze_deployment(read_trial(args.experiment))
-        except (OSError, ValueError) as exc:
-            print(f"error: {args.experiment}: {exc}", file=sys.stderr)
+        measured = analyze_experiment(args.experiment, analyze_deployment)
+        if measured is None:
             return 2
 
     def simulate() -> object:

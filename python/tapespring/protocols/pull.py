@@ -98,6 +98,14 @@ def analyze_pull_trial(
     fz = fp.force[:, 2]
     if not np.all(np.isfinite(fz)):
         raise TrialError(trial.metadata.label, "the vertical force has NaN samples")
+    if span > fz.size:
+        # smooth() would shrink the window to the record, leaving a maximum of a mean, not the
+        # smoothed peak.
+        raise TrialError(
+            trial.metadata.label,
+            f"the force smoothing span ({span} samples) is longer than the force record "
+            f"({fz.size} samples at {fp.rate:g} Hz)",
+        )
     f = fz - np.median(fz[fp.time < fp.time[0] + tare])
     fs = smooth(f, span)
     f_sign = np.sign(fs[np.argmax(np.abs(fs))]) or 1.0

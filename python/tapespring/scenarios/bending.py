@@ -163,6 +163,13 @@ class BendingSetup:
             )
         if self.mesh_size <= 0.0:
             raise ValueError(f"mesh_size [m] must be finite and > 0 (got {self.mesh_size})")
+        # A shell as thick as its radius of curvature has no inner surface: the Mindlin shell
+        # (and eqs. (2)-(3)) describe thin walls, t / R of 0.01 for the paper's tape.
+        if self.thickness >= 0.5 * self.radius:
+            raise ValueError(
+                f"thickness = {self.thickness} m is not thin against the radius {self.radius} m "
+                f"(a shell model needs thickness < radius / 2)"
+            )
         # A coarser mesh does not represent the curved section, and the fold that forms in it, at
         # all (38 mm elements on this tape gave M_max = 1.45 N m instead of 0.30).
         width = self.radius * math.radians(self.alpha_deg)
