@@ -84,6 +84,9 @@ def test_equal_sense_turns_gravity_and_markers_over() -> None:
         ({"tape_spacing": 0.01}, "overlap"),
         ({"interface_mass": -1.0}, "interface_mass"),
         ({"mesh_tape": float("nan")}, "mesh_tape"),
+        # Refused before building millions of elements, or counts overflowing (1e-300 m).
+        ({"mesh_tape": 1e-5}, "mesh_tape 1e-05 m is too fine: a tape alone would have 1.9e"),
+        ({"mesh_plates": 1e-300}, "mesh_plates 1e-300 m is too fine"),
         ({"setup_length": 0.12}, "appendix"),
         ({"eta": -1e-4}, "eta"),
         ({"tape": replace(PAPER_SETUP.tape, thickness=0.0)}, "thickness"),

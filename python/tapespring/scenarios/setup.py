@@ -469,6 +469,15 @@ class SetupSpec:
             size = getattr(self, name)
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
+            # Elements per tape at this size, refused before the meshes are built (which takes
+            # minutes at millions of elements) and before their counts overflow.
+            area = self.tape.length * self.tape.radius * math.radians(self.tape.alpha_deg)
+            if area > MAX_ELEMENTS * size * size:
+                n = area / size / size
+                raise ValueError(
+                    f"{name} {size:g} m is too fine: a tape alone would have {n:.3g} elements, "
+                    f"more than {MAX_ELEMENTS:.0e}"
+                )
 
     def _validate_support(self) -> None:
         """Check the flexible support's values: each one always (like every value), against
@@ -497,6 +506,11 @@ class SetupSpec:
                     f"mesh_plates {self.mesh_plates} m is too coarse for {name} (at most a "
                     "quarter of it)"
                 )
+
+
+#: Most elements a tape of the set-up may have: 6 million DOFs, whose factorisation needs more
+#: memory than a workstation has (the paper's 2 mm mesh has 475 per tape).
+MAX_ELEMENTS = 1e6
 
 
 def check_sense(sense: str) -> None:
