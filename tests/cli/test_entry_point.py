@@ -91,4 +91,5 @@ def test_a_peak_left_aside_is_numbered_from_one_before_the_run(value, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["deploy", "--leave-aside-min", value])
     assert exc.value.code == 2
-    assert "argument --leave-aside-min" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "argument --leave-aside-min: --leave-aside-min must be a peak number" in err

@@ -409,7 +409,7 @@ def test_cli_bad_input_exits_2_before_any_run(extra, message, capsys):
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [
-        ("--n-thickness", "0", "n-thickness must be >= 1"),
+        ("--n-thickness", "0", "n-thickness must be an integer >= 1"),
         ("--n-modulus", "two", "n-modulus must be an integer"),
         ("--gravity", "-1", "gravity must be finite and > 0"),
     ],

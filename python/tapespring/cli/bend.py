@@ -35,6 +35,21 @@ def _positive(name: str, *, zero: bool = False):
     return parse
 
 
+def _count(name: str, what: str = "an integer >= 1"):
+    """An argparse type: an integer >= 1 (described as `what` in errors), named `name`."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be {what} (got {text!r})") from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"{name} must be {what} (got {value})")
+        return value
+
+    return parse
+
+
 def _output_file(text: str) -> str:
     """An argparse type: a file the command will write, in a folder that exists (checked before
     anything runs, so that a mistyped path does not cost the run)."""

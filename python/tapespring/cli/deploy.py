@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .bend import _image_file, _output_file, _positive
+from .bend import _count, _image_file, _output_file, _positive
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -15,17 +15,6 @@ from .scenario_options import (
 )
 
 __all__ = ["register", "run"]
-
-
-def _peak_number(text: str) -> int:
-    """An argparse type: a peak's number, counted from 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a peak number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"peaks are numbered from 1 (got {value})")
-    return value
 
 
 #: Defaults of the command: a coarse mesh and a short motion, so that it answers in well under a
@@ -98,7 +87,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     for kind, word in (("min", "minima"), ("max", "maxima")):
         p.add_argument(
             f"--leave-aside-{kind}",
-            type=_peak_number,
+            type=_count(f"--leave-aside-{kind}", "a peak number, counted from 1"),
             nargs="+",
             default=[],
             metavar="K",

@@ -15,26 +15,11 @@ import json
 import math
 import sys
 
-from .bend import _image_file, _output_file, _positive
+from .bend import _count, _image_file, _output_file, _positive
 
 __all__ = ["register", "run"]
 
 _SENSES = {"equal": ("equal",), "opposite": ("opposite",), "both": ("equal", "opposite")}
-
-
-def _count(name: str):
-    """An argparse type: an integer >= 1, named `name` in errors."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer (got {text!r})") from None
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{name} must be >= 1 (got {value})")
-        return value
-
-    return parse
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -24,20 +24,11 @@ from pathlib import Path
 from tapespring.protocols.markers import DEFAULT_MARKERS
 from tapespring.protocols.registry import KINDS
 
+from .bend import _count
+
 __all__ = ["main", "register", "run_analyze"]
 
 _SENSES = ("opposite", "equal")  # tapespring.trials.SENSES, without importing the trials
-
-
-def _int_at_least_1(text: str) -> int:
-    """An argparse type: an integer >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {value}")
-    return value
 
 
 def _seconds(text: str, *, zero: bool) -> float:
@@ -107,7 +98,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--n-peaks",
-        type=_int_at_least_1,
+        type=_count("--n-peaks"),
         default=10,
         help="deployment: maxima and minima analysed, >= 1 (default 10)",
     )
@@ -133,7 +124,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     span = p.add_mutually_exclusive_group()
     span.add_argument(
         "--span",
-        type=_int_at_least_1,
+        type=_count("--span"),
         default=None,
         metavar="SAMPLES",
         help="quasi-static: force smoothing span [samples] (default 101)",
