@@ -93,3 +93,29 @@ def test_a_peak_left_aside_is_numbered_from_one_before_the_run(value, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "argument --leave-aside-min: --leave-aside-min must be a peak number" in err
+
+
+@pytest.mark.parametrize("command", ["deploy", "pull", "vibrate"])
+@pytest.mark.parametrize(("name", "problem"), [("", "empty file name"), (".", "is a folder")])
+def test_an_experiment_that_is_no_file_is_refused_before_the_run(command, name, problem, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([command, "--experiment", name])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "argument --experiment" in err and problem in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["bend", "--theta-max", "1e-300"], "theta_max_deg"),
+        (["release", "--fold-deg", "1e-300"], "fold_deg"),
+        (["pull", "--max-displacement", "1e-300"], "max_displacement"),
+        (["equilibrium", "--push", "1e-300"], "push"),
+    ],
+)
+def test_a_motion_too_small_to_resolve_is_named(argv, name, capsys):
+    # It once reached the solver: "the loads and prescribed motions act on no free DOF".
+    assert main([*argv, "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert name in err and "free DOF" not in err

@@ -158,8 +158,11 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert png.stat().st_size > 10_000 and snaps.stat().st_size > 10_000
     # The ParaView series: one file per kept record (every 16th of 241, and the last).
     assert len(list((tmp_path / "run").glob("*.vtu"))) >= 15
-    assert main([*args, f"--experiment={tmp_path / 'missing.csv'}"]) == 2
-    assert "missing.csv" in capsys.readouterr().err
+    # A recording that is not there is refused before the run, by the parser.
+    with pytest.raises(SystemExit) as exc:
+        main([*args, f"--experiment={tmp_path / 'missing.csv'}"])
+    assert exc.value.code == 2
+    assert "no such file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("sense", ["opposite", "equal"])

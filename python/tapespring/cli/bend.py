@@ -50,6 +50,19 @@ def _count(name: str, what: str = "an integer >= 1"):
     return parse
 
 
+def _input_file(text: str) -> str:
+    """An argparse type: a file the command will read, that exists (checked before anything
+    runs); its content is checked by the reader."""
+    path = Path(text)
+    if text == "":
+        raise argparse.ArgumentTypeError("an empty file name")
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a folder, not a file")
+    if not path.exists():
+        raise argparse.ArgumentTypeError(f"no such file: {text}")
+    return text
+
+
 def _output_file(text: str) -> str:
     """An argparse type: a file the command will write, in a folder that exists (checked before
     anything runs, so that a mistyped path does not cost the run)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .bend import _count, _image_file, _output_file, _positive
+from .bend import _count, _image_file, _input_file, _output_file, _positive
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -80,6 +80,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--experiment",
+        type=_input_file,
         metavar="FILE",
         help="a recorded deployment (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
         "drawn under the simulation, and its first peaks compared with the simulation's",

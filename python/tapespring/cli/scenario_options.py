@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .bend import _image_file, _output_file, _positive
+from .bend import _image_file, _input_file, _output_file, _positive
 
 __all__ = [
     "add_comparison_options",
@@ -137,6 +137,7 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
     done with it) and ``--vtu FILE.pvd`` (a ParaView series; `vtu` says which states)."""
     p.add_argument(
         "--experiment",
+        type=_input_file,
         metavar="FILE",
         help="a recorded trial (C3D or CSV, markers M1-M3 as in 'tapespring trials'): "
         + experiment,

@@ -156,9 +156,10 @@ class BendingSetup:
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False (got {value!r})")
-        if not 0.0 < abs(self.theta_max_deg) < 360.0:
+        # From a millionth of a degree: a smaller rotation moves nothing the solver can resolve.
+        if not 1e-6 <= abs(self.theta_max_deg) < 360.0:
             raise ValueError(
-                f"theta_max_deg must be non-zero and within (-360, 360) degrees "
+                f"theta_max_deg must be within (-360, 360) degrees and at least 1e-6 in magnitude "
                 f"(got {self.theta_max_deg})"
             )
         if self.mesh_size <= 0.0:

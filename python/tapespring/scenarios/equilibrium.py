@@ -56,8 +56,9 @@ class EquilibriumSettings:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         p = self.push
-        if isinstance(p, bool) or not isinstance(p, (int, float)) or not 0.0 < p < 0.25:
-            raise ValueError(f"push must lie in (0, 0.25) m (got {p!r})")
+        # From a micron: a smaller push moves nothing the solver can resolve.
+        if isinstance(p, bool) or not isinstance(p, (int, float)) or not 1e-6 <= p < 0.25:
+            raise ValueError(f"push must lie in [1e-6, 0.25) m (got {p!r})")
 
 
 @dataclass(frozen=True)

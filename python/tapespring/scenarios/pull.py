@@ -73,8 +73,9 @@ class PullSettings:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         d = self.max_displacement
-        if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0.0 < d < 0.1:
-            raise ValueError(f"max_displacement must lie in (0, 0.1) m (got {d!r})")
+        # From a micron: a smaller pull moves nothing the solver can resolve.
+        if isinstance(d, bool) or not isinstance(d, (int, float)) or not 1e-6 <= d < 0.1:
+            raise ValueError(f"max_displacement must lie in [1e-6, 0.1) m (got {d!r})")
         check_count("field_interval", self.field_interval, minimum=0)
 
 

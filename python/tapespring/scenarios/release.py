@@ -88,9 +88,10 @@ class ReleaseSetup:
         check_rho_inf(self.rho_inf)
         check_number("gravity", self.gravity, positive=False)
         check_number("fold_deg", self.fold_deg, positive=False)
-        if not 0.0 < abs(self.fold_deg) < 180.0:
+        if not 1e-6 <= abs(self.fold_deg) < 180.0:
             raise ValueError(
-                f"fold_deg must be non-zero and within (-180, 180) (got {self.fold_deg})"
+                f"fold_deg must be within (-180, 180) degrees and at least 1e-6 in magnitude "
+                f"(got {self.fold_deg})"
             )
 
 
