@@ -217,6 +217,14 @@ def test_bad_experiment_file_is_named(command, problem, tmp_path, capsys) -> Non
         # A pull test has no free decay; a free decay has no force plate.
         other = make_vibration_trial() if command == "pull" else make_pull_test_trial()
         write_csv(other, path)
+    if problem == "missing":
+        # Refused by the parser, before the run (its usage line, then the error).
+        with pytest.raises(SystemExit) as exc:
+            main([command, "--no-progress", f"--experiment={path}"])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert f"no such file: {path}" in err and "Traceback" not in err
+        return
     assert main([command, "--no-progress", f"--experiment={path}"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and path.name in err
