@@ -385,9 +385,7 @@ class Results:
         """
         try:
             return cls._read(Path(path))
-        except (FileNotFoundError, IsADirectoryError, PermissionError):
-            raise
-        except _NotResults:
+        except (FileNotFoundError, IsADirectoryError, PermissionError, _NotResults):
             raise
         except ValueError as exc:
             # NumPy reads what is neither .npz nor .npy as a pickle, which it refuses.

@@ -108,14 +108,11 @@ impl Step {
         let kind: String = o.take_or("kind", "static".to_owned())?;
         let activate: Vec<String> = o.take_or("activate", Vec::new())?;
         let deactivate: Vec<String> = o.take_or("deactivate", Vec::new())?;
+        let in_step = |e: Error| e.context(&format!("step '{name}'"));
         let kind = match kind.as_str() {
-            "static" => {
-                StepKind::Static(StaticParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?)
-            }
-            "dynamic" => {
-                StepKind::Dynamic(DynamicParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?)
-            }
-            "modal" => StepKind::Modal(ModalParams::from_options(o).map_err(|e| e.context(&format!("step '{name}'")))?),
+            "static" => StepKind::Static(StaticParams::from_options(o).map_err(in_step)?),
+            "dynamic" => StepKind::Dynamic(DynamicParams::from_options(o).map_err(in_step)?),
+            "modal" => StepKind::Modal(ModalParams::from_options(o).map_err(in_step)?),
             other => {
                 return Err(Error::InvalidParameter(format!(
                     "step '{name}': unknown kind '{other}' (expected 'static', 'dynamic' or 'modal')"

@@ -219,12 +219,14 @@ impl Model {
     /// # Errors
     /// Invalid section, mesh or placement, a mesh without elements, or a part name already used.
     pub fn add_part(&mut self, name: &str, mesh: Mesh, section: ShellSection, placement: &Placement) -> Result<usize> {
-        section
-            .validate()
-            .map_err(|e| e.context(&format!("part '{name}'")))?;
+        // Errors name the part, except the unnamed one of a one-part model.
+        let named = |e: Error| match name {
+            "" => e,
+            _ => e.context(&format!("part '{name}'")),
+        };
+        section.validate().map_err(named)?;
         placement.validate()?;
-        mesh.validate()
-            .map_err(|e| e.context(&format!("part '{name}'")))?;
+        mesh.validate().map_err(named)?;
         if mesh.quads.is_empty() {
             return Err(Error::InvalidMesh(format!("part '{name}': the mesh has no element")));
         }

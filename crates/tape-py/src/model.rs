@@ -149,11 +149,6 @@ impl PyModel {
         let name = name.as_str();
         let mesh = mesh_of(nodes, quads, node_sets)?;
         let section = section(section_kwargs)?;
-        // Named after the part, except the one part of `Model(nodes, quads, ...)`.
-        to_py(section.validate().map_err(|e| match name {
-            "" => e,
-            _ => e.context(&format!("part '{name}'")),
-        }))?;
         let placement = placement(rotation, translation)?;
         to_py(self.inner.add_part(name, mesh, section, &placement))
     }

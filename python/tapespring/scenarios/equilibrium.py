@@ -192,9 +192,8 @@ def equilibrium(
     # The largest force on the push path (not the reference state's round-off, which a push too
     # short to buckle the tapes, with a force negative all along, would otherwise take for it).
     peak = 1 + int(np.argmax(force[1:])) if force.size > 1 else 0
-    pushed_down = peak > 0 and force[peak] > 1e-6 * float(np.max(np.abs(force)))
     after = np.flatnonzero((force[peak:-1] > 0.0) & (force[peak + 1 :] <= 0.0))
-    if pushed_down and after.size:
+    if after.size:
         k = peak + int(after[0])
         w = force[k] / (force[k] - force[k + 1])
         pos = results.marker_positions

@@ -465,13 +465,13 @@ class SetupSpec:
             )
         if self.appendix_width > self.rod_length:
             raise ValueError("appendix_width must not exceed rod_length")
+        # Elements per tape at a mesh size, refused before the meshes are built (which takes
+        # minutes at millions of elements) and before their counts overflow.
+        area = self.tape.length * self.tape.radius * math.radians(self.tape.alpha_deg)
         for name in ("mesh_tape", "mesh_plates"):
             size = getattr(self, name)
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
-            # Elements per tape at this size, refused before the meshes are built (which takes
-            # minutes at millions of elements) and before their counts overflow.
-            area = self.tape.length * self.tape.radius * math.radians(self.tape.alpha_deg)
             if area > MAX_ELEMENTS * size * size:
                 n = area / size / size
                 raise ValueError(
