@@ -6,7 +6,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use tape_core::assembly::Assembled;
-use tape_core::element::shell::{ElementMatrix, ElementVector, Viscous};
+use tape_core::element::shell::{ElementMatrix, ElementVector, Viscous, ViscousWork};
 use tape_core::inertia::{Motion, NodeInertia};
 use tape_core::linalg::LinearSolver;
 use tape_core::rotation::tangent_inverse;
@@ -87,6 +87,7 @@ fn dynamic_terms(c: &mut Criterion) {
     // A step of 1e-4 s at rho_inf = 0.7 and the paper's eta, with velocities of a deploying tape.
     let alpha = Alpha::new(0.7).expect("rho_inf");
     let h = 1e-4;
+    let mut work = ViscousWork::default();
     let mut viscous = Viscous {
         v: std::array::from_fn(|a| Vector3::new(0.1, -0.2 + 0.05 * a as f64, 0.3)),
         w: std::array::from_fn(|a| Vector3::new(1.0, 2.0 * a as f64, -0.5)),
@@ -95,7 +96,17 @@ fn dynamic_terms(c: &mut Criterion) {
         ..Viscous::default()
     };
     c.bench_function("element internal force + tangent, Kelvin-Voigt", |b| {
-        b.iter(|| e.compute_viscous_into(&x, &q, system.section(BENCH_ELEMENT), &viscous, &mut f, Some(&mut k)));
+        b.iter(|| {
+            e.compute_viscous_into(
+                &x,
+                &q,
+                system.section(BENCH_ELEMENT),
+                &viscous,
+                &mut f,
+                Some(&mut k),
+                Some(&mut work),
+            )
+        });
     });
     let stress = e.linearised_stress(
         &x,
@@ -116,12 +127,23 @@ fn dynamic_terms(c: &mut Criterion) {
                 &mut f,
                 &mut k,
                 &mut fg,
+                Some(&mut work),
             )
         });
     });
     viscous.consistent = true;
     c.bench_function("element internal force + tangent, Kelvin-Voigt (consistent)", |b| {
-        b.iter(|| e.compute_viscous_into(&x, &q, system.section(BENCH_ELEMENT), &viscous, &mut f, Some(&mut k)));
+        b.iter(|| {
+            e.compute_viscous_into(
+                &x,
+                &q,
+                system.section(BENCH_ELEMENT),
+                &viscous,
+                &mut f,
+                Some(&mut k),
+                Some(&mut work),
+            )
+        });
     });
     let node = e.nodes[0];
     let body: NodeInertia = system.inertia[node];

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 
 use crate::constraint::{Activity, DofMap, Slot};
 use crate::dof::Dof;
-use crate::element::shell::{ElementMatrix, ElementStress, ElementVector, Viscous};
+use crate::element::shell::{ElementMatrix, ElementStress, ElementVector, Viscous, ViscousWork};
 use crate::element::ShellElement;
 use crate::error::Result;
 use crate::inertia::NodeInertia;
@@ -166,6 +166,8 @@ pub struct System {
     k_buf: Vec<ElementMatrix>,
     /// Strain energy and dissipated power of each element.
     e_buf: Vec<(f64, f64)>,
+    /// Strains and viscous stresses of each element at the last dynamic assembly.
+    w_buf: Vec<ViscousWork>,
     k_scratch_ff: Vec<f64>,
     k_scratch_fc: Vec<f64>,
     /// Use rayon for the element loop.
@@ -365,6 +367,7 @@ impl System {
             fg_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
             e_buf: vec![(0.0, 0.0); n_el],
+            w_buf: vec![ViscousWork::default(); n_el],
             k_scratch_ff: Vec::new(),
             k_scratch_fc: Vec::new(),
             parallel: true,
@@ -616,6 +619,14 @@ impl System {
         self.assemble_with(state, true, stress, Some(rates), out);
     }
 
+    /// Per element, the strains and viscous stresses of the last dynamic assembly (zero stresses
+    /// where the section has no viscosity): between two converged states, the sum of
+    /// [`ViscousWork::work_to`] is the Kelvin-Voigt dissipation of the step.
+    #[must_use]
+    pub fn viscous_work(&self) -> &[ViscousWork] {
+        &self.w_buf
+    }
+
     /// The pieces of [`Self::assemble_dynamic`] without the tangent (`k_ff` and `k_fc` keep what
     /// they held): the residual of an iteration that reuses a factorised iteration matrix.
     pub fn assemble_dynamic_residual(&mut self, state: &State, rates: &Rates, out: &mut Assembled) {
@@ -710,7 +721,8 @@ impl System {
                       f: &mut ElementVector,
                       fg: &mut ElementVector,
                       k: &mut ElementMatrix,
-                      en: &mut (f64, f64)| {
+                      en: &mut (f64, f64),
+                      wk: &mut ViscousWork| {
             let x = e.nodes.map(|n| state.x[n]);
             let q = e
                 .nodes
@@ -728,12 +740,12 @@ impl System {
                 consistent: r.consistent,
             });
             *en = match (stress, &viscous) {
-                (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg),
+                (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg, Some(wk)),
                 (Some(st), None) => (
                     e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
                     0.0,
                 ),
-                (None, Some(v)) => e.compute_viscous_into(&x, &q, section, v, f, tangent.then_some(k)),
+                (None, Some(v)) => e.compute_viscous_into(&x, &q, section, v, f, tangent.then_some(k), Some(wk)),
                 (None, None) => (e.compute_into(&x, &q, section, f, tangent.then_some(k)), 0.0),
             };
         };
@@ -744,20 +756,22 @@ impl System {
                 .zip(self.fg_buf.par_iter_mut())
                 .zip(self.k_buf.par_iter_mut())
                 .zip(self.e_buf.par_iter_mut())
+                .zip(self.w_buf.par_iter_mut())
                 .enumerate()
                 .with_min_len(16)
-                .for_each(|(i, ((((e, f), fg), k), en))| kernel(i, e, f, fg, k, en));
+                .for_each(|(i, (((((e, f), fg), k), en), wk))| kernel(i, e, f, fg, k, en, wk));
         } else {
-            for (i, ((((e, f), fg), k), en)) in self
+            for (i, (((((e, f), fg), k), en), wk)) in self
                 .elements
                 .iter()
                 .zip(&mut self.f_buf)
                 .zip(&mut self.fg_buf)
                 .zip(&mut self.k_buf)
                 .zip(&mut self.e_buf)
+                .zip(&mut self.w_buf)
                 .enumerate()
             {
-                kernel(i, e, f, fg, k, en);
+                kernel(i, e, f, fg, k, en, wk);
             }
         }
 

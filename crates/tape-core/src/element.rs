@@ -10,7 +10,7 @@
 pub mod quadrature;
 pub mod shell;
 
-pub use shell::{ShellElement, ShellStrains, DOFS_PER_ELEMENT};
+pub use shell::{ShellElement, ShellStrains, ViscousWork, DOFS_PER_ELEMENT};
 
 /// Degrees of freedom per node.
 pub const DOFS_PER_NODE: usize = 6;

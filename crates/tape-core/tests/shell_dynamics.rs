@@ -11,7 +11,7 @@
 //!   single-DOF dashpot relation);
 //! * the energy balance closes: without damping and with rho_inf = 1 the integrator dissipates
 //!   less than 1e-3 of the energy released, and with damping the viscous dissipation accounts for
-//!   the lost energy;
+//!   the lost energy to 1e-3 of it;
 //! * runs on one and on two threads give the same history bit for bit.
 
 mod common;
@@ -90,17 +90,19 @@ fn kelvin_voigt_damping_ratio_is_eta_omega_over_two() -> Result<()> {
         (measured / zeta - 1.0).abs() < 0.03,
         "damping ratio {measured:e} vs {zeta:e}"
     );
-    // The energy lost is mostly the viscous dissipation. KNOWN GAP: the dissipation is the
-    // trapezoidal rule on the dissipated power, which misjudges the stiff, overdamped membrane
-    // and shear components the sudden release excites (eta omega / 2 > 1 there): the remainder
-    // is measured at -16 % of the viscous term. A force-times-increment quadrature consistent with
-    // the scheme is the fix; until then this only checks sign and size.
+    // The energy lost is the viscous dissipation: the viscous stresses' work on the strain
+    // increments (trapezoidal in the stresses, the quadrature that makes the strain energy's change
+    // exact) leaves only the scheme's own dissipation, which at 100 steps per period of the first
+    // mode is of order (omega h)^3 per cycle (1e-4 of the energy over these six cycles), plus the
+    // Newton tolerance. The trapezoidal rule on the dissipated power, used before, over-counted the
+    // stiff, overdamped membrane and shear components the sudden release excites: remainder -16 %
+    // of the viscous term.
     let k = hist.len() - 1;
     let viscous = hist.viscous_dissipation[k];
     let numerical = hist.numerical_dissipation[k];
     eprintln!("viscous {viscous:e} J, remainder {numerical:e} J");
     assert!(
-        viscous > 0.0 && numerical.abs() < 0.25 * viscous,
+        viscous > 0.0 && numerical.abs() < 1e-3 * viscous,
         "viscous {viscous:e}, numerical {numerical:e}"
     );
     Ok(())

@@ -887,6 +887,7 @@ pub fn solve_dynamic(
         .assemble_dynamic(state, &rates, None, &mut integ.asm);
     integ.add_inertia(state, state, h, false);
     let mut last = Energies::of(&integ, state);
+    let mut last_work = integ.system.viscous_work().to_vec();
     let mech0 = last.kinetic + last.strain + last.gravity;
 
     let eps_t = 1e-12 * params.duration.max(t_end.abs());
@@ -1021,7 +1022,8 @@ pub fn solve_dynamic(
             continue;
         }
         cutbacks = 0;
-        // Energy terms: trapezoidal work of loads and supports, viscous dissipation.
+        // Energy terms: trapezoidal work of loads and supports, viscous dissipation as the
+        // viscous stresses' work on the strain increments (see `ViscousWork::work_to`).
         let asm = &integ.asm;
         let now = Energies::of(&integ, &scratch);
         let mut w_loads = 0.0;
@@ -1042,7 +1044,13 @@ pub fn solve_dynamic(
             .sum();
         balance.work_loads += w_loads;
         balance.work_prescribed += w_presc;
-        balance.viscous += 0.5 * (last.dissipation + now.dissipation) * step_h;
+        let now_work = integ.system.viscous_work();
+        balance.viscous += last_work
+            .iter()
+            .zip(now_work)
+            .map(|(w0, w1)| w0.work_to(w1))
+            .sum::<f64>();
+        last_work.copy_from_slice(now_work);
         balance.kinetic = now.kinetic;
         balance.numerical = balance.work_loads + balance.work_prescribed
             - balance.viscous
@@ -1073,7 +1081,6 @@ struct Energies {
     kinetic: f64,
     strain: f64,
     gravity: f64,
-    dissipation: f64,
     /// Nodal loads (without gravity) per independent node, `[force, moment]`.
     loads: Vec<[f64; 6]>,
     /// Reactions at the constrained DOFs.
@@ -1087,7 +1094,6 @@ impl Energies {
             kinetic: integ.system.kinetic_energy(state),
             strain: asm.energy,
             gravity: asm.gravity_energy,
-            dissipation: asm.dissipation,
             loads: integ.system.nodal_loads(state),
             reactions: asm.reactions(),
         }
