@@ -70,10 +70,13 @@ def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
     [
         # The solver's own errors (TapeError): a tangent that underflows.
         (["bend", "--mesh-size", "4.5e-3", "-E", "1e-300", "--no-progress"], 1, "factorisation"),
-        # A ValueError found by the solver, not the parser.
-        (["max-mass", "--mesh-size=1e-300", "--n-thickness", "1", "--n-modulus", "1"], 2, "counts"),
-        # A model larger than memory.
-        (["bend", "--length", "1e3", "--no-progress"], 1, "not enough memory"),
+        # Found by the bend tape's validation before the first run (the solver's element counts
+        # once); the solver's own ValueError reaching `main` is stood in for below.
+        (
+            ["max-mass", "--mesh-size=1e-300", "--n-thickness", "1", "--n-modulus", "1"],
+            2,
+            "over 1e+308 elements",
+        ),
         # A failure in a scenario's first (static) step, which has no scenario result to show.
         (["vibrate", "--duration", "0.02", "--thickness=1e300", "--no-progress"], 1, "gravity"),
     ],
@@ -84,6 +87,26 @@ def test_errors_found_while_running_are_messages_not_tracebacks(argv, code, mess
     # After the progress bar's last line, if any.
     last = err.replace("\r", "\n").strip().splitlines()[-1]
     assert last.startswith("error: ") and message in last
+
+
+@pytest.mark.parametrize(
+    ("argv", "module", "error", "code"),
+    [
+        # `bend --length 1e3` once reached this (4.7 million elements); the bend tape's element
+        # bound now refuses it before the mesh is built.
+        (["bend"], "bending.bend", MemoryError("not enough memory"), 1),
+        (["max-mass", "--n-modulus=1"], "max_mass.max_mass", ValueError("invalid: counts"), 2),
+    ],
+)
+def test_the_solvers_errors_reaching_main_are_messages(
+    argv, module, error, code, monkeypatch, capsys
+):
+    def fail(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(f"tapespring.scenarios.{module}", fail)
+    assert main([*argv, "--no-progress"]) == code
+    assert capsys.readouterr().err.strip().splitlines()[-1] == f"error: {error}"
 
 
 @pytest.mark.parametrize("value", ["0", "-1", "x"])

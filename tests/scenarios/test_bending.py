@@ -432,6 +432,19 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
         ({"thickness": 0.02}, "is not thin against the radius"),
         ({"alpha_deg": [1.0]}, r"alpha_deg must be a number \(got \[1.0\]\)"),
         ({"theta_max_deg": None}, r"theta_max_deg must be a number \(got None\)"),
+        # An open section: at 360 degrees it closes (the solver's message printed 1e300 in 300
+        # digits).
+        (
+            {"alpha_deg": 360.0},
+            r"alpha_deg \(the section's subtended angle\) must lie in \(0, 360\)",
+        ),
+        ({"alpha_deg": 1e300}, r"must lie in \(0, 360\) degrees \(got 1e\+300\)"),
+        ({"length": -0.1}, r"length must be > 0 \(got -0.1\)"),
+        # More elements than the set-up allows a tape, in short numbers (the mesh generator's
+        # counts overflowed: "18446744073709551615 x 10 elements").
+        ({"length": 1e300}, r"tape 1e\+300 m long and 0.019 m wide: 4.74e\+303 elements, more"),
+        ({"length": 1e3}, r"4.74e\+06 elements, more than 1e\+06"),
+        ({"radius": 1e300, "alpha_deg": 1.0}, r"1.75e\+298 m wide"),
     ],
 )
 def test_bad_input_raises_value_error_naming_the_problem(change, message):

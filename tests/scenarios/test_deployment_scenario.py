@@ -113,6 +113,30 @@ def test_bad_settings_are_named() -> None:
         deploy(DeploymentSettings(spec=COARSE, sense="sideways"))
     with pytest.raises(ValueError, match="duration"):
         deploy(DeploymentSettings(spec=COARSE, duration=-1.0))
+    # Above 1 MHz the solver cannot land the steps on the samples at the release's time (5 MHz
+    # failed after the fold: "time step cut back ... to 0.000e0 s").
+    with pytest.raises(ValueError, match=r"sample_rate must be at most 1e\+06 Hz.*got 5e\+06"):
+        deploy(DeploymentSettings(spec=COARSE, sample_rate=5e6, duration=1e-3))
+    # Every sample is a step: more than the solver's max_steps, refused before the set-up is built.
+    with pytest.raises(ValueError, match=r"settle = 1 s at sample_rate = 2e\+05 Hz makes 2e\+05"):
+        deploy(DeploymentSettings(spec=COARSE, sample_rate=2e5, duration=0.1, settle=1.0))
+
+
+def test_the_sample_bound_is_the_solvers_step_limit() -> None:
+    from tapespring.analysis import dynamic_step_options
+    from tapespring.scenarios.setup import MAX_DYNAMIC_STEPS
+
+    assert dynamic_step_options()["max_steps"] == MAX_DYNAMIC_STEPS
+
+
+def test_sample_rows_are_the_recorded_samples_only(opposite: DeploymentSimulation) -> None:
+    rows = opposite.sample_rows()
+    # 0.6 s at 800 Hz: the release and 480 samples, landed on to rounding.
+    np.testing.assert_allclose(opposite.time_s[rows], np.arange(481) / 800.0, rtol=0, atol=1e-12)
+    # The error control's steps between them are left out (150 of the 631 rows).
+    assert opposite.time_s.size > rows.size
+    between = np.setdiff1d(np.arange(opposite.time_s.size), rows)
+    assert np.all(np.abs(opposite.time_s[between] * 800.0 % 1.0 - 0.5) < 0.5 - 1e-6)
 
 
 def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> None:
@@ -148,10 +172,16 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     trial, _ = make_deployment_trial("equal", duration=2.0)
     path = write_csv(trial, tmp_path / "equal.csv")
     png, pvd, snaps = tmp_path / "deploy.png", tmp_path / "run.pvd", tmp_path / "snaps.png"
+    csv = tmp_path / "deploy.csv"
     args = ["deploy", "--sense=equal", "--duration=0.3", "--json", f"--plot={png}"]
-    extra = [f"--vtu={pvd}", f"--snapshots={snaps}", "--leave-aside-max", "1"]
+    extra = [f"--vtu={pvd}", f"--snapshots={snaps}", "--leave-aside-max", "1", f"--csv={csv}"]
     assert main([*args, f"--experiment={path}", *extra]) == 0
     out = json.loads(capsys.readouterr().out)
+    # The CSV has a row per sample, as a recording at 800 Hz, where the JSON has every step.
+    table = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert csv.read_text().splitlines()[0] == "time_s,angle_deg,clamp_force_N"
+    np.testing.assert_array_equal(table[:, 0], np.arange(241) / 800.0)
+    assert len(out["time_s"]) > 241
     assert out["comparison"]["left_aside"] == {"max": [1], "min": []}
     assert out["sense"] == "equal" and out["initial_angle_deg"] == pytest.approx(-91.2, abs=0.05)
     assert out["comparison"]["initial_angle_deg"]["experiment"] < 0

@@ -335,6 +335,12 @@ def test_contour_plot_draws_both_fields(opposite, equal):
         ({"angle_deg": 0.0}, r"angle_deg must lie in \(0, 180\)"),
         ({"angle_deg": 200.0}, r"angle_deg must lie in \(0, 180\)"),
         ({"gravity": -9.81}, "gravity must be > 0"),
+        # Physical ranges (GRAVITY_RANGE, LEVER_ARM_RANGE): outside them m_max was printed in
+        # tonnes or micrograms.
+        ({"gravity": 1e300}, r"gravity must lie in \[0.1, 100\] m/s\^2 \(got 1e\+300"),
+        ({"gravity": 0.05}, r"gravity must lie in \[0.1, 100\]"),
+        ({"lever_arm": 1e-300}, r"lever_arm must lie in \[0.001, 10\] m \(got 1e-300"),
+        ({"lever_arm": 20.0}, r"lever_arm must lie in \[0.001, 10\] m"),
         ({"lever_arm": 0.0}, "lever_arm must be finite and > 0"),
         ({"lever_arm": "far"}, "lever_arm must be a number or None"),
         ({"tape": "paper"}, "tape must be a TapeSpring"),
@@ -382,8 +388,14 @@ def test_cli_prints_a_summary(capsys):
         ["max-mass", "--sense", "opposite", "--n-thickness", "1", "--n-modulus", "1"]
         + ["--no-progress"]
     )
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     assert code == 0
+    # One value of the default ranges: their MIN, said on stderr.
+    assert captured.err.splitlines() == [
+        "warning: --n-thickness 1: t = 0.00012, the lower bound of Table 4's range",
+        "warning: --n-modulus 1: E = 1e+11, the lower bound of Table 4's range",
+    ]
     assert "l = 50.0 mm, g = 9.81 m/s^2" in out
     assert "1/1 runs" in out
     assert "opposite sense: m_max 99.3-99.3 g (FE), 102.3-102.3 g (analytical" in out
@@ -411,7 +423,10 @@ def test_cli_bad_input_exits_2_before_any_run(extra, message, capsys):
     [
         ("--n-thickness", "0", "n-thickness must be an integer >= 1"),
         ("--n-modulus", "two", "n-modulus must be an integer"),
-        ("--gravity", "-1", "gravity must be finite and > 0"),
+        ("--gravity", "-1", "gravity must lie in [0.1, 100] m/s^2 (got -1)"),
+        ("--gravity", "1e300", "gravity must lie in [0.1, 100] m/s^2 (got 1e+300)"),
+        ("--lever-arm", "1e-300", "lever arm must lie in [0.001, 10] m (got 1e-300)"),
+        ("--lever-arm", "nan", "lever arm must lie in [0.001, 10] m (got nan)"),
     ],
 )
 def test_cli_parser_rejects_bad_values(option, value, message, capsys):

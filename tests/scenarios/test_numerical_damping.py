@@ -89,6 +89,21 @@ def test_bad_spectral_radii_are_named(rho: tuple[float, ...], message: str) -> N
         numerical_damping_study(SETTINGS, rho)
 
 
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        # Below 1 us the solver cannot land the steps at the decay's time (t = 3).
+        ({"time_step": 1e-7}, r"time_step must be at least 1e-06 s \(got 1e-07 s"),
+        # Every fixed step is a record: more than max_steps, refused before the set-up is built.
+        ({"time_step": 1e-5, "duration": 2.0}, r"duration = 2 s at 1/time_step = 1e\+05 Hz makes"),
+        ({"time_step": 0.0, "sample_rate": 2e6}, r"sample_rate must be at most 1e\+06 Hz"),
+    ],
+)
+def test_fixed_steps_and_samples_within_the_solvers_reach(change, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        replace(SETTINGS, **change).validate()
+
+
 def test_command_writes_the_study(study: NumericalDampingStudy, tmp_path, capsys) -> None:
     plot, csv = tmp_path / "fig26.png", tmp_path / "fig26.csv"
     code = main(

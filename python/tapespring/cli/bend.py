@@ -14,9 +14,9 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
-__all__ = ["add_tape_options", "register", "run", "tape_fields"]
+__all__ = ["add_tape_options", "refuse", "register", "run", "tape_fields", "warn"]
 
 
 def _positive(name: str, *, zero: bool = False):
@@ -33,6 +33,43 @@ def _positive(name: str, *, zero: bool = False):
         return value
 
     return parse
+
+
+def _within(name: str, low: float, high: float, unit: str, *, closed: str = "high"):
+    """An argparse type: a finite number between `low` and `high` [`unit`], named `name` in
+    errors; `closed` says which bounds belong to the range ("low", "high", "both" or "")."""
+    with_low, with_high = closed in ("low", "both"), closed in ("high", "both")
+    shown = f"{'[' if with_low else '('}{low:g}, {high:g}{']' if with_high else ')'} {unit}"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        above = value >= low if with_low else value > low
+        below = value <= high if with_high else value < high
+        if not (math.isfinite(value) and above and below):
+            raise argparse.ArgumentTypeError(f"{name} must lie in {shown} (got {value:.3g})")
+        return value
+
+    return parse
+
+
+def refuse(args: argparse.Namespace, message: str) -> NoReturn:
+    """Stop as argparse does for a bad combination of options: usage and ``error: message`` on
+    stderr, exit code 2 (SystemExit). `args` comes from a parser whose defaults hold its own
+    command's parser (``set_defaults(parser=p)``)."""
+    parser = getattr(args, "parser", None)
+    if parser is None:  # a Namespace made by hand
+        print(f"error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+    parser.error(message)
+
+
+def warn(message: str) -> None:
+    """Print ``warning: message`` on stderr (an option accepted, whose effect is not what its
+    name may suggest)."""
+    print(f"warning: {message}", file=sys.stderr)
 
 
 def _count(name: str, what: str = "an integer >= 1"):
@@ -105,7 +142,11 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
     p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
     p.add_argument(
-        "--alpha", type=_positive("alpha"), default=d.alpha_deg, help="subtended angle [deg]"
+        "--alpha",
+        # A section subtending 360 degrees or more closes on itself: no longer an open tape.
+        type=_within("alpha", 0.0, 360.0, "deg", closed=""),
+        default=d.alpha_deg,
+        help="subtended angle of the cross-section [deg], in (0, 360)",
     )
     p.add_argument("--thickness", type=_positive("thickness"), default=d.thickness, help="t [m]")
     p.add_argument(
@@ -194,7 +235,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help=(
             "with --path jump: where the path loses stability while the angle keeps growing (a "
             "bifurcation, as the perfect tape's in equal sense, or a limit point stepped over), "
-            "close in on it and follow the stable branch leaving it (default: on with --path jump)"
+            "close in on it and follow the stable branch leaving it (default: on with --path jump; "
+            "refused with --path full, which traces every branch)"
         ),
     )
     p.add_argument(
@@ -205,7 +247,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--plot", type=_image_file, help="write the curve as a PNG (paper Fig. 4)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, parser=p)
     return p
 
 
@@ -228,6 +270,11 @@ def run(args: argparse.Namespace) -> int:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.
         imperfection = 0.1 if args.theta_max < 0 else 0.0
     jump = (args.path or ("jump" if args.theta_max < 0 else "full")) == "jump"
+    if args.switch_branches and not jump:
+        # The full path traces every branch: there is none to switch to. (--no-switch-branches
+        # says what the full path does, and is accepted.)
+        default = "" if args.path else " (the default with a positive --theta-max)"
+        refuse(args, f"--switch-branches applies to --path jump only, not --path full{default}")
     setup = BendingSetup(
         **tape_fields(args),
         theta_max_deg=args.theta_max,

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import math
+from typing import Any
 
-from .bend import _count, _image_file, _input_file, _output_file, _positive
+from .bend import _count, _image_file, _input_file, _output_file, _positive, _within, refuse
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -32,7 +34,7 @@ FLEXIBLE_SAMPLE_RATE = 2000.0
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
-    from tapespring.scenarios.setup import SUPPORTS
+    from tapespring.scenarios.setup import MAX_DYNAMIC_STEPS, MAX_SAMPLE_RATE, SUPPORTS
 
     d = DeploymentSettings()
     p = sub.add_parser(
@@ -59,11 +61,13 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--sample-rate",
-        type=_positive("sample rate"),
+        type=_within("sample rate", 0.0, MAX_SAMPLE_RATE, "Hz"),
         default=None,
         help="rate of the recorded histories [Hz]; the time steps land on its multiples "
         f"(default {d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
-        "resolves the support's vibration at 164 Hz)",
+        f"resolves the support's vibration at 164 Hz); at most {MAX_SAMPLE_RATE:.0e} (below a "
+        "microsecond the solver cannot place the steps on the samples at the release's time), "
+        f"and at most {MAX_DYNAMIC_STEPS} samples in --duration",
     )
     p.add_argument(
         "--duration",
@@ -115,9 +119,31 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="draw the set-up from the side at the release and every --duration/5 s (Fig. 13)",
     )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
-    add_output_options(p, "time_s, angle_deg and clamp_force_N")
-    p.set_defaults(func=run)
+    add_output_options(
+        p,
+        "time_s, angle_deg and clamp_force_N at the samples (--sample-rate; the time steps "
+        "between them left out, as in a recording)",
+    )
+    p.set_defaults(func=run, parser=p)
     return p
+
+
+def _check_sense(args: argparse.Namespace, measured: Any) -> None:
+    """Refuse a recording of the other sense than ``--sense`` (its peaks would be compared with
+    the wrong swings): the sense its metadata give, else the sign of its held initial angle
+    (positive in opposite sense, negative in equal sense, in the rig's frame)."""
+    if measured.sense is not None:
+        sense, evidence = measured.sense, "its metadata"
+    else:
+        degrees = math.degrees(measured.initial_angle)
+        sense = "opposite" if degrees > 0.0 else "equal"
+        evidence = f"its initial bending angle, {degrees:+.1f} deg"
+    if sense != args.sense:
+        refuse(
+            args,
+            f"--experiment {args.experiment} is a deployment in {sense} sense ({evidence}), "
+            f"--sense is {args.sense}",
+        )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -126,8 +152,33 @@ def run(args: argparse.Namespace) -> int:
     import sys
     from dataclasses import replace
 
+    import numpy as np
+
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
 
+    if not args.experiment:
+        for kind in ("min", "max"):
+            if getattr(args, f"leave_aside_{kind}"):
+                refuse(args, f"--leave-aside-{kind} applies to the comparison with --experiment")
+    rate = args.sample_rate
+    if rate is None:
+        rate = (
+            FLEXIBLE_SAMPLE_RATE if args.support == "flexible" else DeploymentSettings.sample_rate
+        )
+    settings = DeploymentSettings(
+        spec=replace(spec_from_args(args), support=args.support),
+        sense=args.sense,
+        sample_rate=rate,
+        duration=args.duration,
+        rho_inf=args.rho_inf,
+        tolerance=args.tolerance,
+        field_interval=16 if (args.vtu or args.snapshots) else 0,
+    )
+    try:
+        settings.validate()  # before a recording is read
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     measured = None
     if args.experiment:
         from tapespring.protocols.deployment import analyze_deployment
@@ -135,24 +186,9 @@ def run(args: argparse.Namespace) -> int:
         measured = analyze_experiment(args.experiment, analyze_deployment)
         if measured is None:
             return 2
+        _check_sense(args, measured)
 
     def simulate() -> object:
-        rate = args.sample_rate
-        if rate is None:
-            rate = (
-                FLEXIBLE_SAMPLE_RATE
-                if args.support == "flexible"
-                else DeploymentSettings.sample_rate
-            )
-        settings = DeploymentSettings(
-            spec=replace(spec_from_args(args), support=args.support),
-            sense=args.sense,
-            sample_rate=rate,
-            duration=args.duration,
-            rho_inf=args.rho_inf,
-            tolerance=args.tolerance,
-            field_interval=16 if (args.vtu or args.snapshots) else 0,
-        )
         result = deploy(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
 
@@ -202,7 +238,14 @@ def run(args: argparse.Namespace) -> int:
 
     def columns(result: object) -> dict:
         r = result
-        return {"time_s": r.time_s, "angle_deg": r.angle_deg, "clamp_force_N": r.clamp_force_N}  # type: ignore[attr-defined]
+        rows = r.sample_rows()  # type: ignore[attr-defined]
+        # The sample instants k / rate, which the rows' times are to rounding.
+        k = np.round(r.time_s[rows] * settings.sample_rate)  # type: ignore[attr-defined]
+        return {
+            "time_s": k / settings.sample_rate,
+            "angle_deg": r.angle_deg[rows],  # type: ignore[attr-defined]
+            "clamp_force_N": r.clamp_force_N[rows],  # type: ignore[attr-defined]
+        }
 
     code = finish(args, simulate, columns, plot, extra=fields)
     return 1 if problems and code == 0 else code

@@ -25,9 +25,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--push", type=_positive("push"), default=0.125, help="push of the weight's tip [m]"
     )
-    add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3)
+    add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False)  # static
     add_output_options(p, "push_m and force_N")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, parser=p)
     return p
 
 

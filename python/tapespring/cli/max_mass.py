@@ -15,7 +15,7 @@ import json
 import math
 import sys
 
-from .bend import _count, _image_file, _output_file, _positive
+from .bend import _count, _image_file, _output_file, _positive, _within, refuse, warn
 
 __all__ = ["register", "run"]
 
@@ -35,6 +35,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The ``max-mass`` parser.
     """
+    from tapespring.scenarios.max_mass import GRAVITY_RANGE, LEVER_ARM_RANGE
     from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_SETUP, PAPER_TAPE
 
     b = PAPER_BOUNDS
@@ -63,30 +64,34 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         nargs=2,
         type=_positive("thickness"),
         metavar=("MIN", "MAX"),
-        default=(b.thickness_min, b.thickness_max),
-        help=f"t range [m] (default Table 4: {b.thickness_min:g} {b.thickness_max:g})",
+        default=None,
+        help=f"t range [m] (default Table 4: {b.thickness_min:g} {b.thickness_max:g}); with "
+        "--n-thickness 1, give MIN = MAX, the one value",
     )
     p.add_argument(
         "--modulus-range",
         nargs=2,
         type=_positive("Young's modulus"),
         metavar=("MIN", "MAX"),
-        default=(b.youngs_modulus_min, b.youngs_modulus_max),
-        help=f"E range [Pa] (default Table 4: {b.youngs_modulus_min:g} {b.youngs_modulus_max:g})",
+        default=None,
+        help=f"E range [Pa] (default Table 4: {b.youngs_modulus_min:g} {b.youngs_modulus_max:g}); "
+        "with --n-modulus 1, give MIN = MAX, the one value",
     )
     p.add_argument(
         "--n-thickness",
         type=_count("n-thickness"),
         default=5,
         metavar="N",
-        help="values of t (default 5)",
+        help="values of t, evenly spaced from MIN to MAX (default 5; 1: MIN, the lower "
+        "bound, with the default range)",
     )
     p.add_argument(
         "--n-modulus",
         type=_count("n-modulus"),
         default=5,
         metavar="N",
-        help="values of E (default 5)",
+        help="values of E, evenly spaced from MIN to MAX (default 5; 1: MIN, the lower "
+        "bound, with the default range)",
     )
     p.add_argument(
         "--mesh-size",
@@ -100,17 +105,21 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=90.0,
         help="fold angle at which M* is taken [deg] (default 90)",
     )
+    (l_lo, l_hi), (g_lo, g_hi) = LEVER_ARM_RANGE, GRAVITY_RANGE
     p.add_argument(
         "--lever-arm",
-        type=_positive("lever arm"),
+        type=_within("lever arm", l_lo, l_hi, "m", closed="both"),
         default=None,
-        help=f"lever arm l from the fold to the mass [m] (default L/2 = {PAPER_TAPE.length / 2:g})",
+        help=f"lever arm l from the fold to the mass [m] (default L/2 = {PAPER_TAPE.length / 2:g}),"
+        f" in [{l_lo:g}, {l_hi:g}]: from beyond the fold (about 20 mm long) to a hundred times "
+        "the tape's length, whose own weight eq. 1 leaves out",
     )
     p.add_argument(
         "--gravity",
-        type=_positive("gravity"),
+        type=_within("gravity", g_lo, g_hi, "m/s^2", closed="both"),
         default=PAPER_SETUP.gravity,
-        help=f"g [m/s^2] (default {PAPER_SETUP.gravity:g})",
+        help=f"g [m/s^2] (default {PAPER_SETUP.gravity:g}), in [{g_lo:g}, {g_hi:g}]: from a "
+        "hundredth of the Earth's (below the Moon's 1.62) to ten times it (Jupiter's: 24.8)",
     )
     p.add_argument(
         "--switch-branches",
@@ -130,7 +139,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, parser=p)
     return p
 
 
@@ -144,20 +153,8 @@ def run(args: argparse.Namespace) -> int:
         2 on bad input (the message is printed on stderr).
     """
     from tapespring.scenarios.max_mass import MaxMassSettings, max_mass, write_csv
-    from tapespring.scenarios.setup import IdentificationBounds
+    from tapespring.scenarios.setup import PAPER_BOUNDS, IdentificationBounds
 
-    (t_lo, t_hi), (e_lo, e_hi) = args.thickness_range, args.modulus_range
-    for name, lo, hi, n in (
-        ("--thickness-range", t_lo, t_hi, args.n_thickness),
-        ("--modulus-range", e_lo, e_hi, args.n_modulus),
-    ):
-        if hi < lo or (hi == lo and n > 1):
-            print(
-                f"error: {name} MIN MAX must satisfy MIN < MAX (MIN = MAX with a single value; "
-                f"got {lo:g} {hi:g})",
-                file=sys.stderr,
-            )
-            return 2
     if args.plot and (args.n_thickness < 2 or args.n_modulus < 2):
         print(
             "error: --plot draws contours and needs at least 2 values of t and of E "
@@ -165,6 +162,43 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    b = PAPER_BOUNDS
+    grid = (
+        (
+            "thickness",
+            "t",
+            args.thickness_range,
+            (b.thickness_min, b.thickness_max),
+            args.n_thickness,
+        ),
+        (
+            "modulus",
+            "E",
+            args.modulus_range,
+            (b.youngs_modulus_min, b.youngs_modulus_max),
+            args.n_modulus,
+        ),
+    )
+    for name, symbol, given, default, n in grid:
+        lo, hi = given or default
+        if hi < lo or (hi == lo and n > 1):
+            print(
+                f"error: --{name}-range MIN MAX must satisfy MIN < MAX (MIN = MAX with a single "
+                f"value; got {lo:g} {hi:g})",
+                file=sys.stderr,
+            )
+            return 2
+        # One value is the range's MIN (MaxMassSettings.grid): a different MAX given beside it
+        # would be ignored, so it is refused; of the default range the MIN is taken, and said.
+        if n == 1 and hi > lo:
+            if given is not None:
+                refuse(
+                    args,
+                    f"--n-{name} 1 computes one value of {symbol}, but --{name}-range gives "
+                    f"{lo:g} to {hi:g}: give that value as both MIN and MAX",
+                )
+            warn(f"--n-{name} 1: {symbol} = {lo:g}, the lower bound of Table 4's range")
+    (t_lo, t_hi), (e_lo, e_hi) = (given or default for _, _, given, default, _ in grid)
     if not math.isfinite(args.angle) or args.angle >= 180.0:
         print("error: --angle must lie in (0, 180) degrees", file=sys.stderr)
         return 2

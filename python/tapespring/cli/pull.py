@@ -46,9 +46,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "displacement compared with the simulation's and the paper's model (Table 9)",
         vtu="every state of the pull path; the series' time is the path's load factor",
     )
-    add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3)
+    add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False)  # static
     add_output_options(p, "displacement_m and force_N")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, parser=p)
     return p
 
 

@@ -24,8 +24,12 @@ __all__ = [
 ]
 
 
-def add_spec_options(p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float) -> None:
-    """Add the set-up's options (mesh sizes, tape material, eta) with the given mesh defaults."""
+def add_spec_options(
+    p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float, eta: bool = True
+) -> None:
+    """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
+    viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
+    for a viscosity to act on: it leaves ``--eta`` out."""
     from tapespring.scenarios.setup import PAPER_SETUP
 
     s = PAPER_SETUP
@@ -51,9 +55,10 @@ def add_spec_options(p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plate
         default=s.tape.youngs_modulus,
         help="E [Pa]",
     )
-    g.add_argument(
-        "--eta", type=_positive("eta", zero=True), default=s.eta, help="Kelvin-Voigt eta [s]"
-    )
+    if eta:
+        g.add_argument(
+            "--eta", type=_positive("eta", zero=True), default=s.eta, help="Kelvin-Voigt eta [s]"
+        )
 
 
 def spec_from_args(args: argparse.Namespace) -> Any:
@@ -66,7 +71,7 @@ def spec_from_args(args: argparse.Namespace) -> Any:
     return replace(
         PAPER_SETUP,
         tape=tape,
-        eta=args.eta,
+        eta=getattr(args, "eta", PAPER_SETUP.eta),
         mesh_tape=args.mesh_tape,
         mesh_plates=args.mesh_plates,
     )

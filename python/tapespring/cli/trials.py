@@ -8,8 +8,9 @@ imports no analysis (the trials, protocols and report are imported by
 `run_analyze`).
 
 Exit codes: 0 when every trial was analysed, or when ``--skip-bad`` left some
-out and the summary lists them; 1 on an invalid file, trial or option (the
-message names it); 2 on a command-line syntax error (argparse).
+out and the summary lists them; 1 on an invalid file, trial or option value (the
+message names it); 2 on a command-line error (argparse), an option of another
+kind of test than ``--kind`` included (``--frame`` with ``--kind vibration``).
 """
 
 from __future__ import annotations
@@ -23,8 +24,9 @@ from pathlib import Path
 
 from tapespring.protocols.markers import DEFAULT_MARKERS
 from tapespring.protocols.registry import KINDS
+from tapespring.trials.common import LENGTH
 
-from .bend import _count
+from .bend import _count, refuse
 
 __all__ = ["main", "register", "run_analyze"]
 
@@ -96,15 +98,17 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar=("SUPPORT", "ROD", "TIP"),
         help="names of markers 1, 2 and 3 (default: M1 M2 M3)",
     )
+    # The options of one kind default to None, so that one given with another kind, where it
+    # would have no effect, is refused (`_check_kind_options`).
     p.add_argument(
         "--n-peaks",
         type=_count("--n-peaks"),
-        default=10,
+        default=None,
         help="deployment: maxima and minima analysed, >= 1 (default 10)",
     )
     p.add_argument(
         "--frame",
-        default="lab",
+        default=None,
         metavar="AXES",
         help=(
             "deployment: the rig's frame: 'lab' (markers already in the rig's axes: x along the "
@@ -117,7 +121,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--window",
         type=float,
         nargs=2,
-        default=[0.4e-3, 4.0e-3],
+        default=None,
         metavar=("LOW", "HIGH"),
         help="vibration: |peak| range fitted [m] (default 0.0004 0.004)",
     )
@@ -158,12 +162,39 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--length-unit",
         default=None,
-        help="unit of CSV marker columns without one in the header (m, cm, mm)",
+        choices=tuple(LENGTH),
+        help="unit of CSV marker columns without one in the header",
     )
     p.add_argument("--no-figures", action="store_true", help="write the CSV tables only")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
-    p.set_defaults(func=run_analyze)
+    p.set_defaults(func=run_analyze, parser=p)
     return trials
+
+
+#: Options of one kind of test only, with that kind.
+_KIND_OPTIONS = {
+    "n_peaks": "deployment",
+    "frame": "deployment",
+    "window": "vibration",
+    "span": "quasi-static",
+    "span_time": "quasi-static",
+}
+
+
+def _kind_options(args: argparse.Namespace) -> dict[str, object]:
+    """The given options that belong to ``--kind`` (the protocols' defaults for the rest)."""
+    options = {k: getattr(args, k) for k in _KIND_OPTIONS if getattr(args, k) is not None}
+    if "window" in options:
+        options["window"] = tuple(options["window"])
+    return options
+
+
+def _check_kind_options(args: argparse.Namespace) -> None:
+    """Refuse an option of another kind of test than ``--kind`` (it would be ignored)."""
+    for name, kind in _KIND_OPTIONS.items():
+        if getattr(args, name) is not None and args.kind != kind:
+            option = "--" + name.replace("_", "-")
+            refuse(args, f"{option} applies to --kind {kind} only, not --kind {args.kind}")
 
 
 def run_analyze(args: argparse.Namespace) -> int:
@@ -181,6 +212,7 @@ def run_analyze(args: argparse.Namespace) -> int:
     from tapespring.trials.load import load_trial_set
     from tapespring.trials.trial import TrialError
 
+    _check_kind_options(args)
     progress = not args.no_progress
     required = [args.markers[i] for i in protocol_for(args.kind).marker_roles]
     with warnings.catch_warnings(record=True) as caught:
@@ -201,11 +233,7 @@ def run_analyze(args: argparse.Namespace) -> int:
                 loaded.trials,
                 args.kind,
                 markers=args.markers,
-                n_peaks=args.n_peaks,
-                window=tuple(args.window),
-                span=101 if args.span is None else args.span,
-                span_time=args.span_time,
-                frame=args.frame,
+                **_kind_options(args),
                 progress=progress,
                 skip_bad=args.skip_bad,
                 skipped=loaded.skipped,

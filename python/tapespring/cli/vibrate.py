@@ -6,7 +6,7 @@ import argparse
 import functools
 from typing import Any
 
-from .bend import _positive
+from .bend import _positive, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -21,8 +21,40 @@ from .scenario_options import (
 __all__ = ["register", "run"]
 
 
+def _time_step(text: str) -> float:
+    """An argparse type: 0 (adaptive steps) or a fixed time step of at least 1 us [s] (the
+    shortest output interval, :data:`tapespring.scenarios.setup.MAX_SAMPLE_RATE`)."""
+    from tapespring.scenarios.setup import MAX_SAMPLE_RATE
+
+    value = _positive("time step", zero=True)(text)
+    if 0.0 < value < 1.0 / MAX_SAMPLE_RATE:
+        raise argparse.ArgumentTypeError(
+            f"time step must be 0 (adaptive) or at least {1.0 / MAX_SAMPLE_RATE:g} s "
+            f"(got {value:.3g})"
+        )
+    return value
+
+
+def _given(args: argparse.Namespace, *names: str) -> dict[str, Any]:
+    """The options of `names` that were given (the settings' defaults for the others)."""
+    return {n: getattr(args, n) for n in names if getattr(args, n) is not None}
+
+
+def _check(args: argparse.Namespace) -> None:
+    """Refuse the options that the others given make ineffective."""
+    if args.rho_inf_study:
+        if args.rho_inf is not None:
+            refuse(args, "--rho-inf is not used with --rho-inf-study, which gives the radii")
+        for option in ("experiment", "vtu"):
+            if getattr(args, option):
+                refuse(args, f"--rho-inf-study takes no --{option}")
+    if args.time_step > 0.0 and args.tolerance is not None:
+        refuse(args, "--tolerance applies to adaptive steps, not to a fixed --time-step")
+
+
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
+    from tapespring.scenarios.setup import MAX_SAMPLE_RATE
     from tapespring.scenarios.vibration import VibrationSettings
 
     d = VibrationSettings()
@@ -49,7 +81,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=d.initial_displacement,
         help="push before the release [m] (paper: about 8e-3)",
     )
-    p.add_argument("--rho-inf", type=float, default=d.rho_inf, help="spectral radius, in [0, 1]")
+    p.add_argument(
+        "--rho-inf",
+        type=float,
+        default=None,
+        help=f"spectral radius, in [0, 1] (default {d.rho_inf:g}; not with --rho-inf-study)",
+    )
     p.add_argument(
         "--window-mm",
         type=float,
@@ -60,14 +97,17 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--tolerance",
         type=_positive("tolerance", zero=True),
-        default=d.tolerance,
-        help="local error tolerance of the time steps [m] (0: the solver's default)",
+        default=None,
+        help="local error tolerance of the adaptive time steps [m] (default "
+        f"{d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
     )
     p.add_argument(
         "--time-step",
-        type=_positive("time step", zero=True),
+        type=_time_step,
         default=d.time_step,
-        help="fixed time step of the decay [s], recorded at every step (0: adaptive steps)",
+        help="fixed time step of the decay [s], recorded at every step (0: adaptive steps), "
+        f"from {1.0 / MAX_SAMPLE_RATE:g} s (below a microsecond the solver cannot place the "
+        "steps at the release's time)",
     )
     p.add_argument(
         "--rho-inf-study",
@@ -87,7 +127,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3)
     add_output_options(p, "time_s and displacement_m")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, parser=p)
     return p
 
 
@@ -98,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
 
     from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
+    _check(args)
     window = (args.window_mm[0] * 1e-3, args.window_mm[1] * 1e-3)
     if args.rho_inf_study:
         return _run_study(args, window)
@@ -117,11 +158,10 @@ def run(args: argparse.Namespace) -> int:
             spec=spec_from_args(args),
             duration=args.duration,
             initial_displacement=args.initial_displacement,
-            rho_inf=args.rho_inf,
             window=window,
-            tolerance=args.tolerance,
             time_step=args.time_step,
             field_interval=16 if args.vtu else 0,
+            **_given(args, "rho_inf", "tolerance"),
         )
         result = vibrate(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
@@ -149,14 +189,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
     """``tapespring vibrate --rho-inf-study ...``: the numerical damping study (Fig. 26)."""
-    import sys
-
     from tapespring.scenarios.numerical_damping import numerical_damping_study
     from tapespring.scenarios.vibration import VibrationSettings
-
-    if args.experiment or args.vtu:
-        print("error: --rho-inf-study takes neither --experiment nor --vtu", file=sys.stderr)
-        return 2
 
     def simulate() -> object:
         settings = VibrationSettings(
@@ -164,8 +198,8 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
             duration=args.duration,
             initial_displacement=args.initial_displacement,
             window=window,
-            tolerance=args.tolerance,
             time_step=args.time_step,
+            **_given(args, "tolerance"),
         )
         rho = tuple(args.rho_inf_study)
         return numerical_damping_study(settings, rho, progress=not (args.no_progress or args.json))

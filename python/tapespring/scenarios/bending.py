@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.setup import PAPER_TAPE
+from tapespring.scenarios.setup import MAX_ELEMENTS, PAPER_TAPE
 
 __all__ = [
     "BendingResult",
@@ -164,6 +164,15 @@ class BendingSetup:
             )
         if self.mesh_size <= 0.0:
             raise ValueError(f"mesh_size [m] must be finite and > 0 (got {self.mesh_size})")
+        for name in ("length", "radius"):  # (thickness and modulus: checked by the solver)
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"{name} must be > 0 (got {getattr(self, name):.3g})")
+        # An open section: at 360 degrees the arc closes into a tube.
+        if not 0.0 < self.alpha_deg < 360.0:
+            raise ValueError(
+                f"alpha_deg (the section's subtended angle) must lie in (0, 360) degrees "
+                f"(got {self.alpha_deg:.3g})"
+            )
         # A shell as thick as its radius of curvature has no inner surface: the Mindlin shell
         # (and eqs. (2)-(3)) describe thin walls, t / R of 0.01 for the paper's tape.
         if self.thickness >= 0.5 * self.radius:
@@ -185,6 +194,16 @@ class BendingSetup:
                 f"{MIN_ELEMENTS} elements are needed across and along it, each subtending at most "
                 f"{MAX_ELEMENT_ANGLE_DEG:g} degrees of the section's arc "
                 f"(mesh_size <= {coarsest:.3e} m)"
+            )
+        # Elements of the mesh, refused before it is built (which takes minutes at millions of
+        # elements, and whose counts overflow for a tape kilometres long): the set-up's bound.
+        n = (self.length / self.mesh_size) * (width / self.mesh_size)
+        if n > MAX_ELEMENTS:
+            count = f"{n:.3g}" if math.isfinite(n) else "over 1e+308"
+            raise ValueError(
+                f"mesh_size = {self.mesh_size:.3g} m is too fine for a tape {self.length:.3g} m "
+                f"long and {width:.3g} m wide: {count} elements, more than {MAX_ELEMENTS:.0e} "
+                "(a larger mesh_size, or a shorter or narrower tape)"
             )
         if abs(self.imperfection_deg) > MAX_IMPERFECTION_DEG:
             raise ValueError(

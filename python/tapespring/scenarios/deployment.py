@@ -53,6 +53,7 @@ from tapespring.scenarios.setup import (
     check_count,
     check_number,
     check_rho_inf,
+    check_sampling,
     check_sense,
     drive,
     dynamic_options,
@@ -88,7 +89,9 @@ class DeploymentSettings:
         Spectral radius at infinity of generalised-alpha (paper: 0.7).
     sample_rate : float
         Rate of the recorded histories [Hz] (the steps land on its multiples; the paper's motion
-        capture runs at 800 Hz).
+        capture runs at 800 Hz), at most :data:`~tapespring.scenarios.setup.MAX_SAMPLE_RATE`
+        (1 MHz), and at most :data:`~tapespring.scenarios.setup.MAX_DYNAMIC_STEPS` samples in
+        `duration` (and in `settle`).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default).
     n_peaks : int
@@ -115,6 +118,10 @@ class DeploymentSettings:
         for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
         check_number("settle", self.settle, positive=True, zero=True)
+        for step in ("duration", "settle"):
+            check_sampling(
+                (step, getattr(self, step)), sample_rate=self.sample_rate, rate_name="sample_rate"
+            )
         check_rho_inf(self.rho_inf)
         check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_count("field_interval", self.field_interval, minimum=0)
@@ -162,6 +169,20 @@ class DeploymentSimulation:
     results: Any
     wall_s: float
     comparison: dict[str, Any] | None = None
+
+    def sample_rows(self) -> NDArray[np.int64]:
+        """Rows of the histories at the sample instants ``k / sample_rate`` from the release.
+
+        The time steps land on every sample (``output_interval``); the error control adds steps
+        between them where the motion is fast (150 of the 631 rows of the first 0.6 s at 800 Hz,
+        opposite sense, 5 mm tapes). These rows are the samples only, the release first, as a
+        recording at `sample_rate` has them; a last state off that grid (a `duration` that is no
+        multiple of the interval, a run stopped early) is not one.
+        """
+        k = self.time_s * self.settings.sample_rate
+        # The solver places a sample to 1e-9 of the interval (tape-core solver/dynamics.rs): a
+        # state within a millionth of an interval of a sample instant is that sample.
+        return np.flatnonzero(np.abs(k - np.round(k)) <= 1e-6)
 
     def to_trial(self, *, rate_hz: float | None = None) -> Any:
         """The release and the motion as a :class:`tapespring.trials.Trial`.

@@ -69,6 +69,19 @@ DEFAULT_POINTS = 5
 EQUAL_SENSE_IMPERFECTION_DEG = 0.1
 
 
+#: Admissible gravitational acceleration g [m/s^2]: from 0.1 (a hundredth of the Earth's, below
+#: the Moon's 1.62 and Pluto's 0.62, where m_max of the paper's tape is already about 12 kg in
+#: equal sense) to 100 (ten times the Earth's, four times Jupiter's 24.8). Outside it, m_max
+#: (inversely proportional to g) is printed in tonnes or micrograms.
+GRAVITY_RANGE = (0.1, 100.0)
+
+#: Admissible lever arm l from the fold to the mass's centre [m]: from 1 mm (the fold itself
+#: spans about R theta, 20 mm on the paper's tape at 90 deg, and eq. 1 takes the mass as a point
+#: load beyond it) to 10 m (a hundred times the paper's 0.1 m tape, whose own weight eq. 1
+#: leaves out; the paper's l is L/2 = 50 mm).
+LEVER_ARM_RANGE = (1e-3, 10.0)
+
+
 def _linspace(lo: float, hi: float, n: int) -> tuple[float, ...]:
     return tuple(float(v) for v in np.linspace(lo, hi, n))
 
@@ -98,10 +111,11 @@ class MaxMassSettings:
         Bending angle at which M* is taken [deg], in (0, 180); the paper's 90 (the initial angle
         of the tests, where M* is smallest).
     gravity : float
-        Gravitational acceleration g [m/s^2], > 0.
+        Gravitational acceleration g [m/s^2], within :data:`GRAVITY_RANGE` (0.1 to 100).
     lever_arm : float or None
-        Lever arm l from the fold to the mass's centre [m], > 0; None: ``L / 2`` (mass at the
-        tapes' tip, fold in their middle: the paper's first estimate).
+        Lever arm l from the fold to the mass's centre [m], within :data:`LEVER_ARM_RANGE`
+        (1 mm to 10 m); None: ``L / 2`` (mass at the tapes' tip, fold in their middle: the
+        paper's first estimate).
     imperfection_deg : float
         Twist imperfection of the equal-sense runs [deg] (selects the branch at the bifurcation;
         the opposite-sense runs are perfect), within [-10, 10].
@@ -226,12 +240,22 @@ class MaxMassSettings:
             )
         if self.gravity <= 0.0:
             raise ValueError(f"gravity must be > 0 m/s^2 (got {self.gravity})")
+        if not GRAVITY_RANGE[0] <= self.gravity <= GRAVITY_RANGE[1]:
+            raise ValueError(
+                f"gravity must lie in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2 "
+                f"(got {self.gravity:.3g}; see GRAVITY_RANGE)"
+            )
         if self.lever_arm is not None:
             la = self.lever_arm
             if isinstance(la, bool) or not isinstance(la, (int, float)):
                 raise ValueError(f"lever_arm must be a number or None (got {la!r})")
             if not math.isfinite(la) or la <= 0.0:
                 raise ValueError(f"lever_arm must be finite and > 0 m (got {la})")
+            if not LEVER_ARM_RANGE[0] <= la <= LEVER_ARM_RANGE[1]:
+                raise ValueError(
+                    f"lever_arm must lie in [{LEVER_ARM_RANGE[0]:g}, {LEVER_ARM_RANGE[1]:g}] m "
+                    f"(got {la:.3g}; see LEVER_ARM_RANGE)"
+                )
         if not isinstance(self.switch_branches, (bool, np.bool_)):
             raise ValueError(
                 f"switch_branches must be True or False (got {self.switch_branches!r})"

@@ -17,6 +17,8 @@ from numpy.typing import NDArray
 
 __all__ = [
     "CONFIGURATIONS",
+    "MAX_DYNAMIC_STEPS",
+    "MAX_SAMPLE_RATE",
     "PAPER_BOUNDS",
     "PAPER_MODEL",
     "PAPER_SETUP",
@@ -33,6 +35,7 @@ __all__ = [
     "build_setup",
     "check_count",
     "check_number",
+    "check_sampling",
     "check_sense",
 ]
 
@@ -1006,6 +1009,42 @@ def drive(model: Any, node: int, dof: str, value: float, id: str) -> None:
     from tapespring.analysis import ramp
 
     model.prescribe(node, dof, value, function=ramp(1.0, 2.0), id=id, active=False)
+
+
+#: Highest rate of a dynamic step's records [Hz]: an output interval (or fixed time step) of at
+#: least 1 us. The set-up's dynamic steps start at t = 2 or 3 (the static steps before them count
+#: their load factor as time), where a double resolves t to 4.4e-16 s; the solver lands a step on
+#: an output time to 1e-9 of the interval (tape-core ``solver/dynamics.rs``), which that
+#: resolution defeats below about 0.2 us: the step after the first sample is then of length 0,
+#: "time step cut back ... to 0.000e0 s (the residual is not finite)" (measured on the
+#: deployment: fails at 5 MHz, runs at 3 MHz). 1 MHz keeps a factor of 4 from it, and is 1250
+#: times the motion capture's 800 Hz and 6000 times the flexible support's first mode (164 Hz).
+MAX_SAMPLE_RATE = 1e6
+
+#: Most records a dynamic step of the set-up may make: the solver's default ``max_steps``
+#: (tape-core ``DynamicParams``), which it checks against ``duration / output_interval`` when the
+#: step starts (after the static steps before it). Every sample is a step.
+MAX_DYNAMIC_STEPS = 100_000
+
+
+def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name: str) -> None:
+    """Raise ValueError unless a dynamic step of `duration` (name, value [s]) sampled at
+    `sample_rate` [Hz] (named `rate_name`) is within :data:`MAX_SAMPLE_RATE` and makes at most
+    :data:`MAX_DYNAMIC_STEPS` samples. The values are finite and > 0 (checked before)."""
+    if sample_rate > MAX_SAMPLE_RATE:
+        raise ValueError(
+            f"{rate_name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
+            f"(got {sample_rate:.3g} Hz; see MAX_SAMPLE_RATE)"
+        )
+    name, value = duration
+    # As the solver counts them: duration over the output interval.
+    samples = value / (1.0 / sample_rate)
+    if samples > MAX_DYNAMIC_STEPS:
+        raise ValueError(
+            f"{name} = {value:.3g} s at {rate_name} = {sample_rate:.3g} Hz makes {samples:.3g} "
+            f"samples, each a time step: more than the {MAX_DYNAMIC_STEPS} a dynamic step takes "
+            f"(max_steps); shorten the {name} or lower the {rate_name}"
+        )
 
 
 def dynamic_options(rho_inf: float, sample_rate: float, tolerance: float) -> dict[str, Any]:

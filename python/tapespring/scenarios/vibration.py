@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
+    MAX_SAMPLE_RATE,
     PAPER_MODEL,
     PAPER_SETUP,
     SetupSpec,
@@ -41,6 +42,7 @@ from tapespring.scenarios.setup import (
     check_count,
     check_number,
     check_rho_inf,
+    check_sampling,
     drive,
     dynamic_options,
     gravity_step,
@@ -86,7 +88,10 @@ class VibrationSettings:
         Local error tolerance of the time steps [m] (0: the solver's default).
     time_step : float
         Fixed time step of the decay [s], recorded at every step (`sample_rate` and `tolerance`
-        then do not apply; 0: adaptive steps). The numerical damping study uses it.
+        then do not apply; 0: adaptive steps), at least 1 us (as `sample_rate` is at most
+        :data:`~tapespring.scenarios.setup.MAX_SAMPLE_RATE`); either makes at most
+        :data:`~tapespring.scenarios.setup.MAX_DYNAMIC_STEPS` records in `duration`. The
+        numerical damping study uses it.
     modes : int
         Vibration modes computed about the loaded equilibrium.
     field_interval : int
@@ -113,6 +118,19 @@ class VibrationSettings:
         check_rho_inf(self.rho_inf)
         for name in ("tolerance", "time_step"):
             check_number(name, getattr(self, name), positive=True, zero=True)
+        if self.time_step > 0.0:
+            # Every fixed step is a record: the same bounds as the samples.
+            if self.time_step < 1.0 / MAX_SAMPLE_RATE:
+                raise ValueError(
+                    f"time_step must be at least {1.0 / MAX_SAMPLE_RATE:.0e} s (got "
+                    f"{self.time_step:.3g} s; see MAX_SAMPLE_RATE)"
+                )
+            rate = 1.0 / self.time_step
+            check_sampling(("duration", self.duration), sample_rate=rate, rate_name="1/time_step")
+        else:
+            check_sampling(
+                ("duration", self.duration), sample_rate=self.sample_rate, rate_name="sample_rate"
+            )
         if not isinstance(self.window, tuple | list) or len(self.window) != 2:
             raise ValueError(f"window must be a pair (low, high) [m] (got {self.window!r})")
         for value in self.window:

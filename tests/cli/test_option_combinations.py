@@ -1,0 +1,135 @@
+"""Options that would have no effect, or absurd values, are refused before anything runs.
+
+Each case once ran silently (an option ignored in that combination) or printed absurd numbers.
+A combination is refused as argparse refuses a bad option: usage, one line ``error: ...`` naming
+both options, exit code 2. Nothing here builds a model.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+from tapespring.cli import main
+
+
+def _refused(argv: list[str], capsys) -> str:
+    """The error line of a command refused by its parser (SystemExit 2)."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    line = err.strip().splitlines()[-1]
+    assert "error: " in line and "Traceback" not in err
+    return line
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        # The full path traces every branch: there is none to switch to.
+        (["bend", "--path", "full", "--switch-branches"], ["--switch-branches", "--path full"]),
+        (["bend", "--switch-branches"], ["--switch-branches", "--path full", "the default"]),
+        (["deploy", "--leave-aside-min", "4"], ["--leave-aside-min", "--experiment"]),
+        (["deploy", "--leave-aside-max", "1", "2"], ["--leave-aside-max", "--experiment"]),
+        (["vibrate", "--rho-inf-study", "0.5", "--rho-inf", "0.7"], ["--rho-inf", "-study"]),
+        (["vibrate", "--time-step", "1e-3", "--tolerance", "1e-5"], ["--tolerance", "--time-step"]),
+        (
+            ["max-mass", "--n-thickness", "1", "--thickness-range", "1e-4", "2e-4"],
+            ["--n-thickness"],
+        ),
+        (["max-mass", "--n-modulus", "1", "--modulus-range", "1e11", "2e11"], ["--modulus-range"]),
+    ],
+)
+def test_an_option_without_effect_in_its_combination_is_refused(argv, words, capsys):
+    line = _refused([*argv, "--no-progress"], capsys)
+    assert all(w in line for w in words), line
+
+
+@pytest.mark.parametrize(
+    ("option", "kind"),
+    [
+        (["--frame", "fit"], "vibration"),
+        (["--n-peaks", "3"], "vibration"),
+        (["--n-peaks", "3"], "quasi-static"),
+        (["--window", "0", "0.004"], "deployment"),
+        (["--span", "51"], "vibration"),
+        (["--span-time", "0.01"], "deployment"),
+    ],
+)
+def test_trials_refuse_an_option_of_another_kind_of_test(option, kind, tmp_path, capsys):
+    line = _refused(["trials", "analyze", str(tmp_path), "--kind", kind, *option], capsys)
+    assert f"{option[0]} applies to --kind" in line and f"not --kind {kind}" in line
+
+
+def test_trials_length_unit_is_one_the_readers_know(tmp_path, capsys):
+    # 'km' was accepted, and ignored unless a CSV column had no unit of its own.
+    line = _refused(
+        ["trials", "analyze", str(tmp_path), "--kind", "vibration", "--length-unit", "km"], capsys
+    )
+    assert "--length-unit" in line and "'km'" in line and "'mm'" in line
+
+
+@pytest.mark.parametrize("command", ["pull", "equilibrium"])
+def test_static_scenarios_take_no_viscosity(command, capsys):
+    # A static path has no rates for Kelvin-Voigt's eta to act on.
+    line = _refused([command, "--eta", "1e-4"], capsys)
+    assert "unrecognized arguments: --eta" in line
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["bend", "--alpha", "1e300"], "alpha must lie in (0, 360) deg (got 1e+300)"),
+        (["release", "--alpha", "360"], "alpha must lie in (0, 360) deg (got 360)"),
+        (["max-mass", "--lever-arm", "1e-300"], "lever arm must lie in [0.001, 10] m (got 1e-300)"),
+        (["max-mass", "--gravity", "1e300"], "gravity must lie in [0.1, 100] m/s^2 (got 1e+300)"),
+        (["deploy", "--sample-rate", "1e7"], "sample rate must lie in (0, 1e+06] Hz (got 1e+07)"),
+        (["vibrate", "--time-step", "1e-7"], "0 (adaptive) or at least 1e-06 s (got 1e-07)"),
+    ],
+)
+def test_absurd_values_are_refused_by_the_parser_in_short_numbers(argv, message, capsys):
+    line = _refused(argv, capsys)
+    assert message in line and len(line) < 200, line
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "words"),
+    [
+        ("--length", "1e300", ["1e+300 m long", "4.74e+303 elements, more than 1e+06"]),
+        ("--radius", "1e300", ["1.22e+300 m wide", "elements, more than 1e+06"]),
+    ],
+)
+def test_a_tape_too_large_for_its_mesh_is_named_before_the_run(option, value, words, capsys):
+    # The mesh generator's counts once overflowed: "gives 18446744073709551615 x 10 elements".
+    assert main(["bend", option, value, "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: mesh_size = 0.002 m is too fine") and len(err) < 250, err
+    assert all(w in err for w in words), err
+
+
+def test_deploy_refuses_more_samples_than_a_dynamic_step_takes(capsys):
+    # 1 MHz over the default second: 1e6 samples, each a step, against max_steps = 100000; the
+    # solver refused it only after the set-up was built (and at 5 MHz over a short run, failed
+    # after the fold with a time step of 0 s).
+    assert main(["deploy", "--sample-rate", "1e6", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "error: duration = 1 s at sample_rate = 1e+06 Hz makes 1e+06 samples, each a time step: "
+        "more than the 100000 a dynamic step takes (max_steps); shorten the duration or lower "
+        "the sample_rate"
+    )
+
+
+@pytest.mark.parametrize("metadata", [True, False])
+def test_deploy_refuses_a_recording_of_the_other_sense(metadata, tmp_path, capsys):
+    from tapespring.trials.csv import write_csv
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial("equal", duration=2.0)
+    if not metadata:
+        trial = dataclasses.replace(trial, metadata=dataclasses.replace(trial.metadata, sense=None))
+    path = write_csv(trial, tmp_path / "equal.csv")
+    line = _refused(["deploy", "--sense", "opposite", "--experiment", str(path)], capsys)
+    evidence = "its metadata" if metadata else "its initial bending angle, -"
+    assert f"is a deployment in equal sense ({evidence}" in line and "--sense is opposite" in line
