@@ -26,7 +26,7 @@ use serde_json::{Map, Value};
 
 use crate::assembly::{Assembled, System};
 use crate::constraint::Activity;
-use crate::error::{Error, Result};
+use crate::error::{Clock, Error, Result};
 use crate::model::{Load, Model};
 use crate::options::Options;
 use crate::output::{Fields, History, Outputs};
@@ -420,7 +420,15 @@ pub fn run(
                 Err(e) => {
                     // Kept with the history so far, as a failed static or dynamic step is.
                     result.step_stats.push(Stats::default());
-                    result.error = Some(e.context(&context).in_step(&step.name));
+                    let clock = if steps[..k]
+                        .iter()
+                        .any(|s| matches!(s.kind, StepKind::Dynamic(_)))
+                    {
+                        Clock::Time
+                    } else {
+                        Clock::LoadFactor
+                    };
+                    result.error = Some(e.context(&context).on_clock(clock).in_step(&step.name));
                     break;
                 }
             }

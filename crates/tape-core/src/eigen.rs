@@ -28,7 +28,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::error::{Error, Result};
+use crate::error::{Clock, Error, Result};
 
 /// A symmetric pencil `(K, M)` with `M` positive definite, seen through a factorisation of
 /// `K - s M`.
@@ -256,6 +256,7 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
             return Err(Error::NotConverged {
                 step: None,
                 t: f64::NAN,
+                clock: Clock::LoadFactor,
                 iterations: out.iterations - 1,
                 residual: f64::NAN,
                 detail: format!(

@@ -16,12 +16,14 @@ pub enum Error {
     #[error("factorisation failed: {0}")]
     Factorisation(String),
     /// An increment did not converge even after it was cut back to its minimum.
-    #[error("no convergence{} at t = {t:.6e} (load factor in static steps): {detail}", in_step(.step))]
+    #[error("no convergence{} at {}: {detail}", in_step(.step), at(*.clock, *.t))]
     NotConverged {
         /// Name of the analysis step, when run by [`crate::analysis::run`].
         step: Option<String>,
-        /// Time (load factor in static steps) of the last converged state.
+        /// Time \[s\] (load factor in static steps) of the last converged state.
         t: f64,
+        /// What `t` is.
+        clock: Clock,
         /// Newton iterations spent on the last failed attempt.
         iterations: usize,
         /// Residual norm at the last iteration of that attempt \[N\] (NaN if it had none).
@@ -34,7 +36,7 @@ pub enum Error {
     OutOfMemory(String),
     /// An arc-length path came back onto a stretch it had already followed (it retraces itself,
     /// or closes a loop) and would only repeat it until the step limit.
-    #[error("the path returned onto itself{} at t = {t:.6e} (load factor in static steps): {detail}", in_step(.step))]
+    #[error("the path returned onto itself{} at load factor {}: {detail}", in_step(.step), at_value(*.t))]
     PathReturned {
         /// Name of the analysis step, when run by [`crate::analysis::run`].
         step: Option<String>,
@@ -45,19 +47,56 @@ pub enum Error {
     },
     /// A step ran out of increments before reaching its end.
     #[error(
-        "step limit reached{}: {steps} increments brought t to {t:.6e}, short of {target:.6e}; raise the step's max_steps (or its initial increment)",
-        in_step(.step)
+        "step limit reached{}: {steps} increments brought {} to {}, short of {}; raise the step's max_steps (or its initial increment)",
+        in_step(.step),
+        clock.name(),
+        at_value(*.t),
+        at_value(*.target)
     )]
     StepLimit {
         /// Name of the analysis step, when run by [`crate::analysis::run`].
         step: Option<String>,
-        /// Time (load factor) reached.
+        /// Time \[s\] (load factor in static steps) reached.
         t: f64,
+        /// What `t` is.
+        clock: Clock,
         /// Increments used.
         steps: usize,
         /// Where the step was going.
         target: f64,
     },
+}
+
+/// What the `t` of an error is: the time of a dynamic step or the load factor of a static one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// Time \[s\].
+    Time,
+    /// Load factor of a static step (its time-like parameter).
+    LoadFactor,
+}
+
+impl Clock {
+    /// `"t"` or `"the load factor"`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Time => "t",
+            Self::LoadFactor => "the load factor",
+        }
+    }
+}
+
+/// A time or load factor for a message: seven significant digits, in their shortest form.
+fn at_value(t: f64) -> String {
+    shown(format!("{t:.6e}").parse().unwrap_or(t))
+}
+
+fn at(clock: Clock, t: f64) -> String {
+    match clock {
+        Clock::Time => format!("t = {} s", at_value(t)),
+        Clock::LoadFactor => format!("load factor {}", at_value(t)),
+    }
 }
 
 fn in_step(step: &Option<String>) -> String {
@@ -67,6 +106,16 @@ fn in_step(step: &Option<String>) -> String {
 }
 
 impl Error {
+    /// The same error with its `t` read as `clock` (a modal step's state keeps the time of the
+    /// step before it).
+    #[must_use]
+    pub fn on_clock(mut self, new: Clock) -> Self {
+        if let Self::NotConverged { clock, .. } | Self::StepLimit { clock, .. } = &mut self {
+            *clock = new;
+        }
+        self
+    }
+
     /// The same error, attributed to the analysis step `name`.
     #[must_use]
     pub fn in_step(mut self, name: &str) -> Self {
@@ -122,7 +171,7 @@ pub(crate) fn shown(value: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::shown;
+    use super::{shown, Clock, Error};
 
     #[test]
     fn numbers_in_messages_are_short() {
@@ -131,5 +180,34 @@ mod tests {
         assert_eq!(shown(-1e-300), "-1e-300");
         assert_eq!(shown(f64::NAN), "NaN");
         assert_eq!(shown(0.0), "0");
+    }
+
+    #[test]
+    fn a_failure_says_whether_it_stopped_at_a_time_or_a_load_factor() {
+        let failed = |clock| Error::NotConverged {
+            step: None,
+            t: 0.123_456_789_123,
+            clock,
+            iterations: 3,
+            residual: 1.0,
+            detail: "why".into(),
+        };
+        let dynamic = failed(Clock::Time).in_step("release").to_string();
+        assert_eq!(dynamic, "no convergence in step 'release' at t = 0.1234568 s: why");
+        let fold = failed(Clock::Time).on_clock(Clock::LoadFactor).to_string();
+        assert_eq!(fold, "no convergence at load factor 0.1234568: why");
+        let limit = Error::StepLimit {
+            step: None,
+            t: 0.5,
+            clock: Clock::Time,
+            steps: 10,
+            target: 1e300,
+        };
+        assert!(
+            limit
+                .to_string()
+                .contains("brought t to 0.5, short of 1e300;"),
+            "{limit}"
+        );
     }
 }

@@ -16,7 +16,7 @@
 
 mod common;
 
-use tape_core::{run, History, Model, Outputs, Result};
+use tape_core::{run, History, Model, Outputs, Result, StepKind};
 
 use common::strip::{beam_frequency, bend_then_release as steps, crossings_and_peaks, push_tip, E};
 
@@ -233,5 +233,51 @@ fn reused_iteration_matrix_lands_on_the_full_newton_states() -> Result<()> {
         "tracks differ by {worst:e} m (amplitude {amplitude:e} m)"
     );
     assert!(2 * n_reused <= n_full, "{n_reused} factorisations against {n_full}");
+    Ok(())
+}
+
+/// Output times far finer than the step's start time is round: samples every 0.1 us from t = 1 s
+/// (the static step's load factor) are all landed on, one step each. With the output tolerance in
+/// units of the interval alone, the round-off of `t - t0` (2e-16 s, 2e-9 of the interval) brought
+/// back the output time just reached as the next target and the steps shrank to nothing.
+#[test]
+fn fine_output_times_late_in_an_analysis_are_all_landed_on() -> Result<()> {
+    let interval = 1e-7;
+    let mut steps = steps(0.7, interval, 20.0 * interval);
+    if let StepKind::Dynamic(p) = &mut steps[1].kind {
+        p.adaptive = true;
+        p.max_step = 0.0;
+        p.output_interval = interval;
+    }
+    let result = run(&strip(0.0)?, &steps, &Outputs::default(), &mut |_| true)?;
+    assert!(result.error.is_none(), "{:?}", result.error);
+    let hist = &result.history;
+    let times: Vec<f64> = (0..hist.len())
+        .filter(|&k| hist.step[k] == 1)
+        .map(|k| hist.t[k])
+        .collect();
+    assert_eq!(times.len(), 20, "{times:?}");
+    for (k, t) in times.iter().enumerate() {
+        #[allow(clippy::cast_precision_loss)]
+        let expected = 1.0 + (k + 1) as f64 * interval;
+        assert!((t - expected).abs() < 1e-14, "record {k}: t = {t}, expected {expected}");
+    }
+    Ok(())
+}
+
+/// Output times below a thousand times the time's resolution are refused before the run.
+#[test]
+fn output_times_finer_than_the_time_resolves_are_refused() -> Result<()> {
+    let mut steps = steps(0.7, 1e-7, 1e-6);
+    if let StepKind::Dynamic(p) = &mut steps[1].kind {
+        p.adaptive = true;
+        p.max_step = 0.0;
+        p.output_interval = 1e-10;
+    }
+    let message = match run(&strip(0.0)?, &steps, &Outputs::default(), &mut |_| true) {
+        Err(e) => e.to_string(),
+        Ok(r) => format!("ran: {:?}", r.error),
+    };
+    assert!(message.contains("output_interval [s] (1e-10) is too fine"), "{message}");
     Ok(())
 }

@@ -3,7 +3,7 @@
 use nalgebra::Vector3;
 
 use super::Mesh;
-use crate::error::{check_positive, Error, Result};
+use crate::error::{check_positive, shown, Error, Result};
 
 /// Structured grid of `nx * ny` quadrilaterals over a parametric rectangle, mapped by `place(s, r)`
 /// with `s, r` in `[0, 1]`. Node `(i, j)` has index `j * (nx + 1) + i`.
@@ -95,8 +95,8 @@ impl TapeGeometry {
         check_positive("subtended angle alpha [rad]", self.alpha)?;
         if self.alpha >= 2.0 * std::f64::consts::PI {
             return Err(Error::InvalidParameter(format!(
-                "subtended angle alpha must be < 2 pi (got {})",
-                self.alpha
+                "subtended angle alpha must be < 2 pi (got {} rad)",
+                shown(self.alpha)
             )));
         }
         Ok(())
@@ -117,6 +117,10 @@ impl TapeGeometry {
     }
 }
 
+/// Most elements [`tape_spring`] generates: a guard against a mesh size that would exhaust memory
+/// or wrap the counts (the set-up and bending scenarios refuse far fewer, a million per tape).
+pub const MAX_GENERATED_ELEMENTS: f64 = 2e7;
+
 /// Tape-spring mesh with elements of size about `h` \[m\] (the arc count is rounded up to an even
 /// number so that a line of nodes lies on the symmetry plane).
 ///
@@ -128,15 +132,21 @@ impl TapeGeometry {
 pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
     geometry.validate()?;
     check_positive("mesh size h [m]", h)?;
-    let nx = (geometry.length / h).round().max(1.0) as usize;
-    let arc = geometry.radius * geometry.alpha;
-    let mut na = (arc / h).round().max(2.0) as usize;
-    na += na % 2;
-    if nx.checked_mul(na).is_none_or(|e| e > 20_000_000) {
+    // Counted in floating point first: an absurd ratio must be refused, not wrapped by the cast.
+    let nx_f = (geometry.length / h).round().max(1.0);
+    let na_f = (geometry.radius * geometry.alpha / h).round().max(2.0);
+    if nx_f * na_f > MAX_GENERATED_ELEMENTS {
         return Err(Error::InvalidParameter(format!(
-            "mesh size h = {h} m gives {nx} x {na} elements, more than the 20 000 000 this generator makes: use a larger h"
+            "mesh size h = {} m gives {} x {} elements, more than the {} this generator makes: use a larger h",
+            shown(h),
+            shown(nx_f),
+            shown(na_f),
+            shown(MAX_GENERATED_ELEMENTS)
         )));
     }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let (nx, mut na) = (nx_f as usize, na_f as usize);
+    na += na % 2;
     let g = *geometry;
     let mut mesh = grid(nx, na, |s, r| g.point(s * g.length, (r - 0.5) * g.alpha))?;
     rename(
@@ -189,5 +199,20 @@ mod tests {
         }
         let side = mesh.nodes[mesh.node_set("side1").unwrap()[0]];
         assert!((side.y.atan2(g.radius - side.z) - g.alpha / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_absurd_tape_is_refused_with_short_numbers() {
+        let long = TapeGeometry {
+            length: 1e300,
+            radius: 15.55e-3,
+            alpha: 1.2,
+        };
+        let message = tape_spring(&long, 2e-3).unwrap_err().to_string();
+        assert!(message.contains("gives 5e302 x 9 elements"), "{message}");
+        assert!(message.len() < 200, "{message}");
+        let wide = TapeGeometry { alpha: 1e300, ..long };
+        let message = wide.validate().unwrap_err().to_string();
+        assert!(message.contains("(got 1e300 rad)"), "{message}");
     }
 }

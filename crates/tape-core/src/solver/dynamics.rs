@@ -42,7 +42,7 @@ use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
-use crate::error::{check_positive, shown, Error, Result};
+use crate::error::{check_positive, shown, Clock, Error, Result};
 use crate::inertia::Motion;
 use crate::options::Options;
 use crate::rotation::tangent_inverse;
@@ -146,6 +146,10 @@ fn default_true() -> bool {
 /// iterations, 23 % less time, the same damping ratio to 8 digits; the deployments on 5 mm, 1 s:
 /// 2 to 4 % fewer iterations, as many rejected steps).
 pub const DYNAMIC_TOL_FORCE: f64 = 1e-6;
+
+/// Relative resolution of times in a dynamic step: a duration at or below this fraction of the
+/// step's end time is refused, and the step ends within it of its end.
+pub const TIME_RESOLUTION: f64 = 1e-12;
 
 /// Largest residual ratio of two successive iterations at which a reused iteration matrix is kept
 /// (modified Newton, [`DynamicParams::reuse_factorisation`]): slower contraction refreshes it.
@@ -820,12 +824,31 @@ pub fn solve_dynamic(
 ) -> Result<DynamicPath> {
     let start_time = Instant::now();
     params.validate()?;
-    if params.duration <= 1e-12 * (state.t + params.duration).abs() {
+    // Times are resolved to `TIME_RESOLUTION` of their size: a duration, output interval or fixed
+    // step below a thousand times that would land steps on round-off.
+    let resolution = TIME_RESOLUTION * state.t.abs().max((state.t + params.duration).abs());
+    if params.duration <= resolution {
         return Err(Error::InvalidParameter(format!(
             "duration [s] ({}) is below the resolution of the time at the step's start ({} s)",
             shown(params.duration),
             shown(state.t)
         )));
+    }
+    for (name, every) in [
+        ("output_interval [s]", params.output_interval),
+        (
+            "the fixed step (initial_step) [s]",
+            if params.adaptive { 0.0 } else { params.initial_step },
+        ),
+    ] {
+        if every > 0.0 && every < 1e3 * resolution {
+            return Err(Error::InvalidParameter(format!(
+                "{name} ({}) is too fine for times near {} s: it must be at least {}",
+                shown(every),
+                shown(state.t + params.duration),
+                shown(1e3 * resolution)
+            )));
+        }
     }
     let linear_counts = (system.linear.refinement_sweeps, system.linear.lu_fallbacks);
     let alpha = Alpha::new(params.rho_inf)?;
@@ -890,7 +913,7 @@ pub fn solve_dynamic(
     let mut last_work = integ.system.viscous_work().to_vec();
     let mech0 = last.kinetic + last.strain + last.gravity;
 
-    let eps_t = 1e-12 * params.duration.max(t_end.abs());
+    let eps_t = TIME_RESOLUTION * params.duration.max(t_end.abs());
     let mut cutbacks = 0;
     // Largest step Newton is trusted with: set below a step that failed to converge, relaxed
     // at every accepted step (see `NEWTON_CAP_SHRINK`).
@@ -904,6 +927,7 @@ pub fn solve_dynamic(
             path.error = Some(Error::StepLimit {
                 step: None,
                 t: state.t,
+                clock: Clock::Time,
                 steps: path.steps.len(),
                 target: t_end,
             });
@@ -912,7 +936,13 @@ pub fn solve_dynamic(
         // Land on the end and on output times.
         let mut target = t_end;
         if params.output_interval > 0.0 {
-            let k = ((state.t - t0) / params.output_interval + 1e-9).floor() + 1.0;
+            // A state within the time's resolution of an output time is on it: with a tolerance
+            // in units of the interval alone, `t - t0` at t = 2 s carried more round-off than
+            // 1e-9 of a 0.2 us interval, the output time just reached came back as the target,
+            // and the step shrank to nothing.
+            let r = (state.t - t0) / params.output_interval;
+            let tol = 1e-9 + (eps_t + 4.0 * f64::EPSILON * state.t.abs()) / params.output_interval;
+            let k = (r + tol).floor() + 1.0;
             target = target.min(t0 + k * params.output_interval);
         }
         let mut step_h = h.min(target - state.t);
@@ -992,6 +1022,7 @@ pub fn solve_dynamic(
                     path.error = Some(Error::NotConverged {
                         step: None,
                         t: state.t,
+                        clock: Clock::Time,
                         iterations,
                         residual,
                         detail: format!(
@@ -1010,6 +1041,7 @@ pub fn solve_dynamic(
                 path.error = Some(Error::NotConverged {
                     step: None,
                     t: state.t,
+                    clock: Clock::Time,
                     iterations,
                     residual: f64::NAN,
                     detail: format!(

@@ -391,10 +391,12 @@ pub fn solve_modal(system: &mut System, state: &State, params: &ModalParams) -> 
             iterations,
             residual,
             detail,
+            clock,
             ..
         } => Error::NotConverged {
             step,
             t: state.t,
+            clock,
             iterations,
             residual,
             detail,

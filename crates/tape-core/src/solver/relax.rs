@@ -20,7 +20,7 @@
 use super::events::Found;
 use super::statics::Driver;
 use super::{Event, StaticStep};
-use crate::error::{Error, Result};
+use crate::error::{Clock, Error, Result};
 use crate::state::State;
 
 /// An eigenvalue above `-NEUTRAL` times the largest diagonal entry of the tangent is zero to
@@ -79,6 +79,7 @@ impl Driver<'_> {
         Err(Error::NotConverged {
             step: None,
             t: state.t,
+            clock: Clock::LoadFactor,
             iterations: 0,
             residual: f64::NAN,
             detail: "no stable equilibrium found beyond the limit point".into(),
@@ -197,6 +198,7 @@ impl Driver<'_> {
             return Err(Error::NotConverged {
                 step: None,
                 t: t_switch,
+                clock: Clock::LoadFactor,
                 iterations: 0,
                 residual: f64::NAN,
                 detail: "no stable equilibrium found along the critical mode of a bifurcation".into(),
@@ -395,6 +397,7 @@ impl Driver<'_> {
         Err(Error::NotConverged {
             step: None,
             t: state.t,
+            clock: Clock::LoadFactor,
             iterations: MAX_STEPS,
             residual: self.force_norm(&self.r),
             detail: "relaxation past a limit point found no stable equilibrium".into(),

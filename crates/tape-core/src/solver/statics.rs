@@ -48,7 +48,7 @@ const SINGULAR_CONDITION: f64 = 1e12;
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
 use crate::element::shell::ElementStress;
-use crate::error::{Error, Result};
+use crate::error::{Clock, Error, Result};
 use crate::state::State;
 
 /// What one increment does.
@@ -1479,6 +1479,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 self.path.error = Some(Error::StepLimit {
                     step: None,
                     t: state.t,
+                    clock: Clock::LoadFactor,
                     steps: *max_steps,
                     target: end,
                 });
@@ -1525,6 +1526,7 @@ fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: 
     Error::NotConverged {
         step: None,
         t: state.t,
+        clock: Clock::LoadFactor,
         iterations,
         residual,
         detail: format!("{how}; last failure: {last}{hint}"),
