@@ -88,7 +88,9 @@ def step_options(control: str = "load") -> dict[str, Any]:
     """Every option of a static step with `control`, with its default value.
 
     The options are documented in ``docs/python-api.md``; unknown ones, and ones that do not apply
-    to the chosen control, are refused by :func:`run` with a message naming them.
+    to the chosen control, are refused by :func:`run` with a message naming them. The arc-length
+    monitor's ``monitor_node`` and ``monitor_dof`` have no default (no monitor) and are therefore
+    not in the dict; give both to monitor a reaction.
     """
     options = dict(_core.step_defaults("static", control))
     for key in ("name", "kind", "activate", "deactivate"):

@@ -157,6 +157,10 @@ def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> Non
     # steps, omega h = 0.073: 1.1e-6 of damping ratio, `_core.generalized_alpha_decay`).
     assert sim.fit.damping_ratio == pytest.approx(sim.kelvin_voigt_damping_ratio, rel=0.03)
     # Damping ratio proportional to eta: the paper's eta gives a tenth (checked in benchmarks).
+    # The rows `--csv` writes are those of a recording: every 800 Hz sample from the release,
+    # none of the steps the error control puts between them.
+    rows = sim.sample_rows()
+    np.testing.assert_allclose(sim.time_s[rows], np.arange(801) / 800.0, rtol=0, atol=1e-12)
     summary = sim.summary()
     assert summary["period_s"] == sim.fit.period
     json.dumps(summary)

@@ -126,7 +126,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         vtu="every 16th record: 50 Hz at 800 Hz samples",
     )
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3)
-    add_output_options(p, "time_s and displacement_m")
+    add_output_options(
+        p, "time_s and displacement_m, one row per sample (--time-step or 800 Hz) from the release"
+    )
     p.set_defaults(func=run, parser=p)
     return p
 
@@ -176,7 +178,11 @@ def run(args: argparse.Namespace) -> int:
         save_figure(plot_vibration(result, measured), path)
 
     def columns(result: object) -> dict:
-        return {"time_s": result.time_s, "displacement_m": result.displacement_m}  # type: ignore[attr-defined]
+        rows = result.sample_rows()  # type: ignore[attr-defined]
+        return {
+            "time_s": result.time_s[rows],  # type: ignore[attr-defined]
+            "displacement_m": result.displacement_m[rows],  # type: ignore[attr-defined]
+        }
 
     def extra(result: object) -> None:
         write_vtu(args, result.results, None)  # type: ignore[attr-defined]

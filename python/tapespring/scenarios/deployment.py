@@ -59,6 +59,7 @@ from tapespring.scenarios.setup import (
     dynamic_options,
     gravity_step,
     raise_if_stopped,
+    sample_rows,
 )
 
 __all__ = ["TRIAL_MARKERS", "DeploymentSettings", "DeploymentSimulation", "deploy"]
@@ -179,10 +180,7 @@ class DeploymentSimulation:
         recording at `sample_rate` has them; a last state off that grid (a `duration` that is no
         multiple of the interval, a run stopped early) is not one.
         """
-        k = self.time_s * self.settings.sample_rate
-        # The solver places a sample to 1e-9 of the interval (tape-core solver/dynamics.rs): a
-        # state within a millionth of an interval of a sample instant is that sample.
-        return np.flatnonzero(np.abs(k - np.round(k)) <= 1e-6)
+        return sample_rows(self.time_s, self.settings.sample_rate)
 
     def to_trial(self, *, rate_hz: float | None = None) -> Any:
         """The release and the motion as a :class:`tapespring.trials.Trial`.

@@ -47,6 +47,7 @@ from tapespring.scenarios.setup import (
     dynamic_options,
     gravity_step,
     raise_if_stopped,
+    sample_rows,
 )
 
 __all__ = ["VibrationComparison", "VibrationSettings", "VibrationSimulation", "vibrate"]
@@ -174,6 +175,13 @@ class VibrationSimulation:
     results: Any
     wall_s: float
     comparison: VibrationComparison | None = None
+
+    def sample_rows(self) -> NDArray[np.int64]:
+        """Rows of the histories at the sample instants from the release: ``k / sample_rate``, or
+        every fixed ``time_step`` (the error control adds steps between samples where the motion
+        is fast; a recording has the samples only)."""
+        s = self.settings
+        return sample_rows(self.time_s, 1.0 / s.time_step if s.time_step > 0.0 else s.sample_rate)
 
     def to_trial(self, *, rate_hz: float | None = None, hold: float = 0.25) -> Any:
         """The free decay sampled like a recorded vibration test, as a
