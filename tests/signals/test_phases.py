@@ -50,3 +50,27 @@ def test_phase_at_labels_instants():
     phases = detect_phases(_peaks(trial))
     labels = phases.phase_at(np.array([0.4, phases.phase_ii_start, phases.phase_iii_start + 1]))
     np.testing.assert_array_equal(labels, [1, 2, 3])
+
+
+def test_peaks_at_one_instant_are_a_value_error_not_a_log_of_zero():
+    # An angle measured in the wrong plane jumps by 180 deg: a maximum and a minimum on one
+    # instant, a half-cycle of no duration whose log-duration was -inf (numpy warnings, NaN).
+    import warnings
+
+    from tapespring.signals.peaks import Extrema, Peaks
+
+    def extrema(time, value):
+        time = np.asarray(time, dtype=float)
+        return Extrema(time, np.asarray(value, dtype=float), np.diff(time, prepend=0.0), time * 0)
+
+    peaks = Peaks(
+        extrema([0.1, 0.3, 0.5], [1, 0.5, 0.4]),
+        extrema([0.2, 0.3, 0.6], [-1, -2, -0.3]),
+        0.01,
+        0.001,
+        0.0,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"successive peaks at 0\.3 and 0\.3 s are not in"):
+            detect_phases(peaks)

@@ -20,11 +20,11 @@ from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
 from tapespring.signals.angle import bending_angle
 from tapespring.signals.circle import CircleFit, fit_circle, max_lateral_displacement
-from tapespring.signals.frame import fit_motion_frame, parse_frame, to_frame
+from tapespring.signals.frame import fit_motion_frame, motion_plane, parse_frame, to_frame
 from tapespring.signals.levels import equilibrium_value, release_index
 from tapespring.signals.peaks import Peaks, PeakStatistics, extract_peaks, peak_statistics
 from tapespring.signals.phases import Phases, detect_phases
-from tapespring.signals.smoothing import complete_windows, smooth, span_samples
+from tapespring.signals.smoothing import complete_windows, noise_std, smooth, span_samples
 from tapespring.signals.stats import Summary, summarize
 from tapespring.trials.trial import Trial, TrialError, TrialWarning
 
@@ -101,6 +101,26 @@ class DeploymentResult:
 # Sign of the initial bending angle for each sense (paper Sec. 2).
 _SENSE_SIGN = {"opposite": 1.0, "equal": -1.0}
 
+# Largest tilt of the markers' plane of motion from the frame's x-z plane (the angle between its
+# normal and the y axis; `tapespring.signals.frame.motion_plane`). In the rig's frame the rod turns
+# about y: the tilt is a degree or so (the lateral motion, 4.3 mm at the 235 mm tip). A rig turned
+# about the vertical tilts it by the turn (its angles are then stretched, and the sense warning or
+# frame='fit' tells it); a wrong frame (--frame x,-z,y on a rig in x-z) puts the motion in its x-y
+# or y-z plane, 90 deg, where the x-z projection of the marker 1 -> 2 vector shrinks to the noise
+# and its angle jumps by 180 deg (with half-cycles of no duration). 45 deg is halfway.
+_MAX_TILT = np.deg2rad(45.0)
+# The plane of motion is defined only if the motion spreads along its second direction clearly
+# beyond the marker noise there (10 sigma: the 0.3 mm lateral noise spreads a marker pulled along
+# a line by one sigma across it) and beyond 2 % of the main spread (`fit_motion_frame`'s
+# criterion); otherwise (a marker pulled along a line, markers at rest) the other checks speak.
+_PLANE_NOISE_FACTOR = 10.0
+_PLANE_MIN_SPREAD_RATIO = 0.02
+# Smallest held angle of a deployment. It starts from a fold past the buckling of the tapes (the
+# paper's 95.5 and -91.2 deg); the set-up's simulated free decay turns markers 1-2 by 4 deg, its
+# simulated pull by 11 deg (16 mm), so a third of the paper's fold leaves a factor three or more
+# on either side.
+_MIN_INITIAL_ANGLE = np.deg2rad(30.0)
+
 
 def _rig_frame(frame: str | np.ndarray | None) -> tuple[np.ndarray | None, str]:
     """The rotation to the rig's axes (None: as recorded) and its label."""
@@ -116,6 +136,33 @@ def _rig_frame(frame: str | np.ndarray | None) -> tuple[np.ndarray | None, str]:
     if np.linalg.det(rotation) < 0:
         raise ValueError("frame is a mirror image (determinant -1): it would flip every angle")
     return rotation, "given"
+
+
+def _check_bending_plane(
+    label: str, m1: np.ndarray, m2: np.ndarray, markers: Sequence[str], frame_name: str
+) -> None:
+    """Refuse markers whose plane of motion is tilted from the frame's x-z plane (`_MAX_TILT`)."""
+    plane = motion_plane(m1, m2)
+    d = m2 - m1
+    sigma = np.array([noise_std(d[:, k]) for k in range(3)])
+    noise = float(np.sqrt(np.sum(plane.axes[1] ** 2 * sigma**2)))  # along the second direction
+    spread = plane.spread
+    if not (
+        spread[1] > _PLANE_NOISE_FACTOR * noise and spread[1] > _PLANE_MIN_SPREAD_RATIO * spread[0]
+    ):
+        return
+    if plane.tilt <= _MAX_TILT:
+        return
+    named = {"lab": "the laboratory's axes", "given": "the given frame"}
+    axes = named.get(frame_name, f"the frame {frame_name!r}")
+    raise TrialError(
+        label,
+        f"markers {markers[0]} and {markers[1]} turn in a plane tilted by "
+        f"{np.rad2deg(plane.tilt):.0f} deg from the bending plane (x-z in {axes}; allowed "
+        f"{np.rad2deg(_MAX_TILT):.0f} deg): the frame's y axis is not the axis they turn about, so "
+        "the bending angle would mean nothing; give the rig's frame (frame='x,-z,y', --frame) or "
+        "fit it (frame='fit', --frame fit)",
+    )
 
 
 def _angle_and_release(
@@ -187,7 +234,10 @@ def analyze_deployment(
     ------
     TrialError
         If a marker is missing or has unfilled gaps, no peak is found, or the
-        plane of motion cannot be fitted.
+        plane of motion cannot be fitted; if markers 1 and 2 turn in a plane
+        tilted by more than 45 deg from the frame's x-z plane (a wrong frame), or
+        the angle held before the release is under 30 deg (not a deployment: it
+        starts from a fold of about 90 deg).
 
     Warns
     -----
@@ -210,9 +260,18 @@ def analyze_deployment(
             raise TrialError(label, str(exc)) from None
     if rotation is not None:
         m1, m2, m3 = (to_frame(rotation, m) for m in (m1, m2, m3))
+    _check_bending_plane(label, m1, m2, markers, frame_name)
     angle, i0, initial = _angle_and_release(t, m1, m2, tail, release_threshold)
     if i0 == 0:
         raise TrialError(label, "the bending angle never leaves its initial value")
+    if abs(initial) < _MIN_INITIAL_ANGLE:
+        raise TrialError(
+            label,
+            f"the bending angle is held at {np.rad2deg(initial):+.1f} deg from the deployed "
+            "equilibrium before it moves: a deployment starts from a fold (the paper's 95.5 and "
+            f"-91.2 deg; at least {np.rad2deg(_MIN_INITIAL_ANGLE):.0f} deg needed), so this is "
+            "not a deployment record (a vibration or pull test?)",
+        )
     expected = _SENSE_SIGN.get(sense)
     if frame_name == "fitted" and expected is not None and np.sign(initial) == -expected:
         # A fit cannot tell which way the bending axis points: the sense decides.
@@ -241,7 +300,10 @@ def analyze_deployment(
     if len(all_peaks.maxima) == 0 and len(all_peaks.minima) == 0:
         raise TrialError(trial.metadata.label, "no peak found in the bending angle")
     peaks = all_peaks.head(n_peaks)
-    phases = detect_phases(all_peaks)
+    try:
+        phases = detect_phases(all_peaks)
+    except ValueError as exc:
+        raise TrialError(label, f"no phases in the bending angle: {exc}") from None
 
     tip_eq = np.array([equilibrium_value(t, m3[:, k], tail=tail) for k in range(3)])
     tip_xz = (m3 - tip_eq)[:, [0, 2]]
@@ -249,7 +311,12 @@ def analyze_deployment(
     pt = phases.peak_time[:end] if end is not None else phases.peak_time[:5]
     pt = np.concatenate(([t[max(0, i0 - 1)]], pt))
     tip_points = np.column_stack([np.interp(pt, t, tip_xz[:, k]) for k in range(2)])
-    circle = fit_circle(tip_points) if tip_points.shape[0] >= 3 else None
+    try:
+        circle = fit_circle(tip_points) if tip_points.shape[0] >= 3 else None
+    except ValueError as exc:
+        raise TrialError(
+            label, f"no circle through the tip's positions at the peaks: {exc}"
+        ) from None
     span = span_samples(lateral_span_time, trial.rate) if lateral_span_time else lateral_span
     lateral = smooth(m3[:, 1], span) if span > 1 else m3[:, 1]
     lateral_max = max_lateral_displacement(

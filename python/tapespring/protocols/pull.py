@@ -4,6 +4,17 @@ One trial: the pulled marker's displacement against the force-plate force, the
 maximum force before buckling and its displacement (`analyze_pull_trial`, Fig. 19).
 A set of trials: the statistics of the maximum force and its displacement (paper
 Table 2). Marker roles and gaps: see `tapespring.protocols.markers`.
+
+A record that is not a pull test is refused before its maximum is taken (a deployment's
+swings gave a "maximum force" 394 % off). A pull test, as `analyze_pull_trial` checks it:
+
+- the pulled marker moves clearly: by 10 times its noise, and at least 0.1 mm;
+- slowly: over the middle 80 % of its travel (from 10 % to 90 % of its largest
+  displacement) at 30 mm/s at most on average (the paper pulls at 1 mm/s; a deployment swings
+  the rod's middle at about 1 m/s);
+- mostly one way: it turns back by more than a fifth of its travel at most once (a return
+  after the pull);
+- and the force rises to a maximum: the smoothed force goes above 3 times the force noise.
 """
 
 from __future__ import annotations
@@ -17,7 +28,7 @@ import numpy as np
 from tapespring import plot
 from tapespring.report import save_figure, summary_json, summary_row, write_table
 from tapespring.signals.pull import PullTest, analyze_pull_test
-from tapespring.signals.smoothing import smooth, span_samples
+from tapespring.signals.smoothing import noise_std, smooth, span_samples
 from tapespring.signals.stats import summarize
 from tapespring.trials.trial import Trial, TrialError
 
@@ -27,6 +38,27 @@ from .registry import Protocol, TrialsAnalysis
 __all__ = ["PROTOCOL", "PullTestResult", "analyze_pull_group", "analyze_pull_trial"]
 
 KIND = "quasi-static"
+
+# The pull-test checks (module docs), loose on purpose: the margins on either side are given.
+# Smallest travel of the pulled marker: 10 sigma of its noise (no noise makes it), and 0.1 mm
+# (twice the paper's 0.05 mm marker precision) for noise-free simulated records; the tapes buckle
+# at about 11 mm.
+_MIN_TRAVEL_SIGMA = 10.0
+_MIN_TRAVEL = 0.1e-3
+# Largest mean speed over the middle 80 % of the travel [m/s]: 30 times the paper's 1 mm/s
+# (quasi-static), and 12 to 40 times below a deployment's swing of the rod's middle (0.36 to
+# 1.2 m/s, the same mean, in the synthetic and simulated deployments of either sense).
+_MAX_SPEED = 30e-3
+# Turn-backs of the pulled marker by more than this fraction of its travel (and 8 sigma), and how
+# many are allowed: one, a return after the pull; a deployment swings back and forth.
+_TURN_FRACTION = 0.2
+_MAX_TURNS = 1
+# The smoothed force must rise above this many times the force noise: white noise smoothed over
+# 101 samples has a standard deviation of sigma / 10, its maximum over a minute at 4 kHz stays
+# under 0.5 sigma; the synthetic pull tests rise to 20 sigma (9.8 N over 0.5 N).
+_MIN_FORCE_SIGMA = 3.0
+# Smoothing of the displacement for the checks [s]: 25 ms, the force's span at 4 kHz.
+_CHECK_SPAN_TIME = 0.025
 
 
 @dataclass(frozen=True)
@@ -87,6 +119,14 @@ def analyze_pull_trial(
     Returns
     -------
     PullTestResult
+
+    Raises
+    ------
+    TrialError
+        If the marker or the force plate is missing, the marker has gaps, the force has NaN
+        samples or the span is longer than the force record; or if the record is not a pull
+        test (module docs: the marker moves too little, too fast or back and forth, or the
+        force does not rise), with the reason.
     """
     z = finite_marker(trial, marker)[:, 2]
     fp = trial.force_plate(plate)
@@ -110,11 +150,80 @@ def analyze_pull_trial(
     fs = smooth(f, span)
     f_sign = np.sign(fs[np.argmax(np.abs(fs))]) or 1.0
     d_sign = np.sign(d[np.argmax(np.abs(d))]) or 1.0
+    _check_pull_record(trial, marker, d_sign * z, f_sign * f, f_sign * fs)
     test = analyze_pull_test(d_sign * d, f_sign * f, span=span)
     meta = trial.metadata
     return PullTestResult(
         name=trial.name, tape_pair=meta.tape_pair, session=meta.session, time=fp.time, test=test
     )
+
+
+def _turn_backs(y: np.ndarray, height: float) -> int:
+    """How many times ``y`` turns back by more than ``height`` (a zigzag with hysteresis)."""
+    turns = 0
+    direction = 0  # +1 rising, -1 falling, 0 not yet moved by `height`
+    top = bottom = y[0]
+    for v in y:
+        top, bottom = max(top, v), min(bottom, v)
+        if direction >= 0 and top - v > height:
+            turns += direction == 1
+            direction, bottom = -1, v
+        elif direction <= 0 and v - bottom > height:
+            turns += direction == -1
+            direction, top = 1, v
+    return turns
+
+
+def _check_pull_record(
+    trial: Trial, marker: str, z: np.ndarray, force: np.ndarray, force_smoothed: np.ndarray
+) -> None:
+    """Refuse a record that is not a pull test (module docs).
+
+    ``z`` is the pulled marker's vertical displacement at the marker instants and ``force`` the
+    force at the plate's, both zeroed by the tare and positive in the pulling direction.
+    """
+    label = trial.metadata.label
+    t = trial.time
+    sigma = noise_std(z)
+    d = smooth(z, span_samples(_CHECK_SPAN_TIME, trial.rate))
+    travel = float(np.max(d))
+    needed = max(_MIN_TRAVEL_SIGMA * sigma, _MIN_TRAVEL)
+    if not travel >= needed:
+        raise TrialError(
+            label,
+            f"not a pull test: the pulled marker {marker!r} moves by {travel * 1e3:.3g} mm at "
+            f"most (a pull test moves it by {needed * 1e3:.2g} mm at least: 10 times its noise "
+            "and 0.1 mm)",
+        )
+    i10 = int(np.argmax(d >= 0.1 * travel))
+    i90 = int(np.argmax(d >= 0.9 * travel))
+    speed = 0.8 * travel / max(t[i90] - t[i10], 1.0 / trial.rate)
+    if speed > _MAX_SPEED:
+        raise TrialError(
+            label,
+            f"not a pull test: the pulled marker {marker!r} covers the middle of its "
+            f"{travel * 1e3:.3g} mm travel at {speed * 1e3:.3g} mm/s (from t = {t[i10]:.4g} s "
+            f"to {t[i90]:.4g} s); a quasi-static pull is slow (the paper's 1 mm/s; at most "
+            f"{_MAX_SPEED * 1e3:.0f} mm/s here): a deployment or a vibration record?",
+        )
+    turns = _turn_backs(d, max(_TURN_FRACTION * travel, 8.0 * sigma))
+    if turns > _MAX_TURNS:
+        raise TrialError(
+            label,
+            f"not a pull test: the pulled marker {marker!r} turns back {turns} times by more "
+            f"than {100 * _TURN_FRACTION:.0f} % of its {travel * 1e3:.3g} mm travel (a pull "
+            f"moves it one way, and back once at most): a deployment or a "
+            "vibration record?",
+        )
+    f_max = float(np.max(force_smoothed))
+    f_noise = noise_std(force)
+    if not f_max > _MIN_FORCE_SIGMA * f_noise or not f_max > 0:
+        raise TrialError(
+            label,
+            f"not a pull test: the vertical force never rises clearly from its tare (smoothed "
+            f"maximum {f_max:.3g} N, force noise {f_noise:.3g} N; a pull needs "
+            f"{_MIN_FORCE_SIGMA:.0f} times the noise): no pulling force recorded?",
+        )
 
 
 def analyze_pull_group(

@@ -5,6 +5,21 @@ damped-oscillator fit of its free decay (`analyze_vibration`, eqs. 5-6). A set o
 trials: the statistics of the damping ratio and the period over all tests and
 over the session means (paper Table 7). Marker roles and gaps: see
 `tapespring.protocols.markers`.
+
+A record that is not a free decay is refused before the fit (the late swings of a deployment
+gave a "damping ratio" of 4.8 %). A free decay, as `analyze_vibration` checks it on the peaks
+after the release that stand clear of the noise (20 sigma, and the window's low end):
+
+- one period: every half-cycle but one (the release may disturb the first) lasts within a factor
+  1.5 of their median (a linear oscillator keeps its period; a deployment's phases differ by
+  factors of 2 to 5);
+- even swings: at most half of the peaks are lopsided, more than twice or less than half the
+  geometric mean of the peaks either side (twice the noise allowed): a free vibration's peak
+  amplitudes decay smoothly, whatever its damping, a deployment's first swings alternate
+  between large and small about the deployed equilibrium;
+- amplitudes that mostly decay: at most a third of the peaks exceed the previous peak of the same
+  kind by more than 1 % and twice the noise (a steady, undamped oscillation passes: its fit gives
+  a damping ratio of zero).
 """
 
 from __future__ import annotations
@@ -19,6 +34,7 @@ from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
 from tapespring.signals.damping import DampingFit, fit_damping
 from tapespring.signals.levels import release_index
+from tapespring.signals.peaks import extract_peaks
 from tapespring.signals.smoothing import noise_std
 from tapespring.signals.stats import summarize
 from tapespring.trials.trial import Trial, TrialError
@@ -29,6 +45,28 @@ from .registry import Protocol, TrialsAnalysis
 __all__ = ["PROTOCOL", "VibrationResult", "analyze_vibration", "analyze_vibration_group"]
 
 KIND = "vibration"
+
+# The free-decay checks (module docs). Peaks count from 20 sigma of the marker noise (a noise
+# extremum never gets there), and never below the window's low end or 0.1 % of the largest peak
+# (noise-free simulated records).
+_PEAK_FLOOR_SIGMA = 20.0
+# Half-cycles may differ from their median by this factor, and this many may differ more. The
+# synthetic and simulated free decays stay within 1-3 %; the synthetic and simulated deployments
+# span factors of 2.3 to 5 between their phases.
+_PERIOD_FACTOR = 1.5
+_PERIOD_OUTLIERS = 1
+# A peak is lopsided if it is more than twice, or less than half, the geometric mean of the peaks
+# either side (noise allowance 2 sigma); at most this share may be. An exponential decay gives 1
+# at any damping (the simulated decay, at a damping ratio of about 0.1, stays within 1.7 where it
+# settles on an equilibrium taken from its still swinging end); a deployment's phase I and II
+# swings give 2.3 to 2.5 and 0.4, alternately.
+_LOPSIDED_RATIO = 2.0
+_MAX_LOPSIDED = 0.5
+# A peak "grows" if it exceeds the previous peak of the same kind by this fraction and twice the
+# noise (1 %: the rounding and interpolation of noise-free records); at most this share may grow
+# (noise around a steady amplitude makes about half of them grow without the allowance).
+_GROWTH_TOLERANCE = 0.01
+_MAX_GROWING = 1.0 / 3.0
 
 
 @dataclass(frozen=True)
@@ -88,14 +126,18 @@ def analyze_vibration(
     Raises
     ------
     TrialError
-        If the marker is missing or has gaps, or the fit is impossible.
+        If the marker is missing or has gaps, or the fit is impossible; or if the record is
+        not a free decay (module docs: the half-cycles change their duration, the peaks
+        alternate large and small, or the amplitudes grow), with the reason.
     """
     if not 0 < tail_fraction <= 1:
         raise ValueError(f"tail_fraction must satisfy 0 < tail_fraction <= 1, got {tail_fraction}")
     z_abs = finite_marker(trial, marker)[:, 2]
     t = trial.time
     z = z_abs - np.median(z_abs[-max(1, round(tail_fraction * z_abs.size)) :])
-    i0 = release_index(z, max(window[0], 5.0 * noise_std(z)))
+    sigma = noise_std(z)
+    i0 = release_index(z, max(window[0], 5.0 * sigma))
+    _check_free_decay(trial.metadata.label, t[i0:], z[i0:], window[0], sigma, prominence)
     try:
         fit = fit_damping(t, z, window, prominence=prominence, t_start=float(t[i0]))
     except ValueError as exc:
@@ -110,6 +152,59 @@ def analyze_vibration(
         release_time=float(t[i0]),
         fit=fit,
     )
+
+
+def _check_free_decay(
+    label: str, t: np.ndarray, z: np.ndarray, low: float, sigma: float, prominence: float | None
+) -> None:
+    """Refuse a record whose motion after the release is not a free decay (module docs).
+
+    ``t``, ``z``: the record from the release on, ``z`` about the equilibrium [m]; ``low``: the
+    window's low end [m]; ``sigma``: the noise of ``z`` [m].
+    """
+    if z.size < 3:
+        return  # released at the record's end: fit_damping finds no peak
+    time, value, _ = extract_peaks(t, z, None, prominence=prominence).sequence()
+    amp = np.abs(value)
+    if amp.size < 3:
+        return  # too few peaks for a fit: fit_damping says so
+    floor = max(low, _PEAK_FLOOR_SIGMA * sigma, 1e-3 * float(np.max(amp)))
+    pair = (amp[1:] >= floor) & (amp[:-1] >= floor)
+    half = np.diff(time)[pair]
+    if half.size >= 2:
+        median = float(np.median(half))
+        off = (half > _PERIOD_FACTOR * median) | (_PERIOD_FACTOR * half < median)
+        if np.count_nonzero(off) > _PERIOD_OUTLIERS:
+            raise TrialError(
+                label,
+                f"not a free decay: its half-cycles after the release last from "
+                f"{np.min(half):.3g} to {np.max(half):.3g} s ({np.count_nonzero(off)} of "
+                f"{half.size} more than a factor {_PERIOD_FACTOR:g} from their median "
+                f"{median:.3g} s), where a free vibration keeps one period: a deployment record?",
+            )
+    inner = (amp[1:-1] >= floor) & (amp[2:] >= floor) & (amp[:-2] >= floor)
+    sides = np.sqrt(amp[2:] * amp[:-2])[inner]
+    big = np.maximum(amp[1:-1][inner], sides) - 2.0 * sigma
+    small = np.minimum(amp[1:-1][inner], sides) + 2.0 * sigma
+    lopsided = big > _LOPSIDED_RATIO * small
+    if lopsided.size >= 2 and np.count_nonzero(lopsided) > _MAX_LOPSIDED * lopsided.size:
+        raise TrialError(
+            label,
+            f"not a free decay: {np.count_nonzero(lopsided)} of its {lopsided.size} peaks after "
+            f"the release are more than {_LOPSIDED_RATIO:g} times, or less than 1/"
+            f"{_LOPSIDED_RATIO:g} of, the peaks either side, where a free vibration's amplitudes "
+            "decay smoothly: a deployment record?",
+        )
+    same = (amp[2:] >= floor) & (amp[:-2] >= floor)
+    grows = (amp[2:] > (1.0 + _GROWTH_TOLERANCE) * amp[:-2] + 2.0 * sigma)[same]
+    if grows.size >= 3 and np.count_nonzero(grows) > _MAX_GROWING * grows.size:
+        raise TrialError(
+            label,
+            f"not a free decay: {np.count_nonzero(grows)} of its {grows.size} peaks after the "
+            "release exceed the previous peak of the same kind (by more than "
+            f"{100 * _GROWTH_TOLERANCE:g} % and twice the noise; a third at most may), where a "
+            "free vibration's amplitudes decay",
+        )
 
 
 def analyze_vibration_group(

@@ -11,7 +11,7 @@ smoothing
     with a full window (`complete_windows`), white-noise level (`noise_std`).
 frame
     The rig's frame: given as signed axes (`parse_frame`) or fitted to the markers
-    (`fit_motion_frame`); `to_frame` applies it.
+    (`fit_motion_frame`, from their plane of motion `motion_plane`); `to_frame` applies it.
 angle
     Bending angle from two markers (`bending_angle`).
 levels
@@ -42,6 +42,7 @@ __all__ = [
     "CrossingPeaks",
     "DampingFit",
     "Extrema",
+    "MotionPlane",
     "PeakComparison",
     "PeakStatistics",
     "Peaks",
@@ -60,6 +61,7 @@ __all__ = [
     "fit_motion_frame",
     "force_at_crossings",
     "max_lateral_displacement",
+    "motion_plane",
     "noise_std",
     "parse_frame",
     "peak_statistics",
@@ -79,7 +81,7 @@ __getattr__, __dir__ = lazy_exports(
         "circle": ["CircleFit", "fit_circle", "max_lateral_displacement"],
         "crossings": ["CrossingPeaks", "force_at_crossings"],
         "damping": ["DampingFit", "fit_damping", "select_window_peaks"],
-        "frame": ["fit_motion_frame", "parse_frame", "to_frame"],
+        "frame": ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"],
         "levels": ["equilibrium_value", "release_index"],
         "peaks": [
             "Extrema",

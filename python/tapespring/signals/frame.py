@@ -9,10 +9,14 @@ shifts, or its sign flips. Two remedies:
 - give the frame: ``parse_frame("x,-z,y")`` says that the rig's x, y and z axes
   are the laboratory's x, -z and y (a signed permutation, right-handed);
 - fit it (`fit_motion_frame`): the rod turns in a plane, so the direction of
-  least spread of the marker 1 -> 2 (and 1 -> 3) vectors is the bending axis y;
-  x is the deployed rod direction projected on the plane. A fit cannot tell the
+  least spread of the marker 1 -> 2 (and 1 -> 3) vectors is the bending axis y
+  (`motion_plane`); x is the deployed rod direction projected on the plane. A fit cannot tell the
   sign of y (which way is "positive" bending); the caller chooses it (from the
   sense of bending, for a deployment).
+
+The same plane checks a frame given or assumed: `MotionPlane.tilt` is the angle between the
+plane's normal and the frame's y axis (0 in the rig's frame, 90 degrees when a wrong frame puts
+the motion in its x-y or y-z plane).
 
 A frame is a rotation matrix ``R`` whose rows are the rig's axes in laboratory
 coordinates: ``p_rig = R @ p_lab``.
@@ -20,9 +24,11 @@ coordinates: ``p_rig = R @ p_lab``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["fit_motion_frame", "parse_frame", "to_frame"]
+__all__ = ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 # Below this ratio of spreads (in-plane second direction over first) the vectors barely turn and
@@ -90,6 +96,68 @@ def to_frame(frame: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.asarray(points, dtype=float) @ np.asarray(frame, dtype=float).T
 
 
+@dataclass(frozen=True)
+class MotionPlane:
+    """The plane markers turn in about an origin marker.
+
+    Attributes
+    ----------
+    axes : ndarray, shape (3, 3)
+        Rows: the principal directions of the origin -> marker vectors about their mean, of
+        largest spread first; the last, of least spread, is the plane's normal (sign: a
+        non-negative y component).
+    spread : ndarray, shape (3,)
+        RMS spread of those vectors along ``axes`` [m].
+    """
+
+    axes: np.ndarray
+    spread: np.ndarray
+
+    @property
+    def normal(self) -> np.ndarray:
+        """Unit normal of the plane (``axes[2]``)."""
+        return self.axes[2]
+
+    @property
+    def tilt(self) -> float:
+        """Angle between `normal` and the y axis [rad], in [0, pi/2]."""
+        return float(np.arccos(min(1.0, abs(float(self.normal[1])))))
+
+
+def motion_plane(origin: np.ndarray, *moving: np.ndarray) -> MotionPlane:
+    """The plane of motion of markers about ``origin`` (principal directions of their vectors).
+
+    Parameters
+    ----------
+    origin : ndarray, shape (n, 3)
+        Marker on the axis (marker 1) [m].
+    *moving : ndarray, shape (n, 3)
+        Markers that turn about it [m]; at least one. Samples with NaN are left out.
+
+    Returns
+    -------
+    MotionPlane
+
+    Raises
+    ------
+    ValueError
+        If no moving marker is given, or no marker has 3 complete samples.
+    """
+    if not moving:
+        raise ValueError("the plane of motion needs at least one moving marker")
+    p0 = np.asarray(origin, dtype=float)
+    clouds = [np.asarray(m, dtype=float) - p0 for m in moving]
+    clouds = [c[np.isfinite(c).all(axis=1)] for c in clouds]
+    clouds = [c - c.mean(axis=0) for c in clouds if c.shape[0] >= 3]
+    if not clouds:
+        raise ValueError("cannot fit the plane of motion: fewer than 3 complete samples")
+    cloud = np.vstack(clouds)
+    _, spread, axes = np.linalg.svd(cloud, full_matrices=False)
+    if axes[2][1] < 0:
+        axes[2] = -axes[2]
+    return MotionPlane(axes=axes, spread=spread / np.sqrt(cloud.shape[0]))
+
+
 def fit_motion_frame(
     origin: np.ndarray, *moving: np.ndarray, deployed: np.ndarray | None = None
 ) -> np.ndarray:
@@ -119,20 +187,16 @@ def fit_motion_frame(
     """
     if not moving:
         raise ValueError("fit_motion_frame needs at least one moving marker")
-    p0 = np.asarray(origin, dtype=float)
-    vectors = [np.asarray(m, dtype=float) - p0 for m in moving]
-    clouds = [v[np.isfinite(v).all(axis=1)] for v in vectors]
-    clouds = [c - c.mean(axis=0) for c in clouds if c.shape[0] >= 3]
-    if not clouds:
-        raise ValueError("cannot fit the plane of motion: fewer than 3 complete samples")
-    _, spread, axes = np.linalg.svd(np.vstack(clouds), full_matrices=False)
+    plane = motion_plane(origin, *moving)
+    spread = plane.spread
     if not spread[1] > _MIN_SPREAD_RATIO * spread[0]:
+        ratio = spread[1] / spread[0] if spread[0] > 0 else 0.0
         raise ValueError(
             "cannot fit the plane of motion: the markers barely turn "
-            f"(spread ratio {spread[1] / spread[0]:.2g}, needs > {_MIN_SPREAD_RATIO})"
+            f"(spread ratio {ratio:.2g}, needs > {_MIN_SPREAD_RATIO})"
         )
-    y = axes[2] if axes[2][1] >= 0 else -axes[2]
-    rod = vectors[0]
+    y = plane.normal
+    rod = np.asarray(moving[0], dtype=float) - np.asarray(origin, dtype=float)
     n = rod.shape[0]
     mask = np.zeros(n, bool) if deployed is None else np.asarray(deployed, bool)
     if deployed is None:

@@ -103,6 +103,13 @@ def detect_phases(
     Returns
     -------
     Phases
+
+    Raises
+    ------
+    ValueError
+        If the options are out of range, or two merged peaks are not in strictly increasing time
+        order (a half-cycle of no duration has no frequency: the signal jumps, e.g. an angle
+        measured in the wrong plane).
     """
     if not symmetry_ratio > 1 or not frequency_ratio > 1:
         raise ValueError("symmetry_ratio and frequency_ratio must be > 1")
@@ -110,6 +117,12 @@ def detect_phases(
         raise ValueError(f"min_half_cycles must be >= 1, got {min_half_cycles}")
     time, value, _ = peaks.sequence()
     h = np.diff(time)
+    if np.any(h <= 0):
+        k = int(np.flatnonzero(h <= 0)[0])
+        raise ValueError(
+            f"successive peaks at {time[k]:.6g} and {time[k + 1]:.6g} s are not in increasing "
+            "time order: the signal jumps, and a half-cycle of no duration has no frequency"
+        )
     mag = np.abs(value)
     with np.errstate(divide="ignore", invalid="ignore"):
         allowance = 2.0 * peaks.noise

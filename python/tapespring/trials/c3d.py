@@ -1,10 +1,12 @@
 """Reading and writing trials in C3D files (with ezc3d).
 
 Markers come from ``POINT`` (converted from ``POINT:UNITS`` to metres, NaN where
-a marker is missing). Force plates are extracted by ezc3d
-(``extract_forceplat_data=True``) at the analog rate and converted from the
-plate's force and moment units to N and N m. Metadata live in an optional
-``TAPESPRING`` parameter group (``SENSE``, ``TAPE_PAIR``, ``SESSION``).
+a marker is missing; an infinite coordinate, or one beyond 1 km once converted
+(`tapespring.trials.common.MAX_COORDINATE`), is corrupt data and an error). Force
+plates are extracted by ezc3d (``extract_forceplat_data=True``) at the analog rate
+and converted from the plate's force and moment units to N and N m. Metadata live
+in an optional ``TAPESPRING`` parameter group (``SENSE``, ``TAPE_PAIR``,
+``SESSION``).
 
 ezc3d trusts the sizes written in the file, and a few damaged bytes can make it
 crash the interpreter or loop for minutes. `read_c3d` therefore checks the
@@ -31,7 +33,17 @@ import numpy as np
 
 from .c3d_check import check_c3d
 from .c3d_worker import DEFAULT_TIMEOUT, WorkerFailure, read_raw, read_raw_isolated
-from .common import FORCE, FP_CHANNELS, LENGTH, META_KEYS, MOMENT, check_durations, unit_scale
+from .common import (
+    FORCE,
+    FP_CHANNELS,
+    LENGTH,
+    MAX_COORDINATE,
+    META_KEYS,
+    MOMENT,
+    check_durations,
+    first_absurd_coordinate,
+    unit_scale,
+)
 from .trial import SENSES, ForcePlate, Metadata, Trial, TrialError
 
 # ezc3d is imported inside the functions that touch a C3D file, so that loading CSV trials (or
@@ -87,7 +99,8 @@ def read_c3d(
         If the file does not exist.
     TrialError
         If the file is not a C3D file, is truncated or corrupt (the message says
-        where), makes ezc3d fail, crash or exceed ``timeout``, or has unknown units.
+        where: an infinite marker coordinate or one beyond 1 km names the marker and
+        the frame), makes ezc3d fail, crash or exceed ``timeout``, or has unknown units.
     """
     path = Path(path)
     layout = check_c3d(path)
@@ -125,6 +138,16 @@ def read_c3d(
     markers = {label.strip(): points[:, i, :].T * scale for i, label in enumerate(labels)}
     if len(markers) != len(labels):
         raise TrialError(path, "duplicate marker labels")
+    for label, xyz in markers.items():
+        absurd = first_absurd_coordinate(xyz)
+        if absurd is not None:
+            frame, axis = absurd
+            raise TrialError(
+                path,
+                f"marker {label!r} has {'xyz'[axis]} = {xyz[frame, axis] / scale:.7g} {unit} at "
+                f"frame {frame + 1}: a coordinate beyond {MAX_COORDINATE / scale:g} {unit} "
+                "(1 km) is no position in a laboratory (corrupt data or a wrong POINT:UNITS)",
+            )
 
     plates = []
     for k, pf in enumerate(raw["platforms"]):

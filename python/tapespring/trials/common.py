@@ -1,4 +1,5 @@
-"""What the C3D and CSV readers and writers share: unit tables, metadata keys, channel names.
+"""What the C3D and CSV readers and writers share: unit tables, metadata keys, channel names, the
+range of a marker coordinate.
 
 Each unit table maps a unit name to the factor that converts it to SI.
 """
@@ -7,16 +8,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from .trial import Trial, TrialError
 
 __all__ = [
     "FORCE",
     "FP_CHANNELS",
     "LENGTH",
+    "MAX_COORDINATE",
     "META_KEYS",
     "MOMENT",
     "TIME",
     "check_durations",
+    "first_absurd_coordinate",
     "unit_scale",
 ]
 
@@ -28,6 +33,11 @@ MOMENT = {"Nm": 1.0, "N m": 1.0, "N.m": 1.0, "Nmm": 1e-3, "N mm": 1e-3, "N.mm": 
 META_KEYS = ("sense", "tape_pair", "session")
 #: Force-plate channels, in file order.
 FP_CHANNELS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+#: Largest marker coordinate a reader accepts [m]: 1 km. A motion-capture volume spans metres
+#: (tens at most) about its origin, so a finite coordinate beyond a kilometre is no position in a
+#: laboratory but a damaged value (1e308 mm in a CSV cell, 1e38 in a C3D float) or a unit error
+#: of a factor 1e5 or more; left in, it makes false peaks and a "1e+38 mm" lateral excursion.
+MAX_COORDINATE = 1e3
 
 
 def unit_scale(unit: str, table: dict[str, float], source: Path, what: str) -> float:
@@ -43,6 +53,21 @@ def unit_scale(unit: str, table: dict[str, float], source: Path, what: str) -> f
     except KeyError:
         known = ", ".join(table)
         raise TrialError(source, f"unknown {what} unit {unit!r} (known: {known})") from None
+
+
+def first_absurd_coordinate(xyz: np.ndarray) -> tuple[int, int] | None:
+    """The first coordinate beyond `MAX_COORDINATE`, as (sample, axis), or None.
+
+    Parameters
+    ----------
+    xyz : ndarray, shape (n, 3)
+        Marker positions [m]; NaN (a missing sample) is never beyond.
+    """
+    beyond = np.abs(xyz) > MAX_COORDINATE
+    if not beyond.any():
+        return None
+    sample, axis = np.argwhere(beyond)[0]
+    return int(sample), int(axis)
 
 
 def check_durations(trial: Trial) -> None:

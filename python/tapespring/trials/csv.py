@@ -18,7 +18,9 @@ N m, N mm). A column without a unit takes the unit passed by the caller
 (``length_unit=``, ...); if there is none, reading fails. Missing samples are
 written ``nan``; empty fields are read as missing too. Any other non-finite
 value (``inf``, ``1e999``) is an error naming the file, the column and the line,
-as is a row with too few or too many fields.
+as is a row with too few or too many fields, and a marker coordinate beyond
+1 km once converted (`tapespring.trials.common.MAX_COORDINATE`: 1e308 mm is a
+finite number but no position in a laboratory).
 """
 
 from __future__ import annotations
@@ -29,7 +31,18 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import FORCE, FP_CHANNELS, LENGTH, META_KEYS, MOMENT, TIME, check_durations, unit_scale
+from .common import (
+    FORCE,
+    FP_CHANNELS,
+    LENGTH,
+    MAX_COORDINATE,
+    META_KEYS,
+    MOMENT,
+    TIME,
+    check_durations,
+    first_absurd_coordinate,
+    unit_scale,
+)
 from .trial import ForcePlate, Metadata, Trial, TrialError
 
 __all__ = ["FORCES_SUFFIX", "read_csv", "write_csv"]
@@ -40,8 +53,11 @@ FORCES_SUFFIX = ".forces.csv"
 _HEADER_RE = re.compile(r"^\s*(?P<name>[^\[\]]+?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
 
 
-def _read_table(path: Path) -> tuple[dict[str, str], list[str], list[str | None], np.ndarray]:
-    """Read one CSV table: metadata lines, column names, units and values."""
+def _read_table(
+    path: Path,
+) -> tuple[dict[str, str], list[str], list[str | None], np.ndarray, int]:
+    """Read one CSV table: metadata lines, column names, units, values, and the number of lines
+    up to the header (for `_line_of_row`)."""
     meta: dict[str, str] = {}
     try:
         with path.open(encoding="utf-8") as fh:
@@ -95,7 +111,7 @@ def _read_table(path: Path) -> tuple[dict[str, str], list[str], list[str | None]
             f"{where} is {values[row, col]}: only 'nan' or an empty field mark a missing "
             "sample, every other value must be a finite number",
         )
-    return meta, names, units, values
+    return meta, names, units, values, n_skip
 
 
 def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
@@ -235,7 +251,7 @@ def read_csv(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
-    meta, names, units, values = _read_table(path)
+    meta, names, units, values, n_skip = _read_table(path)
     t_unit = _unit_for(path, names[0], units[0], time_unit, "time_unit")
     time = values[:, 0] * unit_scale(t_unit, TIME, path, "time")
     markers = {}
@@ -248,7 +264,19 @@ def read_csv(
             raise TrialError(path, f"marker {stem!r} has mixed units {sorted(col_units)}")
         unit = col_units.pop()
         found_units.add(unit)
-        markers[stem] = values[:, columns] * unit_scale(unit, LENGTH, path, "length")
+        scale = unit_scale(unit, LENGTH, path, "length")
+        markers[stem] = values[:, columns] * scale
+        absurd = first_absurd_coordinate(markers[stem])
+        if absurd is not None:
+            row, axis = absurd
+            col = columns[axis]
+            raise TrialError(
+                path,
+                f"column {names[col]!r}, data row {row + 1} (line "
+                f"{_line_of_row(path, n_skip, row)}) is {values[row, col]:.10g} {unit}: a marker "
+                f"coordinate beyond {MAX_COORDINATE / scale:g} {unit} (1 km) is no position in "
+                "a laboratory (a damaged value or a wrong unit)",
+            )
     if not markers:
         raise TrialError(path, "no marker columns")
     file_units = {"markers": ",".join(sorted(found_units))}
@@ -256,7 +284,7 @@ def read_csv(
     plates = []
     forces_path = path.with_name(path.name.removesuffix(".csv") + FORCES_SUFFIX)
     if forces_path.is_file():
-        fmeta, fnames, funits, fvalues = _read_table(forces_path)
+        fmeta, fnames, funits, fvalues, _ = _read_table(forces_path)
         ft_unit = _unit_for(forces_path, fnames[0], funits[0], time_unit, "time_unit")
         t_plate = fvalues[:, 0] * unit_scale(ft_unit, TIME, forces_path, "time")
         if (len(fnames) - 1) % 6 != 0:
