@@ -320,7 +320,7 @@ def test_equal_sense_peak_is_lower_than_opposite_and_residual_moment_matches(to_
     m_plus_max = summarize(to_30_deg[2e-3]).m_max
     # Measured |M-max| = 0.147 vs M+max = 0.300 N m (0.49).
     assert abs(s.m_max) < m_plus_max
-    # Two snaps on loading: the twist at the peak, then the fold (measured at -15.7 deg), each
+    # Two snaps on loading: the twist at the peak, then the fold (measured at -15.5 deg), each
     # leaving the last state before it, stable.
     load = result.branch == 0
     jumps = np.nonzero(result.jump & load)[0]

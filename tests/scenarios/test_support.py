@@ -149,14 +149,14 @@ def test_flexible_support_adds_its_vibration_to_the_clamp_force(
     runs: dict[str, DeploymentSimulation],
 ) -> None:
     rigid, flexible = runs["rigid"], runs["flexible"]
-    # The support hardly changes the motion: bending angles within 1 deg (0.34 deg measured).
+    # The support hardly changes the motion: bending angles within 1 deg (0.79 deg measured).
     t = np.linspace(0.0, 0.2, 401)
     gap = np.interp(t, flexible.time_s, flexible.angle_deg) - np.interp(
         t, rigid.time_s, rigid.angle_deg
     )
     assert np.max(np.abs(gap)) < 1.0
     # Spectral energy above the cut-off: the folds' pulses in both, the bracket's ringing only
-    # with the flexible support. Measured: 19.6 times the rigid one's; at least 5 asked.
+    # with the flexible support. Measured: 25.4 times the rigid one's; at least 5 asked.
     energy = {}
     peak = {}
     for name, sim in runs.items():
@@ -167,7 +167,7 @@ def test_flexible_support_adds_its_vibration_to_the_clamp_force(
     assert energy["flexible"] > 5.0 * energy["rigid"]
     # Where the added content is: the bracket's first natural frequency, the mode with the
     # largest vertical effective mass, the one the force plate sees. Measured: spectral peak
-    # at 154.6 Hz, bracket alone 164.4 Hz (-6 %): the tapes load the bracket (the set-up's
+    # at 159.6 Hz, bracket alone 164.4 Hz (-3 %): the tapes load the bracket (the set-up's
     # modes at its gravity equilibrium put it at 160.5 Hz), generalised-alpha stretches the
     # period (2-3 % at 12 steps a period) and the bins of 0.2 s are 5 Hz (3 %): 10 % allowed.
     frequencies, masses = bracket_modes(FLEXIBLE)
