@@ -55,6 +55,41 @@ def _non_negative_seconds(text: str) -> float:
     return _seconds(text, zero=True)
 
 
+class _AnalyzeParser(argparse.ArgumentParser):
+    """The ``analyze`` parser: ``--frame -x,-y,z`` is the frame '-x,-y,z'.
+
+    argparse takes an argument that starts with '-' (and is no negative number) for an option,
+    so ``--frame -x,-y,z`` failed with "expected one argument" and only ``--frame=-x,-y,z``
+    worked. Before parsing, ``--frame`` (or an abbreviation argparse accepts) followed by an
+    argument that starts with '-' and is none of the parser's options is joined into
+    ``--frame=VALUE``; the value is checked as any other (`parse_frame`).
+    """
+
+    def parse_known_args(self, args=None, namespace=None):
+        """`argparse.ArgumentParser.parse_known_args`, after joining ``--frame -VALUE``."""
+        args = list(sys.argv[1:] if args is None else args)
+        options = self._option_string_actions
+        joined, i = [], 0
+        while i < len(args):
+            arg = args[i]
+            if arg == "--":
+                joined += args[i:]
+                break
+            frame = arg == "--frame" or (
+                len(arg) > 2
+                and "--frame".startswith(arg)
+                and [o for o in options if o.startswith(arg)] == ["--frame"]
+            )
+            value = args[i + 1] if i + 1 < len(args) else ""
+            if frame and value.startswith("-") and value not in options and value != "--":
+                joined.append(f"--frame={value}")
+                i += 2
+            else:
+                joined.append(arg)
+                i += 1
+        return super().parse_known_args(joined, namespace)
+
+
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``trials`` command (with its ``analyze`` sub-command) to a CLI.
 
@@ -73,7 +108,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="analyse experimental trials (C3D, CSV)",
         description="Analyse experimental trials of the tape-spring set-up.",
     )
-    sub = trials.add_subparsers(dest="trials_command", required=True)
+    sub = trials.add_subparsers(dest="trials_command", required=True, parser_class=_AnalyzeParser)
     p = sub.add_parser(
         "analyze",
         help="load trials, compute the statistics, write a report",
@@ -113,8 +148,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help=(
             "deployment: the rig's frame: 'lab' (markers already in the rig's axes: x along the "
             "deployed rod, bending about y; default), the lab axes along the rig's x, y, z "
-            "(e.g. 'x,-z,y' for a capture with z up), or 'fit' (fit the plane of motion; the "
-            "sense fixes the sign)"
+            "(e.g. 'x,-z,y' for a capture with z up; a leading minus is fine: --frame -x,-y,z), "
+            "or 'fit' (fit the plane of motion; the sense fixes the sign)"
         ),
     )
     p.add_argument(

@@ -14,10 +14,18 @@ whose absolute value, about the equilibrium, lies in the window
 `scipy.optimize.least_squares`:
 
 1. the peak instants ``t_k = t_0 + k pi / omega_d`` (k counts half periods),
-   which gives ``omega_d``;
+   which gives ``omega_d``. The count k of each gap is the number of half periods
+   nearest to it with the parity of its two peaks (odd from a maximum to a minimum,
+   even between two of a kind), the half period being measured between the
+   selected peaks and their neighbours of the other kind, in or out of the window
+   (about an offset equilibrium the window may keep the maxima only, two half
+   periods apart);
 2. the peak values ``z_k = c + s_k A' exp(-a (t_k - t_first))`` with
    ``s_k = +-1`` for maxima and minima and ``c`` a small offset of the
    equilibrium, which gives the decay rate ``a = epsilon omega0``.
+
+Peaks count from a prominence of ``z_min`` (or less: 8 times the noise), as a
+peak that swings by ``z_min`` stands that far above the troughs either side.
 
 Then ``omega0 = sqrt(omega_d^2 + a^2)``, ``epsilon = a / omega0`` and the
 period ``Delta t = 2 pi / (omega0 sqrt(1 - epsilon^2)) = 2 pi / omega_d``
@@ -33,6 +41,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .peaks import extract_peaks
+from .smoothing import noise_std
 
 __all__ = ["DampingFit", "fit_damping", "select_window_peaks"]
 
@@ -111,7 +120,8 @@ def select_window_peaks(
     window : (float, float)
         Range of absolute peak values kept [m]; paper: (0.4e-3, 4e-3).
     prominence : float, optional
-        Passed to `extract_peaks`.
+        Passed to `extract_peaks`; default: the smaller of `extract_peaks`' default and
+        ``window[0]``.
     t_start : float, optional
         Ignore peaks before this instant [s] (e.g. before the release).
 
@@ -120,15 +130,93 @@ def select_window_peaks(
     time, value : ndarray
         The selected peaks.
     """
+    time, value, _, keep = _all_peaks(t, z, window, prominence, t_start)
+    return time[keep], value[keep]
+
+
+def _all_peaks(
+    t: np.ndarray,
+    z: np.ndarray,
+    window: tuple[float, float],
+    prominence: float | None,
+    t_start: float | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every peak from ``t_start`` on (time, value, kind +1/-1) and the mask of those in the
+    window."""
     lo, hi = window
     if not 0 <= lo < hi:
         raise ValueError(f"window must satisfy 0 <= low < high, got {window}")
-    peaks = extract_peaks(t, z, None, prominence=prominence)
-    time, value, _ = peaks.sequence()
-    keep = (np.abs(value) >= lo) & (np.abs(value) <= hi)
+    if prominence is None and lo > 0:
+        # A peak that swings by `lo` or more about the equilibrium stands at least `lo` above
+        # the troughs either side (they lie across the equilibrium), so `lo` never drops one.
+        # `extract_peaks`' default, 8 times the noise estimated from second differences, can:
+        # the estimate reads the signal's own curvature as noise where the sampling is coarse
+        # (0.16 A for a noise-free sinusoid of amplitude A at 10 samples per period, 0.04 A at
+        # 20), and a noise-free 10 mm decay sampled 10 times per period lost its 1.9 mm peak
+        # (8 sigma = 4.2 mm).
+        z = np.asarray(z, dtype=float)
+        if z.size >= 3 and np.all(np.isfinite(z)):  # else `extract_peaks` says what is wrong
+            prominence = min(max(8.0 * noise_std(z), 1e-3 * float(np.ptp(z))), lo)
+    time, value, kind = extract_peaks(t, z, None, prominence=prominence).sequence()
     if t_start is not None:
-        keep &= time >= t_start
-    return time[keep], value[keep]
+        after = time >= t_start
+        time, value, kind = time[after], value[after], kind[after]
+    keep = (np.abs(value) >= lo) & (np.abs(value) <= hi)
+    return time, value, kind, keep
+
+
+def _half_period_index(
+    time: np.ndarray, kind: np.ndarray, keep: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """Half-period count ``k`` of each selected peak from the first, and the half period [s].
+
+    ``time``, ``kind``: every peak (`_all_peaks`); ``keep``: those in the window. Peaks of a
+    free decay are half a damped period apart and alternate between maxima and minima, but the
+    window may keep one kind only over a stretch: about an equilibrium offset by ``c`` the
+    maxima leave the window at ``lo - c`` and the minima at ``lo + c``, so the selected peaks
+    may all be maxima two half periods apart. The half period is therefore measured on the
+    selected peaks and their neighbours in the whole sequence (of the other kind, wherever
+    their value), never on the selected peaks alone; each gap then counts the number of half
+    periods of its parity (odd between a maximum and a minimum, even between two of a kind)
+    nearest to ``gap / half``.
+
+    Raises
+    ------
+    ValueError
+        If no selected peak has a neighbour of the other kind, or a gap is nearer to a count of
+        the other parity (a spurious or missing extremum: not a free decay).
+    """
+    sel = np.flatnonzero(keep)
+    left = sel[sel > 0]
+    right = sel[sel < time.size - 1] + 1
+    pairs = np.unique(np.concatenate((left, right)))  # pair (i - 1, i)
+    pairs = pairs[kind[pairs] != kind[pairs - 1]]
+    if pairs.size == 0:
+        raise ValueError(
+            "no selected peak is next to a peak of the other kind (maximum after minimum or the "
+            "reverse): not an oscillation"
+        )
+    half = float(np.median(time[pairs] - time[pairs - 1]))
+    gaps = np.diff(time[sel]) / half
+    odd = kind[sel][1:] != kind[sel][:-1]
+    steps = np.where(
+        odd,
+        np.maximum(1, 2 * np.rint((gaps - 1) / 2) + 1),
+        np.maximum(2, 2 * np.rint(gaps / 2)),
+    ).astype(int)
+    wrong = np.flatnonzero(np.abs(gaps - steps) > 0.5)
+    if wrong.size:
+        i = wrong[0]
+        a, b = sel[i], sel[i + 1]
+        names = {1: "maximum", -1: "minimum"}
+        raise ValueError(
+            f"the {names[int(kind[a])]} at {time[a]:.6g} s and the {names[int(kind[b])]} at "
+            f"{time[b]:.6g} s are {gaps[i]:.2f} half periods ({half:.4g} s) apart, where "
+            f"successive peaks of a free decay are a whole number of half periods apart, odd "
+            "between a maximum and a minimum, even between two of a kind (a spurious or "
+            "missing extremum?)"
+        )
+    return np.concatenate(([0], np.cumsum(steps))), half
 
 
 def fit_damping(
@@ -151,7 +239,8 @@ def fit_damping(
     window : (float, float)
         Range of absolute peak values used [m]; paper: (0.4e-3, 4e-3).
     prominence : float, optional
-        Peak prominence threshold (see `extract_peaks`).
+        Peak prominence threshold (see `extract_peaks`); default: the smaller of
+        `extract_peaks`' default and ``window[0]``.
     t_start : float, optional
         Ignore peaks before this instant [s].
 
@@ -162,23 +251,17 @@ def fit_damping(
     Raises
     ------
     ValueError
-        If fewer than 3 peaks fall in the window, or they do not alternate.
+        If fewer than 3 peaks fall in the window, or their spacing is not that of a free
+        decay (two peaks a number of half periods apart of the wrong parity).
     """
-    time, value = select_window_peaks(t, z, window, prominence=prominence, t_start=t_start)
+    time_all, value_all, kind_all, keep = _all_peaks(t, z, window, prominence, t_start)
+    time, value, sign = time_all[keep], value_all[keep], kind_all[keep].astype(float)
     if time.size < 3:
         raise ValueError(
             f"only {time.size} peak(s) with |z| in [{window[0]:g}, {window[1]:g}]; "
             "at least 3 are needed for a damping fit"
         )
-    sign = np.sign(value)
-    # Half-period index of each peak: successive peaks alternate; a missing peak
-    # (noise, window edge) shows as a gap of about two half periods.
-    gaps = np.diff(time)
-    half = np.median(gaps)
-    steps = np.maximum(1, np.rint(gaps / half)).astype(int)
-    k = np.concatenate(([0], np.cumsum(steps)))
-    if np.any(sign[1:] * sign[:-1] != np.where(steps % 2 == 1, -1, 1)):
-        raise ValueError("the selected peaks do not alternate between maxima and minima")
+    k, half = _half_period_index(time_all, kind_all, keep)
 
     # 1. Peak instants: t_k = t0 + k * h, h = pi / omega_d (linear least squares).
     def time_residual(p: np.ndarray) -> np.ndarray:

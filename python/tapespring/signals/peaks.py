@@ -4,17 +4,27 @@ Peaks are picked with `scipy.signal.find_peaks` on ``y`` (maxima) and ``-y``
 (minima) with a prominence threshold, so that noise cannot create peaks:
 by default the threshold is ``8 sigma`` where ``sigma`` is the noise level
 estimated from the signal (`noise_std`), but never less than 0.1 % of the
-signal's range (noise-free simulated signals). At the paper's marker precision
-(0.05 mm, i.e. about 0.05 deg of bending angle over the 82 mm between markers
-1 and 2), a noise-only local extremum with a prominence of 8 sigma has a
-probability below 1e-14 per sample.
+signal's range (noise-free simulated signals). The paper's marker precision is
+0.05 mm, i.e. about 0.05 deg of bending angle over the 82 mm between markers 1
+and 2. The prominence of a noise maximum is its height above the lowest samples
+either side, as far as the nearest higher sample: over a long stretch of noise
+it grows with the stretch's range. Of 2000 records of white noise, none of 800
+samples had a peak of 8 sigma prominence, and 0.65 % of those of 3200 samples
+(a 4 s tail at 800 Hz) had one; analyses of peak values keep their own floor
+above the noise (the damping fit's window: 0.4 mm, 8 sigma of the markers).
 
 Each peak is then refined by a least-squares parabola through the samples
-around it that lie within ``4 sigma`` of the top (at least two samples on each
-side; the window is found on a 5-sample moving average, then re-centred on the
-first vertex and the parabola refitted), which averages the noise and removes
+around it that lie within ``4 sigma`` of the top, and within a quarter of its
+prominence (at least two samples on each side; the window is found on a
+5-sample moving average, then re-centred on the first vertex, no wider than the
+first window, and the parabola refitted), which averages the noise and removes
 the sampling quantisation. A fit is kept only if the parabola has the right
-curvature and its vertex lies inside the fitted samples.
+curvature and its vertex lies inside the fitted samples. The quarter of the
+prominence (60 deg either side of a cosine's top) keeps the parabola on the peak
+where the noise estimate is too high: below about 20 samples per period it reads
+the signal's own curvature as noise (0.16 of a sinusoid's amplitude at 10 samples
+per period), and ``4 sigma`` then reached across a whole small peak, whose vertex
+fell to a third of its value.
 
 Time separation: for the maxima (resp. minima), ``separation[0]`` is the time
 from the reference instant ``t_ref`` (the release in a deployment) to the first
@@ -159,38 +169,60 @@ def _fit_vertex(t: np.ndarray, y: np.ndarray, lo: int, hi: int, t0: float):
 
 
 def _refine(
-    t: np.ndarray, y: np.ndarray, y_smooth: np.ndarray, i: int, depth: float
+    t: np.ndarray, y: np.ndarray, y_smooth: np.ndarray, i: int, depth: float, reach: int
 ) -> tuple[float, float]:
     """Vertex of a least-squares parabola through the top of the maximum at sample i.
 
     The first window is the run of samples around i where a 5-sample moving
-    average stays within ``depth`` of its top (the average keeps single noisy
-    samples from cutting the run). The window is then re-centred on the vertex
-    with the half-width where the parabola has dropped by ``depth``, and the
+    average stays within ``depth`` of its top, below or above (the average keeps
+    single noisy samples from cutting the run; a noise maximum on a held plateau
+    has higher samples further on, where the run must stop), and at most
+    ``reach`` samples from i (a quarter of the way to the nearest maximum: a run
+    of noise may last seconds, and its vertex would land among other peaks). The
+    window is then re-centred on the vertex with the half-width where the
+    parabola has dropped by ``depth`` (at most the first window's width), and the
     parabola refitted once.
+
+    A parabola through a long run of noise is nearly flat and its vertex can lie anywhere
+    in the run, or far above the samples once refitted (a 0.16 mm noise maximum in a
+    decay's tail was refined to 0.59 mm, 0.3 s away; that parabola dropped by 0.024
+    ``depth`` over its run): a maximum whose parabola drops by less than ``depth / 16``
+    keeps its sample. A peak's drops by about ``depth`` (its run ends there): of 36 000
+    peaks of noisy free decays, 1 in 9 000 dropped by less than ``depth / 16`` (1 in 400
+    by less than ``depth / 4``; and 1 in 3 000 had no vertex in its run).
+
+    The refitted vertex is kept only if it lies in the first window and exceeds the first
+    window's highest sample by at most ``depth + |c2| dt^2`` (noise-free, a parabola's
+    top is at most ``|c2| (dt / 2)^2`` above its nearest sample); otherwise the first
+    vertex is used.
     """
     n = y.size
     top = np.max(y_smooth[max(0, i - 2) : i + 3])
     lo = i
-    while lo > 0 and y_smooth[lo - 1] >= top - depth:
+    while lo > max(0, i - reach) and abs(y_smooth[lo - 1] - top) <= depth:
         lo -= 1
     hi = i
-    while hi < n - 1 and y_smooth[hi + 1] >= top - depth:
+    while hi < min(n - 1, i + reach) and abs(y_smooth[hi + 1] - top) <= depth:
         hi += 1
     lo, hi = max(0, min(lo, i - 2)), min(n - 1, max(hi, i + 2))
     fallback = (float(t[i]), float(y[i]))
     if hi - lo < 4:
         return fallback
     first = _fit_vertex(t, y, lo, hi, t[i])
-    if first is None:
+    if first is None or -first[0] * (0.5 * (t[hi] - t[lo])) ** 2 < depth / 16:
         return fallback
     c2, tv, _ = first
     dt = (t[-1] - t[0]) / (n - 1)
-    half = max(2, round(np.sqrt(2.0 * depth / -c2) / dt))
+    # No wider than the first window (the drop-by-depth half-width of a flat top is unbounded).
+    half = max(2, min(hi - lo, round(np.sqrt(2.0 * depth / -c2) / dt)))
     centre = round((tv - t[0]) / dt)
-    lo, hi = max(0, centre - half), min(n - 1, centre + half)
-    second = _fit_vertex(t, y, lo, hi, t[centre]) if hi - lo >= 4 else None
-    if second is None:
+    lo2, hi2 = max(0, centre - half), min(n - 1, centre + half)
+    second = _fit_vertex(t, y, lo2, hi2, t[centre]) if hi2 - lo2 >= 4 else None
+    if (
+        second is None
+        or not t[lo] <= second[1] <= t[hi]
+        or second[2] > np.max(y[lo : hi + 1]) + depth - second[0] * dt * dt
+    ):
         return float(tv), float(first[2])
     return float(second[1]), float(second[2])
 
@@ -207,15 +239,22 @@ def _extrema(
     sign: float,
 ) -> Extrema:
     signed = sign * y
-    idx, _ = find_peaks(signed, prominence=prominence, distance=distance)
+    idx, props = find_peaks(signed, prominence=prominence, distance=distance)
+    prominences = props["prominences"]
+    # A quarter of the way to the nearest peak of the same kind (the whole record if alone):
+    # a peak's parabola reaches 60 deg, a sixth of a period, either side of its top at most.
+    gaps = np.diff(idx)
+    nearest = np.minimum(np.r_[y.size, gaps], np.r_[gaps, y.size])
+    reach = np.maximum(2, nearest // 4)
     if n is not None:
-        idx = idx[:n]
+        idx, prominences = idx[:n], prominences[:n]
     signed_smooth = smooth(signed, 5) if refine else signed
     times = np.empty(idx.size)
     values = np.empty(idx.size)
     for k, i in enumerate(idx):
         if refine:
-            tk, vk = _refine(t, signed, signed_smooth, int(i), depth)
+            top_depth = min(depth, 0.25 * prominences[k])
+            tk, vk = _refine(t, signed, signed_smooth, int(i), top_depth, int(reach[k]))
         else:
             tk, vk = float(t[i]), float(sign * y[i])
         times[k] = tk

@@ -45,7 +45,7 @@ from .common import (
 )
 from .trial import ForcePlate, Metadata, Trial, TrialError
 
-__all__ = ["FORCES_SUFFIX", "read_csv", "write_csv"]
+__all__ = ["FORCES_SUFFIX", "needs_length_unit", "read_csv", "write_csv"]
 
 #: Suffix of the force-plate file that goes with a marker CSV file.
 FORCES_SUFFIX = ".forces.csv"
@@ -58,6 +58,38 @@ def _read_table(
 ) -> tuple[dict[str, str], list[str], list[str | None], np.ndarray, int]:
     """Read one CSV table: metadata lines, column names, units, values, and the number of lines
     up to the header (for `_line_of_row`)."""
+    meta, names, units, n_skip = _read_header(path)
+    values = _read_values(path, n_skip, names)
+    if values.size == 0:
+        raise TrialError(path, "no data rows")
+    if values.shape[1] != len(names):
+        raise TrialError(
+            path, f"the header has {len(names)} columns but the data rows have {values.shape[1]}"
+        )
+    if names[0].lower() != "time":
+        raise TrialError(path, f"the first column must be 'time', got {names[0]!r}")
+    # A value is a number or missing (NaN, empty field); inf or 1e999 is a damaged value, and
+    # a missing instant cannot be placed at all.
+    bad = np.isinf(values)
+    bad[:, 0] |= np.isnan(values[:, 0])
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        where = (
+            f"column {names[col]!r}, data row {row + 1} (line {_line_of_row(path, n_skip, row)})"
+        )
+        if np.isnan(values[row, col]):
+            raise TrialError(path, f"{where} is missing: every row needs its instant")
+        raise TrialError(
+            path,
+            f"{where} is {values[row, col]}: only 'nan' or an empty field mark a missing "
+            "sample, every other value must be a finite number",
+        )
+    return meta, names, units, values, n_skip
+
+
+def _read_header(path: Path) -> tuple[dict[str, str], list[str], list[str | None], int]:
+    """The metadata lines, column names and units of a CSV table, and the number of lines up
+    to its header."""
     meta: dict[str, str] = {}
     try:
         with path.open(encoding="utf-8") as fh:
@@ -86,32 +118,30 @@ def _read_table(
             raise TrialError(path, f"cannot parse header cell {cell!r}")
         names.append(match["name"])
         units.append(match["unit"].strip() if match["unit"] else None)
-    values = _read_values(path, n_skip, names)
-    if values.size == 0:
-        raise TrialError(path, "no data rows")
-    if values.shape[1] != len(names):
-        raise TrialError(
-            path, f"the header has {len(names)} columns but the data rows have {values.shape[1]}"
-        )
-    if names[0].lower() != "time":
-        raise TrialError(path, f"the first column must be 'time', got {names[0]!r}")
-    # A value is a number or missing (NaN, empty field); inf or 1e999 is a damaged value, and
-    # a missing instant cannot be placed at all.
-    bad = np.isinf(values)
-    bad[:, 0] |= np.isnan(values[:, 0])
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        where = (
-            f"column {names[col]!r}, data row {row + 1} (line {_line_of_row(path, n_skip, row)})"
-        )
-        if np.isnan(values[row, col]):
-            raise TrialError(path, f"{where} is missing: every row needs its instant")
-        raise TrialError(
-            path,
-            f"{where} is {values[row, col]}: only 'nan' or an empty field mark a missing "
-            "sample, every other value must be a finite number",
-        )
-    return meta, names, units, values, n_skip
+    return meta, names, units, n_skip
+
+
+def needs_length_unit(path: str | Path) -> bool:
+    """Whether a marker CSV file has a column without a unit in its header, which would take
+    `read_csv`'s ``length_unit``.
+
+    Only the header is read. A file whose header cannot be read counts as needing it (reading
+    the file will say what is wrong).
+
+    Parameters
+    ----------
+    path : str or Path
+        The marker CSV file.
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        _, names, units, _ = _read_header(Path(path))
+    except (OSError, TrialError):
+        return True
+    return any(unit is None for unit in units[1:]) or len(names) < 2
 
 
 def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
@@ -245,12 +275,22 @@ def read_csv(
     FileNotFoundError
         If the file does not exist.
     TrialError
-        If the layout, the units or the data are invalid; the message names the
-        file and the problem.
+        If the layout, the units or the data are invalid, or ``path`` is a force
+        side file (``*.forces.csv``: the message names its marker file); the
+        message names the file and the problem.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
+    if path.name.endswith(FORCES_SUFFIX):
+        # Read as markers, its first force column would be "not a marker coordinate".
+        marker = path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
+        there = "" if marker.is_file() else " (there is no such file)"
+        raise TrialError(
+            path,
+            f"this is the force side file of trial {marker.stem!r}, not a trial: give its "
+            f"marker file {marker}{there}, which reads the forces from it",
+        )
     meta, names, units, values, n_skip = _read_table(path)
     t_unit = _unit_for(path, names[0], units[0], time_unit, "time_unit")
     time = values[:, 0] * unit_scale(t_unit, TIME, path, "time")

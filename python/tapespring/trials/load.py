@@ -35,7 +35,7 @@ from tqdm import tqdm
 
 from .c3d import read_c3d
 from .common import META_KEYS
-from .csv import FORCES_SUFFIX, read_csv
+from .csv import FORCES_SUFFIX, needs_length_unit, read_csv
 from .trial import SENSES, Trial, TrialError, TrialWarning
 
 __all__ = [
@@ -121,7 +121,10 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
 
     A folder contributes its ``*.c3d`` and ``*.csv`` files (not recursively,
     sorted by name), except the ``*.forces.csv`` companions and the metadata
-    side file (``metadata.csv``).
+    side file (``metadata.csv``). A ``*.forces.csv`` file given by name is left
+    out too when its marker file is given as well (a shell's ``*.csv`` gives
+    both; the forces are read with the markers); given alone, it stays, and
+    `read_csv` says which marker file to give instead.
 
     Raises
     ------
@@ -149,7 +152,16 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
             files.append(path)
         else:
             raise FileNotFoundError(f"{path}: no such file or folder")
-    return files
+    given = {p.resolve() for p in files}
+    # A force side file given with its marker file is read with it.
+    return [p for p in files if (m := _marker_file(p)) is None or m.resolve() not in given]
+
+
+def _marker_file(path: Path) -> Path | None:
+    """The marker file of a force side file ``<stem>.forces.csv``; None for another file."""
+    if not path.name.endswith(FORCES_SUFFIX):
+        return None
+    return path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
 
 
 def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
@@ -247,6 +259,8 @@ def load_trial_set(
     **options
         Passed to `read_trial`: metadata (``sense``, ``tape_pair``,
         ``session``; None keeps the side file's or the file's) and CSV units.
+        A ``length_unit`` no file would use (no CSV file, or every CSV marker
+        column has its unit in the header) gives a `TrialWarning`.
 
     Returns
     -------
@@ -263,6 +277,9 @@ def load_trial_set(
     if isinstance(paths, str | Path):
         paths = [paths]
     files = find_trial_files(paths)
+    length_unit = options.get("length_unit")
+    if length_unit is not None:
+        _check_length_unit_used(files, length_unit)
     side = _side_metadata(files)
     trials, skipped = [], []
     for file in tqdm(files, desc="loading trials", unit="trial", disable=not progress):
@@ -281,6 +298,23 @@ def load_trial_set(
             continue
         trials.append(trial)
     return TrialSet(tuple(trials), tuple(skipped))
+
+
+def _check_length_unit_used(files: Sequence[Path], length_unit: str) -> None:
+    """Warn (`TrialWarning`) if no file would take ``length_unit``: no CSV file among them (a C3D
+    file carries its units), or none with a marker column without a unit in its header."""
+    csv_files = [f for f in files if f.suffix.lower() == ".csv"]
+    if not csv_files:
+        why = "none of the trial files is a CSV file (a C3D file carries its units)"
+    elif not any(needs_length_unit(f) for f in csv_files):
+        why = "every marker column of the CSV files gives its unit in its header"
+    else:
+        return
+    warnings.warn(
+        f"the length unit {length_unit!r} given (--length-unit, length_unit=) is not used: {why}",
+        TrialWarning,
+        stacklevel=3,
+    )
 
 
 def load_trials(
