@@ -114,6 +114,23 @@ def test_release_command_refuses_bad_input(capsys):
     assert "rho_inf" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    ("option", "name"),
+    [
+        ("--tip-mass=1e300", "tip_mass must be at most 1000"),
+        ("--tip-inertia=2", "tip_inertia must be at most 1"),
+        ("--gravity=1e300", "gravity must lie in [-100, 100]"),
+        ("--gravity=-101", "gravity must lie in [-100, 100]"),
+    ],
+)
+def test_release_refuses_a_tip_body_or_gravity_beyond_round_off(option, name, capsys):
+    # Before the run, in short numbers: they ran into a non-finite tangent or residual at the
+    # first step (exit 1 after the fold), 1e300 printed as such.
+    assert main(["release", option]) == 2
+    err = capsys.readouterr().err
+    assert name in err and len(err.splitlines()) == 1, err
+
+
 def test_a_release_that_stops_early_keeps_what_it_recorded(monkeypatch, capsys):
     # The step limit reached after three steps: the command exits 1 with a warning, and the
     # scenario's ConvergenceError carries the ReleaseResult of the free motion so far.

@@ -17,9 +17,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.bending import BendingSetup, bending_model, bending_steps
+from tapespring.scenarios.max_mass import GRAVITY_RANGE
 from tapespring.scenarios.setup import check_number, check_rho_inf
 
 __all__ = ["ReleaseResult", "ReleaseSetup", "release", "release_model", "release_steps"]
+
+
+#: Largest tip mass [kg] and tip inertia [kg m^2]. The iteration matrix holds the tip's
+#: `m / (beta h^2)` and `I / (beta h^2)` beside the tape's stiffness at its end; at the release's
+#: first step (1e-5 s) these bounds make them about 1e13 times the tape's bending stiffness
+#: `3 E I / L^3` (2 N/m on the default tape) and 1e12 times its rotational `E I / L` (6e-3 N m),
+#: which leaves the tape 3 to 4 significant digits in double precision; beyond, it is lost in
+#: round-off (1e300 kg overflowed into a non-finite tangent). Both are 1e5 to 1e6 times the
+#: default body (10 g, 1e-6 kg m^2), and far beyond what a tape spring lifts.
+MAX_TIP_MASS = 1e3
+MAX_TIP_INERTIA = 1.0
 
 
 @dataclass(frozen=True)
@@ -85,8 +97,19 @@ class ReleaseSetup:
         # The free end needs inertia: a massless tip body leaves its rotations without mass.
         for name in ("tip_mass", "tip_inertia", "duration"):
             check_number(name, getattr(self, name), positive=True)
+        for name, bound in (("tip_mass", MAX_TIP_MASS), ("tip_inertia", MAX_TIP_INERTIA)):
+            if getattr(self, name) > bound:
+                raise ValueError(
+                    f"{name} must be at most {bound:g} (got {getattr(self, name):.3g}; see "
+                    f"MAX_{name.upper()})"
+                )
         check_rho_inf(self.rho_inf)
         check_number("gravity", self.gravity, positive=False)
+        if abs(self.gravity) > GRAVITY_RANGE[1]:
+            raise ValueError(
+                f"gravity must lie in [-{GRAVITY_RANGE[1]:g}, {GRAVITY_RANGE[1]:g}] m/s^2 (got "
+                f"{self.gravity:.3g}; see max_mass.GRAVITY_RANGE)"
+            )
         check_number("fold_deg", self.fold_deg, positive=False)
         if not 1e-6 <= abs(self.fold_deg) < 180.0:
             raise ValueError(
