@@ -67,8 +67,6 @@ pub struct Assembled {
     pub energy: f64,
     /// Potential energy of gravity `-sum m g(t) . x` \[J\].
     pub gravity_energy: f64,
-    /// Power dissipated by Kelvin-Voigt damping \[W\] (dynamic assemblies).
-    pub dissipation: f64,
 }
 
 /// Nodal velocities of every node (tied nodes included), spatial, for the viscous stresses.
@@ -164,8 +162,8 @@ pub struct System {
     /// Element forces of the geometric stresses (mixed iteration), for the tie terms.
     fg_buf: Vec<ElementVector>,
     k_buf: Vec<ElementMatrix>,
-    /// Strain energy and dissipated power of each element.
-    e_buf: Vec<(f64, f64)>,
+    /// Strain energy of each element.
+    e_buf: Vec<f64>,
     /// Strains and viscous stresses of each element at the last dynamic assembly.
     w_buf: Vec<ViscousWork>,
     k_scratch_ff: Vec<f64>,
@@ -366,7 +364,7 @@ impl System {
             f_buf: vec![ElementVector::zeros(); n_el],
             fg_buf: vec![ElementVector::zeros(); n_el],
             k_buf: vec![ElementMatrix::zeros(); n_el],
-            e_buf: vec![(0.0, 0.0); n_el],
+            e_buf: vec![0.0; n_el],
             w_buf: vec![ViscousWork::default(); n_el],
             k_scratch_ff: Vec::new(),
             k_scratch_fc: Vec::new(),
@@ -721,7 +719,7 @@ impl System {
                       f: &mut ElementVector,
                       fg: &mut ElementVector,
                       k: &mut ElementMatrix,
-                      en: &mut (f64, f64),
+                      en: &mut f64,
                       wk: &mut ViscousWork| {
             let x = e.nodes.map(|n| state.x[n]);
             let q = e
@@ -739,14 +737,19 @@ impl System {
                     .map(|n| r.rotation_jacobian.get(n).copied().unwrap_or_default()),
                 consistent: r.consistent,
             });
+            // (The dissipated power the viscous kernels also return is not needed: the energy
+            // balance takes the viscous work from `wk`, see `ViscousWork::work_to`.)
             *en = match (stress, &viscous) {
-                (Some(st), Some(v)) => e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg, Some(wk)),
-                (Some(st), None) => (
-                    e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
-                    0.0,
-                ),
-                (None, Some(v)) => e.compute_viscous_into(&x, &q, section, v, f, tangent.then_some(k), Some(wk)),
-                (None, None) => (e.compute_into(&x, &q, section, f, tangent.then_some(k)), 0.0),
+                (Some(st), Some(v)) => {
+                    e.compute_viscous_mixed_into(&x, &q, section, v, &st[i], f, k, fg, Some(wk))
+                        .0
+                }
+                (Some(st), None) => e.compute_mixed_into(&x, &q, section, Some(&st[i]), f, Some(k), Some(fg)),
+                (None, Some(v)) => {
+                    e.compute_viscous_into(&x, &q, section, v, f, tangent.then_some(k), Some(wk))
+                        .0
+                }
+                (None, None) => e.compute_into(&x, &q, section, f, tangent.then_some(k)),
             };
         };
         if self.parallel {
@@ -781,8 +784,7 @@ impl System {
         let mut f_node = vec![Vector3::zeros(); n_nodes];
         // Condensed nodal internal forces of independent nodes.
         let mut f_cond = vec![[0.0; 6]; n_nodes];
-        out.energy = self.e_buf.iter().map(|e| e.0).sum();
-        out.dissipation = self.e_buf.iter().map(|e| e.1).sum();
+        out.energy = self.e_buf.iter().sum();
         for (e, el) in self.elements.iter().enumerate() {
             let f = &mut self.f_buf[e];
             let k = &mut self.k_buf[e];

@@ -174,11 +174,7 @@ def run(args: argparse.Namespace) -> int:
         tolerance=args.tolerance,
         field_interval=16 if (args.vtu or args.snapshots) else 0,
     )
-    try:
-        settings.validate()  # before a recording is read
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    settings.validate()  # before a recording is read (main prints a ValueError, exit 2)
     measured = None
     if args.experiment:
         from tapespring.protocols.deployment import analyze_deployment

@@ -20,7 +20,13 @@ from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
 from tapespring.signals.angle import bending_angle
 from tapespring.signals.circle import CircleFit, fit_circle, max_lateral_displacement
-from tapespring.signals.frame import fit_motion_frame, motion_plane, parse_frame, to_frame
+from tapespring.signals.frame import (
+    MIN_SPREAD_RATIO,
+    fit_motion_frame,
+    motion_plane,
+    parse_frame,
+    to_frame,
+)
 from tapespring.signals.levels import equilibrium_value, release_index
 from tapespring.signals.peaks import Peaks, PeakStatistics, extract_peaks, peak_statistics
 from tapespring.signals.phases import Phases, detect_phases
@@ -112,9 +118,9 @@ _MAX_TILT = np.deg2rad(45.0)
 # The plane of motion is defined only if the motion spreads along its second direction clearly
 # beyond the marker noise there (10 sigma: the 0.3 mm lateral noise spreads a marker pulled along
 # a line by one sigma across it) and beyond 2 % of the main spread (`fit_motion_frame`'s
-# criterion); otherwise (a marker pulled along a line, markers at rest) the other checks speak.
+# criterion, `MIN_SPREAD_RATIO`); otherwise (a marker pulled along a line, markers at rest) the
+# other checks speak.
 _PLANE_NOISE_FACTOR = 10.0
-_PLANE_MIN_SPREAD_RATIO = 0.02
 # Smallest held angle of a deployment. It starts from a fold past the buckling of the tapes (the
 # paper's 95.5 and -91.2 deg); the set-up's simulated free decay turns markers 1-2 by 4 deg, its
 # simulated pull by 11 deg (16 mm), so a third of the paper's fold leaves a factor three or more
@@ -147,9 +153,7 @@ def _check_bending_plane(
     sigma = np.array([noise_std(d[:, k]) for k in range(3)])
     noise = float(np.sqrt(np.sum(plane.axes[1] ** 2 * sigma**2)))  # along the second direction
     spread = plane.spread
-    if not (
-        spread[1] > _PLANE_NOISE_FACTOR * noise and spread[1] > _PLANE_MIN_SPREAD_RATIO * spread[0]
-    ):
+    if not (spread[1] > _PLANE_NOISE_FACTOR * noise and spread[1] > MIN_SPREAD_RATIO * spread[0]):
         return
     if plane.tilt <= _MAX_TILT:
         return

@@ -31,9 +31,9 @@ import numpy as np
 __all__ = ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
-# Below this ratio of spreads (in-plane second direction over first) the vectors barely turn and
+#: Below this ratio of spreads (in-plane second direction over first) the vectors barely turn and
 # the plane of motion is not defined: 0.02 is a rotation of about 2 degrees.
-_MIN_SPREAD_RATIO = 0.02
+MIN_SPREAD_RATIO = 0.02
 
 
 def parse_frame(spec: str) -> np.ndarray:
@@ -189,11 +189,11 @@ def fit_motion_frame(
         raise ValueError("fit_motion_frame needs at least one moving marker")
     plane = motion_plane(origin, *moving)
     spread = plane.spread
-    if not spread[1] > _MIN_SPREAD_RATIO * spread[0]:
+    if not spread[1] > MIN_SPREAD_RATIO * spread[0]:
         ratio = spread[1] / spread[0] if spread[0] > 0 else 0.0
         raise ValueError(
             "cannot fit the plane of motion: the markers barely turn "
-            f"(spread ratio {ratio:.2g}, needs > {_MIN_SPREAD_RATIO})"
+            f"(spread ratio {ratio:.2g}, needs > {MIN_SPREAD_RATIO})"
         )
     y = plane.normal
     rod = np.asarray(moving[0], dtype=float) - np.asarray(origin, dtype=float)

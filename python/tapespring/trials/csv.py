@@ -50,6 +50,15 @@ __all__ = ["FORCES_SUFFIX", "needs_length_unit", "read_csv", "write_csv"]
 #: Suffix of the force-plate file that goes with a marker CSV file.
 FORCES_SUFFIX = ".forces.csv"
 
+
+def marker_file_of(path: Path) -> Path | None:
+    """The marker file ``<stem>.csv`` of a force side file ``<stem>.forces.csv``; None for
+    another file."""
+    if not path.name.endswith(FORCES_SUFFIX):
+        return None
+    return path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
+
+
 _HEADER_RE = re.compile(r"^\s*(?P<name>[^\[\]]+?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
 
 
@@ -284,7 +293,7 @@ def read_csv(
         raise FileNotFoundError(f"{path}: no such file")
     if path.name.endswith(FORCES_SUFFIX):
         # Read as markers, its first force column would be "not a marker coordinate".
-        marker = path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
+        marker = marker_file_of(path)
         there = "" if marker.is_file() else " (there is no such file)"
         raise TrialError(
             path,

@@ -35,7 +35,7 @@ from tqdm import tqdm
 
 from .c3d import read_c3d
 from .common import META_KEYS
-from .csv import FORCES_SUFFIX, needs_length_unit, read_csv
+from .csv import FORCES_SUFFIX, marker_file_of, needs_length_unit, read_csv
 from .trial import SENSES, Trial, TrialError, TrialWarning
 
 __all__ = [
@@ -154,14 +154,7 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
             raise FileNotFoundError(f"{path}: no such file or folder")
     given = {p.resolve() for p in files}
     # A force side file given with its marker file is read with it.
-    return [p for p in files if (m := _marker_file(p)) is None or m.resolve() not in given]
-
-
-def _marker_file(path: Path) -> Path | None:
-    """The marker file of a force side file ``<stem>.forces.csv``; None for another file."""
-    if not path.name.endswith(FORCES_SUFFIX):
-        return None
-    return path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
+    return [p for p in files if (m := marker_file_of(p)) is None or m.resolve() not in given]
 
 
 def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
