@@ -19,7 +19,9 @@ def test_a_smoothing_span_longer_than_the_record_is_refused():
 
     trial = make_pull_test_trial(seed=3)
     n = trial.force_plate(0).force.shape[0]
-    with pytest.raises(TrialError, match=f"span \\({n + 1} samples\\) is longer than the force"):
+    rate = trial.force_plate(0).rate
+    message = f"span \\({n + 1} samples\\) is longer than the force record \\({n} samples\\)"
+    with pytest.raises(TrialError, match=f"{message}.*force plate at {rate:g} Hz"):
         analyze_pull_trial(trial, span=n + 1)
     with pytest.raises(TrialError, match="is longer than the force record"):
         analyze_pull_trial(trial, span_time=1e3)

@@ -55,3 +55,21 @@ def test_monotonic_force_is_not_buckled():
 def test_mismatched_lengths_raise():
     with pytest.raises(ValueError, match="equal length"):
         analyze_pull_test(np.zeros(5), np.zeros(6))
+
+
+def test_a_span_longer_than_the_record_is_refused_not_shrunk():
+    # smooth() limits its window to the record: a 101-sample span on 60 samples would smooth
+    # over 59 and report a mean over the record as the maximum force.
+    d = np.linspace(0.0, 0.01, 60)
+    with pytest.raises(ValueError, match=r"span \(101 samples\) is longer than the force record "):
+        analyze_pull_test(d, 100 * d, span=101)
+    with pytest.raises(ValueError, match=r"force record \(60 samples\)"):
+        analyze_pull_test(d, 100 * d, span=61)
+
+
+def test_a_span_of_the_whole_record_is_used():
+    d = np.linspace(0.0, 0.01, 61)
+    test = analyze_pull_test(d, 100 * d, span=61)
+    assert test.span == 61
+    # The one complete window is centred on the record; the ends keep their raw samples.
+    assert test.force_smoothed[30] == pytest.approx(np.mean(100 * d))

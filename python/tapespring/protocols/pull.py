@@ -138,16 +138,12 @@ def analyze_pull_trial(
     fz = fp.force[:, 2]
     if not np.all(np.isfinite(fz)):
         raise TrialError(trial.metadata.label, "the vertical force has NaN samples")
-    if span > fz.size:
-        # smooth() would shrink the window to the record, leaving a maximum of a mean, not the
-        # smoothed peak.
-        raise TrialError(
-            trial.metadata.label,
-            f"the force smoothing span ({span} samples) is longer than the force record "
-            f"({fz.size} samples at {fp.rate:g} Hz)",
-        )
     f = fz - np.median(fz[fp.time < fp.time[0] + tare])
-    fs = smooth(f, span)
+    try:
+        # As recorded, to find the pulling direction; analyze_pull_test checks the span.
+        fs = analyze_pull_test(d, f, span=span).force_smoothed
+    except ValueError as exc:
+        raise TrialError(trial.metadata.label, f"{exc} (force plate at {fp.rate:g} Hz)") from None
     f_sign = np.sign(fs[np.argmax(np.abs(fs))]) or 1.0
     d_sign = np.sign(d[np.argmax(np.abs(d))]) or 1.0
     _check_pull_record(trial, marker, d_sign * z, f_sign * f, f_sign * fs)

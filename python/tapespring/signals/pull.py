@@ -69,7 +69,7 @@ def analyze_pull_test(
     force : ndarray, shape (m,)
         Force [N], positive in the pulling direction.
     span : int
-        Smoothing span [samples] (paper: 101).
+        Smoothing span [samples], from 1 to the record's length (paper: 101).
     drop_fraction : float
         Relative force drop after the maximum that counts as buckling, in (0, 1).
 
@@ -80,7 +80,10 @@ def analyze_pull_test(
     Raises
     ------
     ValueError
-        If the arrays differ in length or hold no finite force.
+        If the arrays differ in length or hold no finite force, or ``span`` is
+        longer than the record (`smooth` would shrink the window to the whole
+        record: its maximum would be a mean over the record, not the smoothed
+        peak).
     """
     d = np.asarray(displacement, dtype=float)
     f = np.asarray(force, dtype=float)
@@ -90,6 +93,12 @@ def analyze_pull_test(
         )
     if not 0 < drop_fraction < 1:
         raise ValueError(f"drop_fraction must satisfy 0 < drop_fraction < 1, got {drop_fraction}")
+    if span > f.size:
+        raise ValueError(
+            f"the smoothing span ({span} samples) is longer than the force record ({f.size} "
+            "samples): the window would shrink to the whole record and the maximum would be a "
+            "mean over it, not the smoothed peak; give a span of at most the record's length"
+        )
     fs = smooth(f, span)
     if not np.any(np.isfinite(fs)):
         raise ValueError("the force record has no finite sample")
