@@ -9,7 +9,6 @@ on other records than the synthetic ones.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import replace
 
 import pytest
@@ -18,7 +17,11 @@ from tapespring.scenarios.deployment import DeploymentSettings, deploy
 from tapespring.scenarios.pull import PullSettings, pull
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.scenarios.vibration import VibrationSettings, vibrate
-from tapespring.trials import Trial, TrialError, TrialWarning
+from tapespring.trials import Trial, TrialError
+
+# A TrialWarning (the sense check's) is the analysis' own; every other warning is an error
+# (pyproject's filterwarnings), so no numpy warning leaks.
+pytestmark = pytest.mark.filterwarnings("ignore::tapespring.trials.TrialWarning")
 
 DEPLOY_SPEC = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3)
 PULL_SPEC = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=5e-3)
@@ -44,38 +47,34 @@ ANALYSES = {
 }
 
 
-def _quiet(analyze, trial, **options):
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        warnings.simplefilter("ignore", TrialWarning)
-        return analyze(trial, **options)
-
-
 @pytest.mark.parametrize("kind", list(ANALYSES))
 def test_a_simulated_trial_passes_its_own_protocol(trials, kind):
-    _quiet(ANALYSES[kind], trials[kind])
+    ANALYSES[kind](trials[kind])
 
 
 @pytest.mark.parametrize(
     ("kind", "analysed_as", "reason"),
     [
         ("deployment", "quasi-static", "not a pull test: the pulled marker 'M2' covers"),
-        # Half a second of deployment: two lopsided swings and no peak in the 0.4-4 mm window.
-        ("deployment", "vibration", "not a free decay|damping fit impossible: only 0 peak"),
+        # Half a second of deployment: three swings of the tip (-77, +291, -23 mm), too few for
+        # the free-decay checks to judge, and none in the fit's 0.4-4 mm window.
+        ("deployment", "vibration", "damping fit impossible: only 0 peak"),
         ("quasi-static", "deployment", "missing marker 'M3'"),
         ("quasi-static", "vibration", "missing marker 'M3'"),
         ("vibration", "quasi-static", "no force plate"),
-        ("vibration", "deployment", "is held at [+-]\\d\\.\\d deg|never leaves"),
+        # The free decay starts from the tip pulled down (the paper's 8 mm): markers 1 and 2
+        # held at +2.9 deg, far from a deployment's fold (30 deg at least).
+        ("vibration", "deployment", "is held at \\+\\d\\.\\d deg from the deployed equilibrium"),
     ],
 )
 def test_a_simulated_trial_fails_the_other_protocols(trials, kind, analysed_as, reason):
     with pytest.raises(TrialError, match=reason):
-        _quiet(ANALYSES[analysed_as], trials[kind])
+        ANALYSES[analysed_as](trials[kind])
 
 
 def test_a_wrong_frame_on_the_simulated_deployment_is_refused(trials):
     with pytest.raises(TrialError, match="tilted by 90 deg from the bending plane"):
-        _quiet(analyze_deployment, trials["deployment"], frame="x,-z,y")
-    fitted = _quiet(analyze_deployment, trials["deployment"], frame="fit")
-    lab = _quiet(analyze_deployment, trials["deployment"])
+        analyze_deployment(trials["deployment"], frame="x,-z,y")
+    fitted = analyze_deployment(trials["deployment"], frame="fit")
+    lab = analyze_deployment(trials["deployment"])
     assert fitted.initial_angle == pytest.approx(lab.initial_angle, abs=1e-3)

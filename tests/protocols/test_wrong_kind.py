@@ -7,7 +7,6 @@ loose, so generated records of the right kind, over wide ranges of their paramet
 """
 
 import re
-import warnings
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
 from tapespring.protocols import analyze_deployment, analyze_pull_trial, analyze_vibration
-from tapespring.trials import ForcePlate, Trial, TrialError, TrialWarning
+from tapespring.trials import ForcePlate, Trial, TrialError
 from tapespring.trials.samples import (
     make_deployment_trial,
     make_pull_test_trial,
@@ -26,12 +25,9 @@ senses = st.sampled_from(["opposite", "equal"])
 seeds = st.integers(0, 2**16)
 
 
-def _quiet(analyze, trial, **options):
-    """`analyze(trial)` with every warning but a TrialWarning an error (no numpy warning leaks)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        warnings.simplefilter("ignore", TrialWarning)
-        return analyze(trial, **options)
+# A TrialWarning (the sense check's) is the analysis' own; every other warning is an error
+# (pyproject's filterwarnings), so no numpy warning leaks.
+pytestmark = pytest.mark.filterwarnings("ignore::tapespring.trials.TrialWarning")
 
 
 @examples(ci=10, long=150)
@@ -59,7 +55,7 @@ def test_generated_pull_tests_pass_the_pull_check(
         force_sd=noise * max_force,
         residual_fraction=residual,
     )
-    result = _quiet(analyze_pull_trial, trial)
+    result = analyze_pull_trial(trial)
     assert result.test.max_force > 0
 
 
@@ -68,7 +64,7 @@ def test_generated_pull_tests_pass_the_pull_check(
 def test_a_deployment_is_not_a_pull_test(sense, seed, spread, duration):
     trial, _ = make_deployment_trial(sense, seed=seed, spread=spread, duration=duration)
     with pytest.raises(TrialError, match="not a pull test: the pulled marker 'M2' covers") as info:
-        _quiet(analyze_pull_trial, trial)
+        analyze_pull_trial(trial)
     # The deployment's swing is named: its speed, far beyond a quasi-static pull's.
     assert "a quasi-static pull is slow" in str(info.value)
 
@@ -83,7 +79,7 @@ def test_a_pull_without_a_pulling_force_is_refused():
     trial = make_pull_test_trial(seed=1, duration=4.0, force_sd=0.0)
     weight_only = _with_force(trial, np.full(trial.force_plate(0).time.size, -5.0))
     with pytest.raises(TrialError, match="not a pull test: the vertical force never rises"):
-        _quiet(analyze_pull_trial, weight_only)
+        analyze_pull_trial(weight_only)
 
 
 def test_a_marker_moved_back_and_forth_slowly_is_not_one_pull():
@@ -97,14 +93,14 @@ def test_a_marker_moved_back_and_forth_slowly_is_not_one_pull():
     cycled = Trial(t, markers, trial.force_plates, trial.metadata)
     # Down and up three times: five turns (a pull and its return would be one).
     with pytest.raises(TrialError, match=r"turns back 5 times by more than 20 % of its 4\.\d+ mm"):
-        _quiet(analyze_pull_trial, cycled)
+        analyze_pull_trial(cycled)
 
 
 def test_a_marker_that_barely_moves_is_not_pulled():
     trial = make_vibration_trial(seed=3, duration=3.0)  # M2 at rest, M3 vibrating
     plate = make_pull_test_trial(seed=3, duration=3.0).force_plate(0)
     with pytest.raises(TrialError, match=r"moves by 0\.\d+ mm at most \(a pull test moves it by"):
-        _quiet(analyze_pull_trial, Trial(trial.time, trial.markers, (plate,), trial.metadata))
+        analyze_pull_trial(Trial(trial.time, trial.markers, (plate,), trial.metadata))
 
 
 @examples(ci=10, long=150)
@@ -129,7 +125,7 @@ def test_generated_free_decays_pass_the_decay_check(
     # At least 3 peaks reach the window (10 s from 10 mm at 3 % at most) and the fit takes them
     # (it refused 1 decay in 40 here, "the selected peaks do not alternate": about the
     # equilibrium taken from the record's end the window kept one kind of peak only).
-    result = _quiet(analyze_vibration, trial)
+    result = analyze_vibration(trial)
     assert result.fit.damping_ratio == pytest.approx(damping_ratio, rel=0.3)
 
 
@@ -161,7 +157,7 @@ def test_a_free_decay_is_fitted_unless_fewer_than_3_peaks_reach_the_window(
         duration=duration,
     )
     try:
-        result = _quiet(analyze_vibration, trial)
+        result = analyze_vibration(trial)
     except TrialError as exc:
         assert re.search(r"damping fit impossible: only [012] peak\(s\)", str(exc)), str(exc)
     else:
@@ -173,11 +169,11 @@ def test_a_free_decay_is_fitted_unless_fewer_than_3_peaks_reach_the_window(
 
 def test_an_undamped_vibration_passes_and_a_growing_one_does_not():
     steady = make_vibration_trial(0.0, 0.1, amplitude=-3e-3, duration=3.0, marker_sd=0.0)
-    result = _quiet(analyze_vibration, steady)
+    result = analyze_vibration(steady)
     assert abs(result.fit.damping_ratio) < 1e-4
     growing = make_vibration_trial(-0.02, 0.1, amplitude=-1e-3, duration=2.0, seed=4)
     with pytest.raises(TrialError, match=r"not a free decay: (\d+) of its \1 peaks after the"):
-        _quiet(analyze_vibration, growing)
+        analyze_vibration(growing)
 
 
 @examples(ci=8, long=100)
@@ -187,7 +183,7 @@ def test_a_deployment_is_not_a_free_decay(sense, seed, spread, duration):
     # shorter one has none in the window, and the fit says so.
     trial, _ = make_deployment_trial(sense, seed=seed, spread=spread, duration=duration)
     with pytest.raises(TrialError, match="not a free decay: .* a deployment record"):
-        _quiet(analyze_vibration, trial)
+        analyze_vibration(trial)
 
 
 @pytest.mark.parametrize(
@@ -204,7 +200,7 @@ def test_a_deployment_is_not_a_free_decay(sense, seed, spread, duration):
 def test_a_short_deployment_is_refused_as_a_free_decay_too(sense, duration, message):
     trial, _ = make_deployment_trial(sense, seed=0, spread=0.05, duration=duration)
     with pytest.raises(TrialError, match=message):
-        _quiet(analyze_vibration, trial)
+        analyze_vibration(trial)
 
 
 @examples(ci=8, long=100)
@@ -212,7 +208,7 @@ def test_a_short_deployment_is_refused_as_a_free_decay_too(sense, duration, mess
 def test_a_pull_test_is_not_a_deployment(seed, duration):
     trial = make_pull_test_trial(seed=seed, duration=duration)
     with pytest.raises(TrialError, match="is held at|never leaves|no peak found"):
-        _quiet(analyze_deployment, trial)
+        analyze_deployment(trial)
 
 
 @examples(ci=8, long=100)
@@ -227,4 +223,4 @@ def test_a_free_decay_is_not_a_deployment(seed, tilt):
     markers["M2"][:, 2] += 0.05 * np.tan(np.deg2rad(tilt) * z3 / np.max(np.abs(z3)))
     moving = Trial(trial.time, markers, (), trial.metadata)
     with pytest.raises(TrialError, match=r"is held at [+-]\d\.\d deg .* not a deployment record"):
-        _quiet(analyze_deployment, moving)
+        analyze_deployment(moving)

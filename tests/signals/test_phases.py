@@ -52,11 +52,10 @@ def test_phase_at_labels_instants():
     np.testing.assert_array_equal(labels, [1, 2, 3])
 
 
+@pytest.mark.filterwarnings("error")
 def test_peaks_at_one_instant_are_a_value_error_not_a_log_of_zero():
     # An angle measured in the wrong plane jumps by 180 deg: a maximum and a minimum on one
     # instant, a half-cycle of no duration whose log-duration was -inf (numpy warnings, NaN).
-    import warnings
-
     from tapespring.signals.peaks import Extrema, Peaks
 
     def extrema(time, value):
@@ -70,7 +69,5 @@ def test_peaks_at_one_instant_are_a_value_error_not_a_log_of_zero():
         0.001,
         0.0,
     )
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        with pytest.raises(ValueError, match=r"successive peaks at 0\.3 and 0\.3 s are not in"):
-            detect_phases(peaks)
+    with pytest.raises(ValueError, match=r"successive peaks at 0\.3 and 0\.3 s are not in"):
+        detect_phases(peaks)
