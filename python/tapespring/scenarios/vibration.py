@@ -50,17 +50,29 @@ from tapespring.scenarios.setup import (
     sample_rows,
 )
 
-__all__ = ["VibrationComparison", "VibrationSettings", "VibrationSimulation", "vibrate"]
+__all__ = [
+    "VibrationComparison",
+    "VibrationSettings",
+    "VibrationSimulation",
+    "check_time_step",
+    "vibrate",
+]
 
 #: Trial marker names of the set-up's markers (marker 3 on the additional weight is analysed).
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
 
 
-#: Newton's tolerance in the free decay, relative to the reference force (the solver's dynamic
-#: default is 1e-6): the decay is nearly linear and its forces are dominated by the weight's, so
-#: 1e-4 moves marker 3 by 6e-9 m of its 8 mm (3 s on the paper's meshes: the same damping ratio
-#: and period to 7 digits, 21 % fewer Newton iterations, 9 % less wall time).
-DECAY_TOL_FORCE = 1e-4
+def check_time_step(value: object) -> None:
+    """Raise ValueError unless `value` is a time step of the decay [s]: 0 (adaptive steps) or a
+    fixed step of at least ``1 / MAX_SAMPLE_RATE``, 1 us (every fixed step is a record: the
+    samples' bound; below a microsecond the solver cannot place the steps at the release's
+    time)."""
+    check_number("time_step", value, positive=True, zero=True)
+    if 0.0 < value < 1.0 / MAX_SAMPLE_RATE:  # type: ignore[operator]
+        raise ValueError(
+            f"time_step must be 0 (adaptive steps) or at least {1.0 / MAX_SAMPLE_RATE:.0e} s "
+            f"(got {value:.3g} s; see MAX_SAMPLE_RATE)"
+        )
 
 
 @dataclass(frozen=True)
@@ -117,15 +129,10 @@ class VibrationSettings:
         for name in ("initial_displacement", "duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
         check_rho_inf(self.rho_inf)
-        for name in ("tolerance", "time_step"):
-            check_number(name, getattr(self, name), positive=True, zero=True)
+        check_number("tolerance", self.tolerance, positive=True, zero=True)
+        check_time_step(self.time_step)
         if self.time_step > 0.0:
             # Every fixed step is a record: the same bounds as the samples.
-            if self.time_step < 1.0 / MAX_SAMPLE_RATE:
-                raise ValueError(
-                    f"time_step must be at least {1.0 / MAX_SAMPLE_RATE:.0e} s (got "
-                    f"{self.time_step:.3g} s; see MAX_SAMPLE_RATE)"
-                )
             rate = 1.0 / self.time_step
             check_sampling(("duration", self.duration), sample_rate=rate, rate_name="1/time_step")
         else:
@@ -445,7 +452,6 @@ def vibrate(
     push = settings.initial_displacement * _push_per_marker_displacement(built)
     drive(model, tip, "uz", built.down * push, "push")
     options = dynamic_options(settings.rho_inf, settings.sample_rate, settings.tolerance)
-    options["tol_force"] = DECAY_TOL_FORCE
     if settings.time_step > 0.0:
         h = settings.time_step
         options.update(adaptive=False, initial_step=h, max_step=h, output_interval=h)
