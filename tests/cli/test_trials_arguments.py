@@ -191,3 +191,13 @@ def test_the_module_parser_reads_the_same_frame():
     cli.register(parser.add_subparsers(dest="command"))
     argv = ["trials", "analyze", "d.csv", "--frame", "-y,x,z", "--kind", "deployment"]
     assert parser.parse_args(argv).frame == "-y,x,z"
+
+
+def test_the_typed_kind_options_are_the_kind_options():
+    from tapespring.cli.trials import _KIND_OPTIONS, _kind_options, _KindOptions
+
+    assert _KindOptions.__optional_keys__ == frozenset(_KIND_OPTIONS)
+    args = build_parser().parse_args(
+        ["trials", "analyze", "x.csv", "--kind", "vibration", "--window", "1e-4", "2e-3"]
+    )
+    assert _kind_options(args) == {"window": (1e-4, 2e-3)}

@@ -205,3 +205,22 @@ def test_csv_writer_removes_stale_forces_file(tmp_path):
     assert (tmp_path / "s.forces.csv").exists()
     write_csv(Trial(t, {"A": np.zeros((10, 3))}), tmp_path / "s.csv")
     assert read_csv(tmp_path / "s.csv").force_plates == ()
+
+
+def test_load_trials_gives_each_reader_its_options_and_the_metadata_by_precedence(tmp_path):
+    # isolate= and timeout= reach the C3D reader only (read_csv took them too, and refused
+    # them), the units the CSV reader only; the caller's metadata wins over the side file's,
+    # which wins over the file's.
+    for name, sense in (("a", "equal"), ("b", "opposite")):
+        trial, _ = make_deployment_trial(sense, seed=1, duration=0.5, force_rate=800.0)
+        write = write_c3d if name == "a" else write_csv
+        write(trial, tmp_path / f"{name}.{'c3d' if name == 'a' else 'csv'}")
+    (tmp_path / "metadata.csv").write_text("file,sense,session\na.c3d,opposite,S1\nb.csv,,S2\n")
+    trials = load_trials(
+        tmp_path, progress=False, isolate=False, timeout=5.0, time_unit="s", tape_pair="P"
+    )
+    assert [t.metadata.sense for t in trials] == ["opposite", "opposite"]
+    assert [t.metadata.session for t in trials] == ["S1", "S2"]
+    assert [t.metadata.tape_pair for t in trials] == ["P", "P"]
+    again = load_trials(tmp_path, progress=False, sense="equal", session="S3")
+    assert [(t.metadata.sense, t.metadata.session) for t in again] == [("equal", "S3")] * 2

@@ -21,6 +21,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TypedDict
 
 from tapespring.protocols.markers import DEFAULT_MARKERS
 from tapespring.protocols.registry import KINDS
@@ -216,11 +217,31 @@ _KIND_OPTIONS = {
 }
 
 
-def _kind_options(args: argparse.Namespace) -> dict[str, object]:
-    """The given options that belong to ``--kind`` (the protocols' defaults for the rest)."""
-    options = {k: getattr(args, k) for k in _KIND_OPTIONS if getattr(args, k) is not None}
-    if "window" in options:
-        options["window"] = tuple(options["window"])
+class _KindOptions(TypedDict, total=False):
+    """The options of `_KIND_OPTIONS`, typed as `analyze_trials` takes them."""
+
+    n_peaks: int
+    frame: str
+    window: tuple[float, float]
+    span: int
+    span_time: float
+
+
+def _kind_options(args: argparse.Namespace) -> _KindOptions:
+    """The options of `_KIND_OPTIONS` given on the command line (`_check_kind_options` has
+    refused those of another kind than ``--kind``; the protocols' defaults for the rest)."""
+    options: _KindOptions = {}
+    if args.n_peaks is not None:
+        options["n_peaks"] = args.n_peaks
+    if args.frame is not None:
+        options["frame"] = args.frame
+    if args.window is not None:
+        low, high = args.window
+        options["window"] = (low, high)
+    if args.span is not None:
+        options["span"] = args.span
+    if args.span_time is not None:
+        options["span_time"] = args.span_time
     return options
 
 

@@ -30,16 +30,18 @@ import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypedDict, Unpack
 
 from tqdm import tqdm
 
-from .c3d import read_c3d
+from .c3d import DEFAULT_TIMEOUT, read_c3d
 from .common import META_KEYS
 from .csv import FORCES_SUFFIX, marker_file_of, needs_length_unit, read_csv
 from .trial import SENSES, Trial, TrialError, TrialWarning
 
 __all__ = [
     "METADATA_FILE",
+    "ReaderOptions",
     "SkippedTrial",
     "TrialSet",
     "find_trial_files",
@@ -85,15 +87,44 @@ class TrialSet:
     skipped: tuple[SkippedTrial, ...] = ()
 
 
-def read_trial(path: str | Path, **options: str | None) -> Trial:
+class ReaderOptions(TypedDict, total=False):
+    """Options of `read_trial` that `load_trial_set` and `load_trials` pass on, each file's reader
+    taking its own: the CSV units to `read_csv`, ``isolate`` and ``timeout`` to `read_c3d`."""
+
+    length_unit: str | None
+    time_unit: str | None
+    force_unit: str | None
+    moment_unit: str | None
+    isolate: bool
+    timeout: float
+
+
+def read_trial(
+    path: str | Path,
+    *,
+    sense: str | None = None,
+    tape_pair: str | None = None,
+    session: str | None = None,
+    length_unit: str | None = None,
+    time_unit: str | None = None,
+    force_unit: str | None = None,
+    moment_unit: str | None = None,
+    isolate: bool = True,
+    timeout: float = DEFAULT_TIMEOUT,
+) -> Trial:
     """Read one trial, choosing the reader from the file suffix.
 
     Parameters
     ----------
     path : str or Path
         A ``.c3d`` or ``.csv`` file.
-    **options
-        Passed to `read_c3d` or `read_csv` (metadata overrides; CSV units).
+    sense, tape_pair, session : str, optional
+        Override the metadata stored in the file.
+    length_unit, time_unit, force_unit, moment_unit : str, optional
+        Units of the CSV columns whose header gives none (`read_csv`); a C3D file
+        carries its units.
+    isolate, timeout
+        How ezc3d reads a C3D file (`read_c3d`); unused for a CSV file.
 
     Returns
     -------
@@ -109,10 +140,25 @@ def read_trial(path: str | Path, **options: str | None) -> Trial:
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".c3d":
-        c3d_options = {k: v for k, v in options.items() if not k.endswith("_unit")}
-        return read_c3d(path, **c3d_options)
+        return read_c3d(
+            path,
+            sense=sense,
+            tape_pair=tape_pair,
+            session=session,
+            isolate=isolate,
+            timeout=timeout,
+        )
     if suffix == ".csv":
-        return read_csv(path, **options)
+        return read_csv(
+            path,
+            length_unit=length_unit,
+            time_unit=time_unit,
+            force_unit=force_unit,
+            moment_unit=moment_unit,
+            sense=sense,
+            tape_pair=tape_pair,
+            session=session,
+        )
     raise TrialError(path, f"unknown trial format {path.suffix!r} (expected .c3d or .csv)")
 
 
@@ -231,7 +277,10 @@ def load_trial_set(
     required_markers: Sequence[str] = (),
     progress: bool = True,
     skip_bad: bool = False,
-    **options: str | None,
+    sense: str | None = None,
+    tape_pair: str | None = None,
+    session: str | None = None,
+    **options: Unpack[ReaderOptions],
 ) -> TrialSet:
     """Load many trials (files and folders of files), optionally skipping the bad ones.
 
@@ -249,11 +298,13 @@ def load_trial_set(
     skip_bad : bool
         Leave out (with a `TrialWarning`) a file that raises a `TrialError`,
         and list it in `TrialSet.skipped`.
+    sense, tape_pair, session : str, optional
+        Metadata of every trial; None keeps the side file's or the file's.
     **options
-        Passed to `read_trial`: metadata (``sense``, ``tape_pair``,
-        ``session``; None keeps the side file's or the file's) and CSV units.
-        A ``length_unit`` no file would use (no CSV file, or every CSV marker
-        column has its unit in the header) gives a `TrialWarning`.
+        Passed to `read_trial` (`ReaderOptions`): CSV units, ``isolate`` and
+        ``timeout`` for C3D files. A ``length_unit`` no file would use (no CSV
+        file, or every CSV marker column has its unit in the header) gives a
+        `TrialWarning`.
 
     Returns
     -------
@@ -276,9 +327,15 @@ def load_trial_set(
     side = _side_metadata(files)
     trials, skipped = [], []
     for file in tqdm(files, desc="loading trials", unit="trial", disable=not progress):
-        given = {k: v for k, v in options.items() if v is not None}
+        meta = side[file]
         try:
-            trial = read_trial(file, **(side[file] | given))
+            trial = read_trial(
+                file,
+                sense=sense if sense is not None else meta.get("sense"),
+                tape_pair=tape_pair if tape_pair is not None else meta.get("tape_pair"),
+                session=session if session is not None else meta.get("session"),
+                **options,
+            )
             for name in required_markers:
                 trial.marker(name)
             if max_gap is not None:
@@ -317,7 +374,10 @@ def load_trials(
     required_markers: Sequence[str] = (),
     progress: bool = True,
     skip_bad: bool = False,
-    **options: str | None,
+    sense: str | None = None,
+    tape_pair: str | None = None,
+    session: str | None = None,
+    **options: Unpack[ReaderOptions],
 ) -> list[Trial]:
     """Load many trials (files and folders of files) with a progress bar.
 
@@ -336,8 +396,10 @@ def load_trials(
     skip_bad : bool
         Leave out a file that raises a `TrialError`, with a `TrialWarning` (use
         `load_trial_set` to get the list of skipped files).
+    sense, tape_pair, session : str, optional
+        Metadata of every trial; None keeps the side file's or the file's.
     **options
-        Passed to `read_trial`.
+        Passed to `read_trial` (`ReaderOptions`).
 
     Returns
     -------
@@ -351,6 +413,9 @@ def load_trials(
             required_markers=required_markers,
             progress=progress,
             skip_bad=skip_bad,
+            sense=sense,
+            tape_pair=tape_pair,
+            session=session,
             **options,
         ).trials
     )
