@@ -418,8 +418,12 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
     [
         ({"thickness": 0.0}, "thickness"),
         ({"thickness": -1e-4}, "thickness"),
-        ({"youngs_modulus": 0.0}, "Young's modulus"),
-        ({"youngs_modulus": -1.0}, "Young's modulus"),
+        ({"youngs_modulus": 0.0}, r"youngs_modulus must be > 0 \(got 0.0\)"),
+        ({"youngs_modulus": -1.0}, "youngs_modulus must be > 0"),
+        # Beyond ten times diamond's: a typing error, refused before the first increment (where
+        # 1e300 made the residual non-finite).
+        ({"youngs_modulus": 1e300}, r"youngs_modulus must be at most 1e\+13 Pa, ten times diam"),
+        ({"youngs_modulus": 1.01e13}, r"at most 1e\+13 Pa.*got 1.01e\+13 Pa; see MAX_YOUNGS"),
         ({"poisson": 0.5}, "Poisson's ratio"),
         ({"theta_max_deg": 0.0}, "theta_max"),
         ({"mesh_size": 0.0}, "mesh_size"),
@@ -450,6 +454,43 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
 def test_bad_input_raises_value_error_naming_the_problem(change, message):
     with pytest.raises(ValueError, match=message):
         bend(BendingSetup(**change))
+
+
+def test_the_youngs_modulus_bound_is_inclusive_and_plausible():
+    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS
+
+    # Diamond's 1.2e12 Pa, the stiffest material known, lies well within it.
+    assert MAX_YOUNGS_MODULUS >= 5 * 1.2e12
+    BendingSetup(youngs_modulus=MAX_YOUNGS_MODULUS).validate()
+
+
+def test_one_element_bound_for_a_tape_alone_and_in_the_set_up(monkeypatch):
+    # One constant, setup.MAX_ELEMENTS, read by the one check both make.
+    from dataclasses import replace
+
+    from tapespring.scenarios import setup
+
+    spec = replace(setup.PAPER_SETUP, mesh_tape=4e-3, mesh_plates=4e-3)
+    BendingSetup(mesh_size=4e-3).validate()
+    spec.validate()
+    monkeypatch.setattr(setup, "MAX_ELEMENTS", 10.0)
+    with pytest.raises(ValueError, match=r"mesh_size = 0.004 m is too fine .* more than 1e\+01"):
+        BendingSetup(mesh_size=4e-3).validate()
+    with pytest.raises(ValueError, match=r"mesh_tape = 0.004 m is too fine .* more than 1e\+01"):
+        spec.validate()
+
+
+def test_one_smallest_end_rotation_for_bending_and_release(monkeypatch):
+    from tapespring.scenarios import bending
+    from tapespring.scenarios.release import ReleaseSetup
+
+    BendingSetup(theta_max_deg=bending.MIN_ROTATION_DEG).validate()
+    ReleaseSetup(fold_deg=-bending.MIN_ROTATION_DEG).validate()
+    monkeypatch.setattr(bending, "MIN_ROTATION_DEG", 1.0)
+    with pytest.raises(ValueError, match="theta_max_deg .* at least 1 in magnitude"):
+        BendingSetup(theta_max_deg=0.5).validate()
+    with pytest.raises(ValueError, match="fold_deg .* at least 1 in magnitude"):
+        ReleaseSetup(fold_deg=-0.5).validate()
 
 
 # ---------------------------------------------------------------------------------------------

@@ -13,6 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from _cli import refused
 from tapespring.scenarios.deployment import DeploymentSettings, DeploymentSimulation, deploy
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.signals.angle import bending_angle
@@ -162,6 +163,49 @@ def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> N
         opposite.compare(measured, leave_aside_max=(99,))
 
 
+@pytest.mark.parametrize("metadata", [True, False])
+def test_compare_refuses_a_recording_of_the_other_sense(
+    metadata: bool, opposite: DeploymentSimulation
+) -> None:
+    # Its peaks would be paired with the wrong swings (only the deploy command refused it).
+    from dataclasses import replace as replaced
+
+    from tapespring.protocols.deployment import analyze_deployment
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial("equal", duration=3.0)
+    if not metadata:
+        trial = replaced(trial, metadata=replaced(trial.metadata, sense=None))
+    measured = analyze_deployment(trial)
+    evidence = "its metadata" if metadata else "its initial bending angle, -9"
+    with pytest.raises(ValueError) as exc:
+        opposite.compare(measured)
+    message = str(exc.value)
+    assert f"is a deployment in equal sense ({evidence}" in message
+    assert message.endswith("the simulation in opposite sense")
+
+
+@pytest.mark.parametrize(
+    ("sense", "initial_deg", "refused_by"),
+    [
+        (None, 95.5, "equal"),
+        (None, -91.2, "opposite"),
+        ("opposite", -91.2, "equal"),  # the metadata decide (the protocol warns of the sign)
+        ("equal", 95.5, "opposite"),
+    ],
+)
+def test_a_recordings_sense_is_its_metadata_else_its_initial_angles_sign(
+    sense, initial_deg, refused_by
+) -> None:
+    from types import SimpleNamespace
+
+    measured = SimpleNamespace(name="trial", sense=sense, initial_angle=np.radians(initial_deg))
+    accepting = "opposite" if refused_by == "equal" else "equal"
+    DeploymentSettings(sense=accepting).check_recording(measured)
+    with pytest.raises(ValueError, match=f"the simulation in {refused_by} sense"):
+        DeploymentSettings(sense=refused_by).check_recording(measured)
+
+
 def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     from tapespring.cli import main
     from tapespring.trials.csv import write_csv
@@ -187,10 +231,7 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     # The ParaView series: one file per kept record (every 16th of 241, and the last).
     assert len(list((tmp_path / "run").glob("*.vtu"))) >= 15
     # A recording that is not there is refused before the run, by the parser.
-    with pytest.raises(SystemExit) as exc:
-        main([*args, f"--experiment={tmp_path / 'missing.csv'}"])
-    assert exc.value.code == 2
-    assert "no such file" in capsys.readouterr().err
+    assert "no such file" in refused([*args, f"--experiment={tmp_path / 'missing.csv'}"], capsys)
 
 
 @pytest.mark.parametrize("sense", ["opposite", "equal"])

@@ -131,6 +131,18 @@ def test_release_refuses_a_tip_body_or_gravity_beyond_round_off(option, name, ca
     assert name in err and len(err.splitlines()) == 1, err
 
 
+def test_release_and_max_mass_share_the_largest_gravity():
+    # One bound, setup.MAX_GRAVITY, documented for both uses (release took max-mass's range).
+    from tapespring.scenarios.max_mass import GRAVITY_RANGE
+    from tapespring.scenarios.release import ReleaseSetup
+    from tapespring.scenarios.setup import MAX_GRAVITY
+
+    assert GRAVITY_RANGE[1] == MAX_GRAVITY
+    ReleaseSetup(gravity=-MAX_GRAVITY).validate()
+    with pytest.raises(ValueError, match=r"gravity must lie in \[-100, 100\].*see setup.MAX_GRAV"):
+        ReleaseSetup(gravity=1.01 * MAX_GRAVITY).validate()
+
+
 def test_a_release_that_stops_early_keeps_what_it_recorded(monkeypatch, capsys):
     # The step limit reached after three steps: the command exits 1 with a warning, and the
     # scenario's ConvergenceError carries the ReleaseResult of the free motion so far.

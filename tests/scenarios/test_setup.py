@@ -12,7 +12,9 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from _cli import refused
 from tapespring.cli import main
+from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.pull import PullSettings, pull
 from tapespring.scenarios.setup import (
     PAPER_MODEL,
@@ -85,8 +87,17 @@ def test_equal_sense_turns_gravity_and_markers_over() -> None:
         ({"interface_mass": -1.0}, "interface_mass"),
         ({"mesh_tape": float("nan")}, "mesh_tape"),
         # Refused before building millions of elements, or counts overflowing (1e-300 m).
-        ({"mesh_tape": 1e-5}, "mesh_tape 1e-05 m is too fine: a tape alone would have 1.9e"),
-        ({"mesh_plates": 1e-300}, "mesh_plates 1e-300 m is too fine"),
+        (
+            {"mesh_tape": 1e-5},
+            r"mesh_tape = 1e-05 m is too fine for a tape 0.1 m long and 0.019 m wide: 1.9e\+07 "
+            r"elements, more than 1e\+06",
+        ),
+        ({"mesh_plates": 1e-300}, "mesh_plates = 1e-300 m is too fine .* over 1e"),
+        # Beyond ten times diamond's (1e300 made the first residual non-finite).
+        (
+            {"tape": replace(PAPER_SETUP.tape, youngs_modulus=1e300)},
+            r"tape.youngs_modulus must be at most 1e\+13 Pa",
+        ),
         ({"setup_length": 0.12}, "appendix"),
         ({"eta": -1e-4}, "eta"),
         ({"tape": replace(PAPER_SETUP.tape, thickness=0.0)}, "thickness"),
@@ -202,10 +213,24 @@ def test_bad_vibration_settings_are_named(change: dict, message: str) -> None:
 
 
 def test_commands_refuse_bad_input(capsys) -> None:
-    assert main(["pull", "--mesh-tape=1.0", "--no-progress"]) == 2
-    assert "mesh_tape" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
-        main(["vibrate", "--thickness=-1"])
+    line = refused(["pull", "--mesh-tape=1.0", "--no-progress"], capsys, by_parser=False)
+    assert "mesh_tape" in line
+    assert "thickness" in refused(["vibrate", "--thickness=-1"], capsys)
+
+
+@pytest.mark.parametrize(
+    ("settings", "name"),
+    [
+        (PullSettings, "max_displacement"),
+        (EquilibriumSettings, "push"),
+    ],
+)
+def test_one_smallest_prescribed_displacement_for_pull_and_push(settings, name) -> None:
+    from tapespring.scenarios.setup import MIN_DISPLACEMENT
+
+    settings(**{name: MIN_DISPLACEMENT}).validate()
+    with pytest.raises(ValueError, match=rf"{name} must lie in \[1e-06, "):
+        settings(**{name: MIN_DISPLACEMENT / 2}).validate()
 
 
 def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None:

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -35,21 +36,23 @@ def _positive(name: str, *, zero: bool = False):
     return parse
 
 
-def _within(name: str, low: float, high: float, unit: str, *, closed: str = "high"):
-    """An argparse type: a finite number between `low` and `high` [`unit`], named `name` in
-    errors; `closed` says which bounds belong to the range ("low", "high", "both" or "")."""
-    with_low, with_high = closed in ("low", "both"), closed in ("high", "both")
-    shown = f"{'[' if with_low else '('}{low:g}, {high:g}{']' if with_high else ')'} {unit}"
+def _checked(name: str, check: Callable[[float], None]):
+    """An argparse type: a number that `check` accepts, named `name` if the text is no number.
+
+    `check` is the settings' own check of that value (it raises ValueError), so a bound has one
+    home and one message: the parser refuses the value before anything runs, with the message
+    the settings' ``validate`` gives.
+    """
 
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        above = value >= low if with_low else value > low
-        below = value <= high if with_high else value < high
-        if not (math.isfinite(value) and above and below):
-            raise argparse.ArgumentTypeError(f"{name} must lie in {shown} (got {value:.3g})")
+        try:
+            check(value)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
         return value
 
     return parse
@@ -59,11 +62,7 @@ def refuse(args: argparse.Namespace, message: str) -> NoReturn:
     """Stop as argparse does for a bad combination of options: usage and ``error: message`` on
     stderr, exit code 2 (SystemExit). `args` comes from a parser whose defaults hold its own
     command's parser (``set_defaults(parser=p)``)."""
-    parser = getattr(args, "parser", None)
-    if parser is None:  # a Namespace made by hand
-        print(f"error: {message}", file=sys.stderr)
-        raise SystemExit(2)
-    parser.error(message)
+    args.parser.error(message)
 
 
 def warn(message: str) -> None:
@@ -139,12 +138,14 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     Shared by the commands that build a tape spring (``bend``, ``release``); read back by
     `tape_fields`.
     """
+    from tapespring.scenarios.bending import check_alpha_deg
+    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, check_youngs_modulus
+
     p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
     p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
     p.add_argument(
         "--alpha",
-        # A section subtending 360 degrees or more closes on itself: no longer an open tape.
-        type=_within("alpha", 0.0, 360.0, "deg", closed=""),
+        type=_checked("alpha", check_alpha_deg),
         default=d.alpha_deg,
         help="subtended angle of the cross-section [deg], in (0, 360)",
     )
@@ -152,9 +153,9 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     p.add_argument(
         "--youngs-modulus",
         "-E",
-        type=_positive("Young's modulus"),
+        type=_checked("Young's modulus", check_youngs_modulus),
         default=d.youngs_modulus,
-        help="E [Pa]",
+        help=f"E [Pa], at most {MAX_YOUNGS_MODULUS:.0e}",
     )
     p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
     p.add_argument(
@@ -262,9 +263,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from tapespring.scenarios.bending import BendingSetup, bend, summarize, write_csv
 
-    if not math.isfinite(args.theta_max) or args.theta_max == 0.0:
-        print("error: --theta-max must be a non-zero angle in degrees", file=sys.stderr)
-        return 2
+    # A zero or non-finite --theta-max is refused by BendingSetup.validate (in `bend`, below).
     imperfection = args.imperfection
     if imperfection is None:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.

@@ -3,10 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import math
-from typing import Any
 
-from .bend import _count, _image_file, _input_file, _output_file, _positive, _within, refuse
+from .bend import _checked, _count, _image_file, _input_file, _output_file, _positive, refuse
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -34,7 +32,12 @@ FLEXIBLE_SAMPLE_RATE = 2000.0
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
-    from tapespring.scenarios.setup import MAX_DYNAMIC_STEPS, MAX_SAMPLE_RATE, SUPPORTS
+    from tapespring.scenarios.setup import (
+        MAX_DYNAMIC_STEPS,
+        MAX_SAMPLE_RATE,
+        SUPPORTS,
+        check_sample_rate,
+    )
 
     d = DeploymentSettings()
     p = sub.add_parser(
@@ -61,7 +64,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--sample-rate",
-        type=_within("sample rate", 0.0, MAX_SAMPLE_RATE, "Hz"),
+        type=_checked("sample rate", check_sample_rate),
         default=None,
         help="rate of the recorded histories [Hz]; the time steps land on its multiples "
         f"(default {d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
@@ -128,24 +131,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _check_sense(args: argparse.Namespace, measured: Any) -> None:
-    """Refuse a recording of the other sense than ``--sense`` (its peaks would be compared with
-    the wrong swings): the sense its metadata give, else the sign of its held initial angle
-    (positive in opposite sense, negative in equal sense, in the rig's frame)."""
-    if measured.sense is not None:
-        sense, evidence = measured.sense, "its metadata"
-    else:
-        degrees = math.degrees(measured.initial_angle)
-        sense = "opposite" if degrees > 0.0 else "equal"
-        evidence = f"its initial bending angle, {degrees:+.1f} deg"
-    if sense != args.sense:
-        refuse(
-            args,
-            f"--experiment {args.experiment} is a deployment in {sense} sense ({evidence}), "
-            f"--sense is {args.sense}",
-        )
-
-
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
     input)."""
@@ -182,7 +167,9 @@ def run(args: argparse.Namespace) -> int:
         measured = analyze_experiment(args.experiment, analyze_deployment)
         if measured is None:
             return 2
-        _check_sense(args, measured)
+        # A recording of the other sense, refused before the run as the comparison would refuse
+        # it after (main prints the ValueError, exit 2).
+        settings.check_recording(measured)
 
     def simulate() -> object:
         result = deploy(settings, progress=not (args.no_progress or args.json))

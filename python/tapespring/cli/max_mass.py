@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 
-from .bend import _count, _image_file, _output_file, _positive, _within, refuse, warn
+from .bend import _checked, _count, _image_file, _output_file, _positive, refuse, warn
 
 __all__ = ["register", "run"]
 
@@ -35,8 +34,19 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The ``max-mass`` parser.
     """
-    from tapespring.scenarios.max_mass import GRAVITY_RANGE, LEVER_ARM_RANGE
-    from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_SETUP, PAPER_TAPE
+    from tapespring.scenarios.max_mass import (
+        GRAVITY_RANGE,
+        LEVER_ARM_RANGE,
+        check_angle_deg,
+        check_gravity,
+        check_lever_arm,
+    )
+    from tapespring.scenarios.setup import (
+        PAPER_BOUNDS,
+        PAPER_SETUP,
+        PAPER_TAPE,
+        check_youngs_modulus,
+    )
 
     b = PAPER_BOUNDS
     p = sub.add_parser(
@@ -71,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--modulus-range",
         nargs=2,
-        type=_positive("Young's modulus"),
+        type=_checked("Young's modulus", check_youngs_modulus),
         metavar=("MIN", "MAX"),
         default=None,
         help=f"E range [Pa] (default Table 4: {b.youngs_modulus_min:g} {b.youngs_modulus_max:g}); "
@@ -102,14 +112,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--angle",
-        type=_positive("angle"),
+        type=_checked("angle", check_angle_deg),
         default=90.0,
-        help="fold angle at which M* is taken [deg] (default 90)",
+        help="fold angle at which M* is taken [deg], in (0, 180) (default 90)",
     )
     (l_lo, l_hi), (g_lo, g_hi) = LEVER_ARM_RANGE, GRAVITY_RANGE
     p.add_argument(
         "--lever-arm",
-        type=_within("lever arm", l_lo, l_hi, "m", closed="both"),
+        type=_checked("lever arm", check_lever_arm),
         default=None,
         help=f"lever arm l from the fold to the mass [m] (default L/2 = {PAPER_TAPE.length / 2:g}),"
         f" in [{l_lo:g}, {l_hi:g}]: from beyond the fold (about 20 mm long) to a hundred times "
@@ -117,7 +127,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--gravity",
-        type=_within("gravity", g_lo, g_hi, "m/s^2", closed="both"),
+        type=_checked("gravity", check_gravity),
         default=PAPER_SETUP.gravity,
         help=f"g [m/s^2] (default {PAPER_SETUP.gravity:g}), in [{g_lo:g}, {g_hi:g}]: from a "
         "hundredth of the Earth's (below the Moon's 1.62) to ten times it (Jupiter's: 24.8)",
@@ -200,9 +210,6 @@ def run(args: argparse.Namespace) -> int:
                 )
             warn(f"--n-{name} 1: {symbol} = {lo:g}, the lower bound of Table 4's range")
     (t_lo, t_hi), (e_lo, e_hi) = (given or default for _, _, given, default, _ in grid)
-    if not math.isfinite(args.angle) or args.angle >= 180.0:
-        print("error: --angle must lie in (0, 180) degrees", file=sys.stderr)
-        return 2
     try:
         settings = MaxMassSettings.grid(
             args.n_thickness,

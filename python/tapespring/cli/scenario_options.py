@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .bend import _image_file, _input_file, _output_file, _positive
+from .bend import _checked, _image_file, _input_file, _output_file, _positive
 
 __all__ = [
     "add_comparison_options",
@@ -30,7 +30,7 @@ def add_spec_options(
     """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
     viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
     for a viscosity to act on: it leaves ``--eta`` out."""
-    from tapespring.scenarios.setup import PAPER_SETUP
+    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, PAPER_SETUP, check_youngs_modulus
 
     s = PAPER_SETUP
     g = p.add_argument_group("set-up (paper's values and this project's choices by default)")
@@ -51,9 +51,9 @@ def add_spec_options(
     )
     g.add_argument(
         "--youngs-modulus",
-        type=_positive("Young's modulus"),
+        type=_checked("Young's modulus", check_youngs_modulus),
         default=s.tape.youngs_modulus,
-        help="E [Pa]",
+        help=f"E [Pa], at most {MAX_YOUNGS_MODULUS:.0e}",
     )
     if eta:
         g.add_argument(

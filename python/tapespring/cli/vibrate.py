@@ -6,7 +6,7 @@ import argparse
 import functools
 from typing import Any
 
-from .bend import _positive, refuse
+from .bend import _checked, _positive, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -19,20 +19,6 @@ from .scenario_options import (
 )
 
 __all__ = ["register", "run"]
-
-
-def _time_step(text: str) -> float:
-    """An argparse type: 0 (adaptive steps) or a fixed time step of at least 1 us [s] (the
-    shortest output interval, :data:`tapespring.scenarios.setup.MAX_SAMPLE_RATE`)."""
-    from tapespring.scenarios.setup import MAX_SAMPLE_RATE
-
-    value = _positive("time step", zero=True)(text)
-    if 0.0 < value < 1.0 / MAX_SAMPLE_RATE:
-        raise argparse.ArgumentTypeError(
-            f"time step must be 0 (adaptive) or at least {1.0 / MAX_SAMPLE_RATE:g} s "
-            f"(got {value:.3g})"
-        )
-    return value
 
 
 def _given(args: argparse.Namespace, *names: str) -> dict[str, Any]:
@@ -55,7 +41,7 @@ def _check(args: argparse.Namespace) -> None:
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.setup import MAX_SAMPLE_RATE
-    from tapespring.scenarios.vibration import VibrationSettings
+    from tapespring.scenarios.vibration import VibrationSettings, check_time_step
 
     d = VibrationSettings()
     p = sub.add_parser(
@@ -103,7 +89,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--time-step",
-        type=_time_step,
+        type=_checked("time step", check_time_step),
         default=d.time_step,
         help="fixed time step of the decay [s], recorded at every step (0: adaptive steps), "
         f"from {1.0 / MAX_SAMPLE_RATE:g} s (below a microsecond the solver cannot place the "

@@ -39,6 +39,7 @@ from .registry import Protocol, TrialsAnalysis
 
 __all__ = [
     "PROTOCOL",
+    "SENSE_SIGN",
     "DeploymentGroup",
     "DeploymentResult",
     "analyze_deployment",
@@ -104,8 +105,8 @@ class DeploymentResult:
     frame: str = "lab"
 
 
-# Sign of the initial bending angle for each sense (paper Sec. 2).
-_SENSE_SIGN = {"opposite": 1.0, "equal": -1.0}
+#: Sign of the initial bending angle for each sense (paper Sec. 2), in the rig's frame.
+SENSE_SIGN = {"opposite": 1.0, "equal": -1.0}
 
 # Largest tilt of the markers' plane of motion from the frame's x-z plane (the angle between its
 # normal and the y axis; `tapespring.signals.frame.motion_plane`). In the rig's frame the rod turns
@@ -276,7 +277,7 @@ def analyze_deployment(
             f"-91.2 deg; at least {np.rad2deg(_MIN_INITIAL_ANGLE):.0f} deg needed), so this is "
             "not a deployment record (a vibration or pull test?)",
         )
-    expected = _SENSE_SIGN.get(sense)
+    expected = SENSE_SIGN.get(sense)
     if frame_name == "fitted" and expected is not None and np.sign(initial) == -expected:
         # A fit cannot tell which way the bending axis points: the sense decides.
         m1, m2, m3 = (to_frame(np.diag([1.0, -1.0, -1.0]), m) for m in (m1, m2, m3))

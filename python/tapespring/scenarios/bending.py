@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.setup import MAX_ELEMENTS, PAPER_TAPE
+from tapespring.scenarios.setup import PAPER_TAPE, check_element_count, check_youngs_modulus
 
 __all__ = [
     "BendingResult",
@@ -48,6 +48,8 @@ __all__ = [
     "bend",
     "bending_model",
     "bending_steps",
+    "check_alpha_deg",
+    "check_rotation_deg",
     "summarize",
     "write_csv",
 ]
@@ -64,6 +66,33 @@ MAX_ELEMENT_ANGLE_DEG = 20.0
 #: Largest twist imperfection amplitude [deg]: an imperfection is a small twist that selects a
 #: branch at a bifurcation (the equal-sense runs use 0.1), not a pre-twisted tape.
 MAX_IMPERFECTION_DEG = 10.0
+
+#: Smallest magnitude of the rotation driven at the tape's end [deg] (the bending's
+#: ``theta_max_deg``, the release's ``fold_deg``): a millionth of a degree. A smaller rotation
+#: moves nothing the solver can resolve (1e-300 reached it as "the loads and prescribed motions
+#: act on no free DOF").
+MIN_ROTATION_DEG = 1e-6
+
+
+def check_rotation_deg(name: str, value: float, limit: float) -> None:
+    """Raise ValueError naming `name` unless the end rotation `value` [deg] lies within
+    ``(-limit, limit)`` and is at least :data:`MIN_ROTATION_DEG` in magnitude (a finite number,
+    checked before)."""
+    if not MIN_ROTATION_DEG <= abs(value) < limit:
+        raise ValueError(
+            f"{name} must be within (-{limit:g}, {limit:g}) degrees and at least "
+            f"{MIN_ROTATION_DEG:g} in magnitude (got {value})"
+        )
+
+
+def check_alpha_deg(value: float) -> None:
+    """Raise ValueError unless `value` [deg], the section's subtended angle, lies in (0, 360): an
+    open section (at 360 degrees the arc closes into a tube)."""
+    if not 0.0 < value < 360.0:
+        raise ValueError(
+            f"alpha_deg (the section's subtended angle) must lie in (0, 360) degrees "
+            f"(got {value:.3g})"
+        )
 
 
 @dataclass(frozen=True)
@@ -156,23 +185,14 @@ class BendingSetup:
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False (got {value!r})")
-        # From a millionth of a degree: a smaller rotation moves nothing the solver can resolve.
-        if not 1e-6 <= abs(self.theta_max_deg) < 360.0:
-            raise ValueError(
-                f"theta_max_deg must be within (-360, 360) degrees and at least 1e-6 in magnitude "
-                f"(got {self.theta_max_deg})"
-            )
+        check_rotation_deg("theta_max_deg", self.theta_max_deg, 360.0)
         if self.mesh_size <= 0.0:
             raise ValueError(f"mesh_size [m] must be finite and > 0 (got {self.mesh_size})")
-        for name in ("length", "radius"):  # (thickness and modulus: checked by the solver)
+        for name in ("length", "radius"):  # (the thickness: checked by the solver)
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0 (got {getattr(self, name):.3g})")
-        # An open section: at 360 degrees the arc closes into a tube.
-        if not 0.0 < self.alpha_deg < 360.0:
-            raise ValueError(
-                f"alpha_deg (the section's subtended angle) must lie in (0, 360) degrees "
-                f"(got {self.alpha_deg:.3g})"
-            )
+        check_youngs_modulus(self.youngs_modulus)
+        check_alpha_deg(self.alpha_deg)
         # A shell as thick as its radius of curvature has no inner surface: the Mindlin shell
         # (and eqs. (2)-(3)) describe thin walls, t / R of 0.01 for the paper's tape.
         if self.thickness >= 0.5 * self.radius:
@@ -195,16 +215,7 @@ class BendingSetup:
                 f"{MAX_ELEMENT_ANGLE_DEG:g} degrees of the section's arc "
                 f"(mesh_size <= {coarsest:.3e} m)"
             )
-        # Elements of the mesh, refused before it is built (which takes minutes at millions of
-        # elements, and whose counts overflow for a tape kilometres long): the set-up's bound.
-        n = (self.length / self.mesh_size) * (width / self.mesh_size)
-        if n > MAX_ELEMENTS:
-            count = f"{n:.3g}" if math.isfinite(n) else "over 1e+308"
-            raise ValueError(
-                f"mesh_size = {self.mesh_size:.3g} m is too fine for a tape {self.length:.3g} m "
-                f"long and {width:.3g} m wide: {count} elements, more than {MAX_ELEMENTS:.0e} "
-                "(a larger mesh_size, or a shorter or narrower tape)"
-            )
+        check_element_count("mesh_size", self.mesh_size, self.length, width)
         if abs(self.imperfection_deg) > MAX_IMPERFECTION_DEG:
             raise ValueError(
                 f"imperfection_deg = {self.imperfection_deg} is not a small imperfection: the "

@@ -128,6 +128,30 @@ class DeploymentSettings:
         check_count("field_interval", self.field_interval, minimum=0)
         check_count("n_peaks", self.n_peaks, minimum=1)
 
+    def check_recording(self, measured: Any) -> None:
+        """Raise ValueError unless the measured deployment `measured` (a
+        :class:`~tapespring.protocols.deployment.DeploymentResult`) was made in this `sense`:
+        the peaks of a recording of the other sense would be compared with the wrong swings.
+
+        Its sense is the one its metadata give, else the one of the sign of its held initial
+        angle (:data:`~tapespring.protocols.deployment.SENSE_SIGN`: positive in opposite sense,
+        negative in equal sense, in the rig's frame). :meth:`DeploymentSimulation.compare`
+        checks it; the ``deploy`` command checks it before the run.
+        """
+        from tapespring.protocols.deployment import SENSE_SIGN
+
+        if measured.sense is not None:
+            sense, evidence = measured.sense, "its metadata"
+        else:
+            sign = np.sign(measured.initial_angle)
+            sense = next((s for s, sign_of in SENSE_SIGN.items() if sign_of == sign), None)
+            evidence = f"its initial bending angle, {math.degrees(measured.initial_angle):+.1f} deg"
+        if sense is not None and sense != self.sense:
+            raise ValueError(
+                f"the recording {measured.name!r} is a deployment in {sense} sense ({evidence}), "
+                f"the simulation in {self.sense} sense"
+            )
+
 
 @dataclass(frozen=True)
 class DeploymentSimulation:
@@ -250,10 +274,13 @@ class DeploymentSimulation:
         Raises
         ------
         ValueError
-            If this run found no peak, or a peak left aside is not one.
+            If `measured` is a deployment of the other sense
+            (:meth:`DeploymentSettings.check_recording`), this run found no peak, or a peak left
+            aside is not one.
         """
         from tapespring.signals.peaks import compare_peaks
 
+        self.settings.check_recording(measured)
         if self.peaks is None:
             raise ValueError("the simulation has no peak to compare (run it longer)")
         k = self.settings.n_peaks if n is None else n

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from tapespring.scenarios.setup import (
+    MIN_DISPLACEMENT,
     PAPER_MODEL,
     PAPER_SETUP,
     SetupSpec,
@@ -56,9 +57,12 @@ class EquilibriumSettings:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         p = self.push
-        # From a micron: a smaller push moves nothing the solver can resolve.
-        if isinstance(p, bool) or not isinstance(p, (int, float)) or not 1e-6 <= p < 0.25:
-            raise ValueError(f"push must lie in [1e-6, 0.25) m (got {p!r})")
+        if (
+            isinstance(p, bool)
+            or not isinstance(p, (int, float))
+            or not MIN_DISPLACEMENT <= p < 0.25
+        ):
+            raise ValueError(f"push must lie in [{MIN_DISPLACEMENT:g}, 0.25) m (got {p!r})")
 
 
 @dataclass(frozen=True)

@@ -45,18 +45,23 @@ from numpy.typing import ArrayLike, NDArray
 from tapespring.report import jsonable_tree
 from tapespring.scenarios.bending import BendingSetup, analytical_residual_moment
 from tapespring.scenarios.setup import (
+    MAX_GRAVITY,
     PAPER_BOUNDS,
     PAPER_SETUP,
     PAPER_TAPE,
     SENSES,
     IdentificationBounds,
     TapeSpring,
+    check_number,
 )
 
 __all__ = [
     "MaxMassResult",
     "MaxMassSettings",
     "analytical_max_mass",
+    "check_angle_deg",
+    "check_gravity",
+    "check_lever_arm",
     "max_mass",
     "write_csv",
 ]
@@ -71,15 +76,47 @@ EQUAL_SENSE_IMPERFECTION_DEG = 0.1
 
 #: Admissible gravitational acceleration g [m/s^2]: from 0.1 (a hundredth of the Earth's, below
 #: the Moon's 1.62 and Pluto's 0.62, where m_max of the paper's tape is already about 12 kg in
-#: equal sense) to 100 (ten times the Earth's, four times Jupiter's 24.8). Outside it, m_max
-#: (inversely proportional to g) is printed in tonnes or micrograms.
-GRAVITY_RANGE = (0.1, 100.0)
+#: equal sense) to :data:`~tapespring.scenarios.setup.MAX_GRAVITY`, 100 (ten times the Earth's,
+#: four times Jupiter's 24.8). Outside it, m_max (inversely proportional to g) is printed in
+#: tonnes or micrograms.
+GRAVITY_RANGE = (0.1, MAX_GRAVITY)
 
 #: Admissible lever arm l from the fold to the mass's centre [m]: from 1 mm (the fold itself
 #: spans about R theta, 20 mm on the paper's tape at 90 deg, and eq. 1 takes the mass as a point
 #: load beyond it) to 10 m (a hundred times the paper's 0.1 m tape, whose own weight eq. 1
 #: leaves out; the paper's l is L/2 = 50 mm).
 LEVER_ARM_RANGE = (1e-3, 10.0)
+
+
+def check_angle_deg(value: object) -> None:
+    """Raise ValueError unless `value` is the fold angle at which M* is taken [deg]: a number in
+    (0, 180), the magnitude of the angle in either sense."""
+    check_number("angle_deg", value, positive=False)
+    if not 0.0 < value < 180.0:  # type: ignore[operator]
+        raise ValueError(
+            f"angle_deg must lie in (0, 180) degrees, the magnitude of the fold angle "
+            f"(got {value}; the paper's is 90)"
+        )
+
+
+def check_gravity(value: object) -> None:
+    """Raise ValueError unless `value` [m/s^2] is a number within :data:`GRAVITY_RANGE`."""
+    check_number("gravity", value, positive=False)
+    low, high = GRAVITY_RANGE
+    if not low <= value <= high:  # type: ignore[operator]
+        raise ValueError(
+            f"gravity must lie in [{low:g}, {high:g}] m/s^2 (got {value:.3g}; see GRAVITY_RANGE)"
+        )
+
+
+def check_lever_arm(value: object) -> None:
+    """Raise ValueError unless `value` [m] is a number within :data:`LEVER_ARM_RANGE`."""
+    check_number("lever_arm", value, positive=False)
+    low, high = LEVER_ARM_RANGE
+    if not low <= value <= high:  # type: ignore[operator]
+        raise ValueError(
+            f"lever_arm must lie in [{low:g}, {high:g}] m (got {value:.3g}; see LEVER_ARM_RANGE)"
+        )
 
 
 def _linspace(lo: float, hi: float, n: int) -> tuple[float, ...]:
@@ -233,29 +270,13 @@ class MaxMassSettings:
                 raise ValueError(f"{name} must be a number (got {value!r})")
             if not math.isfinite(value):
                 raise ValueError(f"{name} must be finite (got {value})")
-        if not 0.0 < self.angle_deg < 180.0:
-            raise ValueError(
-                f"angle_deg must lie in (0, 180) degrees, the magnitude of the fold angle "
-                f"(got {self.angle_deg}; the paper's is 90)"
-            )
-        if self.gravity <= 0.0:
-            raise ValueError(f"gravity must be > 0 m/s^2 (got {self.gravity})")
-        if not GRAVITY_RANGE[0] <= self.gravity <= GRAVITY_RANGE[1]:
-            raise ValueError(
-                f"gravity must lie in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2 "
-                f"(got {self.gravity:.3g}; see GRAVITY_RANGE)"
-            )
+        check_angle_deg(self.angle_deg)
+        check_gravity(self.gravity)
         if self.lever_arm is not None:
             la = self.lever_arm
             if isinstance(la, bool) or not isinstance(la, (int, float)):
                 raise ValueError(f"lever_arm must be a number or None (got {la!r})")
-            if not math.isfinite(la) or la <= 0.0:
-                raise ValueError(f"lever_arm must be finite and > 0 m (got {la})")
-            if not LEVER_ARM_RANGE[0] <= la <= LEVER_ARM_RANGE[1]:
-                raise ValueError(
-                    f"lever_arm must lie in [{LEVER_ARM_RANGE[0]:g}, {LEVER_ARM_RANGE[1]:g}] m "
-                    f"(got {la:.3g}; see LEVER_ARM_RANGE)"
-                )
+            check_lever_arm(la)
         if not isinstance(self.switch_branches, (bool, np.bool_)):
             raise ValueError(
                 f"switch_branches must be True or False (got {self.switch_branches!r})"

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
+    MIN_DISPLACEMENT,
     PAPER_SETUP,
     SetupSpec,
     buckling_step,
@@ -73,9 +74,14 @@ class PullSettings:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         d = self.max_displacement
-        # From a micron: a smaller pull moves nothing the solver can resolve.
-        if isinstance(d, bool) or not isinstance(d, (int, float)) or not 1e-6 <= d < 0.1:
-            raise ValueError(f"max_displacement must lie in [1e-6, 0.1) m (got {d!r})")
+        if (
+            isinstance(d, bool)
+            or not isinstance(d, (int, float))
+            or not MIN_DISPLACEMENT <= d < 0.1
+        ):
+            raise ValueError(
+                f"max_displacement must lie in [{MIN_DISPLACEMENT:g}, 0.1) m (got {d!r})"
+            )
         check_count("field_interval", self.field_interval, minimum=0)
 
 

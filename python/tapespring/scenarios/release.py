@@ -16,9 +16,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.bending import BendingSetup, bending_model, bending_steps
-from tapespring.scenarios.max_mass import GRAVITY_RANGE
-from tapespring.scenarios.setup import check_number, check_rho_inf
+from tapespring.scenarios.bending import (
+    BendingSetup,
+    bending_model,
+    bending_steps,
+    check_rotation_deg,
+)
+from tapespring.scenarios.setup import MAX_GRAVITY, check_number, check_rho_inf
 
 __all__ = ["ReleaseResult", "ReleaseSetup", "release", "release_model", "release_steps"]
 
@@ -105,17 +109,13 @@ class ReleaseSetup:
                 )
         check_rho_inf(self.rho_inf)
         check_number("gravity", self.gravity, positive=False)
-        if abs(self.gravity) > GRAVITY_RANGE[1]:
+        if abs(self.gravity) > MAX_GRAVITY:
             raise ValueError(
-                f"gravity must lie in [-{GRAVITY_RANGE[1]:g}, {GRAVITY_RANGE[1]:g}] m/s^2 (got "
-                f"{self.gravity:.3g}; see max_mass.GRAVITY_RANGE)"
+                f"gravity must lie in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2 (got "
+                f"{self.gravity:.3g}; see setup.MAX_GRAVITY)"
             )
         check_number("fold_deg", self.fold_deg, positive=False)
-        if not 1e-6 <= abs(self.fold_deg) < 180.0:
-            raise ValueError(
-                f"fold_deg must be within (-180, 180) degrees and at least 1e-6 in magnitude "
-                f"(got {self.fold_deg})"
-            )
+        check_rotation_deg("fold_deg", self.fold_deg, 180.0)
 
 
 def release_model(setup: ReleaseSetup) -> tuple[Any, int, int]:

@@ -18,7 +18,11 @@ from numpy.typing import NDArray
 __all__ = [
     "CONFIGURATIONS",
     "MAX_DYNAMIC_STEPS",
+    "MAX_ELEMENTS",
+    "MAX_GRAVITY",
     "MAX_SAMPLE_RATE",
+    "MAX_YOUNGS_MODULUS",
+    "MIN_DISPLACEMENT",
     "PAPER_BOUNDS",
     "PAPER_MODEL",
     "PAPER_SETUP",
@@ -34,9 +38,12 @@ __all__ = [
     "add_flexible_support",
     "build_setup",
     "check_count",
+    "check_element_count",
     "check_number",
+    "check_sample_rate",
     "check_sampling",
     "check_sense",
+    "check_youngs_modulus",
 ]
 
 
@@ -83,6 +90,24 @@ class TapeSpring:
 
 #: The paper's tape: Table 1 geometry, Table 5 identified thickness and modulus.
 PAPER_TAPE = TapeSpring()
+
+#: Largest Young's modulus of a tape [Pa]: ten times diamond's, about 1.2e12 Pa, the stiffest
+#: material known (the paper's steel: 1.5e11). Beyond it the value is a typing error, refused
+#: before the run: at 1e300 the first increment's residual became non-finite ("the residual
+#: became non-finite"); the bending scenario still converges at 1e20, so the bound is one of
+#: plausibility, not of the solver.
+MAX_YOUNGS_MODULUS = 1e13
+
+
+def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
+    """Raise ValueError naming `name` unless `value` is a Young's modulus: a finite number > 0 and
+    at most :data:`MAX_YOUNGS_MODULUS` [Pa]."""
+    check_number(name, value, positive=True)
+    if value > MAX_YOUNGS_MODULUS:  # type: ignore[operator]
+        raise ValueError(
+            f"{name} must be at most {MAX_YOUNGS_MODULUS:.0e} Pa, ten times diamond's (got "
+            f"{value:.3g} Pa; see MAX_YOUNGS_MODULUS)"
+        )
 
 
 @dataclass(frozen=True)
@@ -428,6 +453,7 @@ class SetupSpec:
             raise ValueError(f"tape must be a TapeSpring (got {self.tape!r})")
         for name, value in vars(self.tape).items():
             check_number(f"tape.{name}", value, positive=True)
+        check_youngs_modulus(self.tape.youngs_modulus, "tape.youngs_modulus")
         if not -1.0 < self.tape.poisson < 0.5:
             raise ValueError(f"tape.poisson must lie in (-1, 0.5) (got {self.tape.poisson})")
         if self.support not in SUPPORTS:
@@ -468,19 +494,13 @@ class SetupSpec:
             )
         if self.appendix_width > self.rod_length:
             raise ValueError("appendix_width must not exceed rod_length")
-        # Elements per tape at a mesh size, refused before the meshes are built (which takes
-        # minutes at millions of elements) and before their counts overflow.
-        area = self.tape.length * self.tape.radius * math.radians(self.tape.alpha_deg)
+        # Elements per tape at a mesh size (the plates' size too, measured on a tape).
+        width = self.tape.radius * self.tape.alpha
         for name in ("mesh_tape", "mesh_plates"):
             size = getattr(self, name)
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
-            if area > MAX_ELEMENTS * size * size:
-                n = area / size / size
-                raise ValueError(
-                    f"{name} {size:g} m is too fine: a tape alone would have {n:.3g} elements, "
-                    f"more than {MAX_ELEMENTS:.0e}"
-                )
+            check_element_count(name, size, self.tape.length, width)
 
     def _validate_support(self) -> None:
         """Check the flexible support's values: each one always (like every value), against
@@ -511,9 +531,42 @@ class SetupSpec:
                 )
 
 
-#: Most elements a tape of the set-up may have: 6 million DOFs, whose factorisation needs more
-#: memory than a workstation has (the paper's 2 mm mesh has 475 per tape).
+#: Most elements a tape may have, in the set-up or alone (bending, release): 6 million DOFs,
+#: whose factorisation needs more memory than a workstation has (the paper's 2 mm mesh has 475
+#: per tape). Checked by :func:`check_element_count`.
 MAX_ELEMENTS = 1e6
+
+
+def check_element_count(name: str, size: float, length: float, width: float) -> None:
+    """Raise ValueError naming the mesh size `name` unless a tape `length` long and `width` wide
+    [m] meshed at `size` [m] has at most :data:`MAX_ELEMENTS` elements.
+
+    Refused before the mesh is built, which takes minutes at millions of elements, and whose
+    counts overflow for a tape kilometres long. The values are finite and > 0 (checked before).
+    """
+    n = (length / size) * (width / size)
+    if n > MAX_ELEMENTS:
+        count = f"{n:.3g}" if math.isfinite(n) else "over 1e+308"
+        raise ValueError(
+            f"{name} = {size:.3g} m is too fine for a tape {length:.3g} m long and {width:.3g} m "
+            f"wide: {count} elements, more than {MAX_ELEMENTS:.0e} (a larger {name}, or a smaller "
+            "tape)"
+        )
+
+
+#: Largest gravitational acceleration a scenario takes [m/s^2]: ten times the Earth's, four
+#: times Jupiter's 24.8 (the largest surface gravity of a planet); beyond, a typing error,
+#: refused before the run. Its uses: the upper end of the max-mass study's range
+#: (``max_mass.GRAVITY_RANGE``, where m_max, inversely proportional to g, would otherwise be
+#: printed in micrograms) and the bound on the magnitude of the release's gravity, of either
+#: sign (``release.ReleaseSetup``: 1e300 ran into a non-finite tangent after the fold).
+MAX_GRAVITY = 100.0
+
+#: Smallest displacement the set-up's static scenarios prescribe [m] (the pull's
+#: ``max_displacement``, the equilibrium's ``push``): a micron. A smaller one moves nothing the
+#: solver can resolve (1e-300 reached it as "the loads and prescribed motions act on no free
+#: DOF").
+MIN_DISPLACEMENT = 1e-6
 
 
 def check_sense(sense: str) -> None:
@@ -1036,15 +1089,22 @@ def sample_rows(time_s: NDArray[np.float64], sample_rate: float) -> NDArray[np.i
     return np.flatnonzero(np.abs(k - np.round(k)) <= 1e-6)
 
 
+def check_sample_rate(value: object, name: str = "sample_rate") -> None:
+    """Raise ValueError naming `name` unless `value` is a sample rate: a finite number > 0 and at
+    most :data:`MAX_SAMPLE_RATE` [Hz]."""
+    check_number(name, value, positive=True)
+    if value > MAX_SAMPLE_RATE:  # type: ignore[operator]
+        raise ValueError(
+            f"{name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
+            f"(got {value:.3g} Hz; see MAX_SAMPLE_RATE)"
+        )
+
+
 def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name: str) -> None:
     """Raise ValueError unless a dynamic step of `duration` (name, value [s]) sampled at
     `sample_rate` [Hz] (named `rate_name`) is within :data:`MAX_SAMPLE_RATE` and makes at most
-    :data:`MAX_DYNAMIC_STEPS` samples. The values are finite and > 0 (checked before)."""
-    if sample_rate > MAX_SAMPLE_RATE:
-        raise ValueError(
-            f"{rate_name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
-            f"(got {sample_rate:.3g} Hz; see MAX_SAMPLE_RATE)"
-        )
+    :data:`MAX_DYNAMIC_STEPS` samples. The duration is finite and > 0 (checked before)."""
+    check_sample_rate(sample_rate, rate_name)
     name, value = duration
     # As the solver counts them: duration over the output interval.
     samples = value / (1.0 / sample_rate)
