@@ -189,12 +189,15 @@ def test_a_deployment_is_not_a_free_decay(sense, seed, spread, duration):
 @pytest.mark.parametrize(
     ("sense", "duration", "message"),
     [
-        # Too short to reach the window: the fit says so.
+        # Too short to reach the window: the fit says so (at 2 s in opposite sense, about the
+        # midline of the deployed swings; about the median of the last quarter, the free-decay
+        # check spoke first).
         ("opposite", 1.0, "damping fit impossible: only 0"),
         ("equal", 1.5, "damping fit impossible: only 0"),
         ("equal", 2.0, "damping fit impossible: only 0"),
+        ("opposite", 2.0, "damping fit impossible: only 0"),
         # Long enough: the free-decay check speaks first.
-        ("opposite", 2.0, "not a free decay"),
+        ("opposite", 3.0, "not a free decay"),
     ],
 )
 def test_a_short_deployment_is_refused_as_a_free_decay_too(sense, duration, message):

@@ -33,7 +33,7 @@ import numpy as np
 from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
 from tapespring.signals.damping import DampingFit, fit_damping
-from tapespring.signals.levels import release_index
+from tapespring.signals.levels import release_index, swing_midline
 from tapespring.signals.peaks import extract_peaks
 from tapespring.signals.smoothing import noise_std
 from tapespring.signals.stats import summarize
@@ -117,7 +117,8 @@ def analyze_vibration(
     prominence : float, optional
         Peak prominence threshold [m].
     tail_fraction : float
-        Final fraction of the record whose median is the equilibrium, in (0, 1].
+        Final fraction of the record the equilibrium is taken from, in (0, 1]: the midline of
+        its swings, or its median if it ends at rest (`tapespring.signals.levels.swing_midline`).
 
     Returns
     -------
@@ -134,8 +135,8 @@ def analyze_vibration(
         raise ValueError(f"tail_fraction must satisfy 0 < tail_fraction <= 1, got {tail_fraction}")
     z_abs = finite_marker(trial, marker)[:, 2]
     t = trial.time
-    z = z_abs - np.median(z_abs[-max(1, round(tail_fraction * z_abs.size)) :])
-    sigma = noise_std(z)
+    sigma = noise_std(z_abs)
+    z = z_abs - swing_midline(z_abs, max(_PEAK_FLOOR_SIGMA * sigma, 1e-9), tail=tail_fraction)
     i0 = release_index(z, max(window[0], 5.0 * sigma))
     _check_free_decay(trial.metadata.label, t[i0:], z[i0:], window[0], sigma, prominence)
     try:
