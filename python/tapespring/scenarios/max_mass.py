@@ -99,24 +99,24 @@ def check_angle_deg(value: object) -> None:
         )
 
 
-def check_gravity(value: object) -> None:
-    """Raise ValueError unless `value` [m/s^2] is a number within :data:`GRAVITY_RANGE`."""
-    check_number("gravity", value, positive=False)
-    low, high = GRAVITY_RANGE
+def _check_within(name: str, value: object, bounds: tuple[float, float], unit: str) -> None:
+    check_number(name, value, positive=False)
+    low, high = bounds
     if not low <= value <= high:  # type: ignore[operator]
         raise ValueError(
-            f"gravity must lie in [{low:g}, {high:g}] m/s^2 (got {value:.3g}; see GRAVITY_RANGE)"
+            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {value:.3g}; see "
+            f"{name.upper()}_RANGE)"
         )
+
+
+def check_gravity(value: object) -> None:
+    """Raise ValueError unless `value` [m/s^2] is a number within :data:`GRAVITY_RANGE`."""
+    _check_within("gravity", value, GRAVITY_RANGE, "m/s^2")
 
 
 def check_lever_arm(value: object) -> None:
     """Raise ValueError unless `value` [m] is a number within :data:`LEVER_ARM_RANGE`."""
-    check_number("lever_arm", value, positive=False)
-    low, high = LEVER_ARM_RANGE
-    if not low <= value <= high:  # type: ignore[operator]
-        raise ValueError(
-            f"lever_arm must lie in [{low:g}, {high:g}] m (got {value:.3g}; see LEVER_ARM_RANGE)"
-        )
+    _check_within("lever_arm", value, LEVER_ARM_RANGE, "m")
 
 
 def _linspace(lo: float, hi: float, n: int) -> tuple[float, ...]:
