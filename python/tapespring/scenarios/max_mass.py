@@ -141,7 +141,7 @@ class MaxMassSettings:
         Geometry (L, R, alpha), Poisson's ratio and density of the tapes; its thickness and
         modulus are replaced by the grid's. Default: the paper's tape (Table 1).
     mesh_size : float
-        Element size [m], > 0. The 4 mm default keeps a run at 1.5 to 12 s; it gives M* 1 to 2 %
+        Element size [m], > 0. The 4 mm default keeps a run at 1.5 to 5 s; it gives M* 1 to 2 %
         larger than a 2 mm mesh (measured at the paper's t and E: 0.05596 vs 0.05491 N m
         opposite, -0.03063 vs -0.03027 N m equal).
     angle_deg : float
