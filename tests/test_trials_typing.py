@@ -1,9 +1,12 @@
-"""The trials' loaders and command line type-check: their options reach the readers and the
-protocols with the types these take.
+"""The trials and signals packages, and the trials command line, type-check.
 
 ``read_trial`` took ``**options: str | None`` and passed them to `read_c3d` (``isolate: bool``,
 ``timeout: float``), and the command line passed ``dict[str, object]`` to `analyze_trials`:
-mypy reported six argument-type errors there.
+mypy reported six argument-type errors there. Later the worker of the C3D reader used its
+process and pipes without checking them for None, `Trial.with_metadata` passed
+``**dict[str, object]`` to `Metadata`, and `read_csv` used the optional result of
+`marker_file_of`: the whole of both packages is now checked (about 5 s with a cold cache, against
+4.6 s for the two files).
 """
 
 from pathlib import Path
@@ -12,20 +15,23 @@ import pytest
 
 api = pytest.importorskip("mypy.api")
 
-PACKAGE = Path(__file__).resolve().parents[1] / "python" / "tapespring"
-FILES = [PACKAGE / "cli" / "trials.py", PACKAGE / "trials" / "load.py"]
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "python" / "tapespring"
+PATHS = [PACKAGE / "trials", PACKAGE / "signals", PACKAGE / "cli" / "trials.py"]
 
 
-def test_the_trials_loader_and_command_line_type_check(tmp_path):
-    # tqdm ships no type information (typeshed's types-tqdm is not a dependency): its import is
-    # the one error left aside.
+def test_the_trials_and_signals_packages_type_check(tmp_path):
+    # pyproject.toml lets scipy, ezc3d and meshio (no type information) be imported as Any;
+    # tqdm's stubs are types-tqdm, in the test extra. Modules imported from elsewhere in the
+    # package are followed silently: their own errors are not this test's.
     out, err, status = api.run(
         [
+            "--config-file",
+            str(ROOT / "pyproject.toml"),
             "--cache-dir",
             str(tmp_path / "mypy-cache"),
-            "--disable-error-code=import-untyped",
             "--follow-imports=silent",
-            *map(str, FILES),
+            *map(str, PATHS),
         ]
     )
     assert status == 0, out + err

@@ -167,6 +167,22 @@ def test_worker_crash_and_hang_become_worker_failures(tmp_path):
     assert hang._proc is None  # killed, a new worker starts at the next read
 
 
+def test_a_worker_reply_outside_the_protocol_is_a_worker_failure(tmp_path):
+    # Before, the reply was unpacked unchecked: ("ok", "text") came back as the raw trial.
+    worker = (
+        "import sys\n"
+        "from tapespring.trials.c3d_worker import _receive, _send\n"
+        "_send(sys.stdout.buffer, ('ready', None))\n"
+        "_receive(sys.stdin.buffer)\n"
+        "_send(sys.stdout.buffer, ('ok', 'not a dict'))\n"
+        "sys.stdin.buffer.read()\n"
+    )
+    reader = IsolatedReader([sys.executable, "-c", worker])
+    with pytest.raises(WorkerFailure, match=r"answered \('ok', 'not a dict'\), not"):
+        reader.read(tmp_path / "x.c3d")
+    assert reader._proc is None  # stopped, a new worker starts at the next read
+
+
 def test_read_c3d_turns_a_worker_crash_into_a_trial_error(valid, tmp_path, monkeypatch):
     def crashed(path, timeout):
         raise WorkerFailure("crashed (SIGSEGV)")

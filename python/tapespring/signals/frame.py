@@ -56,7 +56,7 @@ def parse_frame(spec: str) -> np.ndarray:
         If the text is not three distinct signed axes, or the frame is left-handed.
     """
     parts = [p.strip().lower() for p in str(spec).split(",")]
-    rows = []
+    rows: list[np.ndarray] = []
     for part in parts:
         sign = -1.0 if part.startswith("-") else 1.0
         axis = part.lstrip("+-")

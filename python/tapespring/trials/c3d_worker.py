@@ -151,29 +151,31 @@ class IsolatedReader:
 
     def __init__(self, command: list[str] | None = None) -> None:
         self._command = command or [sys.executable, "-m", __name__]
-        self._proc: subprocess.Popen | None = None
+        self._proc: subprocess.Popen[bytes] | None = None
         self._pump_thread: threading.Thread | None = None
-        self._replies: queue.Queue = queue.Queue()
+        self._replies: queue.Queue[object] = queue.Queue()
         self._lock = threading.Lock()
         self._pid = os.getpid()
 
-    def _start(self) -> None:
+    def _start(self) -> subprocess.Popen[bytes]:
         env = dict(os.environ)
         # The worker imports this package: make it importable from where this copy lives.
         root = str(Path(__file__).resolve().parents[2])
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH")]))
-        self._proc = subprocess.Popen(
+        proc = subprocess.Popen(
             self._command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env
         )
+        self._proc = proc
         self._replies = queue.Queue()
         self._pump_thread = threading.Thread(
-            target=self._pump, args=(self._proc.stdout, self._replies), daemon=True
+            target=self._pump, args=(_pipe(proc.stdout, "output"), self._replies), daemon=True
         )
         self._pump_thread.start()
         self._wait_reply(_STARTUP_TIMEOUT, "start")
+        return proc
 
     @staticmethod
-    def _pump(stream: IO[bytes], replies: queue.Queue) -> None:
+    def _pump(stream: IO[bytes], replies: queue.Queue[object]) -> None:
         # Reads the worker's answers; None tells the reader the worker is gone.
         with stream:
             try:
@@ -212,7 +214,8 @@ class IsolatedReader:
         Raises
         ------
         WorkerFailure
-            If the worker crashed or did not answer within ``timeout``.
+            If the worker crashed, did not answer within ``timeout``, or answered something
+            other than ``("ok", dict)`` or ``("error", str)``.
         RuntimeError
             If ezc3d raised (the message is ezc3d's).
         """
@@ -221,17 +224,22 @@ class IsolatedReader:
         with self._lock:
             if self._pid != os.getpid():  # forked: the worker belongs to the parent process
                 self._proc, self._pid = None, os.getpid()
-            if self._proc is None or self._proc.poll() is not None:
-                self._start()
+            proc = self._proc
+            if proc is None or proc.poll() is not None:
+                proc = self._start()
             try:
-                _send(self._proc.stdin, ("read", str(path)))
+                _send(_pipe(proc.stdin, "input"), ("read", str(path)))
             except OSError:
                 code = self._stop(kill=True)
                 raise WorkerFailure(_describe_exit(code)) from None
-            status, value = self._wait_reply(timeout, "finish")
-        if status == "error":
-            raise RuntimeError(value)
-        return value
+            reply = self._wait_reply(timeout, "finish")
+            match reply:
+                case ("ok", dict() as raw):
+                    return raw
+                case ("error", str() as message):
+                    raise RuntimeError(message)
+            self._stop(kill=True)  # the worker does not speak the protocol: start afresh
+        raise WorkerFailure(f"answered {reply!r:.80}, not ('ok', dict) or ('error', str)")
 
     def _stop(self, kill: bool) -> int | None:
         proc, self._proc = self._proc, None
@@ -239,16 +247,19 @@ class IsolatedReader:
             return None
         if kill and proc.poll() is None:
             proc.kill()
-        try:
-            proc.stdin.close()
-        except OSError:
-            pass
+        if proc.stdin is not None:
+            try:
+                proc.stdin.close()
+            except OSError:
+                pass
         try:
             code = proc.wait(timeout=5.0)
         except subprocess.TimeoutExpired:
             proc.kill()
             code = proc.wait()
-        self._pump_thread.join(timeout=5.0)  # it closes the worker's output pipe at its end
+        pump, self._pump_thread = self._pump_thread, None
+        if pump is not None:
+            pump.join(timeout=5.0)  # it closes the worker's output pipe at its end
         return code
 
     def close(self) -> None:
@@ -256,6 +267,13 @@ class IsolatedReader:
         with self._lock:
             if self._proc is not None and self._pid == os.getpid():
                 self._stop(kill=False)
+
+
+def _pipe(stream: IO[bytes] | None, which: str) -> IO[bytes]:
+    """The worker's standard input or output (Popen leaves None where no pipe was asked for)."""
+    if stream is None:
+        raise RuntimeError(f"the C3D worker was started without a pipe on its standard {which}")
+    return stream
 
 
 def _describe_exit(code: int | None) -> str:
@@ -291,11 +309,15 @@ def _serve() -> None:
     _send(replies, ("ready", None))
     requests = sys.stdin.buffer
     while (message := _receive(requests)) is not None:
-        _, path = message
-        try:
-            reply = ("ok", read_raw(path))
-        except Exception as exc:  # ezc3d's exceptions go back as text
-            reply = ("error", f"{type(exc).__name__}: {exc}")
+        reply: tuple[str, object]
+        match message:
+            case ("read", str() as path):
+                try:
+                    reply = ("ok", read_raw(path))
+                except Exception as exc:  # ezc3d's exceptions go back as text
+                    reply = ("error", f"{type(exc).__name__}: {exc}")
+            case _:
+                reply = ("error", f"unknown request {message!r:.80}")
         _send(replies, reply)
 
 

@@ -291,9 +291,9 @@ def read_csv(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
-    if path.name.endswith(FORCES_SUFFIX):
+    marker = marker_file_of(path)  # None unless path is a force side file
+    if marker is not None:
         # Read as markers, its first force column would be "not a marker coordinate".
-        marker = marker_file_of(path)
         there = "" if marker.is_file() else " (there is no such file)"
         raise TrialError(
             path,

@@ -23,10 +23,20 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import TypedDict, Unpack
 
 import numpy as np
 
-__all__ = ["ForcePlate", "Gap", "Metadata", "SENSES", "Trial", "TrialError", "TrialWarning"]
+__all__ = [
+    "ForcePlate",
+    "Gap",
+    "Metadata",
+    "MetadataChanges",
+    "SENSES",
+    "Trial",
+    "TrialError",
+    "TrialWarning",
+]
 
 #: Senses of bending (paper Sec. 2): opposite (M, theta > 0) and equal (M, theta < 0).
 SENSES = ("opposite", "equal")
@@ -176,6 +186,17 @@ class Metadata:
     def label(self) -> str:
         """The best available identifier: source file, else name."""
         return str(self.source) if self.source is not None else self.name or "<trial>"
+
+
+class MetadataChanges(TypedDict, total=False):
+    """The `Metadata` fields `Trial.with_metadata` may replace, with their types."""
+
+    name: str
+    sense: str | None
+    tape_pair: str | None
+    session: str | None
+    units: Mapping[str, str]
+    source: Path | None
 
 
 @dataclass(frozen=True)
@@ -405,6 +426,9 @@ class Trial:
             self, time=self.time[keep], markers=markers, force_plates=tuple(plates)
         )
 
-    def with_metadata(self, **changes: object) -> Trial:
-        """A copy of the trial whose metadata fields are replaced by ``changes``."""
+    def with_metadata(self, **changes: Unpack[MetadataChanges]) -> Trial:
+        """A copy of the trial whose metadata fields are replaced by ``changes``.
+
+        ``changes`` are `Metadata` fields by name (see `MetadataChanges` for their types).
+        """
         return dataclasses.replace(self, metadata=dataclasses.replace(self.metadata, **changes))
