@@ -73,3 +73,14 @@ def test_a_span_of_the_whole_record_is_used():
     assert test.span == 61
     # The one complete window is centred on the record; the ends keep their raw samples.
     assert test.force_smoothed[30] == pytest.approx(np.mean(100 * d))
+
+
+def test_an_even_span_is_recorded_as_the_odd_span_used():
+    # smooth() reduces an even span by one: span 100 smooths over 99 samples, and the result
+    # said 100.
+    d, f = _ramp()
+    test = analyze_pull_test(d, f, span=100)
+    assert test.span == 99
+    np.testing.assert_array_equal(
+        test.force_smoothed, analyze_pull_test(d, f, span=99).force_smoothed
+    )

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from tapespring.signals import noise_std, smooth
+from tapespring.signals import effective_span, noise_std, smooth
 
 
 def _smooth_by_definition(y, span):
@@ -36,6 +36,16 @@ def test_smooth_span_longer_than_signal_is_clipped():
     y = np.array([3.0, 1.0, 2.0, 7.0])
     # span 101 -> 4 -> odd 3: [3, (3+1+2)/3, (1+2+7)/3, 7]
     np.testing.assert_allclose(smooth(y, 101), [3.0, 2.0, 10 / 3, 7.0])
+
+
+@pytest.mark.parametrize(
+    ("span", "n", "used"),
+    [(5, 7, 5), (4, 7, 3), (100, 4000, 99), (101, 4, 3), (101, 5, 5), (2, 1, 1), (3, 0, 1)],
+)
+def test_effective_span_is_the_odd_span_smooth_uses(span, n, used):
+    assert effective_span(span, n) == used
+    y = np.random.default_rng(n).normal(size=n)
+    np.testing.assert_array_equal(smooth(y, span), smooth(y, used))
 
 
 def test_smooth_span_one_is_identity():

@@ -7,8 +7,9 @@ bars, so simulated histories go through the same analyses as measured ones. SI u
 Modules
 -------
 smoothing
-    MATLAB-style moving average (`smooth`), spans from durations (`span_samples`), the samples
-    with a full window (`complete_windows`), white-noise level (`noise_std`).
+    MATLAB-style moving average (`smooth`) and the odd span it uses (`effective_span`), spans
+    from durations (`span_samples`), the samples with a full window (`complete_windows`),
+    white-noise level (`noise_std`).
 frame
     The rig's frame: given as signed axes (`parse_frame`) or fitted to the markers
     (`fit_motion_frame`, from their plane of motion `motion_plane`); `to_frame` applies it.
@@ -54,6 +55,7 @@ __all__ = [
     "compare_peaks",
     "complete_windows",
     "detect_phases",
+    "effective_span",
     "equilibrium_value",
     "extract_peaks",
     "fit_circle",
@@ -89,13 +91,18 @@ __getattr__, __dir__ = lazy_exports(
             "PeakStatistics",
             "Peaks",
             "compare_peaks",
-            "complete_windows",
             "extract_peaks",
             "peak_statistics",
         ],
         "phases": ["Phases", "detect_phases"],
         "pull": ["PullTest", "analyze_pull_test"],
-        "smoothing": ["complete_windows", "noise_std", "smooth", "span_samples"],
+        "smoothing": [
+            "complete_windows",
+            "effective_span",
+            "noise_std",
+            "smooth",
+            "span_samples",
+        ],
         "stats": ["Summary", "summarize"],
     },
 )

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .smoothing import smooth
+from .smoothing import effective_span, smooth
 
 __all__ = ["PullTest", "analyze_pull_test"]
 
@@ -32,7 +32,8 @@ class PullTest:
     force_smoothed : ndarray, shape (m,)
         Smoothed force [N].
     span : int
-        Smoothing span used [samples].
+        Smoothing span used [samples]: the span asked for, reduced by one if even (`smooth`
+        forces it odd, see `effective_span`), e.g. 99 for 100.
     max_force : float
         Maximum smoothed force before buckling [N].
     displacement_at_max : float
@@ -69,7 +70,8 @@ def analyze_pull_test(
     force : ndarray, shape (m,)
         Force [N], positive in the pulling direction.
     span : int
-        Smoothing span [samples], from 1 to the record's length (paper: 101).
+        Smoothing span [samples], from 1 to the record's length (paper: 101); an even span
+        is reduced by one, and `PullTest.span` records the span used.
     drop_fraction : float
         Relative force drop after the maximum that counts as buckling, in (0, 1).
 
@@ -110,7 +112,7 @@ def analyze_pull_test(
         displacement=d,
         force=f,
         force_smoothed=fs,
-        span=int(span),
+        span=effective_span(span, f.size),
         max_force=f_max,
         displacement_at_max=float(d[i]),
         index_at_max=i,

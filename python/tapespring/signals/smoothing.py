@@ -1,6 +1,7 @@
 """Smoothing and noise level of uniformly sampled signals.
 
-`smooth` is MATLAB's ``smooth(y, span)`` moving average; `span_samples` turns a
+`smooth` is MATLAB's ``smooth(y, span)`` moving average; `effective_span` is the
+span it actually uses (odd, at most the signal's length), `span_samples` turns a
 span given as a duration into samples, and `complete_windows` says which smoothed
 samples average a full window (near the ends MATLAB's windows shrink, down to a
 single raw sample at each end). `noise_std` estimates the standard deviation of
@@ -11,18 +12,18 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["complete_windows", "noise_std", "smooth", "span_samples"]
+__all__ = ["complete_windows", "effective_span", "noise_std", "smooth", "span_samples"]
 
 
 def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
     """Moving average with the semantics of MATLAB ``smooth(y, span)``.
 
     The span is forced odd (an even span is reduced by one) and limited to the
-    length of ``y``. Each value is replaced by the mean of a symmetric window of
-    ``span`` samples; near the ends the window shrinks symmetrically: the first
-    value is kept, the second is the mean of the first three, and so on (the
-    same for the last values). NaN samples are ignored in each window, as in
-    MATLAB; a window of NaN only gives NaN.
+    length of ``y``; `effective_span` gives the span used. Each value is replaced
+    by the mean of a symmetric window of ``span`` samples; near the ends the window
+    shrinks symmetrically: the first value is kept, the second is the mean of the
+    first three, and so on (the same for the last values). NaN samples are ignored
+    in each window, as in MATLAB; a window of NaN only gives NaN.
 
     Parameters
     ----------
@@ -47,8 +48,7 @@ def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
     if int(span) != span or span < 1:
         raise ValueError(f"span must be an integer >= 1, got {span}")
     n = y.size
-    width = min(int(span), n)
-    width -= 1 - width % 2  # force odd
+    width = effective_span(span, n)
     if width <= 1:
         return y.copy()
     half = np.minimum(np.arange(n), np.arange(n)[::-1])
@@ -63,6 +63,27 @@ def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
         out = (csum[hi] - csum[lo]) / count
     out[count == 0] = np.nan
     return out
+
+
+def effective_span(span: int, n: int) -> int:
+    """The span `smooth` uses on ``n`` samples: ``span`` limited to ``n``, then made odd.
+
+    An even value is reduced by one, as in MATLAB: ``effective_span(100, 4000) == 99``.
+
+    Parameters
+    ----------
+    span : int
+        Smoothing span asked for [samples], >= 1.
+    n : int
+        Number of samples, >= 0.
+
+    Returns
+    -------
+    int
+        The odd span used, from 1 to ``max(n, 1)``; 1 (no smoothing) if ``n`` is 0 or 1.
+    """
+    width = min(int(span), n)
+    return max(1, width - (1 - width % 2))
 
 
 def span_samples(duration: float, rate: float) -> int:
@@ -105,9 +126,7 @@ def complete_windows(n: int, span: int) -> slice:
         ``slice(h, n - h)`` with ``h`` the half-width actually used; empty if the
         signal is shorter than one window.
     """
-    width = min(int(span), n)
-    width -= 1 - width % 2
-    half = max(width, 1) // 2
+    half = effective_span(span, n) // 2
     return slice(half, max(half, n - half))
 
 
