@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from _cli import refused
 from tapespring.cli import trials as cli
 from tapespring.protocols import analyze_deployment, analyze_trials
 from tapespring.signals.frame import to_frame
@@ -44,10 +45,8 @@ def _pull_without_tip(folder, n=2):
 
 @pytest.mark.parametrize("value", ["0", "-3", "two"])
 def test_n_peaks_below_one_is_refused_by_the_parser(tmp_path, capsys, value):
-    with pytest.raises(SystemExit) as info:
-        _run([str(tmp_path), "--kind", "deployment", "--n-peaks", value])
-    assert info.value.code == 2
-    err = capsys.readouterr().err
+    argv = ["trials", "analyze", str(tmp_path), "--kind", "deployment", "--n-peaks", value]
+    err = refused(argv, capsys)
     assert "--n-peaks" in err and "integer >= 1" in err and "numpy" not in err
 
 
@@ -180,8 +179,8 @@ def test_span_time_equals_the_span_in_samples(tmp_path, capsys):
     by_time = json.loads(capsys.readouterr().out)
     assert by_time["trials"][0]["span"] == 101
     assert by_time["max_force"] == by_samples["max_force"]
-    with pytest.raises(SystemExit):
-        _run([*argv, "--span", "101", "--span-time", "0.02"])
+    err = refused(["trials", "analyze", *argv, "--span", "101", "--span-time", "0.02"], capsys)
+    assert "argument --span-time: not allowed with argument --span" in err
 
 
 def test_json_summary_has_the_peaks_of_each_trial(tmp_path, capsys):

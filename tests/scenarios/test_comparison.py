@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from _cli import refused
 from tapespring.cli import main
 from tapespring.scenarios.pull import PullResult, PullSettings, pull
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
@@ -219,11 +220,8 @@ def test_bad_experiment_file_is_named(command, problem, tmp_path, capsys) -> Non
         write_csv(other, path)
     if problem == "missing":
         # Refused by the parser, before the run (its usage line, then the error).
-        with pytest.raises(SystemExit) as exc:
-            main([command, "--no-progress", f"--experiment={path}"])
-        assert exc.value.code == 2
-        err = capsys.readouterr().err
-        assert f"no such file: {path}" in err and "Traceback" not in err
+        err = refused([command, "--no-progress", f"--experiment={path}"], capsys)
+        assert f"no such file: {path}" in err
         return
     assert main([command, "--no-progress", f"--experiment={path}"]) == 2
     err = capsys.readouterr().err
