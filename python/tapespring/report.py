@@ -17,14 +17,14 @@ from __future__ import annotations
 import csv
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from tapespring.protocols.registry import protocol_for
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure, SubFigure
 
     from tapespring.protocols.registry import TrialsAnalysis
     from tapespring.signals.stats import Summary
@@ -81,7 +81,7 @@ def jsonable(value: object) -> object:
     return value
 
 
-def summary_dict(analysis: TrialsAnalysis) -> dict:
+def summary_dict(analysis: TrialsAnalysis[Any]) -> dict[str, object]:
     """The numbers of an analysis as a JSON-ready dictionary (SI units).
 
     Parameters
@@ -94,10 +94,11 @@ def summary_dict(analysis: TrialsAnalysis) -> dict:
         ``kind``, ``n_trials``, ``skipped`` (file and problem of each trial left
         out) and per-kind statistics; NaN is written as None.
     """
-    out: dict = {"kind": analysis.kind, "n_trials": len(analysis.results)}
+    protocol = protocol_for(analysis.kind)
+    out: dict[str, object] = {"kind": analysis.kind, "n_trials": len(analysis.results)}
     out["skipped"] = [{"file": s.source, "problem": s.problem} for s in analysis.skipped]
-    out |= protocol_for(analysis.kind).summary(analysis)
-    return jsonable_tree(out)
+    out |= protocol.summary(protocol.narrow(analysis))
+    return {k: jsonable_tree(v) for k, v in out.items()}
 
 
 def jsonable_tree(value: object) -> object:
@@ -136,7 +137,7 @@ def summary_row(name: str, unit: str, s: Summary, scale: float = 1.0) -> list[st
     ]
 
 
-def format_summary(analysis: TrialsAnalysis) -> str:
+def format_summary(analysis: TrialsAnalysis[Any]) -> str:
     """The summary table printed by ``tapespring trials analyze``.
 
     Parameters
@@ -148,7 +149,8 @@ def format_summary(analysis: TrialsAnalysis) -> str:
     str
         A plain-text table (mean, std, max difference, variation coefficient).
     """
-    rows = [SUMMARY_HEADER, *protocol_for(analysis.kind).table_rows(analysis)]
+    protocol = protocol_for(analysis.kind)
+    rows = [SUMMARY_HEADER, *protocol.table_rows(protocol.narrow(analysis))]
     widths = [max(len(r[i]) for r in rows) for i in range(len(SUMMARY_HEADER))]
     lines = [f"{analysis.kind}: {len(analysis.results)} trial(s)"]
     for j, r in enumerate(rows):
@@ -172,21 +174,31 @@ def write_table(path: Path, header: Sequence[str], rows: Sequence[Sequence[objec
         writer = csv.writer(fh, lineterminator="\n")
         writer.writerow(header)
         for row in rows:
-            writer.writerow(["" if v is None else v for v in jsonable(list(row))])
+            writer.writerow(["" if v is None else v for v in (jsonable(x) for x in row)])
     return path
 
 
-def save_figure(fig: Figure, path: Path) -> Path:
-    """Save a figure as PNG (120 dpi), close it, and return the path."""
-    import matplotlib.pyplot as plt
+def save_figure(fig: Figure | SubFigure, path: str | Path) -> Path:
+    """Save a figure as PNG (120 dpi), close it, and return the path.
 
+    ``fig`` is typed as `Axes.figure` is; a sub-figure (which cannot be saved on its own) is
+    refused with a TypeError.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise TypeError(
+            f"save_figure saves a whole Figure, got a {type(fig).__name__}: pass its root figure"
+        )
+    path = Path(path)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
 
 
 def write_report(
-    analysis: TrialsAnalysis, folder: str | Path, *, figures: bool = True
+    analysis: TrialsAnalysis[Any], folder: str | Path, *, figures: bool = True
 ) -> list[Path]:
     """Write the CSV tables and PNG figures of an analysis into ``folder``.
 
@@ -206,9 +218,10 @@ def write_report(
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     protocol = protocol_for(analysis.kind)
-    files = [write_table(folder / "summary.csv", SUMMARY_HEADER, protocol.table_rows(analysis))]
+    checked = protocol.narrow(analysis)
+    files = [write_table(folder / "summary.csv", SUMMARY_HEADER, protocol.table_rows(checked))]
     if analysis.skipped:
         rows = [(s.source, s.problem) for s in analysis.skipped]
         files.append(write_table(folder / "skipped.csv", ["file", "problem"], rows))
-    files += protocol.write_files(analysis, folder, figures)
+    files += protocol.write_files(checked, folder, figures)
     return files

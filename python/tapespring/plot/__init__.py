@@ -22,7 +22,30 @@ setup, max_mass, numerical_damping, support, snapshots
     33) and side views of the deformed model (Fig. 13). Some return a Figure rather than axes.
 """
 
+from typing import TYPE_CHECKING
+
 from tapespring._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    # What the lazy __getattr__ below returns, for the type checker (not imported at run time).
+    from .bending import plot_bending
+    from .max_mass import plot_max_mass
+    from .numerical_damping import plot_numerical_damping
+    from .release import plot_release
+    from .setup import plot_deployment, plot_pull, plot_vibration
+    from .snapshots import plot_snapshots
+    from .support import plot_clamp_forces
+    from .trials import (
+        plot_angle_histories,
+        plot_damping_series,
+        plot_force_and_angle,
+        plot_free_decay,
+        plot_peak_differences,
+        plot_pull_test,
+        plot_series_comparison,
+        plot_tip_trajectory,
+        plot_variation_coefficients,
+    )
 
 __all__ = [
     "plot_angle_histories",

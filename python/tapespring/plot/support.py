@@ -66,7 +66,9 @@ def force_spectrum(
     fu = np.interp(tu, t, f)
     window = np.hanning(tu.size)
     spectrum = np.fft.rfft((fu - fu.mean()) * window)
-    return np.fft.rfftfreq(tu.size, 1.0 / rate_hz), 2.0 * np.abs(spectrum) / window.sum()
+    frequency = np.asarray(np.fft.rfftfreq(tu.size, 1.0 / rate_hz), dtype=np.float64)
+    amplitude = np.asarray(2.0 * np.abs(spectrum) / window.sum(), dtype=np.float64)
+    return frequency, amplitude
 
 
 def tared_force(sim: Any) -> NDArray[np.float64]:

@@ -8,11 +8,12 @@ lengths in millimetres, and the axes are labelled with their units.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypedDict
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
+from numpy.typing import ArrayLike
 
 # Annotations only: drawing needs none of the signal modules (nor the scipy they import).
 if TYPE_CHECKING:
@@ -34,8 +35,16 @@ __all__ = [
     "plot_variation_coefficients",
 ]
 
-_MAX_STYLE = {"marker": "^", "color": "tab:red"}
-_MIN_STYLE = {"marker": "v", "color": "tab:blue"}
+
+class _PeakStyle(TypedDict):
+    """Marker and colour of the maxima or the minima (keywords of `Axes.plot`)."""
+
+    marker: str
+    color: str
+
+
+_MAX_STYLE: _PeakStyle = {"marker": "^", "color": "tab:red"}
+_MIN_STYLE: _PeakStyle = {"marker": "v", "color": "tab:blue"}
 
 
 def _axes(ax: Axes | None, figsize: tuple[float, float] = (7.0, 4.0)) -> Axes:
@@ -112,7 +121,7 @@ def plot_variation_coefficients(
     """
     ax = _axes(ax)
     prefix = f"{label}: " if label else ""
-    n = np.arange(1, stats.max_amplitude.cv.size + 1)
+    n = np.arange(1, np.size(stats.max_amplitude.cv) + 1)
     ax.plot(n, 100 * stats.max_amplitude.cv, ls="-", **_MAX_STYLE, label=f"{prefix}max. amplitude")
     ax.plot(n, 100 * stats.min_amplitude.cv, ls="-", **_MIN_STYLE, label=f"{prefix}min. amplitude")
     ax.plot(
@@ -309,7 +318,7 @@ def plot_free_decay(
 
 
 def plot_damping_series(
-    damping_ratio: np.ndarray,
+    damping_ratio: ArrayLike,
     *,
     groups: Sequence[str | None] | None = None,
     ax: Axes | None = None,
@@ -318,7 +327,7 @@ def plot_damping_series(
 
     Parameters
     ----------
-    damping_ratio : ndarray, shape (k,)
+    damping_ratio : array_like, shape (k,)
         epsilon of each test, in test order [-].
     groups : sequence of str, optional
         Session of each test (one colour per session).

@@ -277,7 +277,7 @@ def analyze_deployment(
             f"-91.2 deg; at least {np.rad2deg(_MIN_INITIAL_ANGLE):.0f} deg needed), so this is "
             "not a deployment record (a vibration or pull test?)",
         )
-    expected = SENSE_SIGN.get(sense)
+    expected = SENSE_SIGN.get(sense) if sense is not None else None
     if frame_name == "fitted" and expected is not None and np.sign(initial) == -expected:
         # A fit cannot tell which way the bending axis points: the sense decides.
         m1, m2, m3 = (to_frame(np.diag([1.0, -1.0, -1.0]), m) for m in (m1, m2, m3))
@@ -385,7 +385,7 @@ def analyze_deployment_group(
     markers: Sequence[str] = DEFAULT_MARKERS,
     n_peaks: int = 10,
     frame: str | np.ndarray | None = None,
-) -> TrialsAnalysis:
+) -> TrialsAnalysis[DeploymentResult]:
     """Analyse deployment trials, grouped by sense of bending, with the statistics of each group.
 
     Parameters
@@ -414,9 +414,10 @@ def _analyze_trial(
     return analyze_deployment(trial, markers=markers, n_peaks=n_peaks, frame=frame)
 
 
-def _combine(results: Sequence[DeploymentResult], *, n_peaks: int, **_: object) -> TrialsAnalysis:
+def _combine(
+    results: Sequence[DeploymentResult], *, n_peaks: int, **_: object
+) -> TrialsAnalysis[DeploymentResult]:
     """Group the per-trial results by sense and compute each group's statistics."""
-    results = tuple(results)
     groups = []
     for sense in dict.fromkeys(r.sense for r in results):
         members = tuple(r for r in results if r.sense == sense)
@@ -429,16 +430,16 @@ def _combine(results: Sequence[DeploymentResult], *, n_peaks: int, **_: object) 
                 lateral_max=summarize([r.lateral_max for r in members]),
             )
         )
-    return TrialsAnalysis(kind=KIND, results=results, groups=tuple(groups), summaries={})
+    return TrialsAnalysis(kind=KIND, results=tuple(results), groups=tuple(groups), summaries={})
 
 
-def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
+def _table_rows(analysis: TrialsAnalysis[DeploymentResult]) -> list[list[str]]:
     rows = []
     for g in analysis.groups:
         tag = g.sense or "unknown sense"
         rows.append(summary_row(f"initial angle ({tag})", "deg", g.initial_angle, 180 / np.pi))
         rows.append(summary_row(f"lateral tip excursion ({tag})", "mm", g.lateral_max, 1e3))
-        for k in range(g.peaks.max_amplitude.mean.size):
+        for k in range(np.size(g.peaks.max_amplitude.mean)):
             for field, label in (("max_amplitude", "max"), ("min_amplitude", "min")):
                 s = getattr(g.peaks, field)
                 sk = Summary(s.mean[k], s.std[k], s.max_diff[k], s.cv[k], int(s.count[k]))
@@ -446,8 +447,8 @@ def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
     return rows
 
 
-def _summary(analysis: TrialsAnalysis) -> dict:
-    out: dict = {"groups": []}
+def _summary(analysis: TrialsAnalysis[DeploymentResult]) -> dict[str, object]:
+    groups = []
     for g in analysis.groups:
         peaks = {}
         for field in ("max_amplitude", "min_amplitude", "max_separation", "min_separation"):
@@ -455,7 +456,7 @@ def _summary(analysis: TrialsAnalysis) -> dict:
             peaks[field] = {
                 k: jsonable(getattr(s, k)) for k in ("mean", "std", "max_diff", "cv", "count")
             }
-        out["groups"].append(
+        groups.append(
             {
                 "sense": g.sense,
                 "n_trials": len(g.results),
@@ -464,7 +465,7 @@ def _summary(analysis: TrialsAnalysis) -> dict:
                 "peaks": peaks,
             }
         )
-    out["trials"] = [
+    trials = [
         {
             "name": r.name,
             "sense": r.sense,
@@ -487,10 +488,12 @@ def _summary(analysis: TrialsAnalysis) -> dict:
         }
         for r in analysis.results
     ]
-    return out
+    return {"groups": groups, "trials": trials}
 
 
-def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[Path]:
+def _write_files(
+    analysis: TrialsAnalysis[DeploymentResult], folder: Path, figures: bool
+) -> list[Path]:
     files = []
     rows = []
     for r in analysis.results:
@@ -560,7 +563,7 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
     for g in analysis.groups:
         tag = g.sense or "all"
         rows = []
-        n = g.peaks.max_amplitude.mean.size
+        n = np.size(g.peaks.max_amplitude.mean)
         for field in ("max_amplitude", "min_amplitude", "max_separation", "min_separation"):
             s = getattr(g.peaks, field)
             for k in range(n):
@@ -590,7 +593,7 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
         )
         ax.set_title(f"tip trajectory, {first.name}")
         files.append(save_figure(ax.figure, folder / f"tip_trajectory_{tag}.png"))
-        if first.force_time is not None:
+        if first.force_time is not None and first.force_z is not None:
             ax = plot.plot_force_and_angle(first.force_time, first.force_z, first.time, first.angle)
             ax.set_title(f"vertical force and bending angle, {first.name}")
             files.append(save_figure(ax.figure, folder / f"force_and_angle_{tag}.png"))
@@ -599,6 +602,7 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
+    result_type=DeploymentResult,
     analyze_trial=_analyze_trial,
     combine=_combine,
     options=("n_peaks", "frame"),

@@ -224,7 +224,7 @@ def _check_pull_record(
 
 def analyze_pull_group(
     trials: Iterable[Trial], *, markers: Sequence[str] = DEFAULT_MARKERS, span: int = 101
-) -> TrialsAnalysis:
+) -> TrialsAnalysis[PullTestResult]:
     """Analyse pull tests, with the statistics of the maximum force and its displacement.
 
     Parameters
@@ -251,17 +251,16 @@ def _analyze_trial(
     return analyze_pull_trial(trial, marker=markers[1], span=span, span_time=span_time)
 
 
-def _combine(results: Sequence[PullTestResult], **_: object) -> TrialsAnalysis:
+def _combine(results: Sequence[PullTestResult], **_: object) -> TrialsAnalysis[PullTestResult]:
     """Statistics of the maximum force and its displacement."""
-    results = tuple(results)
     summaries = {
         "max_force": summarize([r.test.max_force for r in results]),
         "displacement_at_max": summarize([r.test.displacement_at_max for r in results]),
     }
-    return TrialsAnalysis(kind=KIND, results=results, summaries=summaries)
+    return TrialsAnalysis(kind=KIND, results=tuple(results), summaries=summaries)
 
 
-def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
+def _table_rows(analysis: TrialsAnalysis[PullTestResult]) -> list[list[str]]:
     rows = []
     rows.append(summary_row("max force", "N", analysis.summaries["max_force"]))
     rows.append(
@@ -270,8 +269,8 @@ def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
     return rows
 
 
-def _summary(analysis: TrialsAnalysis) -> dict:
-    out = {k: summary_json(v) for k, v in analysis.summaries.items()}
+def _summary(analysis: TrialsAnalysis[PullTestResult]) -> dict[str, object]:
+    out: dict[str, object] = {k: summary_json(v) for k, v in analysis.summaries.items()}
     out["trials"] = [
         {
             "name": r.name,
@@ -285,7 +284,9 @@ def _summary(analysis: TrialsAnalysis) -> dict:
     return out
 
 
-def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[Path]:
+def _write_files(
+    analysis: TrialsAnalysis[PullTestResult], folder: Path, figures: bool
+) -> list[Path]:
     rows = [
         [
             r.name,
@@ -321,6 +322,7 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
+    result_type=PullTestResult,
     analyze_trial=_analyze_trial,
     combine=_combine,
     options=("span", "span_time"),

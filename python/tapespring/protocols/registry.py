@@ -25,16 +25,17 @@ import dataclasses
 import importlib
 import math
 import numbers
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Generic, Literal, TypeVar, overload
 
 from .markers import DEFAULT_MARKERS
 
 if TYPE_CHECKING:
     import numpy as np
 
+    from tapespring.signals.stats import Summary
     from tapespring.trials.load import SkippedTrial
     from tapespring.trials.trial import Trial
 
@@ -50,9 +51,12 @@ _MODULES = {"deployment": "deployment", "vibration": "vibration", "quasi-static"
 #: Kinds of test understood by `analyze_trials`.
 KINDS = tuple(_MODULES)
 
+#: The per-trial result of a kind: `DeploymentResult`, `VibrationResult` or `PullTestResult`.
+ResultT = TypeVar("ResultT")
+
 
 @dataclass(frozen=True)
-class TrialsAnalysis:
+class TrialsAnalysis(Generic[ResultT]):
     """Analysis of a set of trials of one kind.
 
     Attributes
@@ -63,8 +67,8 @@ class TrialsAnalysis:
         Per-trial results (`DeploymentResult`, `VibrationResult` or `PullTestResult`).
     groups : tuple of DeploymentGroup
         Deployment only: one group per sense of bending.
-    summaries : dict of str -> Summary
-        Scalar statistics: ``damping_ratio``, ``period``,
+    summaries : mapping of str -> Summary
+        Scalar statistics (empty for deployment): ``damping_ratio``, ``period``,
         ``session_damping_ratio``, ``session_period`` (vibration);
         ``max_force``, ``displacement_at_max`` (quasi-static).
     sessions : tuple of (str, int, float, float)
@@ -75,21 +79,24 @@ class TrialsAnalysis:
     """
 
     kind: str
-    results: tuple[DeploymentResult | VibrationResult | PullTestResult, ...]
+    results: tuple[ResultT, ...]
     groups: tuple[DeploymentGroup, ...] = ()
-    summaries: dict | None = None
-    sessions: tuple = ()
+    summaries: Mapping[str, Summary] = field(default_factory=dict)
+    sessions: tuple[tuple[str | None, int, float, float], ...] = ()
     skipped: tuple[SkippedTrial, ...] = ()
 
 
 @dataclass(frozen=True)
-class Protocol:
+class Protocol(Generic[ResultT]):
     """How one kind of test is analysed and reported.
 
     Attributes
     ----------
     kind : str
         Kind of test, a key of the registry (one of `KINDS`).
+    result_type : type
+        The class of the per-trial results (`DeploymentResult`, `VibrationResult` or
+        `PullTestResult`).
     analyze_trial : callable
         ``analyze_trial(trial, *, markers, **options) -> result``: the analysis of one trial.
     combine : callable
@@ -112,16 +119,55 @@ class Protocol:
     """
 
     kind: str
-    analyze_trial: Callable[..., object]
-    combine: Callable[..., TrialsAnalysis]
+    result_type: type[ResultT]
+    analyze_trial: Callable[..., ResultT]
+    combine: Callable[..., TrialsAnalysis[ResultT]]
     options: tuple[str, ...]
     marker_roles: tuple[int, ...]
-    table_rows: Callable[[TrialsAnalysis], list[list[str]]]
-    summary: Callable[[TrialsAnalysis], dict]
-    write_files: Callable[[TrialsAnalysis, Path, bool], list[Path]]
+    table_rows: Callable[[TrialsAnalysis[ResultT]], list[list[str]]]
+    summary: Callable[[TrialsAnalysis[ResultT]], dict[str, object]]
+    write_files: Callable[[TrialsAnalysis[ResultT], Path, bool], list[Path]]
+
+    def narrow(self, analysis: TrialsAnalysis[Any]) -> TrialsAnalysis[ResultT]:
+        """The analysis, checked to be of this kind and to hold this kind's results.
+
+        Parameters
+        ----------
+        analysis : TrialsAnalysis
+            An analysis, e.g. one built by hand or read back with another kind.
+
+        Returns
+        -------
+        TrialsAnalysis
+            The same object, typed with this kind's results.
+
+        Raises
+        ------
+        ValueError
+            If the analysis is of another kind.
+        TypeError
+            If a result is not a ``result_type`` (the kind and the results disagree).
+        """
+        if analysis.kind != self.kind:
+            raise ValueError(f"expected a {self.kind!r} analysis, got a {analysis.kind!r} one")
+        for i, result in enumerate(analysis.results):
+            if not isinstance(result, self.result_type):
+                raise TypeError(
+                    f"a {self.kind!r} analysis holds {self.result_type.__name__} results, but "
+                    f"result {i} is a {type(result).__name__}"
+                )
+        return analysis
 
 
-def protocol_for(kind: str) -> Protocol:
+@overload
+def protocol_for(kind: Literal["deployment"]) -> Protocol[DeploymentResult]: ...
+@overload
+def protocol_for(kind: Literal["vibration"]) -> Protocol[VibrationResult]: ...
+@overload
+def protocol_for(kind: Literal["quasi-static"]) -> Protocol[PullTestResult]: ...
+@overload
+def protocol_for(kind: str) -> Protocol[Any]: ...
+def protocol_for(kind: str) -> Protocol[Any]:
     """The protocol of one kind of test.
 
     Parameters
@@ -140,7 +186,8 @@ def protocol_for(kind: str) -> Protocol:
     """
     if kind not in _MODULES:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    return importlib.import_module(f"{__package__}.{_MODULES[kind]}").PROTOCOL
+    protocol: Protocol[Any] = importlib.import_module(f"{__package__}.{_MODULES[kind]}").PROTOCOL
+    return protocol
 
 
 def analyze_trials(
@@ -229,8 +276,14 @@ def analyze_trials(
     return dataclasses.replace(analysis, skipped=tuple(left_out))
 
 
-def _check_options(*, n_peaks: object, window: object, span: object, span_time: object) -> None:
-    """Refuse option values that would give empty or meaningless statistics."""
+def _check_options(
+    *, n_peaks: int, window: tuple[float, float], span: int, span_time: float | None
+) -> None:
+    """Refuse option values that would give empty or meaningless statistics.
+
+    The types are the ones `analyze_trials` declares; the checks are for callers that do not
+    type-check (the command line converts its strings, a script may pass anything).
+    """
     if not isinstance(n_peaks, numbers.Integral) or n_peaks < 1:
         raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
     if not isinstance(span, numbers.Integral) or span < 1:

@@ -213,7 +213,7 @@ def analyze_vibration_group(
     *,
     markers: Sequence[str] = DEFAULT_MARKERS,
     window: tuple[float, float] = (0.4e-3, 4.0e-3),
-) -> TrialsAnalysis:
+) -> TrialsAnalysis[VibrationResult]:
     """Analyse vibration tests, with the statistics over all tests and over the session means.
 
     Parameters
@@ -240,9 +240,8 @@ def _analyze_trial(
     return analyze_vibration(trial, marker=markers[2], window=window)
 
 
-def _combine(results: Sequence[VibrationResult], **_: object) -> TrialsAnalysis:
+def _combine(results: Sequence[VibrationResult], **_: object) -> TrialsAnalysis[VibrationResult]:
     """Statistics over all tests and over the session means."""
-    results = tuple(results)
     eps = np.array([r.fit.damping_ratio for r in results])
     per = np.array([r.fit.period for r in results])
     sessions = []
@@ -255,10 +254,12 @@ def _combine(results: Sequence[VibrationResult], **_: object) -> TrialsAnalysis:
         "session_damping_ratio": summarize([s[2] for s in sessions]),
         "session_period": summarize([s[3] for s in sessions]),
     }
-    return TrialsAnalysis(kind=KIND, results=results, summaries=summaries, sessions=tuple(sessions))
+    return TrialsAnalysis(
+        kind=KIND, results=tuple(results), summaries=summaries, sessions=tuple(sessions)
+    )
 
 
-def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
+def _table_rows(analysis: TrialsAnalysis[VibrationResult]) -> list[list[str]]:
     rows = []
     units = {"damping_ratio": ("%", 100.0), "period": ("s", 1.0)}
     for key, s in analysis.summaries.items():
@@ -267,8 +268,8 @@ def _table_rows(analysis: TrialsAnalysis) -> list[list[str]]:
     return rows
 
 
-def _summary(analysis: TrialsAnalysis) -> dict:
-    out = {k: summary_json(v) for k, v in analysis.summaries.items()}
+def _summary(analysis: TrialsAnalysis[VibrationResult]) -> dict[str, object]:
+    out: dict[str, object] = {k: summary_json(v) for k, v in analysis.summaries.items()}
     out["sessions"] = [
         {"session": s, "n_trials": n, "damping_ratio": e, "period": p}
         for s, n, e, p in analysis.sessions
@@ -288,7 +289,9 @@ def _summary(analysis: TrialsAnalysis) -> dict:
     return out
 
 
-def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[Path]:
+def _write_files(
+    analysis: TrialsAnalysis[VibrationResult], folder: Path, figures: bool
+) -> list[Path]:
     rows = [
         [
             r.name,
@@ -346,6 +349,7 @@ def _write_files(analysis: TrialsAnalysis, folder: Path, figures: bool) -> list[
 
 PROTOCOL = Protocol(
     kind=KIND,
+    result_type=VibrationResult,
     analyze_trial=_analyze_trial,
     combine=_combine,
     options=("window",),

@@ -16,6 +16,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["Summary", "summarize"]
 
@@ -40,7 +41,7 @@ class Summary:
     count: int | np.ndarray
 
 
-def summarize(values: np.ndarray, axis: int | None = None) -> Summary:
+def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
     """Summarise values across trials.
 
     Parameters
