@@ -33,3 +33,24 @@ def test_unknown_kind_raises():
 
 def test_each_kind_is_looked_up_in_its_own_protocol():
     assert [protocol_for(kind).kind for kind in KINDS] == list(KINDS)
+
+
+def test_report_refuses_an_analysis_whose_results_are_of_another_kind():
+    import dataclasses
+
+    from tapespring.report import format_summary, summary_dict
+
+    trial = make_vibration_trial(0.005, seed=0)
+    analysis = analyze_trials([trial], "vibration")
+    relabelled = dataclasses.replace(analysis, kind="quasi-static")
+    with pytest.raises(TypeError, match="holds PullTestResult results, but result 0 is a Vib"):
+        format_summary(relabelled)
+    with pytest.raises(TypeError, match="holds PullTestResult results"):
+        summary_dict(relabelled)
+
+
+def test_protocol_narrow_refuses_another_kind():
+    analysis = analyze_trials([make_vibration_trial(0.005, seed=0)], "vibration")
+    with pytest.raises(ValueError, match="expected a 'deployment' analysis, got a 'vibration'"):
+        protocol_for("deployment").narrow(analysis)
+    assert protocol_for("vibration").narrow(analysis) is analysis
