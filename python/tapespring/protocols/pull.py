@@ -27,7 +27,7 @@ import numpy as np
 
 from tapespring import plot
 from tapespring.report import save_figure, summary_json, summary_row, write_table
-from tapespring.signals.pull import PullTest, analyze_pull_test
+from tapespring.signals.pull import PullTest, analyze_pull_test, check_span
 from tapespring.signals.smoothing import noise_std, smooth, span_samples
 from tapespring.signals.stats import summarize
 from tapespring.trials.trial import Trial, TrialError
@@ -140,10 +140,11 @@ def analyze_pull_trial(
         raise TrialError(trial.metadata.label, "the vertical force has NaN samples")
     f = fz - np.median(fz[fp.time < fp.time[0] + tare])
     try:
-        # As recorded, to find the pulling direction; analyze_pull_test checks the span.
-        fs = analyze_pull_test(d, f, span=span).force_smoothed
+        check_span(span, f.size)
     except ValueError as exc:
         raise TrialError(trial.metadata.label, f"{exc} (force plate at {fp.rate:g} Hz)") from None
+    # As recorded, to find the pulling direction.
+    fs = smooth(f, span)
     f_sign = np.sign(fs[np.argmax(np.abs(fs))]) or 1.0
     d_sign = np.sign(d[np.argmax(np.abs(d))]) or 1.0
     _check_pull_record(trial, marker, d_sign * z, f_sign * f, f_sign * fs)

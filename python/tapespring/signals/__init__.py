@@ -52,6 +52,7 @@ __all__ = [
     "Summary",
     "analyze_pull_test",
     "bending_angle",
+    "check_span",
     "compare_peaks",
     "complete_windows",
     "detect_phases",
@@ -72,6 +73,7 @@ __all__ = [
     "smooth",
     "span_samples",
     "summarize",
+    "swing_midline",
     "to_frame",
 ]
 
@@ -84,7 +86,7 @@ __getattr__, __dir__ = lazy_exports(
         "crossings": ["CrossingPeaks", "force_at_crossings"],
         "damping": ["DampingFit", "fit_damping", "select_window_peaks"],
         "frame": ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"],
-        "levels": ["equilibrium_value", "release_index"],
+        "levels": ["equilibrium_value", "release_index", "swing_midline"],
         "peaks": [
             "Extrema",
             "PeakComparison",
@@ -95,7 +97,7 @@ __getattr__, __dir__ = lazy_exports(
             "peak_statistics",
         ],
         "phases": ["Phases", "detect_phases"],
-        "pull": ["PullTest", "analyze_pull_test"],
+        "pull": ["PullTest", "analyze_pull_test", "check_span"],
         "smoothing": [
             "complete_windows",
             "effective_span",

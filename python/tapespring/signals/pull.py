@@ -16,7 +16,7 @@ import numpy as np
 
 from .smoothing import effective_span, smooth
 
-__all__ = ["PullTest", "analyze_pull_test"]
+__all__ = ["PullTest", "analyze_pull_test", "check_span"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,18 @@ class PullTest:
     displacement_at_max: float
     index_at_max: int
     buckled: bool
+
+
+def check_span(span: int, n: int) -> None:
+    """Raise ValueError unless the smoothing span `span` [samples] fits in a force record of `n`
+    samples: `smooth` would shrink a longer window to the whole record, and the maximum would be
+    a mean over it, not the smoothed peak."""
+    if span > n:
+        raise ValueError(
+            f"the smoothing span ({span} samples) is longer than the force record ({n} "
+            "samples): the window would shrink to the whole record and the maximum would be a "
+            "mean over it, not the smoothed peak; give a span of at most the record's length"
+        )
 
 
 def analyze_pull_test(
@@ -95,12 +107,7 @@ def analyze_pull_test(
         )
     if not 0 < drop_fraction < 1:
         raise ValueError(f"drop_fraction must satisfy 0 < drop_fraction < 1, got {drop_fraction}")
-    if span > f.size:
-        raise ValueError(
-            f"the smoothing span ({span} samples) is longer than the force record ({f.size} "
-            "samples): the window would shrink to the whole record and the maximum would be a "
-            "mean over it, not the smoothed peak; give a span of at most the record's length"
-        )
+    check_span(span, f.size)
     fs = smooth(f, span)
     if not np.any(np.isfinite(fs)):
         raise ValueError("the force record has no finite sample")
