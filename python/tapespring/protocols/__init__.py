@@ -18,7 +18,23 @@ pull
 The names below are imported on first use, so listing `KINDS` imports no protocol.
 """
 
+from typing import TYPE_CHECKING
+
 from tapespring._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    # What the lazy __getattr__ below returns, for the type checker (not imported at run time):
+    # without them every name is an `object` to mypy, and `analyze_trials` loses its overloads.
+    from .deployment import (
+        DeploymentGroup,
+        DeploymentResult,
+        analyze_deployment,
+        analyze_deployment_group,
+    )
+    from .markers import DEFAULT_MARKERS
+    from .pull import PullTestResult, analyze_pull_group, analyze_pull_trial
+    from .registry import KINDS, Protocol, TrialsAnalysis, analyze_trials, protocol_for
+    from .vibration import VibrationResult, analyze_vibration, analyze_vibration_group
 
 __all__ = [
     "DEFAULT_MARKERS",

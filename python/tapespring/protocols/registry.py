@@ -190,6 +190,67 @@ def protocol_for(kind: str) -> Protocol[Any]:
     return protocol
 
 
+# The overloads differ in the kind and the type of its results only (as `protocol_for`'s).
+@overload
+def analyze_trials(
+    trials: Sequence[Trial],
+    kind: Literal["deployment"],
+    *,
+    markers: Sequence[str] = ...,
+    n_peaks: int = ...,
+    window: tuple[float, float] = ...,
+    span: int = ...,
+    span_time: float | None = ...,
+    frame: str | np.ndarray | None = ...,
+    progress: bool = ...,
+    skip_bad: bool = ...,
+    skipped: Sequence[SkippedTrial] = ...,
+) -> TrialsAnalysis[DeploymentResult]: ...
+@overload
+def analyze_trials(
+    trials: Sequence[Trial],
+    kind: Literal["vibration"],
+    *,
+    markers: Sequence[str] = ...,
+    n_peaks: int = ...,
+    window: tuple[float, float] = ...,
+    span: int = ...,
+    span_time: float | None = ...,
+    frame: str | np.ndarray | None = ...,
+    progress: bool = ...,
+    skip_bad: bool = ...,
+    skipped: Sequence[SkippedTrial] = ...,
+) -> TrialsAnalysis[VibrationResult]: ...
+@overload
+def analyze_trials(
+    trials: Sequence[Trial],
+    kind: Literal["quasi-static"],
+    *,
+    markers: Sequence[str] = ...,
+    n_peaks: int = ...,
+    window: tuple[float, float] = ...,
+    span: int = ...,
+    span_time: float | None = ...,
+    frame: str | np.ndarray | None = ...,
+    progress: bool = ...,
+    skip_bad: bool = ...,
+    skipped: Sequence[SkippedTrial] = ...,
+) -> TrialsAnalysis[PullTestResult]: ...
+@overload
+def analyze_trials(
+    trials: Sequence[Trial],
+    kind: str,
+    *,
+    markers: Sequence[str] = ...,
+    n_peaks: int = ...,
+    window: tuple[float, float] = ...,
+    span: int = ...,
+    span_time: float | None = ...,
+    frame: str | np.ndarray | None = ...,
+    progress: bool = ...,
+    skip_bad: bool = ...,
+    skipped: Sequence[SkippedTrial] = ...,
+) -> TrialsAnalysis[Any]: ...
 def analyze_trials(
     trials: Sequence[Trial],
     kind: str,
@@ -203,7 +264,7 @@ def analyze_trials(
     progress: bool = False,
     skip_bad: bool = False,
     skipped: Sequence[SkippedTrial] = (),
-) -> TrialsAnalysis:
+) -> TrialsAnalysis[Any]:
     """Analyse trials of one kind and compute the statistics across them.
 
     Parameters
@@ -237,6 +298,9 @@ def analyze_trials(
     Returns
     -------
     TrialsAnalysis
+        Typed with the kind's results for a literal kind (``TrialsAnalysis[DeploymentResult]``
+        for ``"deployment"``, etc.); ``TrialsAnalysis[Any]`` for a kind known only as a str
+        (narrow it with ``protocol_for(kind).narrow``).
 
     Raises
     ------

@@ -24,7 +24,26 @@ simulated
 The names below are imported on first use.
 """
 
+from typing import TYPE_CHECKING
+
 from tapespring._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    # What the lazy __getattr__ below returns, for the type checker (not imported at run time).
+    from .c3d import read_c3d, write_c3d
+    from .csv import FORCES_SUFFIX, read_csv, write_csv
+    from .load import (
+        METADATA_FILE,
+        SkippedTrial,
+        TrialSet,
+        find_trial_files,
+        load_trial_set,
+        load_trials,
+        read_metadata_file,
+        read_trial,
+    )
+    from .simulated import results_to_trial
+    from .trial import SENSES, ForcePlate, Gap, Metadata, Trial, TrialError, TrialWarning
 
 __all__ = [
     "FORCES_SUFFIX",
