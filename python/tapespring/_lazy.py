@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
 
 __all__ = ["lazy_exports"]
@@ -36,12 +37,25 @@ def lazy_exports(
     Raises
     ------
     ValueError
-        If ``names`` and the names of ``modules`` differ (the two lists have drifted apart).
+        If a name is exported twice (by two modules of ``modules``, where the later one would
+        win silently, or twice by one) or listed twice in ``names``, or if ``names`` and the
+        names of ``modules`` differ (the two lists have drifted apart).
     """
-    where = {name: module for module, defined in modules.items() for name in defined}
-    if set(where) != set(names):
+    where: dict[str, str] = {}
+    for module, defined in modules.items():
+        for name in defined:
+            if name in where:
+                first, second = f"{package}.{where[name]}", f"{package}.{module}"
+                by = f"{first} twice" if first == second else f"both {first} and {second}"
+                raise ValueError(f"{package}: {name!r} is exported by {by}")
+            where[name] = module
+    counts = Counter(names)
+    twice = sorted(name for name, count in counts.items() if count > 1)
+    if twice:
+        raise ValueError(f"{package}: __all__ lists {twice} more than once")
+    if set(where) != set(counts):
         raise ValueError(
-            f"{package}: __all__ and the lazy exports differ by {sorted(set(where) ^ set(names))}"
+            f"{package}: __all__ and the lazy exports differ by {sorted(set(where) ^ set(counts))}"
         )
 
     def __getattr__(name: str) -> object:
