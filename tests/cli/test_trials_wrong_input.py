@@ -10,6 +10,7 @@
 
 import json
 
+from _cli import refused
 from tapespring.cli import main
 from tapespring.trials import write_csv
 from tapespring.trials.samples import make_deployment_trial
@@ -26,7 +27,8 @@ def _analyze(tmp_path, path, *options):
 
 
 def _one_error(err, path):
-    """The run's stderr: one 'error:' line naming the file, no numpy warning, no traceback."""
+    """The run's stderr (or `refused`'s line): one 'error:' line naming the file, no numpy
+    warning, no traceback. An analysis that fails exits 1: that is no refusal for `refused`."""
     assert err.startswith(f"error: {path}: ") and len(err.splitlines()) == 1, err
     assert "RuntimeWarning" not in err and "invalid value" not in err and "Traceback" not in err
     return err
@@ -38,9 +40,8 @@ def test_a_deployment_is_not_analysed_as_a_pull_test(tmp_path, capsys):
     err = _one_error(capsys.readouterr().err, path)
     assert "not a pull test: the pulled marker 'M2' covers the middle" in err
     # The pull command refuses it before it simulates anything.
-    assert main(["pull", "--no-progress", f"--experiment={path}"]) == 2
-    err = _one_error(capsys.readouterr().err, path)
-    assert "not a pull test" in err
+    line = refused(["pull", "--no-progress", f"--experiment={path}"], capsys, by_parser=False)
+    assert "not a pull test" in _one_error(line, path)
 
 
 def test_a_deployment_is_not_analysed_as_a_free_decay(tmp_path, capsys):
@@ -48,8 +49,8 @@ def test_a_deployment_is_not_analysed_as_a_free_decay(tmp_path, capsys):
     assert _analyze(tmp_path, path, "--kind", "vibration") == 1
     err = _one_error(capsys.readouterr().err, path)
     assert "not a free decay: its half-cycles after the release last from" in err
-    assert main(["vibrate", "--no-progress", f"--experiment={path}"]) == 2
-    assert "not a free decay" in _one_error(capsys.readouterr().err, path)
+    line = refused(["vibrate", "--no-progress", f"--experiment={path}"], capsys, by_parser=False)
+    assert "not a free decay" in _one_error(line, path)
 
 
 def test_an_absurd_coordinate_is_named_with_its_column_and_line(tmp_path, capsys):
