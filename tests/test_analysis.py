@@ -245,6 +245,15 @@ def test_convergence_error_names_the_step_and_keeps_the_results():
     assert info.value.result.n_records == 1 and not info.value.result.completed
 
 
+def test_a_convergence_error_without_results_has_result_none():
+    # The class is the native one; every instance, also one the solver raises itself, has
+    # `result` (None by default): `exc.result` was an AttributeError there.
+    from tapespring import _core
+
+    assert ConvergenceError is _core.ConvergenceError
+    assert ConvergenceError("stopped").result is None
+
+
 def test_progress_sees_step_name_and_time_and_can_stop():
     model, tip = strip()
     model.add_load(tip, "uz", 1.0)

@@ -82,9 +82,15 @@ def test_summary_carries_the_figures_and_the_settings(study: NumericalDampingStu
 
 
 @pytest.mark.parametrize(
-    ("rho", "message"), [((), "at least one"), ((0.7, 1.5), "rho_inf must lie in")]
+    ("rho", "message"),
+    [
+        ((), "at least one"),
+        ((0.7, 1.5), "rho_inf must lie in"),
+        # One number was a TypeError from len() ("object of type 'float' has no len()").
+        (0.7, r"rho_inf must be a sequence of spectral radii \(got 0.7"),
+    ],
 )
-def test_bad_spectral_radii_are_named(rho: tuple[float, ...], message: str) -> None:
+def test_bad_spectral_radii_are_named(rho, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         numerical_damping_study(SETTINGS, rho)
 

@@ -101,11 +101,29 @@ def test_equal_sense_turns_gravity_and_markers_over() -> None:
         ({"setup_length": 0.12}, "appendix"),
         ({"eta": -1e-4}, "eta"),
         ({"tape": replace(PAPER_SETUP.tape, thickness=0.0)}, "thickness"),
+        # One bound for every scenario's gravity (setup.MAX_GRAVITY); 1e300 was accepted.
+        ({"gravity": 1e300}, r"gravity must be at most 100 m/s\^2 \(got 1e\+300; see"),
+        ({"gravity": 0.0}, r"gravity must be > 0"),
     ],
 )
 def test_bad_spec_is_named(change: dict, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         build_setup(replace(PAPER_SETUP, **change))
+
+
+def test_gravity_up_to_the_bound_is_accepted() -> None:
+    from tapespring.scenarios.setup import MAX_GRAVITY
+
+    replace(PAPER_SETUP, gravity=MAX_GRAVITY).validate()
+
+
+def test_the_bare_configuration_has_no_tip_node() -> None:
+    built = build_setup(COARSE, configuration="bare")
+    assert built.tip is None
+    with pytest.raises(ValueError, match="the bare configuration has no tip node"):
+        _ = built.tip_node
+    weight = build_setup(COARSE, configuration="weight")
+    assert weight.tip_node == weight.tip
 
 
 def test_unknown_configuration_or_sense_is_refused() -> None:

@@ -460,23 +460,25 @@ def bend(
     model, _, driven = bending_model(setup)
     theta_max = math.radians(setup.theta_max_deg)
     bar = None
+    # What `run` calls after each converged state (its ProgressCallback), if anything.
+    callback: Callable[[int, str, float], bool | None] | None = None
     if progress is True:
         from tqdm import tqdm
 
         bar = tqdm(unit=" states", file=sys.stderr, desc="bending", leave=False)
 
-        def callback(_step: int, _name: str, t: float) -> None:
+        def show(_step: int, _name: str, t: float) -> None:
             bar.update(1)
             bar.set_postfix_str(f"theta = {math.degrees(t * theta_max):7.2f} deg", refresh=False)
 
+        callback = show
     elif callable(progress):
         user = progress
 
-        def callback(_step: int, _name: str, t: float) -> bool | None:
+        def forward(_step: int, _name: str, t: float) -> bool | None:
             return user(t * theta_max)
 
-    else:
-        callback = None  # type: ignore[assignment]
+        callback = forward
     try:
         results = run(
             model,

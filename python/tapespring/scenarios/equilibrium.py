@@ -173,7 +173,7 @@ def equilibrium(
     settings.validate()
     start = time.perf_counter()
     built = build_setup(settings.spec, configuration="weight", sense="opposite")
-    model, tip = built.model, built.tip
+    model, tip = built.model, built.tip_node
     drive(model, tip, "uz", built.down * settings.push, "push")
     steps = [gravity_step(), buckling_step("push", activate=("push",))]
     outputs = Outputs(reactions=((tip, "uz"),))

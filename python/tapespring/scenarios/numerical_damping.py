@@ -17,6 +17,7 @@ are then predictions, not fits.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
@@ -118,7 +119,7 @@ class NumericalDampingStudy:
 
 def numerical_damping_study(
     settings: VibrationSettings | None = None,
-    rho_inf: tuple[float, ...] = DEFAULT_RHO_INF,
+    rho_inf: Sequence[float] = DEFAULT_RHO_INF,
     *,
     progress: bool = False,
 ) -> NumericalDampingStudy:
@@ -132,30 +133,38 @@ def numerical_damping_study(
     Raises
     ------
     ValueError
-        For bad settings or an empty `rho_inf`.
+        For bad settings, or a `rho_inf` that is empty or not a sequence (one number).
+    tapespring.analysis.ConvergenceError
+        If a run stops with nothing recorded to keep (its ``result`` is None).
 
     A run that stops early keeps the decay it computed (fitted if it can be); its error is in
     ``summary()["errors"]``.
     """
     if settings is None:
         settings = VibrationSettings(time_step=5e-3)
-    if len(rho_inf) == 0:
+    rho = np.asarray(rho_inf, dtype=float)
+    if rho.ndim != 1:
+        raise ValueError(
+            f"rho_inf must be a sequence of spectral radii (got {rho_inf!r}; one value is (value,))"
+        )
+    if rho.size == 0:
         raise ValueError("rho_inf must hold at least one spectral radius")
-    for rho in rho_inf:
-        replace(settings, rho_inf=float(rho)).validate()
+    for value in rho:
+        replace(settings, rho_inf=float(value)).validate()
     from tapespring.analysis import ConvergenceError
 
     start = time.perf_counter()
-    done = []
-    for value in rho_inf:
+    done: list[VibrationSimulation] = []
+    for value in rho:
         try:
             done.append(vibrate(replace(settings, rho_inf=float(value)), progress=progress))
         except ConvergenceError as exc:
             # The decay up to where the run stopped is kept (and fitted if it can be); the
-            # summary names the error.
-            done.append(exc.result)  # type: ignore[attr-defined]
+            # summary names the error. A stop before the decay (no result) ends the study.
+            if exc.result is None:
+                raise
+            done.append(exc.result)
     runs = tuple(done)
-    rho = np.asarray(rho_inf, dtype=float)
     nan = float("nan")
     eps = np.array([nan if r.fit is None else r.fit.damping_ratio for r in runs])
     period = np.array([nan if r.fit is None else r.fit.period for r in runs])

@@ -290,6 +290,6 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         err = ConvergenceError(
             f"{results.error} (the release recorded so far is kept in the 'result' attribute)"
         )
-        err.result = out  # type: ignore[attr-defined]
+        err.result = out
         raise err
     return out

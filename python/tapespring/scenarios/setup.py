@@ -329,7 +329,7 @@ class SetupSpec:
         Height of markers 1-3 above the plane of the tapes' mid-lines, on the laboratory's upper
         side [m].
     gravity : float
-        Gravitational acceleration [m/s^2].
+        Gravitational acceleration [m/s^2], in (0, :data:`MAX_GRAVITY`].
     initial_angle_opposite_deg, initial_angle_equal_deg : float
         Initial bending angles of the deployment tests [deg] (Sec. 4.1).
     fold_rate : float
@@ -469,6 +469,11 @@ class SetupSpec:
             )
         for value in self.support_marker:
             check_number("support_marker", value, positive=False)
+        if self.gravity > MAX_GRAVITY:
+            raise ValueError(
+                f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {self.gravity:.3g}; see "
+                "setup.MAX_GRAVITY)"
+            )
         if self.eta < 0.0:
             raise ValueError(f"eta must be >= 0 s (got {self.eta})")
         if not -1.0 < self.plate_poisson < 0.5:
@@ -558,8 +563,9 @@ def check_element_count(name: str, size: float, length: float, width: float) -> 
 #: times Jupiter's 24.8 (the largest surface gravity of a planet); beyond, a typing error,
 #: refused before the run. Its uses: the upper end of the max-mass study's range
 #: (``max_mass.GRAVITY_RANGE``, where m_max, inversely proportional to g, would otherwise be
-#: printed in micrograms) and the bound on the magnitude of the release's gravity, of either
-#: sign (``release.ReleaseSetup``: 1e300 ran into a non-finite tangent after the fold).
+#: printed in micrograms), the bound on the magnitude of the release's gravity, of either
+#: sign (``release.ReleaseSetup``: 1e300 ran into a non-finite tangent after the fold), and
+#: the upper bound of the set-up's (``SetupSpec.gravity``, which had none).
 MAX_GRAVITY = 100.0
 
 #: Smallest displacement the set-up's static scenarios prescribe [m] (the pull's
@@ -628,7 +634,8 @@ class SetupModel:
     rod_middle : int
         The rod's middle node (marker 2, where the fold and the pull are driven).
     tip : int or None
-        The node carrying marker 3: the appendix's tip node or the weight's reference node.
+        The node carrying marker 3: the appendix's tip node or the weight's reference node;
+        None in the bare configuration (see `tip_node`).
     down : float
         Sign of "downwards" along z in this frame: -1 in opposite sense, +1 in equal sense.
     flexible_support : FlexibleSupport or None
@@ -655,6 +662,22 @@ class SetupModel:
     tip: int | None
     down: float
     flexible_support: FlexibleSupport | None = None
+
+    @property
+    def tip_node(self) -> int:
+        """`tip`, for the scenarios that drive or read it (weight or appendix configuration).
+
+        Raises
+        ------
+        ValueError
+            In the bare configuration, which has no tip node (no marker 3).
+        """
+        if self.tip is None:
+            raise ValueError(
+                f"the {self.configuration} configuration has no tip node (marker 3): the "
+                "scenario needs the appendix or the weight"
+            )
+        return self.tip
 
     @property
     def gravity_vector(self) -> tuple[float, float, float]:
@@ -1006,10 +1029,10 @@ def build_setup(
     up = -down * spec.marker_height
     model.add_marker("marker1", interfaces[0], offset=[0.0, 0.0, up - zc])
     model.add_marker("marker2", rod_middle, offset=[0.0, 0.0, up])
-    if configuration == "appendix":
-        model.add_marker("marker3", tip, offset=[0.0, 0.0, up])
-    elif configuration == "weight":
-        model.add_marker("marker3", tip, offset=[spec.weight_length, 0.0, up])
+    if tip is not None:
+        # On the appendix's tip node, or on the weight's far end beyond its reference node.
+        dx = spec.weight_length if configuration == "weight" else 0.0
+        model.add_marker("marker3", tip, offset=[dx, 0.0, up])
     return SetupModel(
         model=model,
         spec=spec,
@@ -1150,5 +1173,5 @@ def raise_if_stopped(results: Any, result: Any, what: str) -> None:
 
     if results.error is not None:
         err = ConvergenceError(f"{results.error} (the {what} so far is in the 'result' attribute)")
-        err.result = result  # type: ignore[attr-defined]
+        err.result = result
         raise err

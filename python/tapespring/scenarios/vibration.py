@@ -417,7 +417,7 @@ def _push_per_marker_displacement(built: Any) -> float:
 
     model = copy.deepcopy(built.model)
     probe = 1e-3
-    drive(model, built.tip, "uz", built.down * probe, "probe")
+    drive(model, built.tip_node, "uz", built.down * probe, "probe")
     results = run(
         model,
         [gravity_step(), Step.static("probe", activate=["probe"], increments=1, lambda_end=2.0)],
@@ -448,7 +448,7 @@ def vibrate(
     settings.validate()
     start = time.perf_counter()
     built = build_setup(settings.spec, configuration="weight", sense="opposite")
-    model, tip = built.model, built.tip
+    model, tip = built.model, built.tip_node
     push = settings.initial_displacement * _push_per_marker_displacement(built)
     drive(model, tip, "uz", built.down * push, "push")
     options = dynamic_options(settings.rho_inf, settings.sample_rate, settings.tolerance)
