@@ -16,6 +16,8 @@ from tapespring.cli import build_parser, main
 from tapespring.scenarios.bending import BendingSetup
 from tapespring.scenarios.deployment import DeploymentSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
+from tapespring.scenarios.release import ReleaseSetup
+from tapespring.scenarios.setup import PAPER_SETUP, PAPER_TAPE
 from tapespring.scenarios.vibration import VibrationSettings
 
 
@@ -102,6 +104,24 @@ def test_absurd_values_are_refused_by_the_parser_in_short_numbers(argv, message,
         (["max-mass", "--gravity", "-1"], MaxMassSettings(gravity=-1.0)),
         (["max-mass", "--lever-arm", "20"], MaxMassSettings(lever_arm=20.0)),
         (["max-mass", "--angle", "200"], MaxMassSettings(angle_deg=200.0)),
+        # The "> 0" of numbers the settings check with setup.check_number (the parser said
+        # "tolerance must be finite and >= 0 (got -1)", validate() "tolerance must be >= 0").
+        (["release", "--tolerance", "-1"], ReleaseSetup(tolerance=-1.0)),
+        (["release", "--eta", "nan"], ReleaseSetup(eta=float("nan"))),
+        (["release", "--duration", "0"], ReleaseSetup(duration=0.0)),
+        (["release", "--tip-mass", "0"], ReleaseSetup(tip_mass=0.0)),
+        (["release", "--tip-inertia", "-1"], ReleaseSetup(tip_inertia=-1.0)),
+        (["vibrate", "--tolerance", "-1"], VibrationSettings(tolerance=-1.0)),
+        (["vibrate", "--duration", "0"], VibrationSettings(duration=0.0)),
+        (["vibrate", "--initial-displacement", "-1"], VibrationSettings(initial_displacement=-1.0)),
+        (["deploy", "--tolerance", "inf"], DeploymentSettings(tolerance=float("inf"))),
+        (["deploy", "--duration", "0"], DeploymentSettings(duration=0.0)),
+        (["pull", "--mesh-tape", "0"], dataclasses.replace(PAPER_SETUP, mesh_tape=0.0)),
+        (["vibrate", "--mesh-plates", "-1"], dataclasses.replace(PAPER_SETUP, mesh_plates=-1.0)),
+        (
+            ["equilibrium", "--thickness", "0"],
+            dataclasses.replace(PAPER_SETUP, tape=dataclasses.replace(PAPER_TAPE, thickness=0.0)),
+        ),
     ],
 )
 def test_the_parser_refuses_a_bound_with_the_settings_own_message(argv, settings, capsys):

@@ -58,11 +58,23 @@ def _checked(name: str, check: Callable[[float], None]):
     return parse
 
 
+def _field(name: str, *, zero: bool = False):
+    """An argparse type: a value of the settings' field `name`, a finite number > 0 (>= 0 with
+    `zero`), checked by the settings' own `check_number` (refused with validate()'s message)."""
+    from functools import partial
+
+    from tapespring.scenarios.setup import check_number
+
+    return _checked(name, partial(check_number, name, positive=True, zero=zero))
+
+
 def refuse(args: argparse.Namespace, message: str) -> NoReturn:
     """Stop as argparse does for a bad combination of options: usage and ``error: message`` on
     stderr, exit code 2 (SystemExit). `args` comes from a parser whose defaults hold its own
     command's parser (``set_defaults(parser=p)``)."""
-    args.parser.error(message)
+    # A Namespace's attributes are Any; the annotation gives `error` its NoReturn.
+    parser: argparse.ArgumentParser = args.parser
+    parser.error(message)
 
 
 def warn(message: str) -> None:
@@ -297,13 +309,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from tapespring.plot.bending import plot_bending
+        from tapespring.report import save_figure
 
-        ax = plot_bending(result)
-        ax.figure.savefig(args.plot, dpi=150)
-        plt.close(ax.figure)
+        save_figure(plot_bending(result).figure, args.plot)
     if args.json:
         out = {
             "theta_deg": result.theta_deg.tolist(),

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from .bend import _checked, _count, _image_file, _input_file, _output_file, _positive, refuse
+from .bend import (
+    _checked,
+    _count,
+    _field,
+    _image_file,
+    _input_file,
+    _output_file,
+    refuse,
+)
 from .scenario_options import (
     add_output_options,
     add_spec_options,
@@ -74,14 +82,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--duration",
-        type=_positive("duration"),
+        type=_field("duration"),
         default=DEFAULT_DURATION,
         help=f"motion after the release [s] (default {DEFAULT_DURATION}; paper: 10)",
     )
     p.add_argument("--rho-inf", type=float, default=d.rho_inf, help="spectral radius, in [0, 1]")
     p.add_argument(
         "--tolerance",
-        type=_positive("tolerance", zero=True),
+        type=_field("tolerance", zero=True),
         default=d.tolerance,
         help="local error tolerance of the time steps [m] (0: the solver's default)",
     )

@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from .bend import _image_file, _output_file, _positive, add_tape_options, tape_fields
+from .bend import _field, _image_file, _output_file, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
 
@@ -52,23 +52,21 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=d.fold_deg,
         help="fold angle [deg], positive opposite sense, negative equal sense (default 60)",
     )
-    p.add_argument(
-        "--tip-mass", type=_positive("tip mass", zero=True), default=d.tip_mass, help="m [kg]"
-    )
+    p.add_argument("--tip-mass", type=_field("tip_mass"), default=d.tip_mass, help="m [kg]")
     p.add_argument(
         "--tip-inertia",
-        type=_positive("tip inertia", zero=True),
+        type=_field("tip_inertia"),
         default=d.tip_inertia,
         help="moment of inertia of the tip body about each axis [kg m^2]",
     )
     p.add_argument(
         "--duration",
-        type=_positive("duration"),
+        type=_field("duration"),
         default=d.duration,
         help="free motion after the release [s]",
     )
     p.add_argument(
-        "--eta", type=_positive("eta", zero=True), default=d.eta, help="Kelvin-Voigt eta [s]"
+        "--eta", type=_field("eta", zero=True), default=d.eta, help="Kelvin-Voigt eta [s]"
     )
     p.add_argument(
         "--rho-inf", type=float, default=d.rho_inf, help="spectral radius at infinity, in [0, 1]"
@@ -83,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_positive("tolerance", zero=True),
+        type=_field("tolerance", zero=True),
         default=d.tolerance,
         help="local error tolerance of the time steps [m] (0: the solver's default)",
     )

@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .bend import _checked, _image_file, _input_file, _output_file, _positive
+from .bend import _checked, _field, _image_file, _input_file, _output_file, _positive
 
 __all__ = [
     "add_comparison_options",
@@ -36,18 +36,18 @@ def add_spec_options(
     g = p.add_argument_group("set-up (paper's values and this project's choices by default)")
     g.add_argument(
         "--mesh-tape",
-        type=_positive("mesh size"),
+        type=_field("mesh_tape"),
         default=mesh_tape,
         help=f"element size of the tapes [m] (paper: 2e-3; default {mesh_tape:g})",
     )
     g.add_argument(
         "--mesh-plates",
-        type=_positive("mesh size"),
+        type=_field("mesh_plates"),
         default=mesh_plates,
         help=f"element size of the rod and appendix [m] (paper: 3e-3; default {mesh_plates:g})",
     )
     g.add_argument(
-        "--thickness", type=_positive("thickness"), default=s.tape.thickness, help="t [m]"
+        "--thickness", type=_field("tape.thickness"), default=s.tape.thickness, help="t [m]"
     )
     g.add_argument(
         "--youngs-modulus",
@@ -109,14 +109,14 @@ def finish(
     except ConvergenceError as exc:
         # The scenario's partial result, if the run got that far (a failure in an earlier step
         # carries the raw analysis results, which have no summary).
-        result = getattr(exc, "result", None)
+        result = exc.result
         if result is None or not hasattr(result, "describe"):
             print(f"error: {exc}", file=sys.stderr)
             return 1
         failure = str(exc)
     if args.csv:
         table = columns(result)
-        write_table(Path(args.csv), list(table), zip(*table.values(), strict=True))
+        write_table(Path(args.csv), list(table), list(zip(*table.values(), strict=True)))
     if args.plot:
         import matplotlib
 

@@ -6,7 +6,7 @@ import argparse
 import functools
 from typing import Any
 
-from .bend import _checked, _positive, refuse
+from .bend import _checked, _field, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -58,12 +58,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "--rho-inf-study runs it once per spectral radius (Fig. 26)."
         ),
     )
-    p.add_argument(
-        "--duration", type=_positive("duration"), default=d.duration, help="free decay [s]"
-    )
+    p.add_argument("--duration", type=_field("duration"), default=d.duration, help="free decay [s]")
     p.add_argument(
         "--initial-displacement",
-        type=_positive("initial displacement"),
+        type=_field("initial_displacement"),
         default=d.initial_displacement,
         help="push before the release [m] (paper: about 8e-3)",
     )
@@ -82,7 +80,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_positive("tolerance", zero=True),
+        type=_field("tolerance", zero=True),
         default=None,
         help="local error tolerance of the adaptive time steps [m] (default "
         f"{d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
