@@ -410,7 +410,9 @@ def test_cli_prints_a_summary(capsys):
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        (["--thickness-range", "2e-4", "1e-4"], "--thickness-range MIN MAX must satisfy MIN < MAX"),
+        # The range's order is the settings' check (one home, validate's message).
+        (["--thickness-range", "2e-4", "1e-4"], "thicknesses must be strictly increasing"),
+        (["--modulus-range", "2e11", "2e11"], "youngs_moduli must be strictly increasing"),
         (["--plot", "x.png", "--n-modulus", "1"], "--plot draws contours and needs at least 2"),
         (["--mesh-size", "0.01"], "too coarse"),
     ],
@@ -420,6 +422,15 @@ def test_cli_bad_input_exits_2_before_any_run(extra, message, capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert re.search(message, err), err
+
+
+@pytest.mark.parametrize("values", [("1e-4", "2e-4"), ("2e-4", "1e-4")])
+def test_cli_refuses_a_range_beside_a_single_value(values, capsys):
+    """One value of t is the range's MIN: a MAX on either side of it would be ignored."""
+    argv = ["max-mass", "--n-thickness", "1", "--thickness-range", *values]
+    line = refused(argv, capsys)
+    assert "--n-thickness 1 computes one value of t, but --thickness-range gives" in line
+    assert "give that value as both MIN and MAX" in line
 
 
 @pytest.mark.parametrize(

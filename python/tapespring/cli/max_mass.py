@@ -192,16 +192,11 @@ def run(args: argparse.Namespace) -> int:
     )
     for name, symbol, given, default, n in grid:
         lo, hi = given or default
-        if hi < lo or (hi == lo and n > 1):
-            print(
-                f"error: --{name}-range MIN MAX must satisfy MIN < MAX (MIN = MAX with a single "
-                f"value; got {lo:g} {hi:g})",
-                file=sys.stderr,
-            )
-            return 2
-        # One value is the range's MIN (MaxMassSettings.grid): a different MAX given beside it
-        # would be ignored, so it is refused; of the default range the MIN is taken, and said.
-        if n == 1 and hi > lo:
+        # The order of MIN and MAX is the settings' check (validate: the grid's values strictly
+        # increasing). One value is the range's MIN (MaxMassSettings.grid): a different MAX given
+        # beside it, either side of MIN, would be ignored, so it is refused here; of the default
+        # range the MIN is taken, and said.
+        if n == 1 and hi != lo:
             if given is not None:
                 refuse(
                     args,
