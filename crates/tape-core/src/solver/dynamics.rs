@@ -378,6 +378,9 @@ struct Integrator<'a> {
     last_reference: f64,
     /// [`Self::node_blocks`].
     node_blocks: Vec<[usize; 36]>,
+    /// The last predictor's residual called for a fresh iteration matrix
+    /// ([`REUSE_PREDICTOR`]).
+    predictor_fresh: bool,
 }
 
 /// Outcome of one attempted time step.
@@ -582,8 +585,13 @@ impl Integrator<'_> {
             let reusable = self
                 .factor_h
                 .is_some_and(|fh| (fh - h).abs() <= REUSE_STEP_CHANGE * h);
-            // Whether the iteration matrix is assembled at this iterate.
-            let mut with_tangent = !reusable;
+            // Whether a fresh iteration matrix must be built at this iterate, and whether it is
+            // assembled with the residual. A predictor is assembled with it at once when the last
+            // step's predictor needed a fresh one: it usually does again (every step of a smooth
+            // motion at the samples' steps), and assembling the residual alone first would
+            // assemble that state twice.
+            let mut refresh = !reusable;
+            let mut with_tangent = refresh || (it == 0 && self.predictor_fresh);
             let (mut res, mut reference) = self.assemble(start, state, h, with_tangent, &mut r);
             log::debug!(
                 "t = {:.6e} s, step {h:.3e} s: iteration {it}, residual {res:.3e} N (reference {reference:.3e} N){}",
@@ -598,7 +606,7 @@ impl Integrator<'_> {
                 std::mem::swap(state, s0);
                 std::mem::swap(&mut self.stress, st0);
                 std::mem::swap(&mut a_new, a0);
-                with_tangent = true;
+                (refresh, with_tangent) = (true, true);
                 (res, reference) = self.assemble(start, state, h, with_tangent, &mut r);
             }
             residual = res;
@@ -642,11 +650,12 @@ impl Integrator<'_> {
             // a predictor far off the last step's equilibrium (a violent step, where corrections
             // from an outdated matrix send a thin shell's membrane strains astray).
             let slow = if it == 0 {
-                res > REUSE_PREDICTOR * self.last_reference
+                self.predictor_fresh = res > REUSE_PREDICTOR * self.last_reference;
+                self.predictor_fresh
             } else {
                 res > REUSE_CONTRACTION * previous
             };
-            let fresh = with_tangent || slow;
+            let fresh = refresh || slow;
             if fresh {
                 if !with_tangent {
                     // The same residual, now with the iteration matrix.
@@ -880,6 +889,7 @@ pub fn solve_dynamic(
         factor_h: None,
         last_reference: 0.0,
         node_blocks,
+        predictor_fresh: false,
     };
     let lc = integ.system.char_length;
     integ.inertia_round_off = f64::EPSILON
