@@ -31,7 +31,14 @@ class TapeError(Exception):
     """Base class of the errors raised by the tapespring solver."""
 
 class ConvergenceError(TapeError):
-    """The nonlinear solver did not converge (the equilibrium path stopped early)."""
+    """The nonlinear solver did not converge (the equilibrium path stopped early).
+
+    ``result`` is what was recorded before the stop: the `Results` so far when
+    ``tapespring.analysis.run`` raises it, a scenario's own partial result (its docstring says
+    which) when a scenario does; None (the class default) when the solver raises it directly.
+    """
+
+    result: Any
 
 _NodeSelection = int | str | Sequence[int] | NDArray[np.integer[Any]]
 _Node = int | np.integer[Any]

@@ -35,10 +35,10 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tapespring import _core
-from tapespring._core import Model, TapeError
+from tapespring._core import ConvergenceError, Model, TapeError
 from tapespring.modes import SystemMatrices
 from tapespring.results import Results
 
@@ -59,28 +59,6 @@ __all__ = [
     "system_matrices",
     "table",
 ]
-
-if TYPE_CHECKING:
-
-    class ConvergenceError(_core.ConvergenceError):
-        """The nonlinear solver did not converge (the equilibrium path stopped early).
-
-        Attributes
-        ----------
-        result : object or None
-            What was recorded before the stop: the `Results` so far when :func:`run` raises it,
-            a scenario's own partial result (its docstring says which) when a scenario does;
-            None (the class default) when the solver raises it directly.
-        """
-
-        result: Any
-
-else:
-    # The class is the native one (tapespring._core), whose stub knows no `result`: the
-    # declaration above types it for mypy, and the line below gives every instance, raised
-    # here or by the solver directly, the default None, so ``exc.result`` never fails.
-    ConvergenceError = _core.ConvergenceError
-    ConvergenceError.result = None
 
 #: Names of the six nodal degrees of freedom, in solver order.
 DOFS: tuple[str, ...] = tuple(_core.DOFS)

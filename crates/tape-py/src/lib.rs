@@ -28,7 +28,11 @@ mod _core {
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         let py = m.py();
         m.add("TapeError", py.get_type::<super::error::TapeError>())?;
-        m.add("ConvergenceError", py.get_type::<super::error::ConvergenceError>())?;
+        let convergence = py.get_type::<super::error::ConvergenceError>();
+        // What was recorded before the stop, set by whoever raises it with a partial result;
+        // the class default, so that `exc.result` never fails on one raised by the solver.
+        convergence.setattr("result", py.None())?;
+        m.add("ConvergenceError", convergence)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("DOFS", tape_core::Dof::NAMES.to_vec())?;
         super::logging::install(py);
