@@ -6,7 +6,10 @@ It returned a bare ``TrialsAnalysis`` (``TrialsAnalysis[Any]``) whatever the kin
 literal kind gives ``TrialsAnalysis[DeploymentResult]`` etc., a kind known only as a str
 ``TrialsAnalysis[Any]``. ``tapespring.protocols`` and ``tapespring.trials`` import their lazy names
 under TYPE_CHECKING; before, mypy saw each of them as an `object` (``analyze_trials`` was not
-callable, ``Trial`` not a type).
+callable, ``Trial`` not a type). So do ``tapespring.scenarios`` and ``tapespring.io`` (their names
+were `object`s too: ``deploy`` not callable), and the top-level package for what it re-exports
+from ``analysis`` and ``results`` (``tapespring.run`` was an `Any`, through its ``__getattr__``):
+one assertion each below.
 """
 
 import textwrap
@@ -20,8 +23,12 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # assert_type wants the exact type: an Any where a TrialsAnalysis[...] is expected is an error.
 SNIPPET = """
+from pathlib import Path
 from typing import Any, assert_type
 
+from tapespring import Model, run
+from tapespring.analysis import Model as AnalysisModel
+from tapespring.io import write_pvd
 from tapespring.protocols import (
     DeploymentResult,
     PullTestResult,
@@ -30,6 +37,9 @@ from tapespring.protocols import (
     analyze_trials,
 )
 from tapespring.protocols.registry import analyze_trials as analyze_trials_in_registry
+from tapespring.results import Results
+from tapespring.scenarios import DeploymentSettings, deploy
+from tapespring.scenarios.deployment import DeploymentSimulation
 from tapespring.trials import Trial
 
 
@@ -41,6 +51,15 @@ def check(trials: list[Trial], kind: str) -> None:
     assert_type(analyze_trials(trials, "quasi-static", span=11), TrialsAnalysis[PullTestResult])
     assert_type(analyze_trials_in_registry(trials, "vibration"), TrialsAnalysis[VibrationResult])
     assert_type(analyze_trials(trials, kind), TrialsAnalysis[Any])
+
+
+def check_lazy_names(model: AnalysisModel, results: Results) -> None:
+    # The lazy names of tapespring, tapespring.scenarios and tapespring.io (the expected types
+    # from the modules that define them: an Any on either side would pass).
+    assert_type(run(model, []), Results)
+    assert_type(Model, type[AnalysisModel])
+    assert_type(deploy(DeploymentSettings()), DeploymentSimulation)
+    assert_type(write_pvd(results, model, "series.pvd"), Path)
 """
 
 # And a literal kind's analysis is not another kind's.

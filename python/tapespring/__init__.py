@@ -36,7 +36,14 @@ Sub-modules are imported on first use, so the pure-Python parts work without the
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    # What __getattr__ below returns for the re-exported names, for the type checker (not
+    # imported at run time, which would load the native extension): without them each is an
+    # `Any` to mypy, through __getattr__'s return type.
+    from .analysis import ConvergenceError, Model, Outputs, Step, TapeError, run
+    from .results import Results
 
 __version__ = "0.1.0"
 

@@ -10,7 +10,14 @@ vtu
 The names below are imported on first use.
 """
 
+from typing import TYPE_CHECKING
+
 from tapespring._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    # What the lazy __getattr__ below returns, for the type checker (not imported at run time):
+    # without it each name is an `object` to mypy.
+    from .vtu import reference_mesh, write_pvd
 
 __all__ = ["reference_mesh", "write_pvd"]
 

@@ -23,7 +23,32 @@ Each scenario builds a :class:`tapespring.Model` and a list of steps, runs them 
 turns the results into what the paper reports.
 """
 
+from typing import TYPE_CHECKING
+
 from tapespring._lazy import lazy_exports
+
+if TYPE_CHECKING:
+    # What the lazy __getattr__ below returns, for the type checker (not imported at run time):
+    # without them every name is an `object` to mypy (`deploy` not callable, `SetupSpec` not a
+    # type).
+    from .bending import (
+        BendingResult,
+        BendingSetup,
+        BendingSummary,
+        analytical_residual_moment,
+        bend,
+        bending_model,
+        bending_steps,
+        summarize,
+        write_csv,
+    )
+    from .deployment import DeploymentSettings, deploy
+    from .equilibrium import EquilibriumSettings, equilibrium
+    from .max_mass import MaxMassSettings, max_mass
+    from .numerical_damping import numerical_damping_study
+    from .pull import PullSettings, pull
+    from .setup import PAPER_MODEL, PAPER_SETUP, PAPER_TAPE, SetupSpec, TapeSpring, build_setup
+    from .vibration import VibrationSettings, vibrate
 
 __all__ = [
     "PAPER_MODEL",
