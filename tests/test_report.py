@@ -1,8 +1,11 @@
 """The report helpers: saving figures."""
 
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import pytest
-from tapespring.report import save_figure
+import tapespring
+from tapespring.report import FIGURE_DPI, save_figure
 
 
 def test_save_figure_takes_a_str_path_and_returns_a_path(tmp_path):
@@ -18,3 +21,24 @@ def test_save_figure_refuses_a_subfigure(tmp_path):
     with pytest.raises(TypeError, match="saves a whole Figure, got a SubFigure"):
         save_figure(sub, tmp_path / "f.png")
     plt.close(fig)
+
+
+def test_save_figure_saves_at_the_one_resolution(tmp_path):
+    fig = plt.figure(figsize=(2.0, 1.0))
+    data = save_figure(fig, tmp_path / "f.png").read_bytes()
+    # The PNG header's IHDR chunk: width and height in pixels, big-endian, from byte 16.
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    assert (width, height) == (2 * FIGURE_DPI, FIGURE_DPI)
+
+
+def test_every_figure_of_the_package_is_saved_by_save_figure():
+    # The commands saved at 120, 150 and 200 dpi, two of them calling savefig themselves.
+    package = Path(tapespring.__file__).parent
+    bypass = [
+        f"{path.relative_to(package)}:{number}"
+        for path in sorted(package.rglob("*.py"))
+        if path.name != "report.py" or path.parent != package
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if "savefig(" in line
+    ]
+    assert bypass == []

@@ -228,13 +228,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from tapespring.plot.max_mass import plot_max_mass_figure
+        from tapespring.report import save_figure
 
-        fig = plot_max_mass_figure(result)
-        fig.savefig(args.plot, dpi=200)
-        plt.close(fig)
+        save_figure(plot_max_mass_figure(result), args.plot)
     if args.json:
         json.dump(result.to_json(), sys.stdout)
         sys.stdout.write("\n")

@@ -156,13 +156,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from tapespring.plot.release import plot_release
+        from tapespring.report import save_figure
 
-        fig = plot_release(result)
-        fig.savefig(args.plot, dpi=150)
-        plt.close(fig)
+        save_figure(plot_release(result), args.plot)
     summary = result.summary()
     if args.json:
         json.dump(summary, sys.stdout)
