@@ -71,9 +71,9 @@ def test_csv_plot_and_text_summary(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [
-        ("--thickness", "-1", "thickness must be finite and > 0"),
+        ("--thickness", "-1", "thickness must be > 0 (got -1.0)"),
         ("--youngs-modulus", "0", "youngs_modulus must be > 0"),
-        ("--mesh-size", "0", "mesh size must be finite and > 0"),
+        ("--mesh-size", "0", "mesh_size must be > 0 (got 0.0)"),
         ("--length", "abc", "length must be a number"),
         ("-E", "x", "Young's modulus must be a number"),
         # 1e300 failed at the first increment: "the residual became non-finite".

@@ -15,7 +15,9 @@ from _cli import refused
 from tapespring.cli import build_parser, main
 from tapespring.scenarios.bending import BendingSetup
 from tapespring.scenarios.deployment import DeploymentSettings
+from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
+from tapespring.scenarios.pull import PullSettings
 from tapespring.scenarios.release import ReleaseSetup
 from tapespring.scenarios.setup import PAPER_SETUP, PAPER_TAPE
 from tapespring.scenarios.vibration import VibrationSettings
@@ -122,6 +124,36 @@ def test_absurd_values_are_refused_by_the_parser_in_short_numbers(argv, message,
             ["equilibrium", "--thickness", "0"],
             dataclasses.replace(PAPER_SETUP, tape=dataclasses.replace(PAPER_TAPE, thickness=0.0)),
         ),
+        # The spectral radius, a plain float checked only by validate() (rho_inf = 2 ran to the
+        # settings' ValueError after the parser had accepted it).
+        (["release", "--rho-inf", "2"], ReleaseSetup(rho_inf=2.0)),
+        (["deploy", "--rho-inf", "-0.5"], DeploymentSettings(rho_inf=-0.5)),
+        (["vibrate", "--rho-inf", "nan"], VibrationSettings(rho_inf=float("nan"))),
+        (["vibrate", "--rho-inf-study", "0.5", "1.5"], VibrationSettings(rho_inf=1.5)),
+        # Values whose check was written inline in validate(), with a parser copy of "> 0" in its
+        # own words ("mesh size must be finite and > 0 (got 0)" against validate()'s "mesh_size
+        # [m] must be finite and > 0"); the push and the pull's displacement were accepted by the
+        # parser at any size and refused by validate() beyond 0.25 m and 0.1 m.
+        (["bend", "--length", "0"], BendingSetup(length=0.0)),
+        (["bend", "--radius", "-1"], BendingSetup(radius=-1.0)),
+        (["bend", "--thickness", "0"], BendingSetup(thickness=0.0)),
+        (["bend", "--mesh-size", "inf"], BendingSetup(mesh_size=float("inf"))),
+        (["release", "--mesh-size", "0"], BendingSetup(mesh_size=0.0)),
+        (["max-mass", "--mesh-size", "0"], MaxMassSettings(mesh_size=0.0)),
+        (
+            ["max-mass", "--thickness-range", "0", "1e-4"],
+            MaxMassSettings(thicknesses=(0.0, 1e-4)),
+        ),
+        (
+            ["max-mass", "--thickness-range", "1e-4", "nan"],
+            MaxMassSettings(thicknesses=(1e-4, float("nan"))),
+        ),
+        (["equilibrium", "--push", "0.3"], EquilibriumSettings(push=0.3)),
+        (["equilibrium", "--push", "1e-7"], EquilibriumSettings(push=1e-7)),
+        (["pull", "--max-displacement", "0.1"], PullSettings(max_displacement=0.1)),
+        (["pull", "--max-displacement", "-1"], PullSettings(max_displacement=-1.0)),
+        (["vibrate", "--eta", "-1"], dataclasses.replace(PAPER_SETUP, eta=-1.0)),
+        (["deploy", "--eta", "inf"], dataclasses.replace(PAPER_SETUP, eta=float("inf"))),
     ],
 )
 def test_the_parser_refuses_a_bound_with_the_settings_own_message(argv, settings, capsys):
@@ -132,6 +164,31 @@ def test_the_parser_refuses_a_bound_with_the_settings_own_message(argv, settings
         settings.validate()
     line = refused(argv, capsys)
     assert line.endswith(f": {exc.value}"), line
+
+
+@pytest.mark.parametrize(
+    ("argv", "dest", "value"),
+    [
+        # The ends of each range the parser now checks with the settings' own check: still taken.
+        (["release", "--rho-inf", "0"], "rho_inf", 0.0),
+        (["deploy", "--rho-inf", "1"], "rho_inf", 1.0),
+        (["vibrate", "--rho-inf-study", "0", "1"], "rho_inf_study", [0.0, 1.0]),
+        (["vibrate", "--eta", "0"], "eta", 0.0),
+        (["equilibrium", "--push", "1e-6"], "push", 1e-6),
+        (["equilibrium", "--push", "0.2499"], "push", 0.2499),
+        (["pull", "--max-displacement", "1e-6"], "max_displacement", 1e-6),
+        (["bend", "--mesh-size", "1e-300"], "mesh_size", 1e-300),
+        (["max-mass", "--thickness-range", "1e-300", "1e300"], "thickness_range", [1e-300, 1e300]),
+        # And the defaults.
+        (["equilibrium"], "push", EquilibriumSettings().push),
+        (["pull"], "max_displacement", PullSettings().max_displacement),
+        (["max-mass"], "mesh_size", MaxMassSettings().mesh_size),
+        (["bend"], "length", BendingSetup().length),
+        (["vibrate"], "eta", PAPER_SETUP.eta),
+    ],
+)
+def test_the_parser_takes_the_values_the_settings_take(argv, dest, value):
+    assert getattr(build_parser().parse_args(argv), dest) == value
 
 
 @pytest.mark.parametrize(

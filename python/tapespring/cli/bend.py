@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 from collections.abc import Callable
@@ -20,28 +19,12 @@ from typing import Any, NoReturn
 __all__ = ["add_tape_options", "refuse", "register", "run", "tape_fields", "warn"]
 
 
-def _positive(name: str, *, zero: bool = False):
-    """An argparse type: a finite number > 0 (>= 0 with `zero`), named `name` in errors."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        if not math.isfinite(value) or value < 0.0 or (value == 0.0 and not zero):
-            bound = ">= 0" if zero else "> 0"
-            raise argparse.ArgumentTypeError(f"{name} must be finite and {bound} (got {text})")
-        return value
-
-    return parse
-
-
-def _checked(name: str, check: Callable[[float], None]):
+def _checked(name: str, check: Callable[[float], object]):
     """An argparse type: a number that `check` accepts, named `name` if the text is no number.
 
-    `check` is the settings' own check of that value (it raises ValueError), so a bound has one
-    home and one message: the parser refuses the value before anything runs, with the message
-    the settings' ``validate`` gives.
+    `check` is the settings' own check of that value (it raises ValueError; what it returns is
+    not used), so a bound has one home and one message: the parser refuses the value before
+    anything runs, with the message the settings' ``validate`` gives.
     """
 
     def parse(text: str) -> float:
@@ -153,15 +136,15 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     from tapespring.scenarios.bending import check_alpha_deg
     from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, check_youngs_modulus
 
-    p.add_argument("--length", type=_positive("length"), default=d.length, help="L [m]")
-    p.add_argument("--radius", type=_positive("radius"), default=d.radius, help="R [m]")
+    p.add_argument("--length", type=_field("length"), default=d.length, help="L [m]")
+    p.add_argument("--radius", type=_field("radius"), default=d.radius, help="R [m]")
     p.add_argument(
         "--alpha",
         type=_checked("alpha", check_alpha_deg),
         default=d.alpha_deg,
         help="subtended angle of the cross-section [deg], in (0, 360)",
     )
-    p.add_argument("--thickness", type=_positive("thickness"), default=d.thickness, help="t [m]")
+    p.add_argument("--thickness", type=_field("thickness"), default=d.thickness, help="t [m]")
     p.add_argument(
         "--youngs-modulus",
         "-E",
@@ -172,7 +155,7 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
     p.add_argument(
         "--mesh-size",
-        type=_positive("mesh size"),
+        type=_field("mesh_size"),
         default=d.mesh_size,
         help="element size [m] (default 0.002)",
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from .bend import (
     _checked,
@@ -21,6 +22,9 @@ from .scenario_options import (
     spec_from_args,
     with_comparison,
 )
+
+if TYPE_CHECKING:
+    from tapespring.scenarios.deployment import DeploymentSimulation
 
 __all__ = ["register", "run"]
 
@@ -44,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         MAX_DYNAMIC_STEPS,
         MAX_SAMPLE_RATE,
         SUPPORTS,
+        check_rho_inf,
         check_sample_rate,
     )
 
@@ -86,7 +91,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=DEFAULT_DURATION,
         help=f"motion after the release [s] (default {DEFAULT_DURATION}; paper: 10)",
     )
-    p.add_argument("--rho-inf", type=float, default=d.rho_inf, help="spectral radius, in [0, 1]")
+    p.add_argument(
+        "--rho-inf",
+        type=_checked("rho_inf", check_rho_inf),
+        default=d.rho_inf,
+        help="spectral radius, in [0, 1]",
+    )
     p.add_argument(
         "--tolerance",
         type=_field("tolerance", zero=True),
@@ -179,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
         # it after (main prints the ValueError, exit 2).
         settings.check_recording(measured)
 
-    def simulate() -> object:
+    def simulate() -> DeploymentSimulation:
         result = deploy(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
 
@@ -193,7 +203,7 @@ def run(args: argparse.Namespace) -> int:
             result = with_comparison(result, compare, args.experiment, problems)
         return result
 
-    def plot(result: object, path: str) -> None:
+    def plot(result: DeploymentSimulation, path: str) -> None:
         from tapespring.plot.setup import plot_deployment
         from tapespring.report import save_figure
 
@@ -201,14 +211,13 @@ def run(args: argparse.Namespace) -> int:
 
     problems: list[str] = []
 
-    def fields(result: object) -> None:
-        r = result  # a DeploymentSimulation
+    def fields(result: DeploymentSimulation) -> None:
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
         if args.vtu:
             from tapespring.io.vtu import write_pvd
 
-            write_pvd(r.results, r.setup.model, args.vtu)  # type: ignore[attr-defined]
+            write_pvd(result.results, result.setup.model, args.vtu)
             if not args.json:
                 print(f"  wrote {args.vtu}")
         if args.snapshots:
@@ -219,23 +228,22 @@ def run(args: argparse.Namespace) -> int:
             from tapespring.report import save_figure
 
             # Simulation time of the release: the records' time runs on from the static steps.
-            span = float(r.time_s[-1])  # type: ignore[attr-defined]
-            t0 = float(r.results.t[-1]) - span  # type: ignore[attr-defined]
+            span = float(result.time_s[-1])
+            t0 = float(result.results.t[-1]) - span
             times = [t0 + k * span / 5.0 for k in range(6)]
-            ax = plot_snapshots(r.results, r.setup.model, times)  # type: ignore[attr-defined]
+            ax = plot_snapshots(result.results, result.setup.model, times)
             save_figure(ax.figure, args.snapshots)
             if not args.json:
                 print(f"  wrote {args.snapshots}")
 
-    def columns(result: object) -> dict:
-        r = result
-        rows = r.sample_rows()  # type: ignore[attr-defined]
+    def columns(result: DeploymentSimulation) -> dict:
+        rows = result.sample_rows()
         # The sample instants k / rate, which the rows' times are to rounding.
-        k = np.round(r.time_s[rows] * settings.sample_rate)  # type: ignore[attr-defined]
+        k = np.round(result.time_s[rows] * settings.sample_rate)
         return {
             "time_s": k / settings.sample_rate,
-            "angle_deg": r.angle_deg[rows],  # type: ignore[attr-defined]
-            "clamp_force_N": r.clamp_force_N[rows],  # type: ignore[attr-defined]
+            "angle_deg": result.angle_deg[rows],
+            "clamp_force_N": result.clamp_force_N[rows],
         }
 
     code = finish(args, simulate, columns, plot, extra=fields)

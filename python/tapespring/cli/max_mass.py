@@ -13,8 +13,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from functools import partial
 
-from .bend import _checked, _count, _image_file, _output_file, _positive, refuse, warn
+from .bend import _checked, _count, _field, _image_file, _output_file, refuse, warn
 
 __all__ = ["register", "run"]
 
@@ -39,6 +40,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         LEVER_ARM_RANGE,
         check_angle_deg,
         check_gravity,
+        check_grid_value,
         check_lever_arm,
     )
     from tapespring.scenarios.setup import (
@@ -72,7 +74,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--thickness-range",
         nargs=2,
-        type=_positive("thickness"),
+        type=_checked("thickness", partial(check_grid_value, "thicknesses")),
         metavar=("MIN", "MAX"),
         default=None,
         help=f"t range [m] (default Table 4: {b.thickness_min:g} {b.thickness_max:g}); with "
@@ -105,7 +107,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--mesh-size",
-        type=_positive("mesh size"),
+        type=_field("mesh_size"),
         default=4e-3,
         help="element size [m] (default 0.004; 0.002 is the paper's, 1.3 to 5.7 times the cost "
         "per run)",

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import functools
+from typing import TYPE_CHECKING
 
-from .bend import _positive
+from .bend import _checked
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -17,11 +18,16 @@ from .scenario_options import (
     write_vtu,
 )
 
+if TYPE_CHECKING:
+    from tapespring.scenarios.pull import PullResult
+
 __all__ = ["register", "run"]
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``pull`` command to a CLI (`sub` from ``add_subparsers``)."""
+    from tapespring.scenarios.pull import PullSettings, check_max_displacement
+
     p = sub.add_parser(
         "pull",
         help="quasi-static pull of the set-up without appendix until the tapes buckle",
@@ -35,8 +41,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--max-displacement",
-        type=_positive("max displacement"),
-        default=0.020,
+        type=_checked("max displacement", check_max_displacement),
+        default=PullSettings.max_displacement,
         help="displacement of marker 2 at the end of the pull [m] (default 0.02)",
     )
     add_comparison_options(
@@ -68,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
             return 2
     problems: list[str] = []
 
-    def simulate() -> object:
+    def simulate() -> PullResult:
         settings = PullSettings(
             spec=spec_from_args(args),
             max_displacement=args.max_displacement,
@@ -80,17 +86,17 @@ def run(args: argparse.Namespace) -> int:
             result = with_comparison(result, compare, args.experiment, problems)
         return result
 
-    def plot(result: object, path: str) -> None:
+    def plot(result: PullResult, path: str) -> None:
         from tapespring.plot.setup import plot_pull
         from tapespring.report import save_figure
 
         save_figure(plot_pull(result, measured), path)
 
-    def columns(result: object) -> dict:
-        return {"displacement_m": result.displacement_m, "force_N": result.force_N}  # type: ignore[attr-defined]
+    def columns(result: PullResult) -> dict:
+        return {"displacement_m": result.displacement_m, "force_N": result.force_N}
 
-    def extra(result: object) -> None:
-        write_vtu(args, result.results, result.setup.model)  # type: ignore[attr-defined]
+    def extra(result: PullResult) -> None:
+        write_vtu(args, result.results, result.setup.model)
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
 

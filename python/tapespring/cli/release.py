@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from .bend import _field, _image_file, _output_file, add_tape_options, tape_fields
+from .bend import _checked, _field, _image_file, _output_file, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
 
@@ -33,6 +33,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         The ``release`` parser.
     """
     from tapespring.scenarios.release import ReleaseSetup
+    from tapespring.scenarios.setup import check_rho_inf
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -69,7 +70,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--eta", type=_field("eta", zero=True), default=d.eta, help="Kelvin-Voigt eta [s]"
     )
     p.add_argument(
-        "--rho-inf", type=float, default=d.rho_inf, help="spectral radius at infinity, in [0, 1]"
+        "--rho-inf",
+        type=_checked("rho_inf", check_rho_inf),
+        default=d.rho_inf,
+        help="spectral radius at infinity, in [0, 1]",
     )
     p.add_argument(
         "--gravity", type=float, default=d.gravity, help="gravity along -z [m/s^2] (default 0)"

@@ -8,9 +8,12 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from .bend import _checked, _field, _image_file, _input_file, _output_file, _positive
+from .bend import _checked, _field, _image_file, _input_file, _output_file
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 __all__ = [
     "add_comparison_options",
@@ -23,6 +26,13 @@ __all__ = [
     "write_vtu",
 ]
 
+#: A scenario's result (a ``DeploymentSimulation``, a ``PullResult``, ...): `finish` hands the
+#: result of its run to the command's callbacks, typed by the command.
+R = TypeVar("R")
+
+#: A scenario's result that `with_comparison` copies with its comparison (a frozen dataclass).
+D = TypeVar("D", bound="DataclassInstance")
+
 
 def add_spec_options(
     p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float, eta: bool = True
@@ -30,7 +40,12 @@ def add_spec_options(
     """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
     viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
     for a viscosity to act on: it leaves ``--eta`` out."""
-    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, PAPER_SETUP, check_youngs_modulus
+    from tapespring.scenarios.setup import (
+        MAX_YOUNGS_MODULUS,
+        PAPER_SETUP,
+        check_eta,
+        check_youngs_modulus,
+    )
 
     s = PAPER_SETUP
     g = p.add_argument_group("set-up (paper's values and this project's choices by default)")
@@ -57,7 +72,7 @@ def add_spec_options(
     )
     if eta:
         g.add_argument(
-            "--eta", type=_positive("eta", zero=True), default=s.eta, help="Kelvin-Voigt eta [s]"
+            "--eta", type=_checked("eta", check_eta), default=s.eta, help="Kelvin-Voigt eta [s]"
         )
 
 
@@ -87,10 +102,10 @@ def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
 
 def finish(
     args: argparse.Namespace,
-    run: Callable[[], Any],
-    columns: Callable[[Any], dict[str, Sequence[float]]],
-    plot: Callable[[Any, str], None],
-    extra: Callable[[Any], None] | None = None,
+    run: Callable[[], R],
+    columns: Callable[[R], dict[str, Sequence[float]]],
+    plot: Callable[[R, str], None],
+    extra: Callable[[R], None] | None = None,
 ) -> int:
     """Run a scenario and write its outputs; returns the exit code.
 
@@ -101,6 +116,7 @@ def finish(
     from tapespring.report import jsonable_tree, write_table
 
     failure = None
+    result: Any  # R, or the partial result a ConvergenceError carries
     try:
         result = run()
     except ValueError as exc:
@@ -176,8 +192,8 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
 
 
 def with_comparison(
-    result: Any, compare: Callable[[], Any], experiment: str, problems: list[str]
-) -> Any:
+    result: D, compare: Callable[[], object], experiment: str, problems: list[str]
+) -> D:
     """`result` with ``comparison=compare()``; if the comparison cannot be made (ValueError), the
     result unchanged and the reason appended to `problems` (the command prints it after its
     outputs and exits with 1)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import functools
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .bend import _checked, _field, refuse
 from .scenario_options import (
@@ -17,6 +17,10 @@ from .scenario_options import (
     with_comparison,
     write_vtu,
 )
+
+if TYPE_CHECKING:
+    from tapespring.scenarios.numerical_damping import NumericalDampingStudy
+    from tapespring.scenarios.vibration import VibrationSimulation
 
 __all__ = ["register", "run"]
 
@@ -40,7 +44,7 @@ def _check(args: argparse.Namespace) -> None:
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
-    from tapespring.scenarios.setup import MAX_SAMPLE_RATE
+    from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
     from tapespring.scenarios.vibration import VibrationSettings, check_time_step
 
     d = VibrationSettings()
@@ -67,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--rho-inf",
-        type=float,
+        type=_checked("rho_inf", check_rho_inf),
         default=None,
         help=f"spectral radius, in [0, 1] (default {d.rho_inf:g}; not with --rho-inf-study)",
     )
@@ -95,7 +99,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--rho-inf-study",
-        type=float,
+        type=_checked("rho_inf", check_rho_inf),
         nargs="+",
         metavar="RHO",
         help="run the test once per spectral radius and compare the fitted damping ratios and "
@@ -139,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
             return 2
     problems: list[str] = []
 
-    def simulate() -> object:
+    def simulate() -> VibrationSimulation:
         settings = VibrationSettings(
             spec=spec_from_args(args),
             duration=args.duration,
@@ -155,21 +159,21 @@ def run(args: argparse.Namespace) -> int:
             result = with_comparison(result, compare, args.experiment, problems)
         return result
 
-    def plot(result: object, path: str) -> None:
+    def plot(result: VibrationSimulation, path: str) -> None:
         from tapespring.plot.setup import plot_vibration
         from tapespring.report import save_figure
 
         save_figure(plot_vibration(result, measured), path)
 
-    def columns(result: object) -> dict:
-        rows = result.sample_rows()  # type: ignore[attr-defined]
+    def columns(result: VibrationSimulation) -> dict:
+        rows = result.sample_rows()
         return {
-            "time_s": result.time_s[rows],  # type: ignore[attr-defined]
-            "displacement_m": result.displacement_m[rows],  # type: ignore[attr-defined]
+            "time_s": result.time_s[rows],
+            "displacement_m": result.displacement_m[rows],
         }
 
-    def extra(result: object) -> None:
-        write_vtu(args, result.results, None)  # type: ignore[attr-defined]
+    def extra(result: VibrationSimulation) -> None:
+        write_vtu(args, result.results, None)
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
 
@@ -182,7 +186,7 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
     from tapespring.scenarios.numerical_damping import numerical_damping_study
     from tapespring.scenarios.vibration import VibrationSettings
 
-    def simulate() -> object:
+    def simulate() -> NumericalDampingStudy:
         settings = VibrationSettings(
             spec=spec_from_args(args),
             duration=args.duration,
@@ -194,20 +198,19 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
         rho = tuple(args.rho_inf_study)
         return numerical_damping_study(settings, rho, progress=not (args.no_progress or args.json))
 
-    def plot(result: object, path: str) -> None:
+    def plot(result: NumericalDampingStudy, path: str) -> None:
         from tapespring.plot.numerical_damping import plot_numerical_damping
         from tapespring.report import save_figure
 
         save_figure(plot_numerical_damping(result), path)
 
-    def columns(result: object) -> dict:
-        r: Any = result
+    def columns(result: NumericalDampingStudy) -> dict:
         return {
-            "rho_inf": r.rho_inf,
-            "damping_ratio": r.damping_ratio,
-            "period_s": r.period_s,
-            "predicted_damping_ratio": r.predicted_damping_ratio,
-            "predicted_period_s": r.predicted_period_s,
+            "rho_inf": result.rho_inf,
+            "damping_ratio": result.damping_ratio,
+            "period_s": result.period_s,
+            "predicted_damping_ratio": result.predicted_damping_ratio,
+            "predicted_period_s": result.predicted_period_s,
         }
 
     return finish(args, simulate, columns, plot)

@@ -38,7 +38,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tapespring.scenarios.setup import PAPER_TAPE, check_element_count, check_youngs_modulus
+from tapespring.scenarios.setup import (
+    PAPER_TAPE,
+    check_element_count,
+    check_number,
+    check_youngs_modulus,
+)
 
 __all__ = [
     "BendingResult",
@@ -176,21 +181,16 @@ class BendingSetup:
             "locate_tolerance_deg",
         )
         for name in numbers:
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{name} must be a number (got {value!r})")
-            if not math.isfinite(value):
-                raise ValueError(f"{name} must be finite (got {value})")
+            check_number(name, getattr(self, name), positive=False)
         for name in ("unload", "jump", "switch_branches"):
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False (got {value!r})")
         check_rotation_deg("theta_max_deg", self.theta_max_deg, 360.0)
-        if self.mesh_size <= 0.0:
-            raise ValueError(f"mesh_size [m] must be finite and > 0 (got {self.mesh_size})")
-        for name in ("length", "radius"):  # (the thickness: checked by the solver)
-            if getattr(self, name) <= 0.0:
-                raise ValueError(f"{name} must be > 0 (got {getattr(self, name):.3g})")
+        # Sizes [m]: the command line's --mesh-size, --length, --radius and --thickness are
+        # refused by the same check.
+        for name in ("mesh_size", "length", "radius", "thickness"):
+            check_number(name, getattr(self, name), positive=True)
         check_youngs_modulus(self.youngs_modulus)
         check_alpha_deg(self.alpha_deg)
         # A shell as thick as its radius of curvature has no inner surface: the Mindlin shell

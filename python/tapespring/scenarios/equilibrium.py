@@ -34,7 +34,18 @@ from tapespring.scenarios.setup import (
     raise_if_stopped,
 )
 
-__all__ = ["EquilibriumResult", "EquilibriumSettings", "equilibrium"]
+__all__ = ["EquilibriumResult", "EquilibriumSettings", "check_push", "equilibrium"]
+
+
+def check_push(value: object) -> None:
+    """Raise ValueError unless `value` is a push of the weight's tip [m]: a number in
+    [:data:`~tapespring.scenarios.setup.MIN_DISPLACEMENT`, 0.25)."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not MIN_DISPLACEMENT <= value < 0.25
+    ):
+        raise ValueError(f"push must lie in [{MIN_DISPLACEMENT:g}, 0.25) m (got {value!r})")
 
 
 @dataclass(frozen=True)
@@ -56,13 +67,7 @@ class EquilibriumSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
-        p = self.push
-        if (
-            isinstance(p, bool)
-            or not isinstance(p, (int, float))
-            or not MIN_DISPLACEMENT <= p < 0.25
-        ):
-            raise ValueError(f"push must lie in [{MIN_DISPLACEMENT:g}, 0.25) m (got {p!r})")
+        check_push(self.push)
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,7 @@ __all__ = [
     "analytical_max_mass",
     "check_angle_deg",
     "check_gravity",
+    "check_grid_value",
     "check_lever_arm",
     "max_mass",
     "write_csv",
@@ -91,20 +92,29 @@ LEVER_ARM_RANGE = (1e-3, 10.0)
 def check_angle_deg(value: object) -> None:
     """Raise ValueError unless `value` is the fold angle at which M* is taken [deg]: a number in
     (0, 180), the magnitude of the angle in either sense."""
-    check_number("angle_deg", value, positive=False)
-    if not 0.0 < value < 180.0:  # type: ignore[operator]
+    number = check_number("angle_deg", value, positive=False)
+    if not 0.0 < number < 180.0:
         raise ValueError(
             f"angle_deg must lie in (0, 180) degrees, the magnitude of the fold angle "
-            f"(got {value}; the paper's is 90)"
+            f"(got {number}; the paper's is 90)"
         )
 
 
+def check_grid_value(name: str, value: object) -> None:
+    """Raise ValueError unless `value` is one of the grid values `name` (``"thicknesses"`` [m] or
+    ``"youngs_moduli"`` [Pa]): a finite number > 0."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
+        raise ValueError(f"{name} must hold numbers (got {value!r})")
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} must be finite and > 0 (got {value})")
+
+
 def _check_within(name: str, value: object, bounds: tuple[float, float], unit: str) -> None:
-    check_number(name, value, positive=False)
+    number = check_number(name, value, positive=False)
     low, high = bounds
-    if not low <= value <= high:  # type: ignore[operator]
+    if not low <= number <= high:
         raise ValueError(
-            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {value:.3g}; see "
+            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {number:.3g}; see "
             f"{name.upper()}_RANGE)"
         )
 
@@ -247,10 +257,7 @@ class MaxMassSettings:
             if len(values) == 0:
                 raise ValueError(f"{name} must hold at least one value")
             for v in values:
-                if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)):
-                    raise ValueError(f"{name} must hold numbers (got {v!r})")
-                if not math.isfinite(v) or v <= 0.0:
-                    raise ValueError(f"{name} must be finite and > 0 (got {v})")
+                check_grid_value(name, v)
             if any(b <= a for a, b in zip(values[:-1], values[1:], strict=True)):
                 raise ValueError(f"{name} must be strictly increasing (got {tuple(values)})")
         if isinstance(self.senses, str) or not isinstance(self.senses, Sequence):
@@ -264,12 +271,9 @@ class MaxMassSettings:
             raise ValueError(f"senses must not repeat (got {tuple(self.senses)})")
         if not isinstance(self.tape, TapeSpring):
             raise ValueError(f"tape must be a TapeSpring (got {self.tape!r})")
-        for name in ("mesh_size", "angle_deg", "gravity", "imperfection_deg"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{name} must be a number (got {value!r})")
-            if not math.isfinite(value):
-                raise ValueError(f"{name} must be finite (got {value})")
+        for name in ("angle_deg", "gravity", "imperfection_deg"):
+            check_number(name, getattr(self, name), positive=False)
+        check_number("mesh_size", self.mesh_size, positive=True)
         check_angle_deg(self.angle_deg)
         check_gravity(self.gravity)
         if self.lever_arm is not None:

@@ -41,7 +41,15 @@ from tapespring.scenarios.setup import (
     raise_if_stopped,
 )
 
-__all__ = ["PULL_SPEED", "PullComparison", "PullResult", "PullSettings", "pull", "rest_before"]
+__all__ = [
+    "PULL_SPEED",
+    "PullComparison",
+    "PullResult",
+    "PullSettings",
+    "check_max_displacement",
+    "pull",
+    "rest_before",
+]
 
 #: Pulling speed of the paper's model [m/s] (Sec. 6.2: 1 mm/s imposed on the rod's middle); the
 #: time scale of a simulated pull turned into a trial.
@@ -49,6 +57,19 @@ PULL_SPEED = 1e-3
 
 #: Trial marker names of the bare set-up's markers (marker 2, the middle of the rod, is pulled).
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2"}
+
+
+def check_max_displacement(value: object) -> None:
+    """Raise ValueError unless `value` is the displacement of marker 2 at the end of the pull
+    [m]: a number in [:data:`~tapespring.scenarios.setup.MIN_DISPLACEMENT`, 0.1)."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not MIN_DISPLACEMENT <= value < 0.1
+    ):
+        raise ValueError(
+            f"max_displacement must lie in [{MIN_DISPLACEMENT:g}, 0.1) m (got {value!r})"
+        )
 
 
 @dataclass(frozen=True)
@@ -73,15 +94,7 @@ class PullSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
-        d = self.max_displacement
-        if (
-            isinstance(d, bool)
-            or not isinstance(d, (int, float))
-            or not MIN_DISPLACEMENT <= d < 0.1
-        ):
-            raise ValueError(
-                f"max_displacement must lie in [{MIN_DISPLACEMENT:g}, 0.1) m (got {d!r})"
-            )
+        check_max_displacement(self.max_displacement)
         check_count("field_interval", self.field_interval, minimum=0)
 
 

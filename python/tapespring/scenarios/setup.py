@@ -39,7 +39,9 @@ __all__ = [
     "build_setup",
     "check_count",
     "check_element_count",
+    "check_eta",
     "check_number",
+    "check_rho_inf",
     "check_sample_rate",
     "check_sampling",
     "check_sense",
@@ -102,11 +104,11 @@ MAX_YOUNGS_MODULUS = 1e13
 def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
     """Raise ValueError naming `name` unless `value` is a Young's modulus: a finite number > 0 and
     at most :data:`MAX_YOUNGS_MODULUS` [Pa]."""
-    check_number(name, value, positive=True)
-    if value > MAX_YOUNGS_MODULUS:  # type: ignore[operator]
+    number = check_number(name, value, positive=True)
+    if number > MAX_YOUNGS_MODULUS:
         raise ValueError(
             f"{name} must be at most {MAX_YOUNGS_MODULUS:.0e} Pa, ten times diamond's (got "
-            f"{value:.3g} Pa; see MAX_YOUNGS_MODULUS)"
+            f"{number:.3g} Pa; see MAX_YOUNGS_MODULUS)"
         )
 
 
@@ -459,9 +461,9 @@ class SetupSpec:
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
-            if name in ("tape", "support_marker", "support"):
+            if name in ("tape", "support_marker", "support", "eta", "support_eta"):
                 continue
-            positive = not name.startswith("initial_angle") and name not in ("eta", "support_eta")
+            positive = not name.startswith("initial_angle")
             check_number(name, value, positive=positive)
         if not isinstance(self.support_marker, tuple | list) or len(self.support_marker) != 3:
             raise ValueError(
@@ -474,8 +476,7 @@ class SetupSpec:
                 f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {self.gravity:.3g}; see "
                 "setup.MAX_GRAVITY)"
             )
-        if self.eta < 0.0:
-            raise ValueError(f"eta must be >= 0 s (got {self.eta})")
+        check_eta(self.eta)
         if not -1.0 < self.plate_poisson < 0.5:
             raise ValueError(f"plate_poisson must lie in (-1, 0.5) (got {self.plate_poisson})")
         self._validate_support()
@@ -511,8 +512,7 @@ class SetupSpec:
         """Check the flexible support's values: each one always (like every value), against
         the rest of the set-up only when the support is flexible (a rigid support's spec is
         accepted as before)."""
-        if self.support_eta < 0.0:
-            raise ValueError(f"support_eta must be >= 0 s (got {self.support_eta})")
+        check_eta(self.support_eta, "support_eta")
         if not -1.0 < self.support_poisson < 0.5:
             raise ValueError(f"support_poisson must lie in (-1, 0.5) (got {self.support_poisson})")
         if self.support != "flexible":
@@ -581,9 +581,13 @@ def check_sense(sense: str) -> None:
         raise ValueError(f"sense must be one of {SENSES} (got {sense!r})")
 
 
-def check_number(name: str, value: object, *, positive: bool, zero: bool = False) -> None:
+def check_number(name: str, value: object, *, positive: bool, zero: bool = False) -> float:
     """Raise ValueError naming `name` unless `value` is a finite number, > 0 if `positive`
-    (>= 0 with `zero` too, for settings where 0 means "the default")."""
+    (>= 0 with `zero` too, for settings where 0 means "the default").
+
+    Returns `value`, unchanged, typed as a number: a check that goes on to bound it compares
+    the returned value (`value` itself is still an ``object`` to mypy).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{name} must be a number (got {value!r})")
     if not math.isfinite(value):
@@ -592,6 +596,15 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
         raise ValueError(f"{name} must be >= 0 (got {value})")
     if positive and not zero and value <= 0.0:
         raise ValueError(f"{name} must be > 0 (got {value})")
+    return value
+
+
+def check_eta(value: object, name: str = "eta") -> None:
+    """Raise ValueError naming `name` unless `value` is a Kelvin-Voigt viscosity eta [s]: a
+    finite number >= 0 (0: no viscous damping)."""
+    number = check_number(name, value, positive=False)
+    if number < 0.0:
+        raise ValueError(f"{name} must be >= 0 s (got {number})")
 
 
 def check_rho_inf(value: float) -> None:
@@ -1115,11 +1128,11 @@ def sample_rows(time_s: NDArray[np.float64], sample_rate: float) -> NDArray[np.i
 def check_sample_rate(value: object, name: str = "sample_rate") -> None:
     """Raise ValueError naming `name` unless `value` is a sample rate: a finite number > 0 and at
     most :data:`MAX_SAMPLE_RATE` [Hz]."""
-    check_number(name, value, positive=True)
-    if value > MAX_SAMPLE_RATE:  # type: ignore[operator]
+    number = check_number(name, value, positive=True)
+    if number > MAX_SAMPLE_RATE:
         raise ValueError(
             f"{name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
-            f"(got {value:.3g} Hz; see MAX_SAMPLE_RATE)"
+            f"(got {number:.3g} Hz; see MAX_SAMPLE_RATE)"
         )
 
 

@@ -67,11 +67,11 @@ def check_time_step(value: object) -> None:
     fixed step of at least ``1 / MAX_SAMPLE_RATE``, 1 us (every fixed step is a record: the
     samples' bound; below a microsecond the solver cannot place the steps at the release's
     time)."""
-    check_number("time_step", value, positive=True, zero=True)
-    if 0.0 < value < 1.0 / MAX_SAMPLE_RATE:  # type: ignore[operator]
+    number = check_number("time_step", value, positive=True, zero=True)
+    if 0.0 < number < 1.0 / MAX_SAMPLE_RATE:
         raise ValueError(
             f"time_step must be 0 (adaptive steps) or at least {1.0 / MAX_SAMPLE_RATE:.0e} s "
-            f"(got {value:.3g} s; see MAX_SAMPLE_RATE)"
+            f"(got {number:.3g} s; see MAX_SAMPLE_RATE)"
         )
 
 
