@@ -118,16 +118,16 @@ def test_an_experiment_that_is_no_file_is_refused_before_the_run(command, name, 
 
 
 @pytest.mark.parametrize(
-    ("argv", "name", "by_parser"),
+    ("argv", "name"),
     [
-        (["bend", "--theta-max", "1e-300"], "theta_max_deg", False),
-        (["release", "--fold-deg", "1e-300"], "fold_deg", False),
         # The settings' own check, which the parser calls.
-        (["pull", "--max-displacement", "1e-300"], "max_displacement", True),
-        (["equilibrium", "--push", "1e-300"], "push", True),
+        (["bend", "--theta-max", "1e-300"], "theta_max_deg"),
+        (["release", "--fold-deg", "1e-300"], "fold_deg"),
+        (["pull", "--max-displacement", "1e-300"], "max_displacement"),
+        (["equilibrium", "--push", "1e-300"], "push"),
     ],
 )
-def test_a_motion_too_small_to_resolve_is_named(argv, name, by_parser, capsys):
+def test_a_motion_too_small_to_resolve_is_named(argv, name, capsys):
     # It once reached the solver: "the loads and prescribed motions act on no free DOF".
-    line = refused([*argv, "--no-progress"], capsys, by_parser=by_parser)
+    line = refused([*argv, "--no-progress"], capsys)
     assert name in line and "free DOF" not in line

@@ -9,17 +9,18 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 
 import pytest
 from _cli import refused
 from tapespring.cli import build_parser, main
-from tapespring.scenarios.bending import BendingSetup
+from tapespring.scenarios.bending import MAX_IMPERFECTION_DEG, MIN_ROTATION_DEG, BendingSetup
 from tapespring.scenarios.deployment import DeploymentSettings
 from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
 from tapespring.scenarios.pull import PullSettings
-from tapespring.scenarios.release import ReleaseSetup
-from tapespring.scenarios.setup import PAPER_SETUP, PAPER_TAPE
+from tapespring.scenarios.release import MAX_TIP_INERTIA, MAX_TIP_MASS, ReleaseSetup
+from tapespring.scenarios.setup import MAX_GRAVITY, PAPER_SETUP, PAPER_TAPE
 from tapespring.scenarios.vibration import VibrationSettings
 
 
@@ -234,6 +235,106 @@ def test_deploy_refuses_a_recording_of_the_other_sense(metadata, tmp_path, capsy
     evidence = "its metadata" if metadata else "its initial bending angle, -"
     assert f"is a deployment in equal sense ({evidence}" in line
     assert "the simulation in opposite sense" in line
+
+
+def _inside(end: float, toward: float) -> float:
+    """The float next to `end`, toward `toward`: just inside an open end, just outside a closed
+    one."""
+    return math.nextafter(end, toward)
+
+
+_INF = math.inf
+_THETA = (360.0, MIN_ROTATION_DEG)
+_FOLD = (180.0, MIN_ROTATION_DEG)
+
+# Each option the parser checks with the settings' own check: (command, option, settings made
+# from a value, values accepted at the ends of its range, values refused just outside them).
+_BOUNDS = [
+    (
+        "bend",
+        "--theta-max",
+        lambda v: BendingSetup(theta_max_deg=v),
+        [_inside(-_THETA[0], 0), -_THETA[1], _THETA[1], _inside(_THETA[0], 0)],
+        [-_THETA[0], _inside(-_THETA[1], 0), _inside(_THETA[1], 0), _THETA[0]],
+    ),
+    (
+        "bend",
+        "--poisson",
+        lambda v: BendingSetup(poisson=v),
+        [_inside(-1.0, 0), _inside(0.5, 0)],
+        [-1.0, 0.5],
+    ),
+    (
+        "release",
+        "--poisson",
+        lambda v: BendingSetup(poisson=v),
+        [_inside(-1.0, 0), _inside(0.5, 0)],
+        [-1.0, 0.5],
+    ),
+    (
+        "bend",
+        "--imperfection",
+        lambda v: BendingSetup(imperfection_deg=v),
+        [-MAX_IMPERFECTION_DEG, MAX_IMPERFECTION_DEG],
+        [_inside(-MAX_IMPERFECTION_DEG, -_INF), _inside(MAX_IMPERFECTION_DEG, _INF)],
+    ),
+    (
+        "release",
+        "--fold-deg",
+        lambda v: ReleaseSetup(fold_deg=v),
+        [_inside(-_FOLD[0], 0), -_FOLD[1], _FOLD[1], _inside(_FOLD[0], 0)],
+        [-_FOLD[0], _inside(-_FOLD[1], 0), _inside(_FOLD[1], 0), _FOLD[0]],
+    ),
+    (
+        "release",
+        "--gravity",
+        lambda v: ReleaseSetup(gravity=v),
+        [-MAX_GRAVITY, MAX_GRAVITY],
+        [_inside(-MAX_GRAVITY, -_INF), _inside(MAX_GRAVITY, _INF)],
+    ),
+    (
+        "release",
+        "--tip-mass",
+        lambda v: ReleaseSetup(tip_mass=v),
+        [_inside(0.0, 1), MAX_TIP_MASS],
+        [0.0, _inside(MAX_TIP_MASS, _INF)],
+    ),
+    (
+        "release",
+        "--tip-inertia",
+        lambda v: ReleaseSetup(tip_inertia=v),
+        [_inside(0.0, 1), MAX_TIP_INERTIA],
+        [0.0, _inside(MAX_TIP_INERTIA, _INF)],
+    ),
+]
+
+
+def _dest(option: str) -> str:
+    return {"--theta-max": "theta_max", "--imperfection": "imperfection"}.get(
+        option, option[2:].replace("-", "_")
+    )
+
+
+@pytest.mark.parametrize(
+    ("command", "option", "make", "value"),
+    [(c, o, m, v) for c, o, m, ok, _ in _BOUNDS for v in ok],
+)
+def test_the_parser_takes_an_option_at_the_ends_of_its_range(command, option, make, value):
+    # "--option=value": a negative value is not read as an option; repr gives the float back.
+    args = build_parser().parse_args([command, f"{option}={value!r}"])
+    assert getattr(args, _dest(option)) == value
+    make(value).validate()
+
+
+@pytest.mark.parametrize(
+    ("command", "option", "make", "value"),
+    [(c, o, m, v) for c, o, m, _, refused_values in _BOUNDS for v in refused_values],
+)
+def test_the_parser_refuses_an_option_just_outside_its_range(command, option, make, value, capsys):
+    with pytest.raises(ValueError) as exc:
+        make(value).validate()
+    line = refused([command, f"{option}={value!r}"], capsys)
+    assert line.endswith(f"argument {option}: {exc.value}"), line
 
 
 def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:

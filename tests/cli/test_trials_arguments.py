@@ -12,6 +12,8 @@ a frame starting with a minus, a length unit no file uses.
 
 import argparse
 import json
+import math
+import sys
 
 import numpy as np
 import pytest
@@ -20,6 +22,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
 from tapespring.cli import build_parser, main
+from tapespring.protocols.registry import analyze_trials, check_span_time
 from tapespring.signals.frame import to_frame
 from tapespring.trials import (
     FORCES_SUFFIX,
@@ -200,3 +203,23 @@ def test_the_typed_kind_options_are_the_kind_options():
         ["trials", "analyze", "x.csv", "--kind", "vibration", "--window", "1e-4", "2e-3"]
     )
     assert _kind_options(args) == {"window": (1e-4, 2e-3)}
+
+
+@pytest.mark.parametrize("value", [math.nextafter(0.0, 1.0), 0.0253, sys.float_info.max])
+def test_span_time_is_taken_at_the_ends_of_its_range(value):
+    args = build_parser().parse_args(
+        ["trials", "analyze", "x.csv", "--kind", "quasi-static", f"--span-time={value!r}"]
+    )
+    assert args.span_time == value
+    check_span_time(value)
+
+
+@pytest.mark.parametrize("value", ["0.0", "-5e-324", "inf", "nan"])
+def test_span_time_just_outside_its_range_is_refused_with_the_analysis_own_message(value, capsys):
+    # One home: the parser calls the check analyze_trials makes (the parser had its own
+    # "must be a finite duration > 0 s, got 0").
+    with pytest.raises(ValueError) as exc:
+        analyze_trials([], "quasi-static", span_time=float(value))
+    argv = ["trials", "analyze", "x.csv", "--kind", "quasi-static", f"--span-time={value}"]
+    line = refused(argv, capsys)
+    assert line.endswith(f"argument --span-time: {exc.value}"), line

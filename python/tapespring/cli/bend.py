@@ -134,7 +134,7 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     `tape_fields`.
     """
     from tapespring.scenarios.bending import check_alpha_deg
-    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, check_youngs_modulus
+    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, check_poisson, check_youngs_modulus
 
     p.add_argument("--length", type=_field("length"), default=d.length, help="L [m]")
     p.add_argument("--radius", type=_field("radius"), default=d.radius, help="R [m]")
@@ -152,7 +152,12 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
         default=d.youngs_modulus,
         help=f"E [Pa], at most {MAX_YOUNGS_MODULUS:.0e}",
     )
-    p.add_argument("--poisson", type=float, default=d.poisson, help="Poisson's ratio")
+    p.add_argument(
+        "--poisson",
+        type=_checked("poisson", check_poisson),
+        default=d.poisson,
+        help="Poisson's ratio nu, in (-1, 0.5)",
+    )
     p.add_argument(
         "--mesh-size",
         type=_field("mesh_size"),
@@ -187,7 +192,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The ``bend`` parser.
     """
-    from tapespring.scenarios.bending import BendingSetup
+    from tapespring.scenarios.bending import (
+        MAX_IMPERFECTION_DEG,
+        BendingSetup,
+        check_imperfection_deg,
+        check_theta_max_deg,
+    )
 
     d = BendingSetup()
     p = sub.add_parser(
@@ -203,16 +213,17 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_tape_options(p, d)
     p.add_argument(
         "--theta-max",
-        type=float,
+        type=_checked("theta_max_deg", check_theta_max_deg),
         default=d.theta_max_deg,
-        help="final angle [deg] (default 90; negative for equal sense)",
+        help="final angle [deg] in (-360, 360) (default 90; negative for equal sense)",
     )
     p.add_argument("--unload", action="store_true", help="unload back to 0 (hysteresis)")
     p.add_argument(
         "--imperfection",
-        type=float,
+        type=_checked("imperfection_deg", check_imperfection_deg),
         default=None,
-        help="twist imperfection amplitude [deg] (default 0.1 in equal sense, else 0)",
+        help=f"twist imperfection amplitude [deg] in [-{MAX_IMPERFECTION_DEG:g}, "
+        f"{MAX_IMPERFECTION_DEG:g}] (default 0.1 in equal sense, else 0)",
     )
     p.add_argument(
         "--path",
@@ -258,7 +269,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from tapespring.scenarios.bending import BendingSetup, bend, summarize, write_csv
 
-    # A zero or non-finite --theta-max is refused by BendingSetup.validate (in `bend`, below).
+    # A zero or non-finite --theta-max was refused by the parser (BendingSetup's own check).
     imperfection = args.imperfection
     if imperfection is None:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.

@@ -32,8 +32,16 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The ``release`` parser.
     """
-    from tapespring.scenarios.release import ReleaseSetup
-    from tapespring.scenarios.setup import check_rho_inf
+    from tapespring.scenarios.release import (
+        MAX_TIP_INERTIA,
+        MAX_TIP_MASS,
+        ReleaseSetup,
+        check_fold_deg,
+        check_gravity,
+        check_tip_inertia,
+        check_tip_mass,
+    )
+    from tapespring.scenarios.setup import MAX_GRAVITY, check_rho_inf
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -49,16 +57,23 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--fold-deg",
-        type=float,
+        type=_checked("fold_deg", check_fold_deg),
         default=d.fold_deg,
-        help="fold angle [deg], positive opposite sense, negative equal sense (default 60)",
+        help="fold angle [deg] in (-180, 180), positive opposite sense, negative equal sense "
+        "(default 60)",
     )
-    p.add_argument("--tip-mass", type=_field("tip_mass"), default=d.tip_mass, help="m [kg]")
+    p.add_argument(
+        "--tip-mass",
+        type=_checked("tip_mass", check_tip_mass),
+        default=d.tip_mass,
+        help=f"m [kg], at most {MAX_TIP_MASS:g}",
+    )
     p.add_argument(
         "--tip-inertia",
-        type=_field("tip_inertia"),
+        type=_checked("tip_inertia", check_tip_inertia),
         default=d.tip_inertia,
-        help="moment of inertia of the tip body about each axis [kg m^2]",
+        help=f"moment of inertia of the tip body about each axis [kg m^2], at most "
+        f"{MAX_TIP_INERTIA:g}",
     )
     p.add_argument(
         "--duration",
@@ -76,7 +91,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="spectral radius at infinity, in [0, 1]",
     )
     p.add_argument(
-        "--gravity", type=float, default=d.gravity, help="gravity along -z [m/s^2] (default 0)"
+        "--gravity",
+        type=_checked("gravity", check_gravity),
+        default=d.gravity,
+        help=f"gravity along -z [m/s^2], in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] (default 0)",
     )
     p.add_argument(
         "--planar",

@@ -24,36 +24,25 @@ from pathlib import Path
 from typing import TypedDict
 
 from tapespring.protocols.markers import DEFAULT_MARKERS
-from tapespring.protocols.registry import KINDS
+from tapespring.protocols.registry import KINDS, check_span_time
 from tapespring.trials.common import LENGTH
 
-from .bend import _count, refuse
+from .bend import _checked, _count, refuse
 
 __all__ = ["main", "register", "run_analyze"]
 
 _SENSES = ("opposite", "equal")  # tapespring.trials.SENSES, without importing the trials
 
 
-def _seconds(text: str, *, zero: bool) -> float:
+def _non_negative_seconds(text: str) -> float:
+    """An argparse type: a finite duration >= 0 [s]."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a duration in seconds, got {text!r}") from None
-    if not ((0 <= value if zero else 0 < value) and value < float("inf")):
-        raise argparse.ArgumentTypeError(
-            f"must be a finite duration {'>=' if zero else '>'} 0 s, got {text}"
-        )
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite duration >= 0 s, got {text}")
     return value
-
-
-def _positive_seconds(text: str) -> float:
-    """An argparse type: a finite duration > 0 [s]."""
-    return _seconds(text, zero=False)
-
-
-def _non_negative_seconds(text: str) -> float:
-    """An argparse type: a finite duration >= 0 [s]."""
-    return _seconds(text, zero=True)
 
 
 class _AnalyzeParser(argparse.ArgumentParser):
@@ -171,7 +160,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     span.add_argument(
         "--span-time",
-        type=_positive_seconds,
+        type=_checked("span_time", check_span_time),
         default=None,
         metavar="SECONDS",
         help="quasi-static: force smoothing span as a duration [s] (0.0253 = 101 at 4 kHz)",

@@ -43,7 +43,14 @@ if TYPE_CHECKING:
     from .pull import PullTestResult
     from .vibration import VibrationResult
 
-__all__ = ["KINDS", "Protocol", "TrialsAnalysis", "analyze_trials", "protocol_for"]
+__all__ = [
+    "KINDS",
+    "Protocol",
+    "TrialsAnalysis",
+    "analyze_trials",
+    "check_span_time",
+    "protocol_for",
+]
 
 # Kind of test -> module of this package that defines its `PROTOCOL`.
 _MODULES = {"deployment": "deployment", "vibration": "vibration", "quasi-static": "pull"}
@@ -340,6 +347,13 @@ def analyze_trials(
     return dataclasses.replace(analysis, skipped=tuple(left_out))
 
 
+def check_span_time(value: object) -> None:
+    """Raise ValueError unless `value` is a quasi-static force smoothing span ``span_time``: a
+    finite duration > 0 [s] (the command line's ``--span-time`` is refused by this check)."""
+    if not (isinstance(value, numbers.Real) and math.isfinite(value) and float(value) > 0):
+        raise ValueError(f"span_time must be a finite duration > 0 [s], got {value!r}")
+
+
 def _check_options(
     *, n_peaks: int, window: tuple[float, float], span: int, span_time: float | None
 ) -> None:
@@ -352,10 +366,8 @@ def _check_options(
         raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
     if not isinstance(span, numbers.Integral) or span < 1:
         raise ValueError(f"span must be an integer >= 1 [samples], got {span!r}")
-    if span_time is not None and not (
-        isinstance(span_time, numbers.Real) and math.isfinite(span_time) and span_time > 0
-    ):
-        raise ValueError(f"span_time must be a finite duration > 0 [s], got {span_time!r}")
+    if span_time is not None:
+        check_span_time(span_time)
     try:
         low, high = (float(w) for w in window)
     except (TypeError, ValueError):

@@ -42,6 +42,7 @@ from tapespring.scenarios.setup import (
     PAPER_TAPE,
     check_element_count,
     check_number,
+    check_poisson,
     check_youngs_modulus,
 )
 
@@ -54,7 +55,9 @@ __all__ = [
     "bending_model",
     "bending_steps",
     "check_alpha_deg",
+    "check_imperfection_deg",
     "check_rotation_deg",
+    "check_theta_max_deg",
     "summarize",
     "write_csv",
 ]
@@ -100,6 +103,25 @@ def check_alpha_deg(value: float) -> None:
         )
 
 
+def check_theta_max_deg(value: object) -> None:
+    """Raise ValueError unless `value` is the bending's final angle ``theta_max_deg`` [deg]: a
+    number within (-360, 360), at least :data:`MIN_ROTATION_DEG` in magnitude."""
+    number = check_number("theta_max_deg", value, positive=False)
+    check_rotation_deg("theta_max_deg", number, 360.0)
+
+
+def check_imperfection_deg(value: object) -> None:
+    """Raise ValueError unless `value` is a twist imperfection amplitude ``imperfection_deg``
+    [deg]: a number within [-:data:`MAX_IMPERFECTION_DEG`, :data:`MAX_IMPERFECTION_DEG`]."""
+    number = check_number("imperfection_deg", value, positive=False)
+    if abs(number) > MAX_IMPERFECTION_DEG:
+        raise ValueError(
+            f"imperfection_deg = {number} is not a small imperfection: the amplitude of the "
+            f"twist that selects a branch must lie within [-{MAX_IMPERFECTION_DEG:g}, "
+            f"{MAX_IMPERFECTION_DEG:g}] degrees (0.1 in the equal-sense runs)"
+        )
+
+
 @dataclass(frozen=True)
 class BendingSetup:
     """Geometry, material and loading of a pure-bending run (SI units).
@@ -120,15 +142,17 @@ class BendingSetup:
     youngs_modulus : float
         Young's modulus E [Pa].
     poisson : float
-        Poisson's ratio nu.
+        Poisson's ratio nu, in (-1, 0.5).
     mesh_size : float
         Element size [m].
     theta_max_deg : float
-        Final bending angle [deg]; positive for opposite sense, negative for equal sense.
+        Final bending angle [deg]; positive for opposite sense, negative for equal sense. Within
+        (-360, 360), at least :data:`MIN_ROTATION_DEG` in magnitude.
     unload : bool
         Also unload back to zero (hysteresis).
     imperfection_deg : float
         Twist imperfection amplitude [deg]: sections rotated about x by ``a sin(pi x / L)``.
+        Within [-10, 10] (:data:`MAX_IMPERFECTION_DEG`).
     jump : bool
         Follow the path of a slow rotation-controlled test: where the angle reaches a limit, jump
         to the stable equilibrium beyond it instead of tracing the unstable branch back. Off: the
@@ -186,12 +210,13 @@ class BendingSetup:
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False (got {value!r})")
-        check_rotation_deg("theta_max_deg", self.theta_max_deg, 360.0)
+        check_theta_max_deg(self.theta_max_deg)
         # Sizes [m]: the command line's --mesh-size, --length, --radius and --thickness are
         # refused by the same check.
         for name in ("mesh_size", "length", "radius", "thickness"):
             check_number(name, getattr(self, name), positive=True)
         check_youngs_modulus(self.youngs_modulus)
+        check_poisson(self.poisson)
         check_alpha_deg(self.alpha_deg)
         # A shell as thick as its radius of curvature has no inner surface: the Mindlin shell
         # (and eqs. (2)-(3)) describe thin walls, t / R of 0.01 for the paper's tape.
@@ -216,13 +241,7 @@ class BendingSetup:
                 f"(mesh_size <= {coarsest:.3e} m)"
             )
         check_element_count("mesh_size", self.mesh_size, self.length, width)
-        if abs(self.imperfection_deg) > MAX_IMPERFECTION_DEG:
-            raise ValueError(
-                f"imperfection_deg = {self.imperfection_deg} is not a small imperfection: the "
-                f"amplitude of the twist that selects a branch must lie within "
-                f"[-{MAX_IMPERFECTION_DEG:g}, {MAX_IMPERFECTION_DEG:g}] degrees (0.1 in the "
-                f"equal-sense runs)"
-            )
+        check_imperfection_deg(self.imperfection_deg)
         if self.locate_tolerance_deg <= 0.0:
             raise ValueError(f"locate_tolerance_deg must be > 0 (got {self.locate_tolerance_deg})")
 

@@ -24,7 +24,17 @@ from tapespring.scenarios.bending import (
 )
 from tapespring.scenarios.setup import MAX_GRAVITY, check_number, check_rho_inf
 
-__all__ = ["ReleaseResult", "ReleaseSetup", "release", "release_model", "release_steps"]
+__all__ = [
+    "ReleaseResult",
+    "ReleaseSetup",
+    "check_fold_deg",
+    "check_gravity",
+    "check_tip_inertia",
+    "check_tip_mass",
+    "release",
+    "release_model",
+    "release_steps",
+]
 
 
 #: Largest tip mass [kg] and tip inertia [kg m^2]. The iteration matrix holds the tip's
@@ -38,6 +48,45 @@ MAX_TIP_MASS = 1e3
 MAX_TIP_INERTIA = 1.0
 
 
+def _check_tip(name: str, value: object, bound: float) -> None:
+    # The free end needs inertia: a massless tip body leaves its rotations without mass.
+    number = check_number(name, value, positive=True)
+    if number > bound:
+        raise ValueError(
+            f"{name} must be at most {bound:g} (got {number:.3g}; see MAX_{name.upper()})"
+        )
+
+
+def check_tip_mass(value: object) -> None:
+    """Raise ValueError unless `value` is a tip mass ``tip_mass`` [kg]: a number > 0 and at most
+    :data:`MAX_TIP_MASS`."""
+    _check_tip("tip_mass", value, MAX_TIP_MASS)
+
+
+def check_tip_inertia(value: object) -> None:
+    """Raise ValueError unless `value` is a tip inertia ``tip_inertia`` [kg m^2]: a number > 0
+    and at most :data:`MAX_TIP_INERTIA`."""
+    _check_tip("tip_inertia", value, MAX_TIP_INERTIA)
+
+
+def check_gravity(value: object) -> None:
+    """Raise ValueError unless `value` is the release's gravity along -z [m/s^2]: a number of
+    magnitude at most :data:`tapespring.scenarios.setup.MAX_GRAVITY`, of either sign."""
+    number = check_number("gravity", value, positive=False)
+    if abs(number) > MAX_GRAVITY:
+        raise ValueError(
+            f"gravity must lie in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2 (got "
+            f"{number:.3g}; see setup.MAX_GRAVITY)"
+        )
+
+
+def check_fold_deg(value: object) -> None:
+    """Raise ValueError unless `value` is the fold angle ``fold_deg`` [deg]: a number within
+    (-180, 180), at least :data:`tapespring.scenarios.bending.MIN_ROTATION_DEG` in magnitude."""
+    number = check_number("fold_deg", value, positive=False)
+    check_rotation_deg("fold_deg", number, 180.0)
+
+
 @dataclass(frozen=True)
 class ReleaseSetup:
     """What a release run does (SI units, angles in degrees).
@@ -49,11 +98,13 @@ class ReleaseSetup:
     density : float
         Density of the tape [kg/m^3].
     fold_deg : float
-        Fold angle: positive for opposite sense, negative for equal sense.
+        Fold angle [deg]: positive for opposite sense, negative for equal sense. Within
+        (-180, 180), at least 1e-6 in magnitude (:func:`check_fold_deg`).
     tip_mass : float
-        Mass of the tip body [kg].
+        Mass of the tip body [kg], > 0 and at most :data:`MAX_TIP_MASS`.
     tip_inertia : float
-        Its moment of inertia about each axis through the end section's centroid [kg m^2].
+        Its moment of inertia about each axis through the end section's centroid [kg m^2], > 0
+        and at most :data:`MAX_TIP_INERTIA`.
     duration : float
         Free motion after the release [s].
     eta : float
@@ -61,7 +112,8 @@ class ReleaseSetup:
     rho_inf : float
         Spectral radius at infinity of the generalised-alpha scheme.
     gravity : float
-        Gravitational acceleration along -z [m/s^2].
+        Gravitational acceleration along -z [m/s^2], of magnitude at most
+        :data:`tapespring.scenarios.setup.MAX_GRAVITY` (100).
     planar : bool
         After the release, keep the free end in the x-z plane (held in y and about x and z).
     tolerance : float
@@ -98,24 +150,12 @@ class ReleaseSetup:
         """
         for name in ("density", "eta", "tolerance"):
             check_number(name, getattr(self, name), positive=True, zero=True)
-        # The free end needs inertia: a massless tip body leaves its rotations without mass.
-        for name in ("tip_mass", "tip_inertia", "duration"):
-            check_number(name, getattr(self, name), positive=True)
-        for name, bound in (("tip_mass", MAX_TIP_MASS), ("tip_inertia", MAX_TIP_INERTIA)):
-            if getattr(self, name) > bound:
-                raise ValueError(
-                    f"{name} must be at most {bound:g} (got {getattr(self, name):.3g}; see "
-                    f"MAX_{name.upper()})"
-                )
+        check_tip_mass(self.tip_mass)
+        check_tip_inertia(self.tip_inertia)
+        check_number("duration", self.duration, positive=True)
         check_rho_inf(self.rho_inf)
-        check_number("gravity", self.gravity, positive=False)
-        if abs(self.gravity) > MAX_GRAVITY:
-            raise ValueError(
-                f"gravity must lie in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2 (got "
-                f"{self.gravity:.3g}; see setup.MAX_GRAVITY)"
-            )
-        check_number("fold_deg", self.fold_deg, positive=False)
-        check_rotation_deg("fold_deg", self.fold_deg, 180.0)
+        check_gravity(self.gravity)
+        check_fold_deg(self.fold_deg)
 
 
 def release_model(setup: ReleaseSetup) -> tuple[Any, int, int]:

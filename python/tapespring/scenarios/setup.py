@@ -41,6 +41,7 @@ __all__ = [
     "check_element_count",
     "check_eta",
     "check_number",
+    "check_poisson",
     "check_rho_inf",
     "check_sample_rate",
     "check_sampling",
@@ -456,8 +457,7 @@ class SetupSpec:
         for name, value in vars(self.tape).items():
             check_number(f"tape.{name}", value, positive=True)
         check_youngs_modulus(self.tape.youngs_modulus, "tape.youngs_modulus")
-        if not -1.0 < self.tape.poisson < 0.5:
-            raise ValueError(f"tape.poisson must lie in (-1, 0.5) (got {self.tape.poisson})")
+        check_poisson(self.tape.poisson, "tape.poisson")
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
@@ -477,8 +477,7 @@ class SetupSpec:
                 "setup.MAX_GRAVITY)"
             )
         check_eta(self.eta)
-        if not -1.0 < self.plate_poisson < 0.5:
-            raise ValueError(f"plate_poisson must lie in (-1, 0.5) (got {self.plate_poisson})")
+        check_poisson(self.plate_poisson, "plate_poisson")
         self._validate_support()
         if self.appendix_length <= self.mesh_plates:
             raise ValueError(
@@ -513,8 +512,7 @@ class SetupSpec:
         the rest of the set-up only when the support is flexible (a rigid support's spec is
         accepted as before)."""
         check_eta(self.support_eta, "support_eta")
-        if not -1.0 < self.support_poisson < 0.5:
-            raise ValueError(f"support_poisson must lie in (-1, 0.5) (got {self.support_poisson})")
+        check_poisson(self.support_poisson, "support_poisson")
         if self.support != "flexible":
             return
         if self.clamp_interface_length > self.support_length - self.support_thickness / 2.0:
@@ -605,6 +603,15 @@ def check_eta(value: object, name: str = "eta") -> None:
     number = check_number(name, value, positive=False)
     if number < 0.0:
         raise ValueError(f"{name} must be >= 0 s (got {number})")
+
+
+def check_poisson(value: object, name: str = "poisson") -> None:
+    """Raise ValueError naming `name` unless `value` is a Poisson's ratio: a number in (-1, 0.5),
+    the range in which an isotropic material's strain energy is positive definite (the shell
+    material refuses the same)."""
+    number = check_number(name, value, positive=False)
+    if not -1.0 < number < 0.5:
+        raise ValueError(f"{name} must lie in (-1, 0.5) (got {number})")
 
 
 def check_rho_inf(value: float) -> None:
