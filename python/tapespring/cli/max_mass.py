@@ -4,8 +4,10 @@ Maximum mass at the free end of two tape springs for a passive deployment agains
 Sec. 3.1, eq. 1, Fig. 7) over a grid of thickness and Young's modulus, from finite-element
 residual moments at 90 degrees and from the analytical formulas (eqs. 2-3). Prints a summary;
 optionally writes a CSV, a contour plot like Fig. 7 and a JSON object. Building the parser
-imports only `tapespring.scenarios.setup` (numpy) for its defaults; the scenario and matplotlib
-are imported by `run`.
+imports `tapespring.scenarios.max_mass`, the home of the study's ranges and of the checks that
+bound its options, with what it imports at the top (numpy, `scenarios.setup` for the defaults,
+`scenarios.bending`, `report`; no scipy, matplotlib or native extension); the bending runs and
+matplotlib are imported by `run`.
 """
 
 from __future__ import annotations

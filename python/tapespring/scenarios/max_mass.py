@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tapespring.report import jsonable_tree
+from tapespring.report import jsonable, jsonable_tree
 from tapespring.scenarios.bending import BendingSetup, analytical_residual_moment
 from tapespring.scenarios.setup import (
     MAX_GRAVITY,
@@ -517,8 +517,8 @@ class MaxMassResult:
         ``cancelled``.
         """
 
-        def grid(a: NDArray[Any]) -> list[Any]:
-            return jsonable_tree(a)  # type: ignore[return-value]
+        def grid(a: NDArray[Any]) -> list[object]:
+            return [jsonable(row) for row in a.tolist()]
 
         per_sense: dict[str, dict[str, Any]] = {
             "residual_moment_Nm": {},
