@@ -96,6 +96,30 @@ def test_absurd_values_are_refused_by_the_parser_in_short_numbers(argv, message,
 
 
 @pytest.mark.parametrize(
+    ("argv", "got"),
+    [
+        # `:.3g` showed these as "got -100", "got 1e+03": as if in range (setup.shown).
+        (["release", "--gravity=-100.1"], "gravity must lie in [-100, 100] m/s^2 (got -100.1;"),
+        (["release", "--gravity", "100.0001"], "(got 100.0001; see setup.MAX_GRAVITY)"),
+        (["release", "--tip-mass", "1000.5"], "tip_mass must be at most 1000 (got 1000.5;"),
+        (["release", "--tip-inertia", "1.0001"], "tip_inertia must be at most 1 (got 1.0001;"),
+        (["bend", "-E", "1.00001e13"], "(got 1.00001e+13 Pa; see MAX_YOUNGS_MODULUS)"),
+        (["pull", "--youngs-modulus", "10000100000000"], "(got 1.00001e+13 Pa;"),
+        (["bend", "--alpha", "360.0001"], "must lie in (0, 360) degrees (got 360.0001)"),
+        (["deploy", "--sample-rate", "1000000.5"], "(got 1000000.5 Hz; see MAX_SAMPLE_RATE)"),
+        (["vibrate", "--time-step", "9.9999e-7"], "at least 1e-06 s (got 9.9999e-07 s;"),
+        (["max-mass", "--gravity", "100.01"], "must lie in [0.1, 100] m/s^2 (got 100.01;"),
+        (["max-mass", "--gravity", "0.0999"], "must lie in [0.1, 100] m/s^2 (got 0.0999;"),
+        (["max-mass", "--lever-arm", "10.001"], "must lie in [0.001, 10] m (got 10.001;"),
+        (["max-mass", "--lever-arm", "0.0009999"], "must lie in [0.001, 10] m (got 0.0009999;"),
+    ],
+)
+def test_a_value_just_out_of_range_is_refused_with_its_exact_value(argv, got, capsys):
+    line = refused(argv, capsys)
+    assert got in line, line
+
+
+@pytest.mark.parametrize(
     ("argv", "settings"),
     [
         (["bend", "--alpha", "1e300"], BendingSetup(alpha_deg=1e300)),

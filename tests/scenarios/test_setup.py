@@ -13,6 +13,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from _cli import refused
+from hypothesis import given
+from hypothesis import strategies as st
+from property_settings import examples
 from tapespring.cli import main
 from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.pull import PullSettings, pull
@@ -21,6 +24,8 @@ from tapespring.scenarios.setup import (
     PAPER_SETUP,
     SetupSpec,
     build_setup,
+    check_sampling,
+    shown,
 )
 from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
@@ -288,3 +293,64 @@ def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:
     assert np.isnan(result.marker3_m).all() and result.unstable_modes == -1
     argv = ["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--push=0.01", "--json"]
     assert main(argv) == 1
+
+
+# How a refused number is shown (setup.shown): `:.3g` printed --gravity=-100.1 as "got -100",
+# which reads as in range, and 1000.5 as "got 1e+03".
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False))
+@examples(ci=500, long=20_000)
+def test_a_shown_number_reads_back_as_the_same_float(value: float) -> None:
+    text = shown(value)
+    assert float(text) == value and math.copysign(1.0, float(text)) == math.copysign(1.0, value)
+    assert text == shown(float(text))
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [
+        (0.0, "0"),
+        (-0.0, "-0"),
+        (-100.1, "-100.1"),
+        (1000.5, "1000.5"),
+        (0.1 + 0.2, "0.30000000000000004"),
+        (1e-4, "0.0001"),
+        (9.9e-5, "9.9e-05"),
+        (999_999_999.5, "999999999.5"),
+        (1e9, "1e+09"),
+        (1.00001e13, "1.00001e+13"),
+        (1e-300, "1e-300"),
+        (-1e300, "-1e+300"),
+        (5e-324, "5e-324"),
+        (float("nan"), "nan"),
+        (float("inf"), "inf"),
+        (-float("inf"), "-inf"),
+        (7, "7"),
+    ],
+)
+def test_a_shown_number_is_positional_for_ordinary_magnitudes(value: float, text: str) -> None:
+    # Positional in [1e-4, 1e9) as tape-core's `shown` (crates/tape-core/src/error.rs).
+    assert shown(value) == text
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"gravity": 100.1}, r"\(got 100.1; see setup.MAX_GRAVITY\)"),
+        (
+            {"tape": replace(PAPER_SETUP.tape, youngs_modulus=1.00001e13)},
+            r"tape.youngs_modulus must be at most 1e\+13 Pa, .*\(got 1.00001e\+13 Pa;",
+        ),
+    ],
+)
+def test_a_spec_just_out_of_range_is_refused_with_its_exact_value(change, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        replace(PAPER_SETUP, **change).validate()
+
+
+def test_sampling_just_beyond_the_steps_shows_the_exact_duration() -> None:
+    # 1.000005 s at 1e5 Hz: 100000.5 samples, beyond the max_steps = 100000 a step takes ("1 s
+    # at 1e+05 Hz" before). The rate (1/time_step in vibrate) and the count keep 3 digits.
+    with pytest.raises(ValueError, match=r"^duration = 1.000005 s at sample_rate = 1e\+05 Hz "):
+        check_sampling(("duration", 1.000005), sample_rate=1e5, rate_name="sample_rate")

@@ -44,6 +44,7 @@ from tapespring.scenarios.setup import (
     check_number,
     check_poisson,
     check_youngs_modulus,
+    shown,
 )
 
 __all__ = [
@@ -99,7 +100,7 @@ def check_alpha_deg(value: float) -> None:
     if not 0.0 < value < 360.0:
         raise ValueError(
             f"alpha_deg (the section's subtended angle) must lie in (0, 360) degrees "
-            f"(got {value:.3g})"
+            f"(got {shown(value)})"
         )
 
 

@@ -53,6 +53,7 @@ from tapespring.scenarios.setup import (
     IdentificationBounds,
     TapeSpring,
     check_number,
+    shown,
 )
 
 __all__ = [
@@ -114,7 +115,7 @@ def _check_within(name: str, value: object, bounds: tuple[float, float], unit: s
     low, high = bounds
     if not low <= number <= high:
         raise ValueError(
-            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {number:.3g}; see "
+            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {shown(number)}; see "
             f"{name.upper()}_RANGE)"
         )
 

@@ -22,7 +22,7 @@ from tapespring.scenarios.bending import (
     bending_steps,
     check_rotation_deg,
 )
-from tapespring.scenarios.setup import MAX_GRAVITY, check_number, check_rho_inf
+from tapespring.scenarios.setup import MAX_GRAVITY, check_number, check_rho_inf, shown
 
 __all__ = [
     "ReleaseResult",
@@ -53,7 +53,7 @@ def _check_tip(name: str, value: object, bound: float) -> None:
     number = check_number(name, value, positive=True)
     if number > bound:
         raise ValueError(
-            f"{name} must be at most {bound:g} (got {number:.3g}; see MAX_{name.upper()})"
+            f"{name} must be at most {bound:g} (got {shown(number)}; see MAX_{name.upper()})"
         )
 
 
@@ -76,7 +76,7 @@ def check_gravity(value: object) -> None:
     if abs(number) > MAX_GRAVITY:
         raise ValueError(
             f"gravity must lie in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2 (got "
-            f"{number:.3g}; see setup.MAX_GRAVITY)"
+            f"{shown(number)}; see setup.MAX_GRAVITY)"
         )
 
 

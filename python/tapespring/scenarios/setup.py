@@ -47,6 +47,7 @@ __all__ = [
     "check_sampling",
     "check_sense",
     "check_youngs_modulus",
+    "shown",
 ]
 
 
@@ -109,7 +110,7 @@ def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
     if number > MAX_YOUNGS_MODULUS:
         raise ValueError(
             f"{name} must be at most {MAX_YOUNGS_MODULUS:.0e} Pa, ten times diamond's (got "
-            f"{number:.3g} Pa; see MAX_YOUNGS_MODULUS)"
+            f"{shown(number)} Pa; see MAX_YOUNGS_MODULUS)"
         )
 
 
@@ -473,7 +474,7 @@ class SetupSpec:
             check_number("support_marker", value, positive=False)
         if self.gravity > MAX_GRAVITY:
             raise ValueError(
-                f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {self.gravity:.3g}; see "
+                f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {shown(self.gravity)}; see "
                 "setup.MAX_GRAVITY)"
             )
         check_eta(self.eta)
@@ -551,9 +552,9 @@ def check_element_count(name: str, size: float, length: float, width: float) -> 
     if n > MAX_ELEMENTS:
         count = f"{n:.3g}" if math.isfinite(n) else "over 1e+308"
         raise ValueError(
-            f"{name} = {size:.3g} m is too fine for a tape {length:.3g} m long and {width:.3g} m "
-            f"wide: {count} elements, more than {MAX_ELEMENTS:.0e} (a larger {name}, or a smaller "
-            "tape)"
+            f"{name} = {shown(size)} m is too fine for a tape {length:.3g} m long and "
+            f"{width:.3g} m wide: {count} elements, more than {MAX_ELEMENTS:.0e} (a larger "
+            f"{name}, or a smaller tape)"
         )
 
 
@@ -577,6 +578,27 @@ def check_sense(sense: str) -> None:
     """Raise ValueError unless `sense` is ``"opposite"`` or ``"equal"``."""
     if sense not in SENSES:
         raise ValueError(f"sense must be one of {SENSES} (got {sense!r})")
+
+
+def shown(value: float) -> str:
+    """How an error message shows a refused number `value`: the shortest text that reads back as
+    the same float, so a value just out of range does not read as in range (``-100.1``, not
+    ``-100`` as ``:.3g`` printed it).
+
+    Positional for magnitudes in [1e-4, 1e9) and for 0 (``0.25``, ``-100.1``, ``1000000``),
+    scientific otherwise (``1e-05``, ``1.00001e+13``, ``1e+300``); ``nan``, ``inf`` and ``-inf``
+    as Python writes them, and an integer in full. The range is that of tape-core's ``shown``
+    (crates/tape-core/src/error.rs), whose messages show numbers the same way. Bounds keep their
+    own readable forms in the messages.
+    """
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    number = float(value)
+    if not math.isfinite(number):
+        return repr(number)
+    if number == 0.0 or 1e-4 <= abs(number) < 1e9:
+        return np.format_float_positional(number, unique=True, trim="-")
+    return np.format_float_scientific(number, unique=True, trim="-")
 
 
 def check_number(name: str, value: object, *, positive: bool, zero: bool = False) -> float:
@@ -1139,7 +1161,7 @@ def check_sample_rate(value: object, name: str = "sample_rate") -> None:
     if number > MAX_SAMPLE_RATE:
         raise ValueError(
             f"{name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
-            f"(got {number:.3g} Hz; see MAX_SAMPLE_RATE)"
+            f"(got {shown(number)} Hz; see MAX_SAMPLE_RATE)"
         )
 
 
@@ -1153,7 +1175,7 @@ def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name
     samples = value / (1.0 / sample_rate)
     if samples > MAX_DYNAMIC_STEPS:
         raise ValueError(
-            f"{name} = {value:.3g} s at {rate_name} = {sample_rate:.3g} Hz makes {samples:.3g} "
+            f"{name} = {shown(value)} s at {rate_name} = {sample_rate:.3g} Hz makes {samples:.3g} "
             f"samples, each a time step: more than the {MAX_DYNAMIC_STEPS} a dynamic step takes "
             f"(max_steps); shorten the {name} or lower the {rate_name}"
         )

@@ -48,6 +48,7 @@ from tapespring.scenarios.setup import (
     gravity_step,
     raise_if_stopped,
     sample_rows,
+    shown,
 )
 
 __all__ = [
@@ -71,7 +72,7 @@ def check_time_step(value: object) -> None:
     if 0.0 < number < 1.0 / MAX_SAMPLE_RATE:
         raise ValueError(
             f"time_step must be 0 (adaptive steps) or at least {1.0 / MAX_SAMPLE_RATE:.0e} s "
-            f"(got {number:.3g} s; see MAX_SAMPLE_RATE)"
+            f"(got {shown(number)} s; see MAX_SAMPLE_RATE)"
         )
 
 
