@@ -169,6 +169,20 @@ impl ViscousWork {
     }
 }
 
+/// `rows[i] . b` for each of the `R` rows, each sum exactly [`dot24`]'s (in index order from
+/// -0.0), the rows' sums interleaved so that their chains of dependent additions overlap instead
+/// of running one after the other.
+#[inline]
+fn dots24<const R: usize>(rows: &[[f64; DOFS_PER_ELEMENT]], b: &[f64; DOFS_PER_ELEMENT]) -> [f64; R] {
+    let mut acc = [-0.0; R];
+    for (k, bk) in b.iter().enumerate() {
+        for (a, row) in acc.iter_mut().zip(rows) {
+            *a += row[k] * bk;
+        }
+    }
+    acc
+}
+
 #[inline]
 fn dot24(a: &[f64; DOFS_PER_ELEMENT], b: &[f64; DOFS_PER_ELEMENT]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -642,9 +656,8 @@ impl ShellElement {
             let rows = (tangent || vel.is_some()).then(|| gauss_rows(&g.dn, &xs, &ds, &d));
             let (mut nv, mut mv) = (Vector3::zeros(), Vector3::zeros());
             if let (Some(vel), Some(rows)) = (&vel, &rows) {
-                let rate =
-                    |i: usize| Vector3::new(dot24(&rows[i], vel), dot24(&rows[i + 1], vel), dot24(&rows[i + 2], vel));
-                let (de, dk) = (rate(0), rate(3));
+                let r: [f64; 6] = dots24(rows, vel);
+                let (de, dk) = (Vector3::new(r[0], r[1], r[2]), Vector3::new(r[3], r[4], r[5]));
                 (nv, mv) = (sec.membrane * de * (eta * g.w), sec.bending * dk * (eta * g.w));
                 power += nv.dot(&de) + mv.dot(&dk);
                 n += nv;
@@ -721,7 +734,7 @@ impl ShellElement {
         });
         let mut qd = Vector4::zeros();
         if let (Some(vel), Some(rows)) = (&vel, &shear_rows) {
-            let rate = Vector4::from_fn(|t, _| dot24(&rows[t], vel));
+            let rate = Vector4::from(dots24::<4>(rows, vel));
             qd = self.shear_metric * rate * (sec.shear * eta);
             power += qd.dot(&rate);
             qv += qd;
@@ -1224,6 +1237,30 @@ mod tests {
             q[a] = rotate(&q[a], &Vector3::ith(c - 3, h));
         }
         (x, q)
+    }
+
+    /// The interleaved dot products are the one-by-one dot products to the bit.
+    #[test]
+    fn interleaved_dot_products_are_the_dot_products_to_the_bit() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((seed % 11) as i32 - 5)
+        };
+        let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
+        let mut b = [0.0; DOFS_PER_ELEMENT];
+        for v in rows.iter_mut().flatten().chain(b.iter_mut()) {
+            *v = next();
+        }
+        rows[5] = [-0.0; DOFS_PER_ELEMENT];
+        let six: [f64; 6] = dots24(&rows, &b);
+        let four: [f64; 4] = dots24(&rows, &b);
+        for i in 0..6 {
+            assert_eq!(six[i].to_bits(), dot24(&rows[i], &b).to_bits(), "row {i}");
+        }
+        for i in 0..4 {
+            assert_eq!(four[i].to_bits(), dot24(&rows[i], &b).to_bits(), "row {i}");
+        }
     }
 
     /// The blocked Gram product gives every entry of `s Bt^T Bt` exactly as the dot products one
