@@ -223,3 +223,22 @@ def test_span_time_just_outside_its_range_is_refused_with_the_analysis_own_messa
     argv = ["trials", "analyze", "x.csv", "--kind", "quasi-static", f"--span-time={value}"]
     line = refused(argv, capsys)
     assert line.endswith(f"argument --span-time: {exc.value}"), line
+
+
+@pytest.mark.parametrize("value", ["0", "0.0125", "inf"])
+def test_max_gap_takes_what_fill_gaps_takes_inf_included(value):
+    args = build_parser().parse_args(
+        ["trials", "analyze", "x.csv", "--kind", "deployment", f"--max-gap={value}"]
+    )
+    assert args.max_gap == float(value)
+    make_deployment_trial()[0].fill_gaps(args.max_gap)
+
+
+@pytest.mark.parametrize("value", ["-0.01", "-5e-324", "-inf", "nan"])
+def test_max_gap_fill_gaps_refuses_is_refused_with_its_message(value, capsys):
+    # One home: the parser calls fill_gaps' check (the parser had its own, which refused inf).
+    with pytest.raises(ValueError) as exc:
+        make_deployment_trial()[0].fill_gaps(float(value))
+    argv = ["trials", "analyze", "x.csv", "--kind", "deployment", f"--max-gap={value}"]
+    line = refused(argv, capsys)
+    assert line.endswith(f"argument --max-gap: {exc.value}"), line

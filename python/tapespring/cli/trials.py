@@ -26,23 +26,13 @@ from typing import TypedDict
 from tapespring.protocols.markers import DEFAULT_MARKERS
 from tapespring.protocols.registry import KINDS, check_span_time
 from tapespring.trials.common import LENGTH
+from tapespring.trials.trial import check_max_gap
 
 from .bend import _checked, _count, refuse
 
 __all__ = ["main", "register", "run_analyze"]
 
 _SENSES = ("opposite", "equal")  # tapespring.trials.SENSES, without importing the trials
-
-
-def _non_negative_seconds(text: str) -> float:
-    """An argparse type: a finite duration >= 0 [s]."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a duration in seconds, got {text!r}") from None
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a finite duration >= 0 s, got {text}")
-    return value
 
 
 class _AnalyzeParser(argparse.ArgumentParser):
@@ -167,7 +157,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--max-gap",
-        type=_non_negative_seconds,
+        type=_checked("max_gap", check_max_gap),
         default=None,
         metavar="SECONDS",
         help=(

@@ -19,6 +19,7 @@ touch either end of the record, stay NaN.
 from __future__ import annotations
 
 import dataclasses
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +37,7 @@ __all__ = [
     "Trial",
     "TrialError",
     "TrialWarning",
+    "check_max_gap",
 ]
 
 #: Senses of bending (paper Sec. 2): opposite (M, theta > 0) and equal (M, theta < 0).
@@ -231,6 +233,16 @@ class Gap:
         return self.stop - self.start
 
 
+def check_max_gap(value: object) -> None:
+    """Raise ValueError unless `value` is a ``max_gap`` of `Trial.fill_gaps`: a duration >= 0 [s],
+    ``inf`` filling every interior gap (the command line's ``--max-gap`` is refused by this
+    check)."""
+    if not (isinstance(value, numbers.Real) and float(value) >= 0):
+        raise ValueError(
+            f"max_gap must be a duration >= 0 [s] (inf fills every interior gap), got {value!r}"
+        )
+
+
 @dataclass(frozen=True)
 class Trial:
     """One experimental record: markers, force plates and metadata, in SI units.
@@ -367,7 +379,8 @@ class Trial:
         Parameters
         ----------
         max_gap : float
-            Longest gap filled [s] (compared with `Gap.duration`); must be >= 0.
+            Longest gap filled [s] (compared with `Gap.duration`); >= 0, ``inf`` fills every
+            interior gap (`check_max_gap`).
 
         Returns
         -------
@@ -377,8 +390,7 @@ class Trial:
         # scipy.interpolate takes longer to import than the rest of the trials together.
         from scipy.interpolate import CubicSpline
 
-        if not max_gap >= 0:
-            raise ValueError(f"max_gap must satisfy max_gap >= 0, got {max_gap}")
+        check_max_gap(max_gap)
         gaps = [g for g in self.gaps() if not g.at_edge and g.duration <= max_gap + 1e-12]
         if not gaps:
             return self
