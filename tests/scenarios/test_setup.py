@@ -110,6 +110,9 @@ def test_equal_sense_turns_gravity_and_markers_over() -> None:
         # One bound for every scenario's gravity (setup.MAX_GRAVITY); 1e300 was accepted.
         ({"gravity": 1e300}, r"gravity must be at most 100 m/s\^2 \(got 1e\+300; see"),
         ({"gravity": 0.0}, r"gravity must be > 0"),
+        # The direction is the sense's (`down`), so a negative gravity would point up: refused.
+        ({"gravity": -9.81}, r"gravity must be > 0 \(got -9.81\)"),
+        ({"gravity": -0.0}, r"gravity must be > 0 \(got -0.0\)"),
     ],
 )
 def test_bad_spec_is_named(change: dict, message: str) -> None:
