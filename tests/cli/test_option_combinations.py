@@ -219,8 +219,8 @@ def test_the_parser_takes_the_values_the_settings_take(argv, dest, value):
 @pytest.mark.parametrize(
     ("option", "value", "words"),
     [
-        ("--length", "1e300", ["1e+300 m long", "4.7392997757888766e+303 elements, more than"]),
-        ("--radius", "1e300", ["1.219112482518039e+300 m wide", "elements, more than 1e+06"]),
+        ("--length", "1e300", ["1e+300 m long", "4.74e+303 elements, more than 1e+06"]),
+        ("--radius", "1e300", ["1.22e+300 m wide", "elements, more than 1e+06"]),
     ],
 )
 def test_a_tape_too_large_for_its_mesh_is_named_before_the_run(option, value, words, capsys):
@@ -238,7 +238,7 @@ def test_deploy_refuses_more_samples_than_a_dynamic_step_takes(capsys):
     assert main(["deploy", "--sample-rate", "1e6", "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "error: duration = 1 s at sample_rate = 1000000 Hz makes 1000000 samples, each a time "
+        "error: duration = 1 s at sample_rate = 1e+06 Hz makes 1000000 samples, each a time "
         "step: more than the 100000 a dynamic step takes (max_steps); shorten the duration or "
         "lower the sample_rate"
     )

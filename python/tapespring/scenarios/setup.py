@@ -551,8 +551,8 @@ def check_element_count(name: str, size: float, length: float, width: float) -> 
     n = (length / size) * (width / size)
     if n > MAX_ELEMENTS:
         raise ValueError(
-            f"{name} = {shown(size)} m is too fine for a tape {shown(length)} m long and "
-            f"{shown(width)} m wide: {_shown_count(n)} elements, more than {MAX_ELEMENTS:.0e} "
+            f"{name} = {shown(size)} m is too fine for a tape {length:.3g} m long and "
+            f"{width:.3g} m wide: {_shown_count(n)} elements, more than {MAX_ELEMENTS:.0e} "
             f"(a larger {name}, or a smaller tape)"
         )
 
@@ -574,11 +574,14 @@ MIN_DISPLACEMENT = 1e-6
 
 
 def _shown_count(n: float) -> str:
-    """How an error message shows a derived count `n` > 0 (elements, samples): rounded up, as
-    `shown` prints that whole number, so a count just above its limit reads as above it
-    (``100001``, not ``1e+05`` as ``:.3g`` printed it). In full below 1e9, which every count
-    near a limit is; an absurd one in scientific notation; ``over 1e+308`` if it overflowed."""
-    return shown(float(math.ceil(n))) if math.isfinite(n) else "over 1e+308"
+    """How an error message shows a derived count `n` > 0 (elements, samples): rounded up to a
+    whole number below 1e9, so a count just above its limit reads as above it (``100001``, not
+    ``1e+05`` as ``:.3g`` printed it); an absurd one to 3 digits; ``over 1e+308`` if it
+    overflowed. (Derived lengths and rates keep 3 digits: they are context, not the refused
+    value, which `shown` prints exactly.)"""
+    if not math.isfinite(n):
+        return "over 1e+308"
+    return str(math.ceil(n)) if n < 1e9 else f"{n:.3g}"
 
 
 def check_sense(sense: str) -> None:
@@ -1182,7 +1185,7 @@ def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name
     samples = value / (1.0 / sample_rate)
     if samples > MAX_DYNAMIC_STEPS:
         raise ValueError(
-            f"{name} = {shown(value)} s at {rate_name} = {shown(sample_rate)} Hz makes "
+            f"{name} = {shown(value)} s at {rate_name} = {sample_rate:.3g} Hz makes "
             f"{_shown_count(samples)} samples, each a time step: more than the "
             f"{MAX_DYNAMIC_STEPS} a dynamic step takes (max_steps); shorten the {name} or lower "
             f"the {rate_name}"
