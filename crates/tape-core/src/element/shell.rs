@@ -1018,13 +1018,7 @@ fn gauss_rate_rows(
 /// which vectorises where the dot products one by one compiled to scalar code; with AVX2 where
 /// the CPU has it (detected at run time). Same values to the bit on every path.
 fn gram_into(btil: &[f64; DOFS_PER_ELEMENT * N_ROWS], s: f64, k: &mut ElementMatrix) {
-    // Row-major by strain row: the four entries of a block are contiguous.
-    let mut bt = [0.0; DOFS_PER_ELEMENT * N_ROWS];
-    for j in 0..DOFS_PER_ELEMENT {
-        for r in 0..N_ROWS {
-            bt[r * DOFS_PER_ELEMENT + j] = btil[j * N_ROWS + r];
-        }
-    }
+    let bt = row_major(btil);
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked above), all `gram_avx2` requires.
@@ -1038,6 +1032,18 @@ fn gram_into(btil: &[f64; DOFS_PER_ELEMENT * N_ROWS], s: f64, k: &mut ElementMat
 #[target_feature(enable = "avx2")]
 fn gram_avx2(bt: &[f64; DOFS_PER_ELEMENT * N_ROWS], s: f64, k: &mut ElementMatrix) {
     gram_blocks(bt, s, k);
+}
+
+/// The strain rows `btil` (column-major by DOF) row-major by strain row, so that the entries of
+/// a block of [`gram_blocks`] are contiguous.
+fn row_major(btil: &[f64; DOFS_PER_ELEMENT * N_ROWS]) -> [f64; DOFS_PER_ELEMENT * N_ROWS] {
+    let mut bt = [0.0; DOFS_PER_ELEMENT * N_ROWS];
+    for j in 0..DOFS_PER_ELEMENT {
+        for r in 0..N_ROWS {
+            bt[r * DOFS_PER_ELEMENT + j] = btil[j * N_ROWS + r];
+        }
+    }
+    bt
 }
 
 /// [`gram_into`]'s product on the row-major rows `bt` (inlined into each instruction-set
@@ -1239,14 +1245,19 @@ mod tests {
         (x, q)
     }
 
+    /// Deterministic pseudo-random numbers of magnitudes 1e-6 to 1e6 (either sign), so that a
+    /// different summation order would show in the last bits.
+    fn mixed_magnitudes(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((seed % 13) as i32 - 6)
+        }
+    }
+
     /// The interleaved dot products are the one-by-one dot products to the bit.
     #[test]
     fn interleaved_dot_products_are_the_dot_products_to_the_bit() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((seed % 11) as i32 - 5)
-        };
+        let mut next = mixed_magnitudes(0x2545_f491_4f6c_dd1d);
         let mut rows = [[0.0; DOFS_PER_ELEMENT]; 6];
         let mut b = [0.0; DOFS_PER_ELEMENT];
         for v in rows.iter_mut().flatten().chain(b.iter_mut()) {
@@ -1267,22 +1278,12 @@ mod tests {
     /// by one do (the same products and sums in the same order), on every instruction set.
     #[test]
     fn gram_product_is_the_dot_products_to_the_bit() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut btil = [0.0; DOFS_PER_ELEMENT * N_ROWS];
-        for v in &mut btil {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            // Mixed magnitudes, so that a different summation order would show.
-            *v = ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((seed % 13) as i32 - 6);
-        }
+        let mut next = mixed_magnitudes(0x9e37_79b9_7f4a_7c15);
+        let btil: [f64; DOFS_PER_ELEMENT * N_ROWS] = std::array::from_fn(|_| next());
         let s = 1.000_173;
         let mut k = ElementMatrix::zeros();
         gram_into(&btil, s, &mut k);
-        let mut bt = [0.0; DOFS_PER_ELEMENT * N_ROWS];
-        for j in 0..DOFS_PER_ELEMENT {
-            for r in 0..N_ROWS {
-                bt[r * DOFS_PER_ELEMENT + j] = btil[j * N_ROWS + r];
-            }
-        }
+        let bt = row_major(&btil);
         let mut k_generic = ElementMatrix::zeros();
         gram_blocks(&bt, s, &mut k_generic);
         for i in 0..DOFS_PER_ELEMENT {
