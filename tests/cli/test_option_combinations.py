@@ -35,6 +35,10 @@ from tapespring.scenarios.vibration import VibrationSettings
         (["vibrate", "--rho-inf-study", "0.5", "--rho-inf", "0.7"], ["--rho-inf", "-study"]),
         (["vibrate", "--time-step", "1e-3", "--tolerance", "1e-5"], ["--tolerance", "--time-step"]),
         (
+            ["vibrate", "--time-step", "1e-3", "--sample-rate", "800"],
+            ["--sample-rate", "--time-step"],
+        ),
+        (
             ["max-mass", "--n-thickness", "1", "--thickness-range", "1e-4", "2e-4"],
             ["--n-thickness"],
         ),
@@ -127,6 +131,7 @@ def test_a_value_just_out_of_range_is_refused_with_its_exact_value(argv, got, ca
         (["bend", "-E", "1e300"], BendingSetup(youngs_modulus=1e300)),
         (["deploy", "--sample-rate", "1e7"], DeploymentSettings(sample_rate=1e7, duration=1e-3)),
         (["vibrate", "--time-step", "1e-7"], VibrationSettings(time_step=1e-7, duration=1e-3)),
+        (["vibrate", "--sample-rate", "1e7"], VibrationSettings(sample_rate=1e7, duration=1e-3)),
         (["max-mass", "--gravity", "1e3"], MaxMassSettings(gravity=1e3)),
         (["max-mass", "--gravity", "-1"], MaxMassSettings(gravity=-1.0)),
         (["max-mass", "--lever-arm", "20"], MaxMassSettings(lever_arm=20.0)),
@@ -199,6 +204,7 @@ def test_the_parser_refuses_a_bound_with_the_settings_own_message(argv, settings
         (["deploy", "--rho-inf", "1"], "rho_inf", 1.0),
         (["vibrate", "--rho-inf-study", "0", "1"], "rho_inf_study", [0.0, 1.0]),
         (["vibrate", "--eta", "0"], "eta", 0.0),
+        (["vibrate", "--sample-rate", "800"], "sample_rate", 800.0),
         (["equilibrium", "--push", "1e-6"], "push", 1e-6),
         (["equilibrium", "--push", "0.2499"], "push", 0.2499),
         (["pull", "--max-displacement", "1e-6"], "max_displacement", 1e-6),

@@ -199,7 +199,7 @@ def test_vibrate_command_with_an_experiment(tmp_path, capsys) -> None:
     }
     assert c["experiment"]["period_s"] == pytest.approx(0.09, rel=0.01)
     assert png.stat().st_size > 10_000
-    # 50 Hz of a 0.4 s decay at 800 Hz samples: every 16th record, and the last.
+    # 50 Hz of a 0.4 s decay at 400 Hz samples: every 8th record, and the last.
     assert len(list((tmp_path / "decay").glob("*.vtu"))) >= 20
 
 

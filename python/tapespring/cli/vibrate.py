@@ -38,13 +38,36 @@ def _check(args: argparse.Namespace) -> None:
         for option in ("experiment", "vtu"):
             if getattr(args, option):
                 refuse(args, f"--rho-inf-study takes no --{option}")
-    if args.time_step > 0.0 and args.tolerance is not None:
-        refuse(args, "--tolerance applies to adaptive steps, not to a fixed --time-step")
+    if args.time_step > 0.0:
+        for option in ("tolerance", "sample_rate"):
+            if getattr(args, option) is not None:
+                flag = "--" + option.replace("_", "-")
+                refuse(args, f"{flag} applies to adaptive steps, not to a fixed --time-step")
+
+
+#: Rate of the ParaView series that ``--vtu`` writes [Hz].
+VTU_RATE = 50.0
+
+
+def _vtu_interval(args: argparse.Namespace) -> int:
+    """Every how many records ``--vtu`` keeps one: about :data:`VTU_RATE` (records are the
+    samples, or every step of a fixed --time-step)."""
+    from tapespring.scenarios.vibration import VibrationSettings
+
+    rate = args.sample_rate or VibrationSettings.sample_rate
+    if args.time_step > 0.0:
+        rate = 1.0 / args.time_step
+    return max(1, round(rate / VTU_RATE))
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
-    from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
+    from tapespring.scenarios.setup import (
+        MAX_DYNAMIC_STEPS,
+        MAX_SAMPLE_RATE,
+        check_rho_inf,
+        check_sample_rate,
+    )
     from tapespring.scenarios.vibration import VibrationSettings, check_time_step
 
     d = VibrationSettings()
@@ -90,6 +113,15 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"{d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
     )
     p.add_argument(
+        "--sample-rate",
+        type=_checked("sample rate", check_sample_rate),
+        default=None,
+        help="rate of the recorded decay [Hz]; the time steps land on its multiples and are at "
+        f"most one sample long (default {d.sample_rate:g}, every other instant of the paper's "
+        f"800 Hz motion capture; not with a fixed --time-step); at most {MAX_SAMPLE_RATE:.0e}, "
+        f"and at most {MAX_DYNAMIC_STEPS} samples in --duration",
+    )
+    p.add_argument(
         "--time-step",
         type=_checked("time step", check_time_step),
         default=d.time_step,
@@ -111,11 +143,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         experiment="a free decay of marker M3 on the additional weight: drawn under the "
         "simulation aligned at the release, with both fits, its period and damping ratio "
         "compared with the simulation's and the paper's model (Table 8)",
-        vtu="every 16th record: 50 Hz at 800 Hz samples",
+        vtu=f"about {VTU_RATE:g} Hz: every {round(d.sample_rate / VTU_RATE)}th record at the "
+        f"default {d.sample_rate:g} Hz samples",
     )
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3)
     add_output_options(
-        p, "time_s and displacement_m, one row per sample (--time-step or 800 Hz) from the release"
+        p,
+        "time_s and displacement_m, one row per sample (--sample-rate or --time-step) from the "
+        "release",
     )
     p.set_defaults(func=run, parser=p)
     return p
@@ -150,8 +185,8 @@ def run(args: argparse.Namespace) -> int:
             initial_displacement=args.initial_displacement,
             window=window,
             time_step=args.time_step,
-            field_interval=16 if args.vtu else 0,
-            **_given(args, "rho_inf", "tolerance"),
+            field_interval=_vtu_interval(args) if args.vtu else 0,
+            **_given(args, "rho_inf", "tolerance", "sample_rate"),
         )
         result = vibrate(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
@@ -193,7 +228,7 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
             initial_displacement=args.initial_displacement,
             window=window,
             time_step=args.time_step,
-            **_given(args, "tolerance"),
+            **_given(args, "tolerance", "sample_rate"),
         )
         rho = tuple(args.rho_inf_study)
         return numerical_damping_study(settings, rho, progress=not (args.no_progress or args.json))

@@ -96,8 +96,13 @@ class VibrationSettings:
     window : tuple of float
         Range of |peak| used in the fit [m] (paper: 0.4 to 4 mm).
     sample_rate : float
-        Rate at which the decay is recorded [Hz] (the steps land on its multiples; the motion
-        capture of the paper samples at 800 Hz).
+        Rate at which the decay is recorded [Hz]; the steps land on its multiples and are at
+        most one sample long. Default 400 Hz, every other instant of the paper's 800 Hz motion
+        capture: 45 samples a period, and steps of 2.5 ms (omega h = 0.14) at which the scheme
+        lengthens the period by 0.18 % and adds 7e-6 to the damping ratio (a seventh of a
+        percent of the paper's 0.5 %), in half the time of 800 Hz (measured on the paper's
+        meshes, 8 s: 0.493 % at either rate, a period of 0.1144 s against 0.1143 s, 52 s of wall
+        time against 97 s).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default).
     time_step : float
@@ -118,7 +123,7 @@ class VibrationSettings:
     duration: float = 8.0
     rho_inf: float = PAPER_MODEL.rho_inf
     window: tuple[float, float] = PAPER_MODEL.vibration_peak_window
-    sample_rate: float = 800.0
+    sample_rate: float = 400.0
     tolerance: float = 1e-4
     time_step: float = 0.0
     modes: int = 4
