@@ -38,6 +38,9 @@ from tapespring.scenarios.vibration import VibrationSettings
             ["vibrate", "--time-step", "1e-3", "--sample-rate", "800"],
             ["--sample-rate", "--time-step"],
         ),
+        # The window in the option's mm, the check's own words in m.
+        (["vibrate", "--window-mm", "4", "0.4"], ["--window-mm 4 0.4", "(0.004, 0.0004) m"]),
+        (["vibrate", "--window-mm", "nan", "4"], ["--window-mm nan 4", "finite"]),
         (
             ["max-mass", "--n-thickness", "1", "--thickness-range", "1e-4", "2e-4"],
             ["--n-thickness"],

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from property_settings import examples
-from tapespring.signals import fit_damping, noise_std, select_window_peaks
+from tapespring.signals import check_window, fit_damping, noise_std, select_window_peaks
 from tapespring.trials.samples import vibration_displacement
 
 RATE = 800.0
@@ -242,3 +242,31 @@ def _fit_tolerances(fit, t_true, v_true, eps, period, dt, t_end, sigma_hat, sigm
     tol_omega_d = np.pi * tol_h / h**2
     tol_eps = (omega_d**2 * tol_a + a * omega_d * tol_omega_d) / omega0**3
     return tol_eps, 2 * tol_h, tol_c
+
+
+@pytest.mark.parametrize(
+    ("window", "words"),
+    [
+        ((4e-3, 0.4e-3), "0 <= low < high (got (0.004, 0.0004) m)"),
+        ((-1e-3, 4e-3), "0 <= low < high"),
+        ((1e-3, 1e-3), "0 <= low < high"),
+        ((float("nan"), 4e-3), "finite"),
+        ((0.0, float("inf")), "finite"),
+        ((True, 4e-3), "pair of numbers"),
+        (("0.4e-3", "4e-3"), "pair of numbers"),
+        ((1e-3,), "pair (low, high) [m]"),
+        (None, "pair (low, high) [m]"),
+    ],
+)
+def test_a_bad_window_is_refused_by_name(window, words):
+    # One check for the fit, the trial analyses and the vibration scenario's settings.
+    with pytest.raises(ValueError, match="window") as info:
+        check_window(window)
+    assert words in str(info.value)
+    with pytest.raises(ValueError, match="window"):
+        select_window_peaks(np.arange(10.0), np.zeros(10), window)
+
+
+def test_a_window_from_zero_and_from_numpy_scalars_is_taken():
+    assert check_window([0, 1]) == (0.0, 1.0)
+    assert check_window(np.array([0.4e-3, 4e-3])) == (0.4e-3, 4e-3)

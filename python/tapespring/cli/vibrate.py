@@ -31,7 +31,14 @@ def _given(args: argparse.Namespace, *names: str) -> dict[str, Any]:
 
 
 def _check(args: argparse.Namespace) -> None:
-    """Refuse the options that the others given make ineffective."""
+    """Refuse a bad --window-mm and the options that the others given make ineffective."""
+    from tapespring.signals.damping import check_window
+
+    low, high = args.window_mm
+    try:
+        check_window((low * 1e-3, high * 1e-3))
+    except ValueError as e:
+        refuse(args, f"--window-mm {low:g} {high:g}: {e}")
     if args.rho_inf_study:
         if args.rho_inf is not None:
             refuse(args, "--rho-inf is not used with --rho-inf-study, which gives the radii")

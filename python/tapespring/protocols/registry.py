@@ -368,9 +368,6 @@ def _check_options(
         raise ValueError(f"span must be an integer >= 1 [samples], got {span!r}")
     if span_time is not None:
         check_span_time(span_time)
-    try:
-        low, high = (float(w) for w in window)
-    except (TypeError, ValueError):
-        raise ValueError(f"window must be two numbers (low, high) [m], got {window!r}") from None
-    if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high):
-        raise ValueError(f"window must satisfy 0 <= low < high [m], got ({low:g}, {high:g})")
+    from tapespring.signals.damping import check_window
+
+    check_window(window)

@@ -145,13 +145,11 @@ class VibrationSettings:
             check_sampling(
                 ("duration", self.duration), sample_rate=self.sample_rate, rate_name="sample_rate"
             )
-        if not isinstance(self.window, tuple | list) or len(self.window) != 2:
+        from tapespring.signals.damping import check_window
+
+        if not isinstance(self.window, tuple | list):
             raise ValueError(f"window must be a pair (low, high) [m] (got {self.window!r})")
-        for value in self.window:
-            check_number("window", value, positive=False)
-        lo, hi = self.window
-        if not 0.0 <= lo < hi:
-            raise ValueError(f"window must satisfy 0 <= low < high (got {self.window})")
+        check_window(self.window)
         check_count("modes", self.modes, minimum=1)
         check_count("field_interval", self.field_interval, minimum=0)
 

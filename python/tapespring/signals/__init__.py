@@ -53,6 +53,7 @@ __all__ = [
     "analyze_pull_test",
     "bending_angle",
     "check_span",
+    "check_window",
     "compare_peaks",
     "complete_windows",
     "detect_phases",
@@ -84,7 +85,7 @@ __getattr__, __dir__ = lazy_exports(
         "angle": ["bending_angle"],
         "circle": ["CircleFit", "fit_circle", "max_lateral_displacement"],
         "crossings": ["CrossingPeaks", "force_at_crossings"],
-        "damping": ["DampingFit", "fit_damping", "select_window_peaks"],
+        "damping": ["DampingFit", "check_window", "fit_damping", "select_window_peaks"],
         "frame": ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"],
         "levels": ["equilibrium_value", "release_index", "swing_midline"],
         "peaks": [

@@ -35,6 +35,10 @@ period ``Delta t = 2 pi / (omega0 sqrt(1 - epsilon^2)) = 2 pi / omega_d``
 
 from __future__ import annotations
 
+import itertools
+import math
+import numbers
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +47,30 @@ from scipy.optimize import least_squares
 from .peaks import extract_peaks
 from .smoothing import noise_std
 
-__all__ = ["DampingFit", "fit_damping", "select_window_peaks"]
+__all__ = ["DampingFit", "check_window", "fit_damping", "select_window_peaks"]
+
+
+def check_window(window: object) -> tuple[float, float]:
+    """The range of |peak| a damping fit uses, `window` = (low, high) [m], as two floats.
+
+    Raises
+    ------
+    ValueError
+        Unless `window` is a pair of finite real numbers with ``0 <= low < high``.
+    """
+    # At most three items: a pair, or enough to tell that it is not one (without reading a long
+    # or endless iterable whole).
+    pair = tuple(itertools.islice(window, 3)) if isinstance(window, Iterable) else ()
+    if len(pair) != 2:
+        raise ValueError(f"window must be a pair (low, high) [m] (got {window!r})")
+    if any(isinstance(v, bool) or not isinstance(v, numbers.Real) for v in pair):
+        raise ValueError(f"window must be a pair of numbers (low, high) [m] (got {window!r})")
+    low, high = float(pair[0]), float(pair[1])
+    if not (math.isfinite(low) and math.isfinite(high)):
+        raise ValueError(f"window must be finite (got ({low:g}, {high:g}) m)")
+    if not 0.0 <= low < high:
+        raise ValueError(f"window must satisfy 0 <= low < high (got ({low:g}, {high:g}) m)")
+    return low, high
 
 
 @dataclass(frozen=True)
@@ -143,9 +170,7 @@ def _all_peaks(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every peak from ``t_start`` on (time, value, kind +1/-1) and the mask of those in the
     window."""
-    lo, hi = window
-    if not 0 <= lo < hi:
-        raise ValueError(f"window must satisfy 0 <= low < high, got {window}")
+    lo, hi = check_window(window)
     if prominence is None and lo > 0:
         # A peak that swings by `lo` or more about the equilibrium stands at least `lo` above
         # the troughs either side (they lie across the equilibrium), so `lo` never drops one.
