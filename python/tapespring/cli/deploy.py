@@ -16,6 +16,7 @@ from .bend import (
 )
 from .scenario_options import (
     add_output_options,
+    add_sample_rate_option,
     add_spec_options,
     analyze_experiment,
     finish,
@@ -45,11 +46,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
     from tapespring.scenarios.setup import (
-        MAX_DYNAMIC_STEPS,
-        MAX_SAMPLE_RATE,
         SUPPORTS,
         check_rho_inf,
-        check_sample_rate,
     )
 
     d = DeploymentSettings()
@@ -75,15 +73,11 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "or a shell model of the support standing on the force plate (flexible, Fig. 33); the "
         "clamp force is the vertical force under it",
     )
-    p.add_argument(
-        "--sample-rate",
-        type=_checked("sample rate", check_sample_rate),
-        default=None,
-        help="rate of the recorded histories [Hz]; the time steps land on its multiples "
-        f"(default {d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
-        f"resolves the support's vibration at 164 Hz); at most {MAX_SAMPLE_RATE:.0e} (below a "
-        "microsecond the solver cannot place the steps on the samples at the release's time), "
-        f"and at most {MAX_DYNAMIC_STEPS} samples in --duration",
+    add_sample_rate_option(
+        p,
+        recorded="histories",
+        default=f"{d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
+        "resolves the support's vibration at 164 Hz",
     )
     p.add_argument(
         "--duration",

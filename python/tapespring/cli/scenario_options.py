@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 __all__ = [
     "add_comparison_options",
     "add_output_options",
+    "add_sample_rate_option",
     "add_spec_options",
     "analyze_experiment",
     "finish",
@@ -89,6 +90,22 @@ def spec_from_args(args: argparse.Namespace) -> Any:
         eta=getattr(args, "eta", PAPER_SETUP.eta),
         mesh_tape=args.mesh_tape,
         mesh_plates=args.mesh_plates,
+    )
+
+
+def add_sample_rate_option(p: argparse.ArgumentParser, *, recorded: str, default: str) -> None:
+    """Add ``--sample-rate`` [Hz], checked as the settings check it (None when not given: the
+    command's default, which `default` describes); `recorded` names what it samples."""
+    from tapespring.scenarios.setup import MAX_DYNAMIC_STEPS, MAX_SAMPLE_RATE, check_sample_rate
+
+    p.add_argument(
+        "--sample-rate",
+        type=_checked("sample rate", check_sample_rate),
+        default=None,
+        help=f"rate of the recorded {recorded} [Hz]; the time steps land on its multiples and "
+        f"are at most one sample long (default {default}); at most {MAX_SAMPLE_RATE:.0e} (below "
+        "a microsecond the solver cannot place the steps on the samples at the release's "
+        f"time), and at most {MAX_DYNAMIC_STEPS} samples in --duration",
     )
 
 

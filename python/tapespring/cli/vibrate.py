@@ -10,6 +10,7 @@ from .bend import _checked, _field, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
+    add_sample_rate_option,
     add_spec_options,
     analyze_experiment,
     finish,
@@ -69,12 +70,7 @@ def _vtu_interval(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
-    from tapespring.scenarios.setup import (
-        MAX_DYNAMIC_STEPS,
-        MAX_SAMPLE_RATE,
-        check_rho_inf,
-        check_sample_rate,
-    )
+    from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
     from tapespring.scenarios.vibration import VibrationSettings, check_time_step
 
     d = VibrationSettings()
@@ -119,14 +115,11 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="local error tolerance of the adaptive time steps [m] (default "
         f"{d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
     )
-    p.add_argument(
-        "--sample-rate",
-        type=_checked("sample rate", check_sample_rate),
-        default=None,
-        help="rate of the recorded decay [Hz]; the time steps land on its multiples and are at "
-        f"most one sample long (default {d.sample_rate:g}, every other instant of the paper's "
-        f"800 Hz motion capture; not with a fixed --time-step); at most {MAX_SAMPLE_RATE:.0e}, "
-        f"and at most {MAX_DYNAMIC_STEPS} samples in --duration",
+    add_sample_rate_option(
+        p,
+        recorded="decay",
+        default=f"{d.sample_rate:g}, every other instant of the paper's 800 Hz motion capture; "
+        "not with a fixed --time-step",
     )
     p.add_argument(
         "--time-step",
