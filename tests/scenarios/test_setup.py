@@ -54,6 +54,8 @@ def flexibility(spec: SetupSpec, lever: float) -> float:
 def test_spec_keeps_the_papers_figures() -> None:
     s = PAPER_SETUP
     assert s.free_end_mass == pytest.approx(0.077, abs=1e-12)
+    # The spec's choices put the free end's centre of mass "about 124 mm from the clamp".
+    assert s.free_end_centre_x == pytest.approx(0.124, abs=1e-3)
     assert s.setup_length == pytest.approx(0.235, rel=0.01)  # "about 236 mm" (4.3 mm = 1.82 %)
     assert (s.mesh_tape, s.mesh_plates) == (2e-3, 3e-3)
     assert (s.initial_angle_opposite_deg, s.initial_angle_equal_deg) == (95.5, -91.2)

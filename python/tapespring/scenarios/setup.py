@@ -438,6 +438,18 @@ class SetupSpec:
         """Mass of the two small interfaces, the rod and the appendix [kg] (paper: 77 g)."""
         return 2.0 * self.interface_mass + self.rod_mass + self.appendix_mass
 
+    @property
+    def free_end_centre_x(self) -> float:
+        """Distance of the free end's centre of mass from the clamp along x [m]: the two small
+        interfaces, the rod and the appendix, each a uniform body (74 mm beyond the tapes'
+        middle by default, the lever arm of eq. (1))."""
+        parts = (
+            (2.0 * self.interface_mass, self.tape.length + 0.5 * self.interface_length),
+            (self.rod_mass, self.rod_x + 0.5 * self.rod_width),
+            (self.appendix_mass, self.appendix_x + 0.5 * self.appendix_length),
+        )
+        return sum(m * x for m, x in parts) / self.free_end_mass
+
     def initial_angle_deg(self, sense: str) -> float:
         """The initial bending angle of a deployment in `sense` [deg]."""
         check_sense(sense)
