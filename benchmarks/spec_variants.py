@@ -1,0 +1,109 @@
+"""The paper's figures for variants of the set-up spec (issue 9): what an undocumented dimension
+decides.
+
+Each variant is the spec with some fields replaced. For each variant this script runs the tests
+asked for, on the paper's meshes (the pull on 3 mm), and prints one line per test:
+
+- ``table6``: the folded equilibrium with the additional weight (Table 6's four displacements);
+- ``pull``: the pull test's maximum force and its displacement (Table 9);
+- ``modal``: the first period about the loaded equilibrium with the weight (Table 8);
+- ``opposite``: the first extrema of the opposite-sense deployment (1.2 s of motion);
+- ``equal``: the large minima (below -20 deg) of the equal-sense deployment (2.6 s) for each
+  ``--eta``, the paper's fourth large peak being the third large minimum, there with eta =
+  1.73e-4 s and gone with 2.1e-4 s in the paper's model (Sec. 6.1, Figs. 29-32).
+
+Named variants (``--variant``) move mass within the free end's 77 g, which the paper gives whole;
+``--set NAME=VALUE`` builds one from any fields. About 90 s per deployment run.
+
+    python benchmarks/spec_variants.py --tests equal                      # the spec as it is
+    python benchmarks/spec_variants.py --variant outward --tests table6 pull modal opposite equal
+    python benchmarks/spec_variants.py --set appendix_mass=0.018 --set interface_mass=0.024
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+
+from tapespring.scenarios.deployment import DeploymentSettings, deploy
+from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+from tapespring.scenarios.pull import PullSettings, pull
+from tapespring.scenarios.setup import PAPER_SETUP, SetupSpec
+from tapespring.scenarios.vibration import VibrationSettings, vibrate
+
+#: Splits of the free end's 77 g [kg] (two small interfaces, the rod, the appendix).
+VARIANTS: dict[str, dict[str, float]] = {
+    "spec": {},
+    # 5 g from the small interfaces to the appendix.
+    "outward": {"appendix_mass": 0.020, "interface_mass": 0.0225},
+    # 5 g from the appendix to the small interfaces.
+    "inward": {"appendix_mass": 0.010, "interface_mass": 0.0275},
+    # The rod and the appendix at the mass of solid aluminium of the spec's dimensions (80 x 10
+    # x 3 mm: 6.48 g; 40 mm x 2 mm over 110 mm: 23.76 g), the interfaces taking the rest.
+    "aluminium": {"rod_mass": 0.00648, "appendix_mass": 0.02376, "interface_mass": 0.02338},
+}
+TESTS = ("table6", "pull", "modal", "opposite", "equal")
+#: Large minima are those below this bending angle [deg].
+LARGE_DEG = -20.0
+
+
+def run_tests(name: str, spec: SetupSpec, tests: list[str], etas: list[float]) -> None:
+    """Print one line per test of `tests` for `spec`."""
+    lever = 1e3 * (spec.free_end_centre_x - spec.tape.length / 2.0)
+    mass = 1e3 * spec.free_end_mass
+    print(f"{name}: free end {mass:.1f} g, {lever:.1f} mm beyond the tapes' middle")
+    if "table6" in tests:
+        d = equilibrium(EquilibriumSettings(spec=spec)).summary()["marker_displacements_m"]
+        keys = ("markers12_dx_m", "markers12_dz_m", "marker3_dx_m", "marker3_dz_m")
+        mm = [1e3 * d[k] for k in keys]
+        print("  table6   markers 1-2 {:.1f} / {:.1f} mm, marker 3 {:.1f} / {:.1f} mm".format(*mm))
+    if "pull" in tests:
+        s = pull(PullSettings(spec=replace(spec, mesh_tape=3e-3, mesh_plates=3e-3))).summary()
+        at = 1e3 * s["max_force_displacement_m"]
+        print(f"  pull     {s['max_force_N']:.2f} N at {at:.1f} mm (3 mm)")
+    if "modal" in tests:
+        v = vibrate(VibrationSettings(spec=spec, duration=0.01))
+        print(f"  modal    {v.modal_periods_s[0]:.4f} s")
+    if "opposite" in tests:
+        p = deploy(DeploymentSettings(spec=spec, duration=1.2)).summary()["peaks"]
+        maxima = zip(p["max_time_s"], p["max_deg"], strict=True)
+        minima = zip(p["min_time_s"], p["min_deg"], strict=True)
+        extrema = sorted([*maxima, *minima])
+        print("  opposite " + ", ".join(f"{v:+.1f} deg at {t:.2f} s" for t, v in extrema[:4]))
+    if "equal" in tests:
+        for eta in etas:
+            start = time.perf_counter()
+            settings = DeploymentSettings(spec=replace(spec, eta=eta), sense="equal", duration=2.6)
+            p = deploy(settings).summary()["peaks"]
+            large = [
+                f"{v:+.1f} deg at {t:.2f} s"
+                for t, v in zip(p["min_time_s"], p["min_deg"], strict=True)
+                if v < LARGE_DEG
+            ]
+            print(
+                f"  equal    eta {eta:.3g} s: large minima {', '.join(large) or 'none'} "
+                f"({time.perf_counter() - start:.0f} s)",
+                flush=True,
+            )
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--variant", choices=sorted(VARIANTS), nargs="+", default=[])
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a field")
+    p.add_argument("--tests", choices=TESTS, nargs="+", default=["equal"])
+    p.add_argument("--eta", type=float, nargs="+", default=[1.73e-4, 2.1e-4], help="[s]")
+    args = p.parse_args()
+    variants = {name: VARIANTS[name] for name in args.variant}
+    if args.set:
+        fields = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
+        variants[" ".join(args.set)] = fields
+    for name, fields in (variants or {"spec": {}}).items():
+        spec = replace(PAPER_SETUP, **fields)
+        spec.validate()
+        run_tests(name, spec, args.tests, args.eta)
+
+
+if __name__ == "__main__":
+    main()
