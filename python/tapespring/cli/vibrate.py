@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 from typing import TYPE_CHECKING, Any
 
@@ -55,17 +56,6 @@ def _check(args: argparse.Namespace) -> None:
 
 #: Rate of the ParaView series that ``--vtu`` writes [Hz].
 VTU_RATE = 50.0
-
-
-def _vtu_interval(args: argparse.Namespace) -> int:
-    """Every how many records ``--vtu`` keeps one: about :data:`VTU_RATE` (records are the
-    samples, or every step of a fixed --time-step)."""
-    from tapespring.scenarios.vibration import VibrationSettings
-
-    rate = args.sample_rate or VibrationSettings.sample_rate
-    if args.time_step > 0.0:
-        rate = 1.0 / args.time_step
-    return max(1, round(rate / VTU_RATE))
 
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -185,9 +175,12 @@ def run(args: argparse.Namespace) -> int:
             initial_displacement=args.initial_displacement,
             window=window,
             time_step=args.time_step,
-            field_interval=_vtu_interval(args) if args.vtu else 0,
             **_given(args, "rho_inf", "tolerance", "sample_rate"),
         )
+        if args.vtu:
+            # About VTU_RATE whatever the records' rate.
+            interval = max(1, round(settings.record_rate / VTU_RATE))
+            settings = dataclasses.replace(settings, field_interval=interval)
         result = vibrate(settings, progress=not (args.no_progress or args.json))
         if measured is not None:
             compare = functools.partial(result.compare, measured)

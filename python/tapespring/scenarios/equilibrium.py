@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 
 from tapespring.scenarios.setup import (
-    MIN_DISPLACEMENT,
     PAPER_MODEL,
     PAPER_SETUP,
     SetupSpec,
     buckling_step,
     build_setup,
+    check_displacement,
     drive,
     gravity_step,
     raise_if_stopped,
@@ -40,12 +40,7 @@ __all__ = ["EquilibriumResult", "EquilibriumSettings", "check_push", "equilibriu
 def check_push(value: object) -> None:
     """Raise ValueError unless `value` is a push of the weight's tip [m]: a number in
     [:data:`~tapespring.scenarios.setup.MIN_DISPLACEMENT`, 0.25)."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float))
-        or not MIN_DISPLACEMENT <= value < 0.25
-    ):
-        raise ValueError(f"push must lie in [{MIN_DISPLACEMENT:g}, 0.25) m (got {value!r})")
+    check_displacement("push", value, 0.25)
 
 
 @dataclass(frozen=True)

@@ -30,12 +30,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
-    MIN_DISPLACEMENT,
     PAPER_SETUP,
     SetupSpec,
     buckling_step,
     build_setup,
     check_count,
+    check_displacement,
     drive,
     gravity_step,
     raise_if_stopped,
@@ -62,14 +62,7 @@ TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2"}
 def check_max_displacement(value: object) -> None:
     """Raise ValueError unless `value` is the displacement of marker 2 at the end of the pull
     [m]: a number in [:data:`~tapespring.scenarios.setup.MIN_DISPLACEMENT`, 0.1)."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float))
-        or not MIN_DISPLACEMENT <= value < 0.1
-    ):
-        raise ValueError(
-            f"max_displacement must lie in [{MIN_DISPLACEMENT:g}, 0.1) m (got {value!r})"
-        )
+    check_displacement("max_displacement", value, 0.1)
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ __all__ = [
     "add_flexible_support",
     "build_setup",
     "check_count",
+    "check_displacement",
     "check_element_count",
     "check_eta",
     "check_number",
@@ -583,6 +584,17 @@ MAX_GRAVITY = 100.0
 #: solver can resolve (1e-300 reached it as "the loads and prescribed motions act on no free
 #: DOF").
 MIN_DISPLACEMENT = 1e-6
+
+
+def check_displacement(name: str, value: object, upper: float) -> None:
+    """Raise ValueError naming `name` unless `value` is a displacement a static scenario
+    prescribes [m]: a number in [:data:`MIN_DISPLACEMENT`, `upper`)."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not MIN_DISPLACEMENT <= value < upper
+    ):
+        raise ValueError(f"{name} must lie in [{MIN_DISPLACEMENT:g}, {upper:g}) m (got {value!r})")
 
 
 def _shown_count(n: float) -> str:

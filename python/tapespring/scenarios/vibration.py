@@ -129,6 +129,12 @@ class VibrationSettings:
     modes: int = 4
     field_interval: int = 0
 
+    @property
+    def record_rate(self) -> float:
+        """Rate of the records [Hz]: every fixed `time_step` (``1 / time_step``), else the
+        samples' `sample_rate` (the rows of :meth:`VibrationSimulation.sample_rows`)."""
+        return 1.0 / self.time_step if self.time_step > 0.0 else self.sample_rate
+
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
@@ -137,14 +143,11 @@ class VibrationSettings:
         check_rho_inf(self.rho_inf)
         check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_time_step(self.time_step)
-        if self.time_step > 0.0:
-            # Every fixed step is a record: the same bounds as the samples.
-            rate = 1.0 / self.time_step
-            check_sampling(("duration", self.duration), sample_rate=rate, rate_name="1/time_step")
-        else:
-            check_sampling(
-                ("duration", self.duration), sample_rate=self.sample_rate, rate_name="sample_rate"
-            )
+        # Every fixed step is a record: the same bounds as the samples.
+        rate_name = "1/time_step" if self.time_step > 0.0 else "sample_rate"
+        check_sampling(
+            ("duration", self.duration), sample_rate=self.record_rate, rate_name=rate_name
+        )
         from tapespring.signals.damping import check_window
 
         if not isinstance(self.window, tuple | list):
@@ -191,8 +194,7 @@ class VibrationSimulation:
         """Rows of the histories at the sample instants from the release: ``k / sample_rate``, or
         every fixed ``time_step`` (the error control adds steps between samples where the motion
         is fast; a recording has the samples only)."""
-        s = self.settings
-        return sample_rows(self.time_s, 1.0 / s.time_step if s.time_step > 0.0 else s.sample_rate)
+        return sample_rows(self.time_s, self.settings.record_rate)
 
     def to_trial(self, *, rate_hz: float | None = None, hold: float = 0.25) -> Any:
         """The free decay sampled like a recorded vibration test, as a
