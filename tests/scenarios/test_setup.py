@@ -208,6 +208,15 @@ def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> Non
     json.dumps(summary)
 
 
+def test_a_decay_with_fixed_steps_is_sampled_on_its_steps() -> None:
+    # With a fixed 5 ms step the records are 200 Hz; the trial samples them there (it once took
+    # the 400 Hz sample_rate and interpolated between the records).
+    sim = vibrate(VibrationSettings(spec=COARSE, duration=0.05, time_step=5e-3))
+    trial = sim.to_trial(hold=0.0)
+    assert trial.rate == pytest.approx(200.0)
+    assert trial.time.size == 11
+
+
 def test_vibrate_command_records_at_the_sample_rate_it_is_given(tmp_path, capsys) -> None:
     csv_path, pvd = tmp_path / "decay.csv", tmp_path / "decay.pvd"
     argv = ["vibrate", "--mesh-tape=5e-3", "--mesh-plates=10e-3", "--duration=0.1"]

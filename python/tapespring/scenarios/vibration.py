@@ -203,8 +203,8 @@ class VibrationSimulation:
         Parameters
         ----------
         rate_hz : float, optional
-            Marker sampling rate [Hz] (default: the run's ``sample_rate``, where the records
-            fall on the samples).
+            Marker sampling rate [Hz] (default: the rate of the records,
+            :attr:`VibrationSettings.record_rate`, so that the samples fall on them).
         hold : float
             Rest in the pushed state before the release [s], >= 0 (a recording starts before
             the hand lets go; the protocol takes the held value from the first samples).
@@ -220,7 +220,7 @@ class VibrationSimulation:
         from tapespring.scenarios.pull import rest_before
         from tapespring.trials.trial import Metadata
 
-        rate = self.settings.sample_rate if rate_hz is None else rate_hz
+        rate = self.settings.record_rate if rate_hz is None else rate_hz
         trial = self.results.to_trial(
             markers=TRIAL_MARKERS,
             rate_hz=rate,
