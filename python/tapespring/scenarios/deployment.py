@@ -199,7 +199,7 @@ class DeploymentSimulation:
         """Rows of the histories at the sample instants ``k / sample_rate`` from the release.
 
         The time steps land on every sample (``output_interval``); the error control adds steps
-        between them where the motion is fast (150 of the 631 rows of the first 0.6 s at 800 Hz,
+        between them where the motion is fast (148 of the 629 rows of the first 0.6 s at 800 Hz,
         opposite sense, 5 mm tapes). These rows are the samples only, the release first, as a
         recording at `sample_rate` has them; a last state off that grid (a `duration` that is no
         multiple of the interval, a run stopped early) is not one.

@@ -101,8 +101,8 @@ class VibrationSettings:
         capture: 45 samples a period, and steps of 2.5 ms (omega h = 0.14) at which the scheme
         lengthens the period by 0.18 % and adds 7e-6 to the damping ratio (a seventh of a
         percent of the paper's 0.5 %), in half the time of 800 Hz (measured on the paper's
-        meshes, 8 s: 0.493 % at either rate, a period of 0.1144 s against 0.1143 s, 52 s of wall
-        time against 97 s).
+        meshes, 8 s, with the spec's earlier mass split: 0.493 % at either rate, a period of
+        0.1144 s against 0.1143 s, 52 s of wall time against 97 s).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default).
     time_step : float

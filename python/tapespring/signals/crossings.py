@@ -13,8 +13,8 @@ shorter half-cycle: an eighth of a period either side). The *peak* is the larges
 ``|f - baseline|`` inside the window; *elsewhere* is the largest outside it in the two flanking
 half-cycles, each trimmed by ``w_k`` at its far end so that the neighbouring crossings' own
 windows are left out. A crossing has a peak of its own when ``ratio = peak / elsewhere`` is well
-above one. Measured on the paper's meshes (opposite sense, 3 s): ratios 3.3 to 6.8 at the four
-crossings of phases I and II, 2.6 at the last one before phase III.
+above one. Measured on the paper's meshes (opposite sense, 10 s): ratios 3.5 to 7.3 at the four
+crossings of phases I and II, 2.5 at the last one before phase III.
 """
 
 from __future__ import annotations
