@@ -32,10 +32,14 @@ Example
 
 from __future__ import annotations
 
+import math
+import numbers
 import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+
+import numpy as np
 
 from tapespring import _core
 from tapespring._core import ConvergenceError, Model, TapeError
@@ -132,6 +136,46 @@ def modal_step_options() -> dict[str, Any]:
     return options
 
 
+def _ids(ids: str | Iterable[str]) -> tuple[str, ...]:
+    """`ids` as a tuple; a single string is one id (``tuple("push")`` would be four)."""
+    return (ids,) if isinstance(ids, str) else tuple(ids)
+
+
+def _index(value: Any, what: str, pair: tuple[Any, Any] | None = None) -> int:
+    """`value` as an int >= 0: `field_interval` named `what`, or the node of `pair` in `what`.
+
+    An integral float is accepted, as by the `Model` methods; a fractional one is refused, not
+    truncated, and so is a bool (``True`` is not the index 1). The messages are worded as the
+    `Model` methods' ("node must hold integer node indices (got the value 1.5)").
+
+    Raises
+    ------
+    TypeError
+        If `value` is not a number.
+    ValueError
+        If it is a bool, not an integer, or negative.
+    """
+    if pair is None:
+        integer, positive, where = "be an integer", "be >= 0", ""
+    else:
+        integer, positive = "hold integer node indices", "hold node indices >= 0"
+        where = f" in {pair!r}"
+    if isinstance(value, bool | np.bool_):
+        raise ValueError(f"{what} must {integer} (got the bool {value}{where})")
+    if isinstance(value, numbers.Integral):
+        index = int(value)
+    elif isinstance(value, numbers.Real):
+        number = float(value)
+        if not (math.isfinite(number) and number.is_integer()):
+            raise ValueError(f"{what} must {integer} (got the value {value}{where})")
+        index = int(number)
+    else:
+        raise TypeError(f"{what} must {integer} (got a {type(value).__name__}: {value!r}{where})")
+    if index < 0:
+        raise ValueError(f"{what} must {positive} (got {index}{where})")
+    return index
+
+
 @dataclass(frozen=True)
 class Step:
     """An analysis step: what it computes, and what it switches on and off at its start.
@@ -144,7 +188,8 @@ class Step:
         ``"static"``: an equilibrium path; ``"dynamic"``: a transient over a duration;
         ``"modal"``: the vibration modes of the current state.
     activate, deactivate : tuple of str
-        Ids of constraints, loads or gravity switched on and off at the start of the step.
+        Ids of constraints, loads or gravity switched on and off at the start of the step (a
+        single string given is one id).
     options : mapping
         The step's options (see :func:`step_options`), e.g. ``control="arc-length"``,
         ``lambda_end=1.0``, ``tol_force=1e-6``.
@@ -156,17 +201,26 @@ class Step:
     deactivate: tuple[str, ...] = ()
     options: Mapping[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        # Also for a Step built directly: a string given as ids would be split into letters.
+        object.__setattr__(self, "activate", _ids(self.activate))
+        object.__setattr__(self, "deactivate", _ids(self.deactivate))
+
     @classmethod
     def static(
         cls,
         name: str = "static",
         *,
-        activate: Sequence[str] = (),
-        deactivate: Sequence[str] = (),
+        activate: str | Sequence[str] = (),
+        deactivate: str | Sequence[str] = (),
         **options: Any,
     ) -> Step:
-        """A static step; `options` are those of :func:`step_options` (``control`` included)."""
-        return cls(name, "static", tuple(activate), tuple(deactivate), dict(options))
+        """A static step; `options` are those of :func:`step_options` (``control`` included).
+
+        `activate` and `deactivate` are the ids switched on and off at its start: a sequence of
+        strings, or one string for one id (``deactivate="push"``).
+        """
+        return cls(name, "static", _ids(activate), _ids(deactivate), dict(options))
 
     @classmethod
     def dynamic(
@@ -174,18 +228,19 @@ class Step:
         name: str = "dynamic",
         *,
         duration: float,
-        activate: Sequence[str] = (),
-        deactivate: Sequence[str] = (),
+        activate: str | Sequence[str] = (),
+        deactivate: str | Sequence[str] = (),
         **options: Any,
     ) -> Step:
         """A dynamic step of `duration` [s]; `options` are those of :func:`dynamic_step_options`.
 
         The step starts from the state the previous one left (a static step leaves it at rest);
         constraints and loads switched off at its start are released at once, with accelerations
-        consistent with what is left.
+        consistent with what is left. `activate` and `deactivate` are the ids switched on and off
+        at its start: a sequence of strings, or one string for one id.
         """
         return cls(
-            name, "dynamic", tuple(activate), tuple(deactivate), {"duration": duration, **options}
+            name, "dynamic", _ids(activate), _ids(deactivate), {"duration": duration, **options}
         )
 
     @classmethod
@@ -196,8 +251,8 @@ class Step:
         modes: int = 10,
         shift: float | None = None,
         matrices: bool = False,
-        activate: Sequence[str] = (),
-        deactivate: Sequence[str] = (),
+        activate: str | Sequence[str] = (),
+        deactivate: str | Sequence[str] = (),
         **options: Any,
     ) -> Step:
         """A modal step: the `modes` vibration modes of the current state, which it leaves as is.
@@ -219,16 +274,16 @@ class Step:
             singular). It must not be a natural frequency.
         matrices : bool
             Keep the free-DOF stiffness and mass (:class:`tapespring.modes.SystemMatrices`).
-        activate, deactivate : sequence of str
-            Ids switched on and off at the start of the step.
+        activate, deactivate : str or sequence of str
+            Ids switched on and off at the start of the step (one string: one id).
         **options
             The other options of :func:`modal_step_options` (``tolerance``, ``reference_point``).
         """
         return cls(
             name,
             "modal",
-            tuple(activate),
-            tuple(deactivate),
+            _ids(activate),
+            _ids(deactivate),
             {"modes": modes, "shift": shift, "matrices": matrices, **options},
         )
 
@@ -250,23 +305,54 @@ class Outputs:
     Attributes
     ----------
     reactions : tuple of (int, str)
-        ``(node, dof)`` whose force ``f_int - f_ext`` is recorded: the reaction where the DOF is
-        constrained, the (vanishing) residual where it is free. Empty: every ``(node, dof)`` a
-        constraint of the model acts on, in model order.
+        ``(node, dof)`` whose force ``f_int - f_ext`` [N or N m] is recorded: the reaction where
+        the DOF is constrained, the (vanishing) residual where it is free. Empty: every
+        ``(node, dof)`` a constraint of the model acts on, in model order.
     field_interval : int
-        Record nodal displacements and rotations every `field_interval`-th record (the last one
-        always); 0 records none.
+        Record nodal displacements [m] and rotations [rad] every `field_interval`-th record (the
+        last one always); 0 records none.
+
+    Node indices and `field_interval` are integers >= 0 (an integral float such as ``2.0`` is
+    accepted, as by the `Model` methods). A fractional value (``1.5`` is refused, not
+    truncated), a bool or a negative one raises ValueError naming ``Outputs.reactions`` or
+    ``Outputs.field_interval``; a value that is not a number, a dof that is not a string or an
+    entry of `reactions` that is not a ``(node, dof)`` pair raises TypeError.
     """
 
     reactions: tuple[tuple[int, str], ...] = ()
     field_interval: int = 0
 
+    def __post_init__(self) -> None:
+        # Checked here, where the mistake is made: int() in to_dict truncated 1.5 to node 1.
+        object.__setattr__(self, "reactions", _reaction_dofs(self.reactions))
+        object.__setattr__(
+            self, "field_interval", _index(self.field_interval, "Outputs.field_interval")
+        )
+
     def to_dict(self) -> dict[str, Any]:
         """The dict the native runner reads."""
         return {
-            "reactions": [(int(n), str(d)) for n, d in self.reactions],
-            "field_interval": int(self.field_interval),
+            "reactions": [(n, d) for n, d in self.reactions],
+            "field_interval": self.field_interval,
         }
+
+
+def _reaction_dofs(reactions: Any) -> tuple[tuple[int, str], ...]:
+    """`reactions` as ``(node, dof)`` pairs of an int >= 0 and a str (see :class:`Outputs`)."""
+    what = "Outputs.reactions"
+    if isinstance(reactions, str | bytes) or not isinstance(reactions, Iterable):
+        raise TypeError(f"{what} must be a sequence of (node, dof) pairs (got {reactions!r})")
+    pairs = []
+    for k, pair in enumerate(reactions):
+        if isinstance(pair, str | bytes) or not isinstance(pair, Sequence) or len(pair) != 2:
+            raise TypeError(
+                f"{what}[{k}] must be a (node, dof) pair such as (3, 'uz') (got {pair!r})"
+            )
+        node, dof = pair
+        if not isinstance(dof, str):
+            raise TypeError(f"{what}[{k}]: the dof must be a DOF name such as 'uz' (got {dof!r})")
+        pairs.append((_index(node, what, (node, dof)), dof))
+    return tuple(pairs)
 
 
 ProgressCallback = Callable[[int, str, float], "bool | None"]
@@ -291,7 +377,8 @@ def run(
     steps : sequence of Step or dict
         The steps, in order (a dict is a step's flat form, as :meth:`Step.to_dict` gives).
     outputs : Outputs, optional
-        What to record besides time, markers, energies and stability.
+        What to record besides time, markers, energies and stability (an `Outputs`; the native
+        layer's dict form is not accepted here).
     progress : bool or callable, optional
         True shows a tqdm bar on stderr; a callable ``progress(step_index, step_name, t)`` is
         called after each converged state and stops the run by returning False. Ctrl-C stops it
@@ -308,6 +395,8 @@ def run(
 
     Raises
     ------
+    TypeError
+        If `outputs` is not an `Outputs`.
     ValueError
         For an invalid model, step or output request (unknown or inapplicable options, unknown
         ids, ...), before anything runs.
@@ -315,7 +404,14 @@ def run(
         If the analysis stopped early and `raise_on_error` is True.
     """
     raw_steps = [s.to_dict() if isinstance(s, Step) else dict(s) for s in steps]
-    out = (outputs or Outputs()).to_dict()
+    if outputs is None:
+        outputs = Outputs()
+    elif not isinstance(outputs, Outputs):
+        raise TypeError(
+            f"outputs must be an Outputs, e.g. Outputs(field_interval=1), not a "
+            f"{type(outputs).__name__}"
+        )
+    out = outputs.to_dict()
     if progress is True:
         from tqdm import tqdm
 

@@ -380,8 +380,11 @@ class Results:
         FileNotFoundError
             If there is no such file.
         ValueError
-            If the file is not a saved `Results` (another file, or one truncated or corrupted:
-            the message names the file and what failed), or is of a newer format.
+            If the file is not a saved `Results` (another file, or one truncated, corrupted or
+            whose parts disagree: per-record arrays of other lengths than ``t``, sparse matrix
+            indices out of range, a ``meta`` that is not a JSON object; the message names the
+            file and what failed), or is of a newer format. Everything is checked before any
+            array is used.
         """
         try:
             return cls._read(Path(path))
@@ -405,22 +408,30 @@ class Results:
             if "meta" not in f:
                 raise _NotResults(f"{path} is not a saved tapespring Results")
             meta = json.loads(str(f["meta"]))
+            if not isinstance(meta, dict):
+                raise ValueError(f"meta is a JSON {type(meta).__name__}, not an object")
             if meta.get("format") != _FORMAT:
                 raise _NotResults(f"{path} is not a saved tapespring Results")
             if meta.get("version", 0) > _VERSION:
                 raise _NotResults(
                     f"{path} was written by a newer tapespring (format {meta['version']})"
                 )
-            n = f["t"].shape[0]
+            # The size, not shape[0]: a 0-d `t` is refused by _check_records, not an IndexError.
+            n = np.size(f["t"])
             # Files of format 1 have no energy balance, files before format 4 no per-record
             # costs (-1 for the counts, NaN for the rest: "not recorded").
             d = {
                 k: f[k] if k in f else np.full(n, -1 if dt is np.int64 else np.nan)
                 for k, dt in _ARRAYS.items()
             }
+            # Meta would otherwise replace the file's arrays of that name, unchecked.
+            clash = sorted(set(meta) & set(_ARRAYS))
+            if clash:
+                raise ValueError(f"meta holds keys of the file's arrays ({', '.join(clash)})")
+            d.update({k: v for k, v in meta.items() if k != "modes"})
+            _check_records(d)
             # Files of formats 1 and 2 have no modes.
-            modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.pop("modes", []))]
-        d.update(meta)
+            modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
         d["modes"] = modes
         return cls.from_dict(d)
 
@@ -436,27 +447,137 @@ def _npz(loaded: Any, path: Path) -> Any:
     return loaded
 
 
+def _check_array(name: str, a: Any, dtype: Any, shape: tuple[int | None, ...]) -> None:
+    """Raise ValueError unless `a` casts to `dtype` within its kind and has `shape` (None: any
+    length along that axis)."""
+    a = np.asarray(a)
+    if not np.can_cast(a.dtype, dtype, casting="same_kind"):
+        # A cast across kinds would truncate (1.5 -> 1) or drop (complex -> real) silently.
+        raise ValueError(f"{name} holds {a.dtype} values, not {np.dtype(dtype)}")
+    if a.ndim != len(shape) or any(
+        e is not None and e != s for e, s in zip(shape, a.shape, strict=True)
+    ):
+        sizes = ["any" if e is None else str(e) for e in shape]
+        want = f"({sizes[0]},)" if len(sizes) == 1 else "(" + ", ".join(sizes) + ")"
+        raise ValueError(f"{name} has shape {a.shape}, not {want}")
+
+
+def _check_records(d: Mapping[str, Any]) -> None:
+    """Raise ValueError naming the first per-record array (or list of the meta) whose length or
+    type disagrees with the others: a file written by another tool, or a partial writer.
+
+    NumPy would broadcast or index such arrays without complaint, giving wrong histories.
+    """
+    _check_array("t", d["t"], float, (None,))
+    n = len(d["t"])
+    for key in ("event", "marker_names", "reaction_dofs"):
+        if not isinstance(d[key], list):
+            raise ValueError(f"{key} is a {type(d[key]).__name__}, not a list")
+    for key in _ARRAYS:
+        if key not in ("field_records", "displacements", "rotations", "ndof"):
+            rows = np.shape(d[key])[:1]
+            if rows != (n,):
+                got = f"{rows[0]} rows" if rows else "no rows (0-d)"
+                raise ValueError(f"{key} has {got} for the {n} records of t")
+    if len(d["event"]) != n:
+        raise ValueError(f"event has {len(d['event'])} entries for the {n} records of t")
+    if not all(e is None or isinstance(e, str) for e in d["event"]):
+        raise ValueError("event must hold strings or nulls")
+    if not all(isinstance(m, str) for m in d["marker_names"]):
+        raise ValueError("marker_names must hold strings")
+    for rd in d["reaction_dofs"]:
+        if not (
+            isinstance(rd, list)
+            and len(rd) == 2
+            and isinstance(rd[0], int)
+            and not isinstance(rd[0], bool)
+            and rd[0] >= 0
+            and isinstance(rd[1], str)
+        ):
+            raise ValueError(f"reaction_dofs holds {rd!r}, not a [node, dof] pair")
+    n_fields = len(np.atleast_1d(d["field_records"]))
+    n_nodes = np.shape(d["displacements"])[1] if np.ndim(d["displacements"]) == 3 else None
+    shapes: dict[str, tuple[int | None, ...]] = {
+        "marker_positions": (n, len(d["marker_names"]), 3),
+        "marker_rotations": (n, len(d["marker_names"]), 3),
+        "reactions": (n, len(d["reaction_dofs"])),
+        "field_records": (n_fields,),
+        "displacements": (n_fields, n_nodes, 3),
+        "rotations": (n_fields, n_nodes, 3),
+        "ndof": (None,),
+    }
+    for key, dtype in _ARRAYS.items():
+        _check_array(key, d[key], dtype, shapes.get(key, (n,)))
+    records = np.asarray(d["field_records"])
+    if records.size and not (records.min() >= 0 and records.max() < n):
+        raise ValueError(f"field_records holds records outside [0, {n})")
+
+
+def _load_csr(f: Any, name: str, n: int) -> Any:
+    """The saved CSR matrix `name` (``modes<i>_k`` or ``modes<i>_m``), of shape (n, n).
+
+    Raises ValueError naming the part that is inconsistent: SciPy checks neither the column
+    indices nor the monotonicity of ``indptr`` by default, and its kernels then read and write
+    out of bounds (a crash of the interpreter, not an exception).
+    """
+    from scipy.sparse import csr_matrix
+
+    data, indices, indptr = (f[f"{name}_{p}"] for p in ("data", "indices", "indptr"))
+    _check_array(f"{name}_data", data, float, (None,))
+    _check_array(f"{name}_indices", indices, np.int64, (len(data),))
+    _check_array(f"{name}_indptr", indptr, np.int64, (n + 1,))
+    if indptr[0] != 0 or indptr[-1] != len(data) or np.any(np.diff(indptr) < 0):
+        raise ValueError(
+            f"{name}_indptr does not run from 0 to {len(data)} (the number of entries) without "
+            "decreasing"
+        )
+    if len(indices) and not (indices.min() >= 0 and indices.max() < n):
+        raise ValueError(f"{name}_indices holds column indices outside [0, {n})")
+    matrix = csr_matrix((data, indices, indptr), shape=(n, n))
+    # Belt and braces: whatever SciPy's own checks add to those above.
+    matrix.check_format(full_check=True)
+    return matrix
+
+
 def _load_modes(f: Any, i: int, entry: Mapping[str, Any]) -> Modes:
-    """The modes of modal step `i` of a saved file (`entry`: its scalars)."""
+    """The modes of modal step `i` of a saved file (`entry`: its scalars).
+
+    Raises ValueError naming the array whose shape or type is inconsistent.
+    """
+    arrays = {k: f[f"modes{i}_{k}"] for k in _MODE_ARRAYS}
+    m = len(np.atleast_1d(arrays["eigenvalues"]))
+    shape = arrays["mode_shapes"].shape
+    n_nodes = shape[1] if len(shape) == 3 and m else None
+    expected: dict[str, tuple[int | None, ...]] = {
+        "mode_shapes": (m, n_nodes, 6),
+        "effective_masses": (m, 6),
+    }
+    for k, a in arrays.items():
+        _check_array(f"modes{i}_{k}", a, float, expected.get(k, (m,)))
     matrices = None
     if entry["matrices"]:
-        from scipy.sparse import csr_matrix
-
-        free = np.asarray(f[f"modes{i}_free_dofs"], dtype=np.int64)
-        n = free.shape[0]
-
-        def csr(name: str) -> Any:
-            parts = (f[f"modes{i}_{name}_{p}"] for p in ("data", "indices", "indptr"))
-            return csr_matrix(tuple(parts), shape=(n, n))
-
-        matrices = SystemMatrices(stiffness=csr("k"), mass=csr("m"), free_dofs=free)
+        free = f[f"modes{i}_free_dofs"]
+        _check_array(f"modes{i}_free_dofs", free, np.int64, (None, 2))
+        if len(free) and not (
+            free[:, 0].min() >= 0
+            and (n_nodes is None or free[:, 0].max() < n_nodes)
+            and free[:, 1].min() >= 0
+            and free[:, 1].max() < 6
+        ):
+            raise ValueError(f"modes{i}_free_dofs holds a node or DOF index out of range")
+        n = len(free)
+        matrices = SystemMatrices(
+            stiffness=_load_csr(f, f"modes{i}_k", n),
+            mass=_load_csr(f, f"modes{i}_m", n),
+            free_dofs=np.asarray(free, dtype=np.int64),
+        )
     return Modes(
         step=int(entry["step"]),
         name=str(entry["name"]),
         record=int(entry["record"]),
         t=float(entry["t"]),
         shift=float(entry["shift"]),
-        **{k: np.asarray(f[f"modes{i}_{k}"], dtype=float) for k in _MODE_ARRAYS},
+        **{k: np.asarray(a, dtype=float) for k, a in arrays.items()},
         below_shift=int(entry["below_shift"]),
         equilibrium_residual=float(entry["equilibrium_residual"]),
         matrices=matrices,
