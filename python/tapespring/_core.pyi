@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "DOFS",
+    "MAX_YOUNGS_MODULUS",
     "ConvergenceError",
     "Model",
     "TapeError",
@@ -26,6 +27,7 @@ __all__ = [
 ]
 __version__: str
 DOFS: list[str]
+MAX_YOUNGS_MODULUS: float
 
 class TapeError(Exception):
     """Base class of the errors raised by the tapespring solver."""

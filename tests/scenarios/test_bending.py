@@ -468,6 +468,10 @@ def test_the_youngs_modulus_bound_is_inclusive_and_plausible():
     # Diamond's 1.2e12 Pa, the stiffest material known, lies well within it.
     assert MAX_YOUNGS_MODULUS >= 5 * 1.2e12
     BendingSetup(youngs_modulus=MAX_YOUNGS_MODULUS).validate()
+    # The core's bound on every section, written out in Python so that --help stays native-free.
+    from tapespring import _core
+
+    assert MAX_YOUNGS_MODULUS == _core.MAX_YOUNGS_MODULUS
 
 
 def test_one_element_bound_for_a_tape_alone_and_in_the_set_up(monkeypatch):

@@ -25,7 +25,8 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use crate::assembly::{Assembled, System};
-use crate::constraint::Activity;
+use crate::constraint::{Activity, DofMap, Slot};
+use crate::dof::Dof;
 use crate::error::{Clock, Error, Result};
 use crate::model::{Load, Model};
 use crate::options::Options;
@@ -212,6 +213,9 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                 .switch(model, id, false)
                 .map_err(|e| e.context(&context))?;
         }
+        if matches!(step.kind, StepKind::Dynamic(_)) && k == first_dynamic(steps).unwrap_or(usize::MAX) {
+            check_initial_velocities(model, &DofMap::try_with(model, &activity)?).map_err(|e| e.context(&context))?;
+        }
         let releases = !step.deactivate.is_empty() && k > 0;
         if releases
             && step
@@ -226,6 +230,50 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
     }
     outputs.reaction_dofs(model)?;
     Ok(())
+}
+
+/// The first dynamic step, where the model's initial velocities apply.
+fn first_dynamic(steps: &[Step]) -> Option<usize> {
+    steps
+        .iter()
+        .position(|s| matches!(s.kind, StepKind::Dynamic(_)))
+}
+
+/// Whether a static step comes before the first dynamic step: it holds the model at rest, so the
+/// initial velocities are given when the dynamic step starts rather than to the initial state.
+fn velocities_wait(steps: &[Step]) -> bool {
+    first_dynamic(steps).is_some_and(|k| {
+        steps[..k]
+            .iter()
+            .any(|s| matches!(s.kind, StepKind::Static(_)))
+    })
+}
+
+/// Refuses an initial velocity component on a DOF that `dofs` constrains (its motion is the
+/// constraint's, and the velocity's energy would be booked as numerical dissipation).
+fn check_initial_velocities(model: &Model, dofs: &DofMap) -> Result<()> {
+    for iv in &model.initial_velocities {
+        let components = iv.velocity.iter().chain(iv.angular_velocity.iter());
+        for (k, value) in components.enumerate() {
+            if *value != 0.0 && matches!(dofs.slots[iv.node][k], Slot::Constrained(_)) {
+                return Err(Error::InvalidModel(format!(
+                    "node {} has an initial {} velocity of {value:e} on a constrained DOF: the \
+                     constraint sets its motion (give initial velocities to free DOFs only)",
+                    iv.node,
+                    Dof::try_from_index(k)?.name()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Gives the model's initial velocities to `state` (spatial, as the model's).
+fn apply_initial_velocities(model: &Model, state: &mut State) {
+    for iv in &model.initial_velocities {
+        state.v[iv.node] = iv.velocity;
+        state.w[iv.node] = iv.angular_velocity;
+    }
 }
 
 /// The loads that release what step `step` switches off: the reactions of released constraints
@@ -353,9 +401,9 @@ pub fn run(
     let mut system = System::try_with(model, &activity)?;
     system.probes.clone_from(&reaction_dofs);
     let mut state = system.initial_state();
-    for iv in &model.initial_velocities {
-        state.v[iv.node] = iv.velocity;
-        state.w[iv.node] = iv.angular_velocity;
+    let wait = velocities_wait(steps);
+    if !wait {
+        apply_initial_velocities(model, &mut state);
     }
     let mut result = RunResult::default();
     let history = &mut result.history;
@@ -468,6 +516,9 @@ pub fn run(
             StepKind::Dynamic(p) => {
                 let mut params = p.clone();
                 params.record_fields = interval > 0;
+                if wait && first_dynamic(steps) == Some(k) {
+                    apply_initial_velocities(model, &mut state);
+                }
                 let path = solve_dynamic(&mut system, &mut state, &params, &mut cb).map_err(|e| e.context(&context))?;
                 (path.steps, path.stats, path.cancelled, path.error)
             }

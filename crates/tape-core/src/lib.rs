@@ -39,6 +39,7 @@ pub mod time_function;
 pub use analysis::{run, RunResult, Step, StepKind};
 pub use assembly::System;
 pub use dof::Dof;
+pub use material::MAX_YOUNGS_MODULUS;
 pub use model::Model;
 pub use output::{History, Outputs};
 pub use state::State;

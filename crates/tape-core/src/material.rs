@@ -18,6 +18,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{check_positive, Error, Result};
 
+/// Largest Young's modulus of a section \[Pa\]: ten times diamond's (about 1.2e12 Pa, the
+/// stiffest material known). Beyond it a value is a typing error: the residual's round-off floor
+/// grows with `E t L` and, past about 1e26 Pa on a 1 mm steel-like plate, swamps a 1 N load, so
+/// that a static step would accept reactions thousands of times the load.
+pub const MAX_YOUNGS_MODULUS: f64 = 1e13;
+
 /// Section properties of a homogeneous shell. Serialised with `thickness`, `youngs_modulus` and
 /// `poisson` required and the other fields optional (the defaults of [`ShellSection::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -96,6 +102,13 @@ impl ShellSection {
     pub fn validate(&self) -> Result<()> {
         check_positive("thickness (t) [m]", self.thickness)?;
         check_positive("youngs_modulus (Young's modulus E) [Pa]", self.youngs_modulus)?;
+        if self.youngs_modulus > MAX_YOUNGS_MODULUS {
+            return Err(Error::InvalidParameter(format!(
+                "youngs_modulus (Young's modulus E) [Pa] must be at most {MAX_YOUNGS_MODULUS:e}, ten \
+                 times diamond's (got {:e})",
+                self.youngs_modulus
+            )));
+        }
         if !(self.poisson > -1.0 && self.poisson < 0.5) {
             return Err(Error::InvalidParameter(format!(
                 "poisson (Poisson's ratio nu) must lie in (-1, 0.5) (got {})",

@@ -28,6 +28,11 @@ use crate::error::{Error, Result};
 /// Largest admissible coordinate magnitude \[m\]: the element computations form products of up to
 /// four lengths, which stay far inside the range of `f64` (1e308) below this.
 pub const MAX_COORDINATE: f64 = 1e50;
+
+/// Largest rotation of a placement \[rad\] (the norm of its rotation vector). A rotation is an
+/// angle modulo 2 pi; beyond a million radians the value is a typing error, and past about
+/// 1e154 the quaternion overflows to NaN coordinates.
+pub const MAX_ROTATION: f64 = 1e6;
 /// Smallest admissible element size (largest edge) \[m\], for the same reason (1e-308).
 pub const MIN_LENGTH: f64 = 1e-50;
 /// Smallest admissible element size relative to its distance from the origin: coordinates carry
@@ -51,10 +56,11 @@ impl Placement {
         UnitQuaternion::from_scaled_axis(self.rotation) * x + self.translation
     }
 
-    /// Checks that every component is finite.
+    /// Checks that every component is finite, the rotation at most [`MAX_ROTATION`] and the
+    /// translation within [`MAX_COORDINATE`].
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a non-finite component.
+    /// [`Error::InvalidParameter`] for a non-finite or out-of-range component.
     pub fn validate(&self) -> Result<()> {
         if self
             .rotation
@@ -62,6 +68,18 @@ impl Placement {
             .chain(self.translation.iter())
             .all(|c| c.is_finite())
         {
+            if self.rotation.norm() > MAX_ROTATION {
+                return Err(Error::InvalidParameter(format!(
+                    "placement rotation {:?} rad is larger than {MAX_ROTATION:e} rad",
+                    self.rotation.as_slice()
+                )));
+            }
+            if self.translation.amax() > MAX_COORDINATE {
+                return Err(Error::InvalidParameter(format!(
+                    "placement translation {:?} m is beyond {MAX_COORDINATE:e} m",
+                    self.translation.as_slice()
+                )));
+            }
             Ok(())
         } else {
             Err(Error::InvalidParameter(format!(

@@ -227,6 +227,19 @@ impl Model {
         section.validate().map_err(named)?;
         placement.validate()?;
         mesh.validate().map_err(named)?;
+        // Placed, the mesh must still be one: within the coordinate bound, its elements not lost
+        // to round-off far from the origin.
+        let mut mesh = mesh;
+        for x in &mut mesh.nodes {
+            *x = placement.apply(x);
+        }
+        mesh.validate().map_err(|e| {
+            named(e.context(&format!(
+                "placed by rotation {:?} rad and translation {:?} m",
+                placement.rotation.as_slice(),
+                placement.translation.as_slice()
+            )))
+        })?;
         if mesh.quads.is_empty() {
             return Err(Error::InvalidMesh(format!("part '{name}': the mesh has no element")));
         }
@@ -250,9 +263,7 @@ impl Model {
         }
         let offset = self.mesh.nodes.len();
         let first = self.mesh.quads.len();
-        self.mesh
-            .nodes
-            .extend(mesh.nodes.iter().map(|x| placement.apply(x)));
+        self.mesh.nodes.extend_from_slice(&mesh.nodes);
         self.mesh
             .quads
             .extend(mesh.quads.iter().map(|q| q.map(|n| n + offset)));
@@ -366,22 +377,45 @@ impl Model {
     /// Ties every node of `nodes` rigidly to `reference`.
     ///
     /// # Errors
-    /// [`Error::InvalidModel`] for an unknown node, an empty set, or a reference node inside the set.
+    /// [`Error::InvalidModel`] for an unknown node, an empty set, a node repeated, already tied or
+    /// the reference itself.
     pub fn tie(&mut self, nodes: &[usize], reference: usize) -> Result<()> {
-        self.check_node(reference)?;
-        if nodes.is_empty() {
-            return Err(Error::InvalidModel("rigid tie with an empty node set".into()));
-        }
-        for &n in nodes {
-            self.check_node(n)?;
-            if n == reference {
-                return Err(Error::InvalidModel(format!("node {n} cannot be tied to itself")));
-            }
+        self.check_tie(nodes, reference)?;
+        if let Some((n, t)) = nodes.iter().find_map(|n| {
+            self.ties
+                .iter()
+                .find(|t| t.nodes.contains(n))
+                .map(|t| (n, t))
+        }) {
+            return Err(Error::InvalidModel(format!(
+                "node {n} is already tied to node {}",
+                t.reference
+            )));
         }
         self.ties.push(Tie {
             nodes: nodes.to_vec(),
             reference,
         });
+        Ok(())
+    }
+
+    /// Checks one tie on its own: known nodes, not empty, none repeated or tied to itself.
+    fn check_tie(&self, nodes: &[usize], reference: usize) -> Result<()> {
+        self.check_node(reference)?;
+        if nodes.is_empty() {
+            return Err(Error::InvalidModel("rigid tie with an empty node set".into()));
+        }
+        for (i, &n) in nodes.iter().enumerate() {
+            self.check_node(n)?;
+            if n == reference {
+                return Err(Error::InvalidModel(format!("node {n} cannot be tied to itself")));
+            }
+            if nodes[..i].contains(&n) {
+                return Err(Error::InvalidModel(format!(
+                    "node {n} appears twice in the tie to node {reference}"
+                )));
+            }
+        }
         Ok(())
     }
 
@@ -558,10 +592,16 @@ impl Model {
     pub fn validate(&self) -> Result<()> {
         self.mesh.validate()?;
         let mut next = 0;
-        for p in &self.parts {
+        for (i, p) in self.parts.iter().enumerate() {
             p.section
                 .validate()
                 .map_err(|e| e.context(&format!("part '{}'", p.name)))?;
+            if p.elements.is_empty() {
+                return Err(Error::InvalidModel(format!("part '{}' has no element", p.name)));
+            }
+            if self.parts[..i].iter().any(|o| o.name == p.name) {
+                return Err(Error::InvalidModel(format!("two parts are named '{}'", p.name)));
+            }
             if p.elements.start != next || p.elements.end < p.elements.start {
                 return Err(Error::InvalidModel(format!(
                     "part '{}': its elements {:?} do not follow the previous part's",
@@ -586,10 +626,14 @@ impl Model {
                 )));
             }
         }
-        for t in &self.ties {
-            self.check_node(t.reference)?;
-            for &n in &t.nodes {
-                self.check_node(n)?;
+        for (i, t) in self.ties.iter().enumerate() {
+            self.check_tie(&t.nodes, t.reference)?;
+            if let Some(n) = t
+                .nodes
+                .iter()
+                .find(|n| self.ties[..i].iter().any(|o| o.nodes.contains(n)))
+            {
+                return Err(Error::InvalidModel(format!("node {n} is tied twice")));
             }
         }
         for c in &self.constraints {

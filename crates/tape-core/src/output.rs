@@ -27,7 +27,7 @@ impl Outputs {
     /// (node, DOF) of the model.
     ///
     /// # Errors
-    /// [`Error::InvalidModel`] for a node that does not exist.
+    /// [`Error::InvalidModel`] for a node that does not exist or is tied to another.
     pub fn reaction_dofs(&self, model: &Model) -> Result<Vec<(usize, Dof)>> {
         if let Some(&(n, _)) = self
             .reactions
@@ -38,6 +38,16 @@ impl Outputs {
                 "a reaction is requested at node {n}, which does not exist (the model has {} nodes)",
                 model.mesh.n_nodes()
             )));
+        }
+        // A tied node has no equations of its own: its forces are its reference node's.
+        for &(n, _) in &self.reactions {
+            if let Some(t) = model.ties.iter().find(|t| t.nodes.contains(&n)) {
+                return Err(Error::InvalidModel(format!(
+                    "a reaction is requested at node {n}, which is tied to node {}: its forces are \
+                     carried by the reference node, request the reaction there",
+                    t.reference
+                )));
+            }
         }
         if !self.reactions.is_empty() {
             return Ok(self.reactions.clone());

@@ -56,6 +56,14 @@ impl TimeFunction {
                         "ramp time function needs finite start < end (got {start}, {end})"
                     ));
                 }
+                // Its span and slope enter every value and rate: overflowing, they would make the
+                // function silently zero, or infinitely steep.
+                if !(end - start).is_finite() || !(1.0 / (end - start)).is_finite() {
+                    return bad(format!(
+                        "ramp time function's span end - start overflows or its slope does (start \
+                         {start:e}, end {end:e})"
+                    ));
+                }
                 Ok(())
             }
             Self::Table { points } => {
@@ -72,6 +80,16 @@ impl TimeFunction {
                     return bad(format!(
                         "table time function needs strictly increasing times ({} then {})",
                         w[0].0, w[1].0
+                    ));
+                }
+                if let Some(w) = points.windows(2).find(|w| {
+                    let (dt, df) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
+                    !(dt.is_finite() && df.is_finite() && (df / dt).is_finite())
+                }) {
+                    return bad(format!(
+                        "table time function's segment from ({:e}, {:e}) to ({:e}, {:e}) has a span \
+                         or slope that overflows",
+                        w[0].0, w[0].1, w[1].0, w[1].1
                     ));
                 }
                 Ok(())

@@ -35,6 +35,7 @@ mod _core {
         m.add("ConvergenceError", convergence)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("DOFS", tape_core::Dof::NAMES.to_vec())?;
+        m.add("MAX_YOUNGS_MODULUS", tape_core::MAX_YOUNGS_MODULUS)?;
         super::logging::install(py);
         Ok(())
     }

@@ -424,7 +424,10 @@ impl PyModel {
     }
 
     /// Gives `node` an initial velocity [m/s] and angular velocity [rad/s] (global axes), the
-    /// initial condition of the first dynamic step.
+    /// initial condition of the first dynamic step: the initial state's, or, after a static step
+    /// (which holds the model at rest), the state the first dynamic step starts from. A
+    /// component on a DOF that the first dynamic step constrains is refused (ValueError) before
+    /// anything runs.
     #[pyo3(signature = (node, *, velocity = None, angular_velocity = None))]
     fn set_initial_velocity(
         &mut self,

@@ -96,11 +96,11 @@ class TapeSpring:
 #: The paper's tape: Table 1 geometry, Table 5 identified thickness and modulus.
 PAPER_TAPE = TapeSpring()
 
-#: Largest Young's modulus of a tape [Pa]: ten times diamond's, about 1.2e12 Pa, the stiffest
-#: material known (the paper's steel: 1.5e11). Beyond it the value is a typing error, refused
-#: before the run: at 1e300 the first increment's residual became non-finite ("the residual
-#: became non-finite"); the bending scenario still converges at 1e20, so the bound is one of
-#: plausibility, not of the solver.
+#: Largest Young's modulus of a tape [Pa]: the core's bound on every section
+#: (``tapespring._core.MAX_YOUNGS_MODULUS``, equal to it by test; written out so that the
+#: commands' help does not load the native module), ten times diamond's, about 1.2e12 Pa, the
+#: stiffest material known (the paper's steel: 1.5e11). Beyond it the value is a typing error,
+#: refused here before a mesh is built.
 MAX_YOUNGS_MODULUS = 1e13
 
 

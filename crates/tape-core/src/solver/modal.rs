@@ -44,7 +44,8 @@ use crate::constraint::Slot;
 use crate::dof::Dof;
 use crate::eigen::{eigenpairs_near, EigenParams, Pencil};
 use crate::error::{Error, Result};
-use crate::linalg::LinearSolver;
+use crate::linalg::{LinearSolver, Pattern};
+use crate::mesh::MAX_COORDINATE;
 use crate::options::Options;
 use crate::state::State;
 
@@ -99,14 +100,23 @@ impl ModalParams {
                 )));
             }
         }
-        if !(self.tolerance > 0.0 && self.tolerance <= 1e-2) {
+        // Below about a hundred ulps the residual cannot get there, and the run would end in a
+        // non-convergence that does not name the tolerance.
+        if !(self.tolerance >= 1e-14 && self.tolerance <= 1e-2) {
             return Err(Error::InvalidParameter(format!(
-                "tolerance must lie in (0, 1e-2] (got {})",
+                "tolerance must lie in [1e-14, 1e-2] (got {})",
                 self.tolerance
             )));
         }
-        if self.reference_point.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter("reference_point [m] must be finite".into()));
+        if self
+            .reference_point
+            .iter()
+            .any(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
+        {
+            return Err(Error::InvalidParameter(format!(
+                "reference_point [m] must be finite and within {MAX_COORDINATE:e} m (got {:?})",
+                self.reference_point
+            )));
         }
         Ok(())
     }
@@ -300,6 +310,53 @@ impl Pencil for FePencil<'_> {
     }
 }
 
+/// Largest relative difference between an eigenvalue found and the Rayleigh quotient
+/// `phi.K phi / phi.M phi` of its vector. The solver's eigenvalue is `sigma + 1 / theta`, from the
+/// shift-inverted operator, whose residual stays at round-off when `|sigma| M` swamps `K` in
+/// `K - sigma M`: the pairs are then wrong and the two values part. A pair converged to the
+/// default tolerance agrees to about 1e-10 (the quotient's error is the residual's square).
+const RAYLEIGH_MISMATCH_MAX: f64 = 1e-6;
+
+/// Refuses eigenpairs whose eigenvalue is not their vector's Rayleigh quotient on the unshifted
+/// problem (with the symmetric part of `K`, the part the eigensolver factorises), naming the
+/// shift that lost `K`'s digits. `scale` [rad^2/s^2] keeps zero eigenvalues (rigid motions)
+/// from dividing by round-off: a small fraction of the largest diagonal ratio `K_ii / M_ii`.
+#[allow(clippy::too_many_arguments)]
+fn check_unshifted(
+    pattern: &Pattern,
+    k: &[f64],
+    blocks: &[NodeBlock],
+    values: &[f64],
+    vectors: &[Vec<f64>],
+    shift: f64,
+    scale: f64,
+) -> Result<()> {
+    let n = pattern.nrows;
+    let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    for (&lambda, phi) in values.iter().zip(vectors) {
+        kx.fill(0.0);
+        pattern.mul_add(k, phi, &mut kx);
+        mx.fill(0.0);
+        mul_blocks(blocks, phi, &mut mx);
+        // phi.K phi is the symmetric part's quotient already.
+        let rayleigh = dot(phi, &kx) / dot(phi, &mx);
+        let mismatch = (rayleigh - lambda).abs() / (lambda.abs() + rayleigh.abs() + scale);
+        if mismatch.is_nan() || mismatch > RAYLEIGH_MISMATCH_MAX {
+            return Err(Error::InvalidParameter(format!(
+                "shift [Hz] = {:.6e}: the mode found at {:.6e} Hz has a Rayleigh quotient of {:.6e} Hz \
+                 (relative difference {mismatch:.1e}): the shift is too far from the frequencies for \
+                 K - sigma M to keep K's digits; choose a shift near the frequencies sought, or none \
+                 (the default lies below the lowest)",
+                frequency_hz(shift),
+                frequency_hz(lambda),
+                frequency_hz(rayleigh)
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The eigenvalue shift [rad^2/s^2] of a shift frequency \[Hz\]: `sign(f) (2 pi f)^2`.
 #[must_use]
 pub fn shift_from_hz(f: f64) -> f64 {
@@ -403,6 +460,22 @@ pub fn solve_modal(system: &mut System, state: &State, params: &ModalParams) -> 
         },
         other => other,
     })?;
+    let largest_ratio = (0..n)
+        .filter_map(|i| {
+            let p = pattern.find(i, i)?;
+            let (k, m) = (asm.k_ff[p], m_values[p]);
+            (k > 0.0 && m > 0.0).then(|| k / m)
+        })
+        .fold(0.0, f64::max);
+    check_unshifted(
+        pattern,
+        &asm.k_ff,
+        &blocks,
+        &found.values,
+        &found.vectors,
+        shift,
+        1e-9 * largest_ratio,
+    )?;
     stats.solve_s = pencil.solve_s;
     stats.factorisations = found.factorisations;
     stats.iterations = found.iterations;
