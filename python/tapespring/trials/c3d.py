@@ -4,9 +4,17 @@ Markers come from ``POINT`` (converted from ``POINT:UNITS`` to metres, NaN where
 a marker is missing; an infinite coordinate, or one beyond 1 km once converted
 (`tapespring.trials.common.MAX_COORDINATE`), is corrupt data and an error). Force
 plates are extracted by ezc3d (``extract_forceplat_data=True``) at the analog rate
-and converted from the plate's force and moment units to N and N m. Metadata live
-in an optional ``TAPESPRING`` parameter group (``SENSE``, ``TAPE_PAIR``,
-``SESSION``).
+and converted to N and N m from the units of their channels in ``ANALOG:UNITS``
+(ezc3d converts nothing and labels every force "N"): force N, kN or lbf, moment
+N m, N mm, kN m, lbf in... (`tapespring.trials.common.FORCE`, ``MOMENT``). A
+channel without a unit, an unknown unit, or force (or moment) channels of one
+plate in different units are errors naming the plate and the channel. So are
+an infinite sample, a force beyond 1e6 N and a moment beyond 1e6 N m
+(`MAX_FORCE`, `MAX_MOMENT`: no force plate measures that; a damaged float reads
+1e38). ``ANALOG:RATE`` must be the header's analog samples per frame times
+``POINT:RATE``: ezc3d derives the samples per frame from it, so a damaged rate
+makes it misread every frame. Metadata live in an optional ``TAPESPRING``
+parameter group (``SENSE``, ``TAPE_PAIR``, ``SESSION``).
 
 ezc3d trusts the sizes written in the file, and a few damaged bytes can make it
 crash the interpreter or loop for minutes. `read_c3d` therefore checks the
@@ -27,21 +35,24 @@ writing; see ``_add_int_parameter``.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .c3d_check import check_c3d
+from .c3d_check import C3DLayout, check_c3d
 from .c3d_worker import DEFAULT_TIMEOUT, WorkerFailure, read_raw, read_raw_isolated
 from .common import (
     FORCE,
     FP_CHANNELS,
     LENGTH,
     MAX_COORDINATE,
+    MAX_FORCE,
+    MAX_MOMENT,
     META_KEYS,
     MOMENT,
     check_durations,
     first_absurd_coordinate,
+    first_absurd_sample,
     unit_scale,
 )
 from .trial import SENSES, ForcePlate, Metadata, Trial, TrialError
@@ -100,7 +111,10 @@ def read_c3d(
     TrialError
         If the file is not a C3D file, is truncated or corrupt (the message says
         where: an infinite marker coordinate or one beyond 1 km names the marker and
-        the frame), makes ezc3d fail, crash or exceed ``timeout``, or has unknown units.
+        the frame), makes ezc3d fail, crash or exceed ``timeout``, has an ``ANALOG:RATE``
+        that disagrees with the header, or has missing, unknown or mixed units; a force-plate
+        sample that is infinite or beyond `MAX_FORCE` / `MAX_MOMENT` names the plate, the
+        channel and the sample.
     """
     path = Path(path)
     layout = check_c3d(path)
@@ -112,6 +126,8 @@ def read_c3d(
         raise TrialError(path, f"not a readable C3D file ({exc})") from exc
     points = raw["points"]
     n = points.shape[2]
+    # Before the frame count: a damaged ANALOG:RATE makes ezc3d read a wrong number of frames.
+    _check_analog_rate(path, layout, raw)
     if layout.n_frames is not None and n != layout.n_frames:
         raise TrialError(path, f"truncated C3D data: {n} of {layout.n_frames} frames")
     if n < 2:
@@ -150,20 +166,28 @@ def read_c3d(
             )
 
     plates = []
+    plate_units: dict[str, str] = {}
     for k, pf in enumerate(raw["platforms"]):
+        name = f"FP{k + 1}"
         m = pf["force"].shape[1]
         t_plate = (raw["analog_first_frame"] + np.arange(m)) / raw["analog_rate"]
-        f_scale = unit_scale(pf["unit_force"], FORCE, path, "force")
-        m_scale = unit_scale(pf["unit_moment"], MOMENT, path, "moment")
+        force, moment, plate_units = _plate_in_si(path, raw, pf, name, unit, scale)
         try:
-            plate = ForcePlate(
-                time=t_plate,
-                force=pf["force"].T * f_scale,
-                moment=pf["moment"].T * m_scale,
-                name=f"FP{k + 1}",
-            )
+            plate = ForcePlate(time=t_plate, force=force, moment=moment, name=name)
         except TrialError as exc:  # the plate has no source of its own: name the file
             raise TrialError(path, exc.problem) from exc
+        for values, bound, what in ((force, MAX_FORCE, "F"), (moment, MAX_MOMENT, "M")):
+            absurd = first_absurd_sample(values, bound)
+            if absurd is not None:
+                sample, axis = absurd
+                si = "N" if what == "F" else "N m"
+                raise TrialError(
+                    path,
+                    f"force plate {name!r}: {what}{'xyz'[axis]} is {values[sample, axis]:.7g} "
+                    f"{si} at analog sample {sample + 1} (t = {t_plate[sample]:.6g} s): beyond "
+                    f"{bound:g} {si}, no force plate's range (corrupt data or a wrong "
+                    "ANALOG:UNITS)",
+                )
         plates.append(plate)
     stored = {}
     for key in META_KEYS:
@@ -178,13 +202,117 @@ def read_c3d(
         )
     overrides = {"sense": sense, "tape_pair": tape_pair, "session": session}
     stored.update({k: v for k, v in overrides.items() if v is not None})
-    units = {"markers": unit}
-    if plates:
-        units |= {"force": pf["unit_force"], "moment": pf["unit_moment"]}
+    units = {"markers": unit} | plate_units
     metadata = Metadata(name=path.stem, units=units, source=path, **stored)
     trial = Trial(time=time, markers=markers, force_plates=tuple(plates), metadata=metadata)
     check_durations(trial)
     return trial
+
+
+def _check_analog_rate(path: Path, layout: C3DLayout, raw: dict[str, Any]) -> None:
+    """``ANALOG:RATE`` must be the header's analog samples per frame times the point rate.
+
+    ezc3d takes the samples per frame from ``ANALOG:RATE / POINT:RATE``, not from the header
+    that fixes the size of every frame; a damaged rate (one float) makes it misread the data
+    silently (markers read as missing, plates at a wrong rate) or stop early.
+    """
+    channels = raw["analog_channels"]
+    if not layout.n_analog_values:
+        return
+    rate = raw["analog_rate_parameter"]
+    point_rate = raw["point_rate"]
+    if not channels or layout.n_analog_values % channels:
+        raise TrialError(
+            path,
+            f"corrupt C3D file: the header's {layout.n_analog_values} analog values per frame "
+            f"do not divide among the {channels} channels of ANALOG:USED",
+        )
+    per_frame = layout.n_analog_values // channels
+    if rate is None or not (np.isfinite(rate) and np.isfinite(point_rate) and point_rate > 0):
+        raise TrialError(
+            path,
+            f"corrupt C3D file: ANALOG:RATE is {'missing' if rate is None else f'{rate:g} Hz'} "
+            f"with POINT:RATE {point_rate:g} Hz and {per_frame} analog samples per frame",
+        )
+    if abs(rate - per_frame * point_rate) > 1e-6 * per_frame * point_rate:
+        raise TrialError(
+            path,
+            f"corrupt C3D file: ANALOG:RATE {rate:g} Hz disagrees with the header's {per_frame} "
+            f"analog samples per {point_rate:g} Hz frame (expected {per_frame * point_rate:g} Hz)",
+        )
+
+
+def _channel_unit(path: Path, raw: dict[str, Any], plate: str, channels: list[int]) -> str:
+    """The one unit of ``channels`` (0-based) in ``ANALOG:UNITS``.
+
+    Raises
+    ------
+    TrialError
+        If a channel has no unit, or the channels have different units.
+    """
+    units, labels = raw["analog_units"], raw["analog_labels"]
+    found: dict[str, list[str]] = {}
+    for ch in channels:
+        label = labels[ch].strip() if ch < len(labels) else ""
+        named = f"analog channel {ch + 1}" + (f" ({label!r})" if label else "")
+        u = units[ch].strip() if 0 <= ch < len(units) else ""
+        if not u:
+            raise TrialError(
+                path,
+                f"force plate {plate!r}: {named} has no unit in ANALOG:UNITS (forces and moments "
+                "are converted from their units; give them, e.g. N and Nmm)",
+            )
+        found.setdefault(u, []).append(named)
+    if len(found) > 1:
+        listed = "; ".join(f"{u}: {', '.join(names)}" for u, names in found.items())
+        raise TrialError(path, f"force plate {plate!r}: mixed units in ANALOG:UNITS ({listed})")
+    return next(iter(found))
+
+
+def _plate_in_si(
+    path: Path,
+    raw: dict[str, Any],
+    pf: dict[str, Any],
+    plate: str,
+    point_unit: str,
+    point_scale: float,
+) -> tuple[np.ndarray, np.ndarray, dict[str, str]]:
+    """A plate's force [N] and moment [N m], shape (m, 3), from ezc3d's values in file units,
+    and the units found (``{"force": ..., "moment": ...}``).
+
+    ezc3d combines channels by plate type (C3D user guide, force platforms): type 2 and 4 give
+    force = F channels and moment = M channels + F x origin (origin in ``POINT:UNITS``); type 3
+    sums eight force channels and takes moments about the origin (force x ``POINT:UNITS``);
+    type 1 gives moment = F x CoP - Tz (CoP channels are lengths).
+    """
+    kind, ch = pf["type"], pf["channels"]
+    force, moment = pf["force"].T, pf["moment"].T
+    if kind == 3:
+        f_unit = _channel_unit(path, raw, plate, ch[:8])
+        f_scale = unit_scale(f_unit, FORCE, path, f"force (plate {plate!r}, ANALOG:UNITS)")
+        units = {"force": f_unit, "moment": f"{f_unit} {point_unit}"}
+        return force * f_scale, moment * (f_scale * point_scale), units
+    f_unit = _channel_unit(path, raw, plate, ch[:3])
+    f_scale = unit_scale(f_unit, FORCE, path, f"force (plate {plate!r}, ANALOG:UNITS)")
+    m_ch = ch[5:6] if kind == 1 else ch[3:6]
+    m_unit = _channel_unit(path, raw, plate, m_ch)
+    m_scale = unit_scale(m_unit, MOMENT, path, f"moment (plate {plate!r}, ANALOG:UNITS)")
+    units = {"force": f_unit, "moment": m_unit}
+    if kind == 1:
+        c_unit = _channel_unit(path, raw, plate, ch[3:5])
+        c_scale = unit_scale(c_unit, LENGTH, path, f"centre of pressure (plate {plate!r})")
+        # ezc3d returns F x CoP - Tz as one sum: its terms must share a unit to be converted.
+        if not np.isclose(f_scale * c_scale, m_scale, rtol=1e-9):
+            raise TrialError(
+                path,
+                f"force plate {plate!r} (type 1): Tz in {m_unit} does not match force x centre "
+                f"of pressure in {f_unit} x {c_unit}; the moment cannot be converted",
+            )
+        return force * f_scale, moment * m_scale, units
+    # Types 2 and 4: the origin term is in force x POINT:UNITS, the rest in the moment unit.
+    origin = pf["origin_moment"].T
+    moment_si = (moment - origin) * m_scale + origin * (f_scale * point_scale)
+    return force * f_scale, moment_si, units
 
 
 def _add_int_parameter(c3d: ezc3d.c3d, group: str, name: str, value: np.ndarray) -> None:

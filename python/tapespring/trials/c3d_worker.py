@@ -51,10 +51,13 @@ def read_raw(path: str | Path) -> dict[str, Any]:
     -------
     dict
         ``point_rate`` [Hz], ``point_first_frame``, ``points`` (ndarray, shape (3, k, n), file
-        units), ``labels``, ``point_unit`` (str or None), ``analog_rate`` [Hz],
-        ``analog_first_frame``, ``platforms`` (list of dict: ``force``, ``moment`` (3, m) in the
-        plate's units, ``unit_force``, ``unit_moment``) and ``meta`` (the ``TAPESPRING`` group:
-        upper-case key -> first value as str).
+        units), ``labels``, ``point_unit`` (str or None), ``analog_rate`` [Hz] (as ezc3d
+        derives it), ``analog_rate_parameter`` (``ANALOG:RATE`` [Hz], None if absent),
+        ``analog_channels`` (number of analog channels), ``analog_first_frame``,
+        ``analog_labels`` and ``analog_units`` (``ANALOG:LABELS`` and ``ANALOG:UNITS``, lists of
+        str, possibly shorter than the channels), ``platforms`` (list of dict, see
+        `_force_platforms`) and ``meta`` (the ``TAPESPRING`` group: upper-case key -> first
+        value as str).
 
     Raises
     ------
@@ -68,6 +71,8 @@ def read_raw(path: str | Path) -> dict[str, Any]:
     params = c3d["parameters"]
     header = c3d["header"]
     units = params["POINT"].get("UNITS", {}).get("value")
+    analog = params.get("ANALOG", {})
+    analog_rate = analog.get("RATE", {}).get("value")
     meta = {}
     for key, entry in params.get("TAPESPRING", {}).items():
         value = entry.get("value") if isinstance(entry, dict) else None
@@ -80,14 +85,33 @@ def read_raw(path: str | Path) -> dict[str, Any]:
         "labels": [str(label) for label in params["POINT"]["LABELS"]["value"]],
         "point_unit": str(units[0]) if units is not None and len(units) else None,
         "analog_rate": float(header["analogs"]["frame_rate"]),
+        "analog_rate_parameter": (
+            float(analog_rate[0]) if analog_rate is not None and len(analog_rate) else None
+        ),
+        "analog_channels": int(header["analogs"]["size"]),
+        "analog_labels": _strings(analog.get("LABELS", {}).get("value")),
+        "analog_units": _strings(analog.get("UNITS", {}).get("value")),
         "analog_first_frame": int(header["analogs"]["first_frame"]),
         "platforms": platforms,
         "meta": meta,
     }
 
 
+def _strings(value: Any) -> list[str]:
+    """A C3D string parameter's values as a list of str (empty if absent)."""
+    return [] if value is None else [str(v) for v in value]
+
+
 def _force_platforms(c3d: Any, path: str) -> list[dict]:
-    """Force, moment and units of each force platform, computed by ezc3d.
+    """Force and moment of each force platform, computed by ezc3d, and what converting them to SI
+    needs.
+
+    Each dict holds ``force``, ``moment`` (3, m) as ezc3d computes them from the channels (in
+    the channels' ``ANALOG:UNITS``: ezc3d converts nothing, and its ``forceUnit`` says "N"
+    whatever the file says), ``type`` (``FORCE_PLATFORM:TYPE``), ``channels`` (0-based analog
+    channels of the plate, from ``FORCE_PLATFORM:CHANNEL``) and ``origin_moment`` (3, m): the
+    part of ``moment`` that ezc3d adds for types 2 and 4, force x plate origin in the laboratory
+    frame, whose unit is the force unit times ``POINT:UNITS`` rather than the moment channels'.
 
     ``ezc3d.c3d(path, extract_forceplat_data=True)`` converts force, moment,
     centre of pressure and free moment frame by frame in Python; the paper's
@@ -99,25 +123,58 @@ def _force_platforms(c3d: Any, path: str) -> list[dict]:
 
     swig = getattr(c3d, "c3d_swig", None)
     extractor = getattr(getattr(ezc3d, "ezc3d", None), "ForcePlatforms", None)
+    computed: list[dict[str, np.ndarray]] = []
     if swig is None or extractor is None:
         full = ezc3d.c3d(path, extract_forceplat_data=True)
-        return [
-            {k: pf[k] for k in ("force", "moment", "unit_force", "unit_moment")}
-            for pf in full["data"].get("platform", [])
-        ]
+        for pf in full["data"].get("platform", []):
+            computed.append(
+                {
+                    "force": np.asarray(pf["force"], dtype=float),
+                    "moment": np.asarray(pf["moment"], dtype=float),
+                    "origin": np.asarray(pf["origin"], dtype=float).reshape(3),
+                    "corners": np.asarray(pf["corners"], dtype=float).reshape(3, 4).T,
+                }
+            )
+    else:
+        for pf in extractor(swig).forcePlatforms():
+            computed.append(
+                {
+                    "force": np.array([v.to_array() for v in pf.forces()]).reshape(-1, 3).T,
+                    "moment": np.array([v.to_array() for v in pf.moments()]).reshape(-1, 3).T,
+                    "origin": np.asarray(pf.origin().to_array(), dtype=float).reshape(3),
+                    "corners": np.array([v.to_array() for v in pf.corners()]).reshape(4, 3),
+                }
+            )
+    group = c3d["parameters"].get("FORCE_PLATFORM", {})
+    types = np.asarray(group.get("TYPE", {}).get("value", []), dtype=int).ravel()
+    channel = np.asarray(group.get("CHANNEL", {}).get("value", []), dtype=int)
     out = []
-    for pf in extractor(swig).forcePlatforms():
-        force = np.array([v.to_array() for v in pf.forces()]).reshape(-1, 3)
-        moment = np.array([v.to_array() for v in pf.moments()]).reshape(-1, 3)
+    for k, pf in enumerate(computed):
+        axes = _plate_axes(pf["corners"])
         out.append(
             {
-                "force": force.T,
-                "moment": moment.T,
-                "unit_force": pf.forceUnit(),
-                "unit_moment": pf.momentUnit(),
+                "force": pf["force"],
+                "moment": pf["moment"],
+                "type": int(types[k]),
+                "channels": [int(c) - 1 for c in channel[:, k]],
+                # ezc3d adds raw force x origin to the raw moment, then rotates both into the
+                # laboratory frame: R (F x o) = (R F) x (R o) for the rotation R.
+                "origin_moment": np.cross(pf["force"].T, axes @ pf["origin"]).T,
             }
         )
     return out
+
+
+def _plate_axes(corners: np.ndarray) -> np.ndarray:
+    """The rotation from plate to laboratory axes (columns x, y, z) that ezc3d derives from the
+    plate's corners (shape (4, 3)): x from corner 2 to 1, y from corner 4 to 1, z = x × y."""
+    x = corners[0] - corners[1]
+    y = corners[0] - corners[3]
+    z = np.cross(x, y)
+    y = np.cross(z, x)
+    axes = np.column_stack([x, y, z])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return axes / np.linalg.norm(axes, axis=0)
 
 
 def _send(stream: IO[bytes], message: object) -> None:

@@ -18,9 +18,15 @@ N m, N mm). A column without a unit takes the unit passed by the caller
 (``length_unit=``, ...); if there is none, reading fails. Missing samples are
 written ``nan``; empty fields are read as missing too. Any other non-finite
 value (``inf``, ``1e999``) is an error naming the file, the column and the line,
-as is a row with too few or too many fields, and a marker coordinate beyond
+as is a row with too few or too many fields, a marker coordinate beyond
 1 km once converted (`tapespring.trials.common.MAX_COORDINATE`: 1e308 mm is a
-finite number but no position in a laboratory).
+finite number but no position in a laboratory), and a force beyond 1e6 N or a
+moment beyond 1e6 N m (`MAX_FORCE`, `MAX_MOMENT`: no force plate measures that).
+
+The files are UTF-8, with or without the byte-order mark a spreadsheet's
+"CSV UTF-8" export writes. Suffixes are matched in any case, as `load_trials`
+finds trials: ``PULL.CSV`` goes with ``PULL.forces.csv`` or ``PULL.FORCES.CSV``
+(two such siblings differing only in case are ambiguous and refused).
 """
 
 from __future__ import annotations
@@ -36,27 +42,76 @@ from .common import (
     FP_CHANNELS,
     LENGTH,
     MAX_COORDINATE,
+    MAX_FORCE,
+    MAX_MOMENT,
     META_KEYS,
     MOMENT,
     TIME,
     check_durations,
     first_absurd_coordinate,
+    first_absurd_sample,
     unit_scale,
 )
 from .trial import ForcePlate, Metadata, Trial, TrialError
 
 __all__ = ["FORCES_SUFFIX", "needs_length_unit", "read_csv", "write_csv"]
 
-#: Suffix of the force-plate file that goes with a marker CSV file.
+#: Suffix of the force-plate file that goes with a marker CSV file (matched in any case).
 FORCES_SUFFIX = ".forces.csv"
+# Encoding of the files read: "utf-8-sig" also reads UTF-8 (it drops a leading byte-order mark,
+# which a spreadsheet's "CSV UTF-8" export writes and which would otherwise glue itself to the
+# first cell: "\ufefftime").
+_ENCODING = "utf-8-sig"
+
+
+def is_forces_file(path: Path) -> bool:
+    """Whether ``path`` is named as a force side file (``*.forces.csv``, in any case)."""
+    return path.name.lower().endswith(FORCES_SUFFIX)
+
+
+def _sibling(path: Path, name: str) -> Path:
+    """The file ``name`` beside ``path``, its case ignored as the ``.csv`` suffix is when trials
+    are found; ``path.with_name(name)`` when there is none.
+
+    Raises
+    ------
+    TrialError
+        If two files beside ``path`` match ``name`` in different cases (a case-sensitive file
+        system): which one belongs to the trial is not known.
+    """
+    exact = path.with_name(name)
+    folder = path.parent
+    try:
+        matches = sorted(p for p in folder.iterdir() if p.name.lower() == name.lower())
+    except OSError:
+        return exact
+    if len(matches) > 1:
+        raise TrialError(
+            path,
+            f"{len(matches)} files match {name!r} but for case "
+            f"({', '.join(p.name for p in matches)}): keep one",
+        )
+    return matches[0] if matches else exact
+
+
+def _stem_of(path: Path, suffix: str) -> str:
+    """``path``'s name without ``suffix``, matched in any case."""
+    name = path.name
+    return name[: -len(suffix)] if name.lower().endswith(suffix) else name
+
+
+def forces_file_of(path: Path) -> Path:
+    """The force side file ``<stem>.forces.csv`` of a marker file ``<stem>.csv`` (suffixes in any
+    case; it may not exist)."""
+    return _sibling(path, _stem_of(path, ".csv") + FORCES_SUFFIX)
 
 
 def marker_file_of(path: Path) -> Path | None:
-    """The marker file ``<stem>.csv`` of a force side file ``<stem>.forces.csv``; None for
-    another file."""
-    if not path.name.endswith(FORCES_SUFFIX):
+    """The marker file ``<stem>.csv`` of a force side file ``<stem>.forces.csv`` (suffixes in any
+    case); None for another file."""
+    if not is_forces_file(path):
         return None
-    return path.with_name(path.name.removesuffix(FORCES_SUFFIX) + ".csv")
+    return _sibling(path, _stem_of(path, FORCES_SUFFIX) + ".csv")
 
 
 _HEADER_RE = re.compile(r"^\s*(?P<name>[^\[\]]+?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
@@ -101,7 +156,7 @@ def _read_header(path: Path) -> tuple[dict[str, str], list[str], list[str | None
     to its header."""
     meta: dict[str, str] = {}
     try:
-        with path.open(encoding="utf-8") as fh:
+        with path.open(encoding=_ENCODING) as fh:
             n_skip = 0
             header = None
             for line in fh:
@@ -159,7 +214,7 @@ def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
         with warnings.catch_warnings():
             # A header without rows: numpy warns, the caller raises "no data rows".
             warnings.filterwarnings("ignore", "loadtxt: input contained no data", UserWarning)
-            return np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding="utf-8")
+            return np.loadtxt(path, delimiter=",", skiprows=n_skip, ndmin=2, encoding=_ENCODING)
     except UnicodeDecodeError as exc:
         raise TrialError(path, f"not a text CSV file ({exc.reason} at byte {exc.start})") from None
     except ValueError:
@@ -167,7 +222,7 @@ def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
     # Empty fields (missing samples) or a damaged row: parse again, slower, line by line, to
     # read empty fields as NaN or say which row and column is wrong.
     rows = []
-    with path.open(encoding="utf-8") as fh:
+    with path.open(encoding=_ENCODING) as fh:
         for line_no, line in enumerate(fh, start=1):
             if line_no <= n_skip or not line.strip():
                 continue
@@ -193,7 +248,7 @@ def _read_values(path: Path, n_skip: int, names: list[str]) -> np.ndarray:
 
 def _line_of_row(path: Path, n_skip: int, row: int) -> int:
     """Line number (1-based) of data row ``row`` (0-based); blank lines are not rows."""
-    with path.open(encoding="utf-8") as fh:
+    with path.open(encoding=_ENCODING) as fh:
         seen = -1
         for line_no, line in enumerate(fh, start=1):
             if line_no > n_skip and line.strip():
@@ -331,9 +386,9 @@ def read_csv(
     file_units = {"markers": ",".join(sorted(found_units))}
 
     plates = []
-    forces_path = path.with_name(path.name.removesuffix(".csv") + FORCES_SUFFIX)
+    forces_path = forces_file_of(path)
     if forces_path.is_file():
-        fmeta, fnames, funits, fvalues, _ = _read_table(forces_path)
+        fmeta, fnames, funits, fvalues, f_skip = _read_table(forces_path)
         ft_unit = _unit_for(forces_path, fnames[0], funits[0], time_unit, "time_unit")
         t_plate = fvalues[:, 0] * unit_scale(ft_unit, TIME, forces_path, "time")
         if (len(fnames) - 1) % 6 != 0:
@@ -346,6 +401,7 @@ def read_csv(
                     forces_path, f"expected columns {expected}, got {fnames[j : j + 6]}"
                 )
             scales = []
+            plate_units: list[str] = []
             for k, ch in zip(range(j, j + 6), FP_CHANNELS, strict=True):
                 if ch.startswith("F"):
                     u = _unit_for(forces_path, fnames[k], funits[k], force_unit, "force_unit")
@@ -355,7 +411,23 @@ def read_csv(
                     u = _unit_for(forces_path, fnames[k], funits[k], moment_unit, "moment_unit")
                     scales.append(unit_scale(u, MOMENT, forces_path, "moment"))
                     file_units["moment"] = u
+                plate_units.append(u)
             block = fvalues[:, j : j + 6] * np.array(scales)
+            for lo, bound, what, si in (
+                (0, MAX_FORCE, "force", "N"),
+                (3, MAX_MOMENT, "moment", "N m"),
+            ):
+                absurd = first_absurd_sample(block[:, lo : lo + 3], bound)
+                if absurd is not None:
+                    row, col = absurd
+                    k = j + lo + col
+                    raise TrialError(
+                        forces_path,
+                        f"column {fnames[k]!r}, data row {row + 1} (line "
+                        f"{_line_of_row(forces_path, f_skip, row)}) is {fvalues[row, k]:.10g} "
+                        f"{plate_units[lo + col]}: a {what} beyond {bound:g} {si} is beyond any "
+                        "force plate's range (a damaged value or a wrong unit)",
+                    )
             try:
                 plates.append(
                     ForcePlate(time=t_plate, force=block[:, :3], moment=block[:, 3:], name=plate)
@@ -368,7 +440,7 @@ def read_csv(
     stored.update({k: v for k, v in overrides.items() if v is not None})
     metadata = Metadata(name=path.stem, units=file_units, source=path, **stored)
     trial = Trial(time=time, markers=markers, force_plates=tuple(plates), metadata=metadata)
-    check_durations(trial)
+    check_durations(trial, forces_path if plates else None)
     return trial
 
 
@@ -404,7 +476,7 @@ def write_csv(trial: Trial, path: str | Path, *, length_unit: str = "mm") -> Pat
     with path.open("w", encoding="utf-8", newline="\n") as fh:
         fh.write(meta_lines + ",".join(names) + "\n")
         np.savetxt(fh, table, delimiter=",", fmt="%.10g")
-    forces_path = path.with_name(path.name.removesuffix(".csv") + FORCES_SUFFIX)
+    forces_path = forces_file_of(path)
     if trial.force_plates:
         t0 = trial.force_plates[0].time
         for plate in trial.force_plates[1:]:

@@ -80,6 +80,19 @@ def _frozen_array(values: np.ndarray) -> np.ndarray:
     return out
 
 
+def _first_infinite(values: np.ndarray) -> tuple[int, int] | None:
+    """The first infinite value of ``values`` (shape (n, 3)) as (sample, column), or None.
+
+    NaN is a missing sample (an occluded marker, a dropped analog sample); an infinity is a
+    damaged value that would pass as a number (arctan2 of an inf is a finite angle).
+    """
+    bad = np.isinf(values)
+    if not bad.any():
+        return None
+    sample, column = np.argwhere(bad)[0]
+    return int(sample), int(column)
+
+
 def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
     """Validate a uniformly sampled time vector and return its rate [Hz]."""
     if time.ndim != 1 or time.size < 2:
@@ -117,11 +130,17 @@ class ForcePlate:
     time : ndarray, shape (m,)
         Sampling instants [s], uniform.
     force : ndarray, shape (m, 3)
-        Force (Fx, Fy, Fz) [N] in the laboratory frame.
+        Force (Fx, Fy, Fz) [N] in the laboratory frame; NaN marks a missing sample.
     moment : ndarray, shape (m, 3)
-        Moment (Mx, My, Mz) [N m] about the plate origin.
+        Moment (Mx, My, Mz) [N m] about the plate origin; NaN marks a missing sample.
     name : str
         Label of the plate (``"FP1"``, ...).
+
+    Raises
+    ------
+    TrialError
+        If the time vector is not uniform, the shapes disagree, or a sample is infinite (the
+        message names the channel and the sample).
     """
 
     time: np.ndarray
@@ -139,6 +158,15 @@ class ForcePlate:
                     None,
                     f"force plate {self.name!r}: {label} has shape {arr.shape}, "
                     f"expected ({time.size}, 3)",
+                )
+            inf = _first_infinite(arr)
+            if inf is not None:
+                sample, axis = inf
+                channel = f"{label[0].upper()}{'xyz'[axis]}"
+                raise TrialError(
+                    None,
+                    f"force plate {self.name!r}: {channel} is {arr[sample, axis]} at sample "
+                    f"{sample + 1} (t = {time[sample]:.6g} s): only NaN marks a missing sample",
                 )
             object.__setattr__(self, label, _frozen_array(arr))
         object.__setattr__(self, "time", time)
@@ -252,7 +280,8 @@ class Trial:
     time : ndarray, shape (n,)
         Marker sampling instants [s], uniform.
     markers : Mapping[str, ndarray]
-        Marker name -> positions [m], shape (n, 3); NaN marks a missing sample.
+        Marker name -> positions [m], shape (n, 3); NaN marks a missing sample, an infinite
+        coordinate is refused.
     force_plates : tuple of ForcePlate
         Force-plate records, each at its own rate.
     metadata : Metadata
@@ -261,8 +290,9 @@ class Trial:
     Raises
     ------
     TrialError
-        If the shapes or the time vector are inconsistent; the message names
-        the source file.
+        If the shapes or the time vector are inconsistent, or a marker coordinate is
+        infinite (the message names the marker and the sample); the message names the
+        source file.
     """
 
     time: np.ndarray
@@ -282,6 +312,14 @@ class Trial:
             if arr.shape != (time.size, 3):
                 raise TrialError(
                     source, f"marker {name!r} has shape {arr.shape}, expected ({time.size}, 3)"
+                )
+            inf = _first_infinite(arr)
+            if inf is not None:
+                sample, axis = inf
+                raise TrialError(
+                    source,
+                    f"marker {name!r} has {'xyz'[axis]} = {arr[sample, axis]} at sample "
+                    f"{sample + 1} (t = {time[sample]:.6g} s): only NaN marks a missing sample",
                 )
             markers[str(name)] = _frozen_array(arr)
         plates = tuple(self.force_plates)
