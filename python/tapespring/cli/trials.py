@@ -9,7 +9,8 @@ imports no analysis (the trials, protocols and report are imported by
 
 Exit codes: 0 when every trial was analysed, or when ``--skip-bad`` left some
 out and the summary lists them; 1 on an invalid file, trial or option value (the
-message names it); 2 on a command-line error (argparse), an option of another
+message names it), or a file that cannot be read or a report that cannot be written (such as
+``--out`` naming an existing file); 2 on a command-line error (argparse), an option of another
 kind of test than ``--kind`` included (``--frame`` with ``--kind vibration``).
 """
 
@@ -24,7 +25,7 @@ from pathlib import Path
 from typing import TypedDict
 
 from tapespring.protocols.markers import DEFAULT_MARKERS
-from tapespring.protocols.registry import KINDS, check_span_time
+from tapespring.protocols.registry import KINDS, MAX_N_PEAKS, check_n_peaks, check_span_time
 from tapespring.trials.common import LENGTH
 from tapespring.trials.trial import check_max_gap
 
@@ -68,6 +69,18 @@ class _AnalyzeParser(argparse.ArgumentParser):
                 joined.append(arg)
                 i += 1
         return super().parse_known_args(joined, namespace)
+
+
+def _n_peaks(text: str) -> int:
+    """The ``--n-peaks`` argparse type: `check_n_peaks`' bounds, with its message."""
+    try:
+        value = int(text)
+        check_n_peaks(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(
+            f"--n-peaks must be an integer >= 1 and <= {MAX_N_PEAKS} (got {text!r})"
+        ) from exc
+    return value
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -117,9 +130,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     # would have no effect, is refused (`_check_kind_options`).
     p.add_argument(
         "--n-peaks",
-        type=_count("--n-peaks"),
+        type=_n_peaks,
         default=None,
-        help="deployment: maxima and minima analysed, >= 1 (default 10)",
+        help=f"deployment: maxima and minima analysed, 1 to {MAX_N_PEAKS} (default 10)",
     )
     p.add_argument(
         "--frame",
@@ -239,8 +252,8 @@ def run_analyze(args: argparse.Namespace) -> int:
     -------
     int
         0 on success (trials skipped with ``--skip-bad`` are listed in the
-        summary), 1 if a trial, a file or an option is invalid (the message is
-        printed on stderr).
+        summary), 1 if a trial, a file or an option is invalid, or a file cannot be read or
+        the report written (the message is printed on stderr).
     """
     from tapespring.protocols.registry import analyze_trials, protocol_for
     from tapespring.report import format_summary, summary_dict, write_report
@@ -274,7 +287,9 @@ def run_analyze(args: argparse.Namespace) -> int:
                 skipped=loaded.skipped,
             )
             write_report(analysis, args.out, figures=not args.no_figures)
-        except (TrialError, FileNotFoundError, ValueError) as exc:
+        except (TrialError, OSError, ValueError) as exc:
+            # OSError: a path that cannot be read, or a report folder that cannot be written
+            # (--out an existing file, no permission): a message, under either entry point.
             _print_warnings(caught)
             print(f"error: {exc}", file=sys.stderr)
             return 1
@@ -299,7 +314,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="tapespring")
     register(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args(argv)
-    return args.func(args)
+    try:
+        return int(args.func(args))
+    except (ValueError, MemoryError, OSError) as exc:
+        # As the ``tapespring`` entry point (`tapespring.cli.main`): what the command did not
+        # report itself is a message, not a traceback.
+        print(f"error: {exc}", file=sys.stderr)
+        return 2 if isinstance(exc, ValueError) else 1
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ of the initial angle and of the lateral tip excursion. Marker roles and gaps: se
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -35,7 +36,7 @@ from tapespring.signals.stats import Summary, summarize
 from tapespring.trials.trial import Trial, TrialError, TrialWarning
 
 from .markers import DEFAULT_MARKERS, finite_marker
-from .registry import Protocol, TrialsAnalysis
+from .registry import Protocol, TrialsAnalysis, check_n_peaks
 
 __all__ = [
     "PROTOCOL",
@@ -127,6 +128,18 @@ _PLANE_NOISE_FACTOR = 10.0
 # simulated pull by 11 deg (16 mm), so a third of the paper's fold leaves a factor three or more
 # on either side.
 _MIN_INITIAL_ANGLE = np.deg2rad(30.0)
+# The tail that defines the equilibrium (its median) must be at rest: its angle, smoothed over
+# 30 ms (25 samples at 800 Hz cut the marker noise five-fold), may span at most 10 times the
+# angle's noise (smoothed noise spans about 1.2 sigma over a 1 s tail at 800 Hz) and 1 deg (the
+# median is then off by half of it at most, 0.5 deg: ten times the 0.05 deg marker precision).
+# The synthetic deployments at rest span 0.1 deg there; stopped at 3 s, during their last swings,
+# 8.6 to 12 deg (every angle 1 deg off), at 1.2 s, 74 to 89 deg (8 to 36 deg off).
+# Checked over the tail's last 60 %: if they are at rest, the median of the tail lies within
+# their band (more than half of its samples do), whatever the swings before them.
+_REST_SHARE = 0.6
+_REST_SMOOTHING = 0.03
+_REST_NOISE_FACTOR = 10.0
+_REST_RANGE = np.deg2rad(1.0)
 
 
 def _rig_frame(frame: str | np.ndarray | None) -> tuple[np.ndarray | None, str]:
@@ -148,8 +161,12 @@ def _rig_frame(frame: str | np.ndarray | None) -> tuple[np.ndarray | None, str]:
 def _check_bending_plane(
     label: str, m1: np.ndarray, m2: np.ndarray, markers: Sequence[str], frame_name: str
 ) -> None:
-    """Refuse markers whose plane of motion is tilted from the frame's x-z plane (`_MAX_TILT`)."""
-    plane = motion_plane(m1, m2)
+    """Refuse markers whose plane of motion is tilted from the frame's x-z plane (`_MAX_TILT`),
+    or too short a record to have one."""
+    try:
+        plane = motion_plane(m1, m2)
+    except ValueError as exc:
+        raise TrialError(label, f"{exc} (the record has {m1.shape[0]})") from None
     d = m2 - m1
     sigma = np.array([noise_std(d[:, k]) for k in range(3)])
     noise = float(np.sqrt(np.sum(plane.axes[1] ** 2 * sigma**2)))  # along the second direction
@@ -168,6 +185,31 @@ def _check_bending_plane(
         "the bending angle would mean nothing; give the rig's frame (frame='x,-z,y', --frame) or "
         "fit it (frame='fit', --frame fit)",
     )
+
+
+def _check_at_rest(label: str, trial: Trial, angle: np.ndarray, tail: float) -> None:
+    """Warn if the bending angle [rad] still moves over the last `_REST_SHARE` of the ``tail``
+    seconds whose median is the equilibrium every angle is measured from (`_REST_RANGE`)."""
+    t = trial.time
+    span = span_samples(_REST_SMOOTHING, trial.rate)
+    last = angle[t >= t[-1] - tail]
+    smoothed = smooth(last, span)[complete_windows(last.size, span)]
+    if smoothed.size < 2:
+        smoothed = last
+    rest = smoothed[-math.ceil(_REST_SHARE * smoothed.size) :]
+    moves = float(np.ptp(rest))
+    allowed = max(_REST_NOISE_FACTOR * noise_std(angle), _REST_RANGE)
+    if moves > allowed:
+        warnings.warn(
+            f"{label}: the bending angle still moves near the record's end: over the last "
+            f"{_REST_SHARE * tail:.2g} s it spans {np.rad2deg(moves):.3g} deg (at rest it stays "
+            f"within {np.rad2deg(allowed):.2g} deg: 10 times its noise and at least 1 deg), so "
+            "the record probably stops before the tape settles, and the equilibrium (the median "
+            f"over the last {tail:g} s) and every angle measured from it may be off by up to "
+            f"{np.rad2deg(np.ptp(smoothed)) / 2:.3g} deg; record until the tape is at rest",
+            TrialWarning,
+            stacklevel=3,
+        )
 
 
 def _angle_and_release(
@@ -202,7 +244,8 @@ def analyze_deployment(
     markers : (str, str, str)
         Names of markers 1 and 2 (on the free end) and 3 (tip).
     n_peaks : int
-        Number of maxima and of minima kept (paper: 10).
+        Number of maxima and of minima kept, from 1 to
+        `tapespring.protocols.registry.MAX_N_PEAKS` (paper: 10).
     prominence : float, optional
         Peak prominence threshold [rad] (default: see `extract_peaks`).
     release_threshold : float
@@ -248,11 +291,14 @@ def analyze_deployment(
     -----
     TrialWarning
         If the sign of the initial angle contradicts the trial's sense (markers
-        probably not in the rig's frame), or a fitted frame has no sense to fix
-        its sign.
+        probably not in the rig's frame), a fitted frame has no sense to fix
+        its sign, or the record does not end at rest: over the last 60 % of
+        ``tail``, the angle smoothed over 30 ms spans more than 10 times its noise
+        and 1 deg (a record stopped before the tape settles: the equilibrium, the
+        median over ``tail``, and so every angle may be off by up to half the
+        tail's range).
     """
-    if not isinstance(n_peaks, int | np.integer) or n_peaks < 1:
-        raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
+    check_n_peaks(n_peaks)
     label = trial.metadata.label
     sense = trial.metadata.sense
     m1, m2, m3 = (finite_marker(trial, name) for name in markers)
@@ -299,6 +345,7 @@ def analyze_deployment(
             TrialWarning,
             stacklevel=2,
         )
+    _check_at_rest(label, trial, angle, tail)
     t_rel = float(t[i0])
     tt, yy = t[i0:], angle[i0:]
     all_peaks = extract_peaks(tt, yy, None, prominence=prominence, t_ref=t_rel)
@@ -395,7 +442,8 @@ def analyze_deployment_group(
     markers : (str, str, str)
         Names of markers 1 and 2 (on the free end) and 3 (tip).
     n_peaks : int
-        Number of maxima and minima analysed, >= 1.
+        Number of maxima and minima analysed, from 1 to
+        `tapespring.protocols.registry.MAX_N_PEAKS`.
     frame : str or ndarray, optional
         Axes of the markers (see `analyze_deployment`).
 

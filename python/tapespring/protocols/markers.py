@@ -32,11 +32,30 @@ def finite_marker(trial: Trial, name: str) -> np.ndarray:
     Raises
     ------
     TrialError
-        If the marker is missing, or has gaps (the message gives their number, the longest and
-        where the first starts).
+        If the marker is missing, never seen (every sample missing), has gaps (the message gives
+        their number, the longest and where the first starts), or an infinite coordinate (a
+        damaged sample: `Trial` holds what it is given).
     """
     xyz = trial.marker(name)
-    if np.isnan(xyz).any():
+    label = trial.metadata.label
+    infinite = np.flatnonzero(np.isinf(xyz).any(axis=1))
+    if infinite.size:
+        # arctan2 and the peak search turn an inf into a finite spike: refuse it here.
+        i = int(infinite[0])
+        raise TrialError(
+            label,
+            f"marker {name!r} has {infinite.size} sample(s) with an infinite coordinate (first "
+            f"at t = {trial.time[i]:.4g} s, sample {i}): a damaged sample; set it to NaN and "
+            "fill it as a gap (Trial.fill_gaps, --max-gap)",
+        )
+    missing = np.isnan(xyz).any(axis=1)
+    if missing.all():
+        raise TrialError(
+            label,
+            f"marker {name!r} is never seen: all its {missing.size} samples are missing; check "
+            "the marker names (markers=, --markers) and the capture's labelling",
+        )
+    if missing.any():
         gaps = [g for g in trial.gaps() if g.marker == name]
         longest = max(gaps, key=lambda g: g.duration)
         text = (
@@ -63,5 +82,5 @@ def finite_marker(trial: Trial, name: str) -> np.ndarray:
                 f"fills interior gaps only): crop the record ({', '.join(ends)}) with "
                 "Trial.crop or in the capture software"
             )
-        raise TrialError(trial.metadata.label, f"{text}; {'; '.join(advice)}")
+        raise TrialError(label, f"{text}; {'; '.join(advice)}")
     return xyz

@@ -14,7 +14,9 @@ swings gave a "maximum force" 394 % off). A pull test, as `analyze_pull_trial` c
   the rod's middle at about 1 m/s);
 - mostly one way: it turns back by more than a fifth of its travel at most once (a return
   after the pull);
-- and the force rises to a maximum: the smoothed force goes above 3 times the force noise.
+- and the force rises to a maximum: the smoothed force goes above 3 times the force noise;
+- inside the record: a maximum in the last half smoothing span, with no buckling drop after it,
+  is where a record stopped early was cut (its force still rising), and is refused.
 """
 
 from __future__ import annotations
@@ -124,7 +126,9 @@ def analyze_pull_trial(
     ------
     TrialError
         If the marker or the force plate is missing, the marker has gaps, the force has NaN
-        samples or the span is longer than the force record; or if the record is not a pull
+        samples or the span is longer than the force record; if the maximum force is at the
+        record's end (within half a span, no drop after it: the record stops before the
+        maximum); or if the record is not a pull
         test (module docs: the marker moves too little, too fast or back and forth, or the
         force does not rise), with the reason.
     """
@@ -149,6 +153,7 @@ def analyze_pull_trial(
     d_sign = np.sign(d[np.argmax(np.abs(d))]) or 1.0
     _check_pull_record(trial, marker, d_sign * z, f_sign * f, f_sign * fs)
     test = analyze_pull_test(d_sign * d, f_sign * f, span=span)
+    _check_maximum_inside(trial, fp.time, test)
     meta = trial.metadata
     return PullTestResult(
         name=trial.name, tape_pair=meta.tape_pair, session=meta.session, time=fp.time, test=test
@@ -221,6 +226,27 @@ def _check_pull_record(
             f"maximum {f_max:.3g} N, force noise {f_noise:.3g} N; a pull needs "
             f"{_MIN_FORCE_SIGMA:.0f} times the noise): no pulling force recorded?",
         )
+
+
+def _check_maximum_inside(trial: Trial, time: np.ndarray, test: PullTest) -> None:
+    """Refuse a maximum force at the record's end with no drop after it (module docs).
+
+    In the last half span the smoothing windows shrink down to the raw last sample, so a maximum
+    there is where a force still rising was cut, not the peak before buckling (a pull cut at 2 s
+    reported the 1.5 N of its last sample for the 9.9 N of the whole test).
+    """
+    n = test.force_smoothed.size
+    i = test.index_at_max
+    if test.buckled or i < n - 1 - test.span // 2:
+        return
+    raise TrialError(
+        trial.metadata.label,
+        f"the force record ends before its maximum: the smoothed force is highest "
+        f"({test.max_force:.3g} N) at t = {time[i]:.4g} s, {n - 1 - i} sample(s) before the "
+        f"last (within half the {test.span}-sample smoothing span), with no drop after it, so "
+        "the maximum before buckling is not in the record (a capture stopped early, or a file "
+        "cut short?)",
+    )
 
 
 def analyze_pull_group(

@@ -45,9 +45,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     "KINDS",
+    "MAX_N_PEAKS",
     "Protocol",
     "TrialsAnalysis",
     "analyze_trials",
+    "check_n_peaks",
     "check_span_time",
     "protocol_for",
 ]
@@ -57,6 +59,12 @@ _MODULES = {"deployment": "deployment", "vibration": "vibration", "quasi-static"
 
 #: Kinds of test understood by `analyze_trials`.
 KINDS = tuple(_MODULES)
+
+#: Largest ``n_peaks`` (deployment): the peak statistics have one row per peak and kind, padded
+#: with NaN beyond the peaks a trial has, and the report writes and plots each row. A deployment
+#: holds tens of peaks (the paper analyses 10; a noise-free simulated one decaying at 0.5 %
+#: damping to the 0.1 % prominence floor, about 200 of each kind); 1e6 ran for minutes.
+MAX_N_PEAKS = 1000
 
 #: The per-trial result of a kind: `DeploymentResult`, `VibrationResult` or `PullTestResult`.
 ResultT = TypeVar("ResultT")
@@ -283,7 +291,7 @@ def analyze_trials(
     markers : (str, str, str)
         Names of markers 1 (support), 2 (rod) and 3 (tip).
     n_peaks : int
-        Deployment: number of maxima and minima analysed, >= 1.
+        Deployment: number of maxima and minima analysed, from 1 to `MAX_N_PEAKS` (1000).
     window : (float, float)
         Vibration: range of absolute peak displacements fitted [m], 0 <= low < high.
     span : int
@@ -354,6 +362,17 @@ def check_span_time(value: object) -> None:
         raise ValueError(f"span_time must be a finite duration > 0 [s], got {value!r}")
 
 
+def check_n_peaks(value: object) -> None:
+    """Raise ValueError unless `value` is a deployment ``n_peaks``: an integer from 1 to
+    `MAX_N_PEAKS` (the command line's ``--n-peaks`` is refused by this check)."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Integral)
+        or not 1 <= int(value) <= MAX_N_PEAKS
+    ):
+        raise ValueError(f"n_peaks must be an integer >= 1 and <= {MAX_N_PEAKS}, got {value!r}")
+
+
 def _check_options(
     *, n_peaks: int, window: tuple[float, float], span: int, span_time: float | None
 ) -> None:
@@ -362,8 +381,7 @@ def _check_options(
     The types are the ones `analyze_trials` declares; the checks are for callers that do not
     type-check (the command line converts its strings, a script may pass anything).
     """
-    if not isinstance(n_peaks, numbers.Integral) or n_peaks < 1:
-        raise ValueError(f"n_peaks must be an integer >= 1, got {n_peaks!r}")
+    check_n_peaks(n_peaks)
     if not isinstance(span, numbers.Integral) or span < 1:
         raise ValueError(f"span must be an integer >= 1 [samples], got {span!r}")
     if span_time is not None:

@@ -32,7 +32,7 @@ import numpy as np
 
 from tapespring import plot
 from tapespring.report import jsonable, save_figure, summary_json, summary_row, write_table
-from tapespring.signals.damping import DampingFit, fit_damping
+from tapespring.signals.damping import DampingFit, check_window, fit_damping
 from tapespring.signals.levels import release_index, swing_midline
 from tapespring.signals.peaks import extract_peaks
 from tapespring.signals.smoothing import noise_std
@@ -127,22 +127,36 @@ def analyze_vibration(
     Raises
     ------
     TrialError
-        If the marker is missing or has gaps, or the fit is impossible; or if the record is
+        If the marker is missing or has gaps, the tip does not move (its height spans less than
+        ``window[0]``, or nothing), or the fit is impossible; or if the record is
         not a free decay (module docs: the half-cycles change their duration, the peaks
         alternate large and small, or the amplitudes grow), with the reason.
     """
     if not 0 < tail_fraction <= 1:
         raise ValueError(f"tail_fraction must satisfy 0 < tail_fraction <= 1, got {tail_fraction}")
+    label = trial.metadata.label
     z_abs = finite_marker(trial, marker)[:, 2]
     t = trial.time
+    low, _ = check_window(window)
+    travel = float(np.ptp(z_abs))
+    if not travel > 0 or travel < low:
+        # |z| about any equilibrium is at most the range: no peak can reach the window.
+        raise TrialError(
+            label,
+            f"the tip marker {marker!r} does not move enough: its height spans "
+            f"{travel * 1e3:.3g} mm over the record, less than the window's low end "
+            f"({low * 1e3:.3g} mm) that the fitted peaks must reach: a record at rest?",
+        )
     sigma = noise_std(z_abs)
     z = z_abs - swing_midline(z_abs, max(_PEAK_FLOOR_SIGMA * sigma, 1e-9), tail=tail_fraction)
     i0 = release_index(z, max(window[0], 5.0 * sigma))
-    _check_free_decay(trial.metadata.label, t[i0:], z[i0:], window[0], sigma, prominence)
     try:
+        _check_free_decay(label, t[i0:], z[i0:], window[0], sigma, prominence)
         fit = fit_damping(t, z, window, prominence=prominence, t_start=float(t[i0]))
+    except TrialError:
+        raise
     except ValueError as exc:
-        raise TrialError(trial.metadata.label, f"damping fit impossible: {exc}") from None
+        raise TrialError(label, f"damping fit impossible: {exc}") from None
     meta = trial.metadata
     return VibrationResult(
         name=trial.name,

@@ -244,6 +244,25 @@ def _half_period_index(
     return np.concatenate(([0], np.cumsum(steps))), half
 
 
+# A fitted envelope that grows over the peaks by more than this fraction (the rounding and
+# interpolation of noise-free records, as `tapespring.protocols.vibration`'s growth check) and by
+# more than twice the damping ratio's standard error is not a decay.
+_GROWTH_TOLERANCE = 0.01
+
+
+def _check_decay(rate: float, duration: float, epsilon: float, eps_std: float, n: int) -> None:
+    """Refuse a fit whose envelope grows (a negative damping ratio is no damping: the record is
+    not a free decay). A steady oscillation's ratio scatters about zero: it passes."""
+    growth = math.exp(min(-rate * duration, 700.0)) - 1.0
+    significant = not math.isfinite(eps_std) or epsilon + 2.0 * eps_std < 0
+    if growth > _GROWTH_TOLERANCE and significant:
+        raise ValueError(
+            f"the peaks grow: the fitted envelope rises by {100 * growth:.3g} % over the {n} "
+            f"peaks fitted ({duration:.4g} s; damping ratio {epsilon:.3g}), where a free decay's "
+            "amplitudes decay: not a free decay (a forced or self-excited oscillation?)"
+        )
+
+
 def fit_damping(
     t: np.ndarray,
     z: np.ndarray,
@@ -276,9 +295,14 @@ def fit_damping(
     Raises
     ------
     ValueError
-        If fewer than 3 peaks fall in the window, or their spacing is not that of a free
-        decay (two peaks a number of half periods apart of the wrong parity).
+        If ``t`` is not finite and strictly increasing or ``z`` is not finite (`extract_peaks`),
+        ``window`` or ``t_start`` is invalid, fewer than 3 peaks fall in the window, their
+        spacing is not that of a free decay (two peaks a number of half periods apart of the
+        wrong parity), or the fitted envelope grows (by more than 1 % over the peaks fitted
+        and twice the damping ratio's standard error: a negative damping ratio, not a decay).
     """
+    if t_start is not None and not math.isfinite(t_start):
+        raise ValueError(f"t_start must be finite [s], got {t_start}")
     time_all, value_all, kind_all, keep = _all_peaks(t, z, window, prominence, t_start)
     time, value, sign = time_all[keep], value_all[keep], kind_all[keep].astype(float)
     if time.size < 3:
@@ -334,6 +358,7 @@ def fit_damping(
         d_omega_d = -rate * omega_d / omega0**3
         var_omega_d = (np.pi / h**2) ** 2 * cov_t[1, 1]
         eps_std = float(np.sqrt(d_rate**2 * cov_z[2, 2] + d_omega_d**2 * var_omega_d))
+    _check_decay(rate, tau[-1], epsilon, eps_std, n)
     ss_tot = np.sum((value - value.mean()) ** 2)
     r2 = float(1.0 - np.sum(fit_z.fun**2) / ss_tot) if ss_tot > 0 else np.nan
     return DampingFit(

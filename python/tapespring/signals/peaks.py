@@ -33,6 +33,8 @@ maximum, and ``separation[k] = time[k] - time[k - 1]``.
 
 from __future__ import annotations
 
+import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -278,16 +280,19 @@ def extract_peaks(
     Parameters
     ----------
     t : ndarray, shape (m,)
-        Sampling instants [s], increasing and uniform.
+        Sampling instants [s], finite, strictly increasing and uniform (uniformity is assumed,
+        not checked).
     y : ndarray, shape (m,)
-        Signal (e.g. bending angle [rad] or displacement [m]); must be finite.
+        Signal (e.g. bending angle [rad] or displacement [m]); must be finite. A constant
+        signal has no peak: the result is empty.
     n : int or None
-        Number of peaks of each kind kept (the first ones in time); None keeps all.
+        Number of peaks of each kind kept (the first ones in time), an integer >= 1; None
+        keeps all.
     prominence : float, optional
-        Minimum prominence of a peak (unit of ``y``). Default:
+        Minimum prominence of a peak (unit of ``y``), > 0. Default:
         ``max(8 * noise_std(y), 1e-3 * ptp(y))``.
     min_distance : float, optional
-        Minimum time between two peaks of the same kind [s].
+        Minimum time between two peaks of the same kind [s], finite and > 0.
     t_ref : float, optional
         Reference instant of the first time separation [s]; default ``t[0]``.
     refine : bool
@@ -300,7 +305,9 @@ def extract_peaks(
     Raises
     ------
     ValueError
-        If the arrays differ in length, hold NaN, or the options are invalid.
+        If the arrays differ in length or have fewer than 3 samples, ``t`` is not finite and
+        strictly increasing, ``y`` is not finite, or an option is invalid (the message names
+        the argument).
     """
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -308,18 +315,25 @@ def extract_peaks(
         raise ValueError(f"t and y must be 1-D arrays of the same length, got {t.shape}, {y.shape}")
     if y.size < 3:
         raise ValueError(f"need at least 3 samples to find peaks, got {y.size}")
+    check_time(t)
     if not np.all(np.isfinite(y)):
+        n_nan = np.count_nonzero(np.isnan(y))
+        n_inf = np.count_nonzero(np.isinf(y))
         raise ValueError(
-            f"the signal has {np.count_nonzero(~np.isfinite(y))} NaN samples; "
+            f"y must be finite: the signal has {n_nan} NaN samples and {n_inf} infinite ones; "
             "fill the marker gaps (Trial.fill_gaps) or crop the record first"
         )
-    if n is not None and n < 1:
-        raise ValueError(f"n must satisfy n >= 1, got {n}")
+    if n is not None and (isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1):
+        raise ValueError(f"n must be an integer >= 1 or None, got {n!r}")
+    if prominence is not None and not prominence > 0:
+        raise ValueError(f"prominence must satisfy prominence > 0, got {prominence}")
+    if min_distance is not None and not (math.isfinite(min_distance) and min_distance > 0):
+        raise ValueError(f"min_distance must be a finite duration > 0 [s], got {min_distance}")
     sigma = noise_std(y)
     if prominence is None:
+        # 0 only for a constant signal, which has no peak (find_peaks finds none at any
+        # prominence): the result is then empty rather than an error about an option not given.
         prominence = max(8.0 * sigma, 1e-3 * float(np.ptp(y)))
-    if not prominence > 0:
-        raise ValueError(f"prominence must satisfy prominence > 0, got {prominence}")
     distance = None
     if min_distance is not None:
         dt = (t[-1] - t[0]) / (t.size - 1)
@@ -334,6 +348,23 @@ def extract_peaks(
         noise=sigma,
         t_ref=t_ref,
     )
+
+
+def check_time(t: np.ndarray) -> None:
+    """Raise ValueError unless the sampling instants `t` [s] are finite and strictly increasing.
+
+    Uniform steps are assumed (the peak refinement uses the mean step) but not checked: a
+    simulated series with slightly uneven steps is still analysed as before.
+    """
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"t must be finite: it has {np.count_nonzero(~np.isfinite(t))} NaN or inf")
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(
+            f"t must be strictly increasing: t[{i + 1}] = {t[i + 1]:.6g} s follows "
+            f"t[{i}] = {t[i]:.6g} s ({bad.size} such step(s))"
+        )
 
 
 def _padded(rows: Sequence[np.ndarray], n: int) -> np.ndarray:

@@ -39,7 +39,9 @@ class PullTest:
     displacement_at_max : float
         Displacement at the maximum force [m].
     index_at_max : int
-        Sample index of the maximum.
+        Sample index of the maximum. One in the last ``span // 2`` samples without a drop after
+        it (``buckled`` False) is where a record stopped early was cut, its force still rising:
+        no maximum before buckling (`tapespring.protocols.pull.analyze_pull_trial` refuses it).
     buckled : bool
         A drop of at least ``drop_fraction`` of the maximum follows it.
     """

@@ -47,7 +47,8 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
     Parameters
     ----------
     values : array_like
-        The values; NaN entries are ignored.
+        The values, at least one along ``axis``; NaN entries are ignored (a trial without
+        that quantity), infinite ones are refused.
     axis : int, optional
         Axis along which the trials run (None: all values are one quantity).
 
@@ -55,10 +56,22 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
     -------
     Summary
         Floats if ``axis`` is None or ``values`` is 1-D, else arrays.
+
+    Raises
+    ------
+    ValueError
+        If ``values`` is empty (along ``axis``) or holds an infinite value (a mean of inf, or
+        a count that leaves it out while the mean uses it, would be no statistic).
     """
     x = np.asarray(values, dtype=float)
     if x.ndim == 1:
         axis = None
+    if x.size == 0 or (axis is not None and x.shape[axis] == 0):
+        raise ValueError(f"values must hold at least one value, got shape {x.shape}")
+    if np.isinf(x).any():
+        raise ValueError(
+            f"values must be finite or NaN (missing): {np.count_nonzero(np.isinf(x))} infinite"
+        )
     count = np.sum(np.isfinite(x), axis=axis)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns give NaN, on purpose

@@ -172,6 +172,9 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
     both; the forces are read with the markers); given alone, it stays, and
     `read_csv` says which marker file to give instead.
 
+    A file given more than once (by a folder and by name, or under two spellings of its path)
+    is listed once, where it first appears, with a `TrialWarning`.
+
     Raises
     ------
     FileNotFoundError
@@ -180,27 +183,49 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
         If a folder holds no trial file.
     """
     files: list[Path] = []
+    given: set[Path] = set()
+    repeated: list[Path] = []
     for raw in paths:
         path = Path(raw)
         if path.is_dir():
-            found = sorted(
-                p
-                for p in path.iterdir()
-                if p.is_file()
-                and p.suffix.lower() in (".c3d", ".csv")
-                and not p.name.endswith(FORCES_SUFFIX)
-                and p.name != METADATA_FILE
-            )
+            found = _folder_trials(path)
             if not found:
                 raise TrialError(path, "the folder holds no .c3d or .csv trial")
-            files.extend(found)
         elif path.is_file():
-            files.append(path)
+            found = [path]
         else:
             raise FileNotFoundError(f"{path}: no such file or folder")
-    given = {p.resolve() for p in files}
+        for p in found:
+            # Counted twice, a trial would weigh twice in the statistics (and its copy give a
+            # spread of zero): a folder and one of its files, overlapping shell patterns.
+            key = p.resolve()
+            if key in given:
+                repeated.append(p)
+            else:
+                given.add(key)
+                files.append(p)
+    if repeated:
+        names = ", ".join(str(p) for p in repeated[:5]) + (", ..." if len(repeated) > 5 else "")
+        warnings.warn(
+            f"{len(repeated)} trial file(s) given more than once (a folder and a file in it, or "
+            f"overlapping patterns) are read once: {names}",
+            TrialWarning,
+            stacklevel=2,
+        )
     # A force side file given with its marker file is read with it.
     return [p for p in files if (m := marker_file_of(p)) is None or m.resolve() not in given]
+
+
+def _folder_trials(folder: Path) -> list[Path]:
+    """The trial files of a folder, sorted by name (`find_trial_files`)."""
+    return sorted(
+        p
+        for p in folder.iterdir()
+        if p.is_file()
+        and p.suffix.lower() in (".c3d", ".csv")
+        and not p.name.endswith(FORCES_SUFFIX)
+        and p.name != METADATA_FILE
+    )
 
 
 def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
@@ -209,7 +234,8 @@ def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
     Parameters
     ----------
     path : str or Path
-        The ``metadata.csv`` file.
+        The ``metadata.csv`` file: UTF-8 text, with or without the byte-order mark Excel writes
+        ("CSV UTF-8"), one row per line.
 
     Returns
     -------
@@ -219,16 +245,38 @@ def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
     Raises
     ------
     TrialError
-        If a column is unknown, ``file`` is missing or repeated, or a sense is invalid (the
-        message names the line).
+        If the file is not UTF-8 text, a cell spans several lines or its quotes are not
+        closed, a column is unknown or repeated, ``file`` is missing or repeated, or a sense is
+        invalid (the message names the file and the line).
     """
-    path = Path(path)
-    with path.open(encoding="utf-8", newline="") as fh:
-        lines = [(n, line) for n, line in enumerate(fh, start=1) if not line.startswith("#")]
-    rows = list(csv.reader(line for _, line in lines))
+    return {name: entry for name, (_, entry) in _read_metadata(Path(path)).items()}
+
+
+def _read_metadata(path: Path) -> dict[str, tuple[int, dict[str, str]]]:
+    """`read_metadata_file`, with the line of each row."""
+    try:
+        with path.open(encoding="utf-8-sig", newline="") as fh:
+            lines = [(n, line) for n, line in enumerate(fh, start=1) if not line.startswith("#")]
+    except UnicodeDecodeError as exc:
+        raise TrialError(
+            path,
+            f"not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset {exc.start}): save "
+            "the metadata file as CSV UTF-8",
+        ) from None
+    rows = []
+    for line_no, line in lines:
+        # One row per line, so that errors name the line (and '#' lines can be comments).
+        try:
+            rows.append((line_no, next(csv.reader([line], strict=True), [])))
+        except csv.Error as exc:
+            raise TrialError(
+                path,
+                f"line {line_no}: {exc}: a quoted cell must close on its line (a metadata cell "
+                "cannot span lines)",
+            ) from None
     if not rows:
         raise TrialError(path, "empty metadata file: expected a header 'file,sense,...'")
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip() for h in rows[0][1]]
     unknown = [h for h in header if h not in ("file", *META_KEYS)]
     if "file" not in header or unknown:
         raise TrialError(
@@ -236,8 +284,13 @@ def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
             f"metadata columns must be 'file' and any of {', '.join(META_KEYS)}; "
             f"got {', '.join(header)}",
         )
-    out: dict[str, dict[str, str]] = {}
-    for (line_no, _), row in zip(lines[1:], rows[1:], strict=True):
+    repeated = sorted({h for h in header if header.count(h) > 1})
+    if repeated:
+        raise TrialError(
+            path, f"line {rows[0][0]}: column(s) {', '.join(repeated)} given more than once"
+        )
+    out: dict[str, tuple[int, dict[str, str]]] = {}
+    for line_no, row in rows[1:]:
         if not any(cell.strip() for cell in row):
             continue
         if len(row) > len(header):
@@ -252,22 +305,43 @@ def read_metadata_file(path: str | Path) -> dict[str, dict[str, str]]:
             raise TrialError(
                 path, f"line {line_no}: sense must be one of {SENSES}, got {entry['sense']!r}"
             )
-        out[name] = entry
+        out[name] = (line_no, entry)
     return out
 
 
 def _side_metadata(files: Sequence[Path]) -> dict[Path, dict[str, str]]:
-    """The side-file entry of each trial file (empty where there is none)."""
-    tables: dict[Path, dict[str, dict[str, str]]] = {}
+    """The side-file entry of each trial file (empty where there is none).
+
+    A row that names no trial file of its folder (by name or stem) is reported with a
+    `TrialWarning`: a typo in a file name would otherwise leave its trial without metadata,
+    silently.
+    """
+    tables: dict[Path, dict[str, tuple[int, dict[str, str]]]] = {}
     out = {}
     for file in files:
         folder = file.parent
         if folder not in tables:
             side = folder / METADATA_FILE
-            tables[folder] = read_metadata_file(side) if side.is_file() else {}
+            tables[folder] = _read_metadata(side) if side.is_file() else {}
+            if tables[folder]:
+                _check_rows_match(side, tables[folder])
         table = tables[folder]
-        out[file] = table.get(file.name) or table.get(file.stem) or {}
+        match = table.get(file.name) or table.get(file.stem)
+        out[file] = match[1] if match else {}
     return out
+
+
+def _check_rows_match(side: Path, table: dict[str, tuple[int, dict[str, str]]]) -> None:
+    """Warn about the rows of the side file `side` that name no trial file of its folder."""
+    known = {n for p in _folder_trials(side.parent) for n in (p.name, p.stem)}
+    for name, (line_no, _) in table.items():
+        if name not in known:
+            warnings.warn(
+                f"{side}: line {line_no}: {name!r} names no trial file in {side.parent} (a "
+                "typo?); its metadata are not used",
+                TrialWarning,
+                stacklevel=4,
+            )
 
 
 def load_trial_set(
