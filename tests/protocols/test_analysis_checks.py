@@ -93,6 +93,21 @@ def test_a_file_given_twice_is_read_once_with_a_warning(tmp_path):
     assert files == [path]
 
 
+# F10, in a folder: a force file is left out whatever its case, as it is paired.
+
+
+@pytest.mark.parametrize("forces_name", ["pull.forces.csv", "PULL.FORCES.CSV", "Pull.Forces.Csv"])
+def test_a_folder_leaves_out_a_force_file_in_any_case(tmp_path, forces_name):
+    # A force file whose marker file is not there (written apart, or renamed): in lower case it
+    # was left out of the folder, in upper case it was loaded as a trial and refused.
+    write_csv(make_pull_test_trial(duration=2.0), tmp_path / "pull.csv")
+    (tmp_path / "pull.csv").unlink()
+    (tmp_path / "pull.forces.csv").rename(tmp_path / forces_name)
+    trial = write_csv(make_vibration_trial(duration=3.0), tmp_path / "decay.csv")
+    assert find_trial_files([tmp_path]) == [trial]
+    assert [t.name for t in load_trial_set(tmp_path, progress=False).trials] == ["decay"]
+
+
 # F7 -----------------------------------------------------------------------------------------
 
 

@@ -36,7 +36,7 @@ from tqdm import tqdm
 
 from .c3d import DEFAULT_TIMEOUT, read_c3d
 from .common import META_KEYS
-from .csv import FORCES_SUFFIX, marker_file_of, needs_length_unit, read_csv
+from .csv import is_forces_file, marker_file_of, needs_length_unit, read_csv
 from .trial import SENSES, Trial, TrialError, TrialWarning
 
 __all__ = [
@@ -166,7 +166,8 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
     """Expand files and folders into the list of trial files.
 
     A folder contributes its ``*.c3d`` and ``*.csv`` files (not recursively,
-    sorted by name), except the ``*.forces.csv`` companions and the metadata
+    sorted by name), except the ``*.forces.csv`` companions (suffix in any case,
+    as they are paired: ``PULL.FORCES.CSV``) and the metadata
     side file (``metadata.csv``). A ``*.forces.csv`` file given by name is left
     out too when its marker file is given as well (a shell's ``*.csv`` gives
     both; the forces are read with the markers); given alone, it stays, and
@@ -223,7 +224,8 @@ def _folder_trials(folder: Path) -> list[Path]:
         for p in folder.iterdir()
         if p.is_file()
         and p.suffix.lower() in (".c3d", ".csv")
-        and not p.name.endswith(FORCES_SUFFIX)
+        # Any case, as the force file is paired: PULL.FORCES.CSV is PULL.CSV's forces, no trial.
+        and not is_forces_file(p)
         and p.name != METADATA_FILE
     )
 
