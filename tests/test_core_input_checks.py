@@ -1,5 +1,5 @@
 """Inputs the core took and then answered wrongly, or refused late with a message naming
-something else (a robustness review, D01-D05, D07, D08, D11, D12, D15): each is now refused by
+something else (a robustness review, D01-D05, D07-D09, D11, D12, D15): each is now refused by
 name before the run, or, for the modal shift, when its modes are found wrong.
 
 * a modal ``shift`` so far from the spectrum that ``K - sigma M`` loses ``K``'s digits gave wrong
@@ -13,7 +13,9 @@ name before the run, or, for the modal shift, when its modes are found wrong.
 * a ramp over (-1e308, 1e308) overflowed into a zero load;
 * modal tolerances below round-off, and a reference point of 1e300 m (infinite effective
   masses);
-* ``Model.from_json`` took ties and parts that ``tie`` and ``add_part`` refuse.
+* ``Model.from_json`` took ties and parts that ``tie`` and ``add_part`` refuse;
+* a body of 1e300 kg, a thickness of 1e300 m or an initial velocity of 1e200 m/s overflowed in
+  the run (D09).
 """
 
 import json
@@ -148,3 +150,24 @@ def test_a_model_read_from_json_is_checked_as_the_methods_check_it():
             Model.from_json(json.dumps(data))
     with pytest.raises(ValueError, match="already tied"):
         model.tie("x1", tip)
+
+
+def test_absurd_magnitudes_are_refused_where_they_are_given():
+    # Each of these overflowed inside the run (a NaN first record, or an error blaming a limit
+    # point or the time step) instead of naming the value.
+    nodes, quads, sets = shell.flat_plate_mesh(0.2, 0.02, 3, 2)
+    section = {"thickness": 1e-3, "youngs_modulus": 2e11, "poisson": 0.3}
+    for key, value in (("thickness", 1e300), ("shear_factor", 1e300), ("drilling_factor", 1e4)):
+        with pytest.raises(ValueError, match=rf"{key} .*must be at most 1e3"):
+            Model(nodes, quads, node_sets=sets, **{**section, key: value})
+    model = plate()
+    with pytest.raises(ValueError, match=r"mass must lie in \[0, 1e12\] kg"):
+        model.add_point_mass(5, 1e300)
+    with pytest.raises(ValueError, match=r"centre of mass must be finite and within 1e50 m"):
+        model.add_rigid_body(5, 1.0, centre_of_mass=[1e200, 0, 0])
+    with pytest.raises(ValueError, match=r"inertia tensor's entries must be at most 1e15"):
+        model.add_rigid_body(5, 1.0, inertia=np.diag([1e300, 1e300, 1e300]))
+    with pytest.raises(ValueError, match="faster than light"):
+        model.set_initial_velocity(5, velocity=[0, 0, 1e200])
+    # A heavy but plausible body is fine: a thousand tonnes.
+    model.add_rigid_body(5, 1e6, inertia=np.diag([1e6, 1e6, 1e6]))

@@ -72,8 +72,15 @@ def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
             2,
             "over 1e+308 elements",
         ),
-        # A failure in a scenario's first (static) step, which has no scenario result to show.
-        (["vibrate", "--duration", "0.02", "--thickness=1e300", "--no-progress"], 1, "gravity"),
+        # A failure in a scenario's first (static) step, which has no scenario result to show:
+        # a tape of 1e-300 Pa cannot carry the set-up's weight (its tangent underflows).
+        (
+            ["vibrate", "--duration", "0.02", "--youngs-modulus=1e-300", "--no-progress"],
+            1,
+            "gravity",
+        ),
+        # A tape as thick as its section's radius is no shell: refused before the run.
+        (["vibrate", "--thickness=900", "--no-progress"], 2, "tape.thickness = 900"),
     ],
 )
 def test_errors_found_while_running_are_messages_not_tracebacks(argv, code, message, capsys):

@@ -258,7 +258,7 @@ def test_deploy_refuses_a_recording_of_the_other_sense(metadata, tmp_path, capsy
     from tapespring.trials.csv import write_csv
     from tapespring.trials.samples import make_deployment_trial
 
-    trial, _ = make_deployment_trial("equal", duration=2.0)
+    trial, _ = make_deployment_trial("equal", duration=4.0)
     if not metadata:
         trial = dataclasses.replace(trial, metadata=dataclasses.replace(trial.metadata, sense=None))
     path = write_csv(trial, tmp_path / "equal.csv")

@@ -142,7 +142,7 @@ def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> N
     from tapespring.protocols.deployment import analyze_deployment
     from tapespring.trials.samples import make_deployment_trial
 
-    trial, _ = make_deployment_trial("opposite", duration=3.0)
+    trial, _ = make_deployment_trial("opposite", duration=4.0)
     measured = analyze_deployment(trial)
     c = opposite.compare(measured, n=3)
     # Simulation minus experiment, peak by peak; None where the short run has no peak.
@@ -173,7 +173,7 @@ def test_compare_refuses_a_recording_of_the_other_sense(
     from tapespring.protocols.deployment import analyze_deployment
     from tapespring.trials.samples import make_deployment_trial
 
-    trial, _ = make_deployment_trial("equal", duration=3.0)
+    trial, _ = make_deployment_trial("equal", duration=4.0)
     if not metadata:
         trial = replaced(trial, metadata=replaced(trial.metadata, sense=None))
     measured = analyze_deployment(trial)
@@ -211,7 +211,7 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     from tapespring.trials.csv import write_csv
     from tapespring.trials.samples import make_deployment_trial
 
-    trial, _ = make_deployment_trial("equal", duration=2.0)
+    trial, _ = make_deployment_trial("equal", duration=4.0)
     path = write_csv(trial, tmp_path / "equal.csv")
     png, pvd, snaps = tmp_path / "deploy.png", tmp_path / "run.pvd", tmp_path / "snaps.png"
     csv = tmp_path / "deploy.csv"

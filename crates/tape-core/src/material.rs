@@ -24,6 +24,12 @@ use crate::error::{check_positive, Error, Result};
 /// that a static step would accept reactions thousands of times the load.
 pub const MAX_YOUNGS_MODULUS: f64 = 1e13;
 
+/// Largest shell thickness \[m\].
+pub const MAX_THICKNESS: f64 = 1e3;
+
+/// Largest shear correction and drilling factor (both of order one: 5/6 and about 1e-3 to 1).
+pub const MAX_SECTION_FACTOR: f64 = 1e3;
+
 /// Section properties of a homogeneous shell. Serialised with `thickness`, `youngs_modulus` and
 /// `poisson` required and the other fields optional (the defaults of [`ShellSection::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,6 +135,23 @@ impl ShellSection {
         }
         check_positive("shear_factor (shear correction factor)", self.shear_factor)?;
         check_positive("drilling_factor", self.drilling_factor)?;
+        // Beyond these the section's products overflow (a thickness of 1e300 m cubed) or the
+        // value is a typing error: a shell a kilometre thick, factors meant to be of order one.
+        for (name, value, max) in [
+            ("thickness (t) [m]", self.thickness, MAX_THICKNESS),
+            (
+                "shear_factor (shear correction factor)",
+                self.shear_factor,
+                MAX_SECTION_FACTOR,
+            ),
+            ("drilling_factor", self.drilling_factor, MAX_SECTION_FACTOR),
+        ] {
+            if value > max {
+                return Err(Error::InvalidParameter(format!(
+                    "{name} must be at most {max:e} (got {value:e})"
+                )));
+            }
+        }
         Ok(())
     }
 

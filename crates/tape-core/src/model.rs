@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::material::ShellSection;
-use crate::mesh::{Mesh, Placement};
+use crate::mesh::{Mesh, Placement, MAX_COORDINATE};
 use crate::time_function::TimeFunction;
 
 pub use crate::dof::Dof;
@@ -45,6 +45,19 @@ pub struct Part {
     /// Indices of its elements in [`Mesh::quads`].
     pub elements: Range<usize>,
 }
+
+/// Largest mass of a rigid body or point mass \[kg\]: a billion tonnes. Beyond it the value is a
+/// typing error (at 1e300 kg under gravity the first residual overflowed, and the error blamed a
+/// limit point).
+pub const MAX_BODY_MASS: f64 = 1e12;
+
+/// Largest entry of a rigid body's inertia tensor \[kg m^2\]: [`MAX_BODY_MASS`] at 30 m from its
+/// centre.
+pub const MAX_BODY_INERTIA: f64 = 1e15;
+
+/// Speed of light [m/s]: the bound on an initial velocity (at 1e200 m/s the first record's
+/// kinetic energy overflowed).
+const SPEED_OF_LIGHT: f64 = 299_792_458.0;
 
 /// A rigid body (or a point mass) carried by a reference node.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -474,19 +487,27 @@ impl Model {
     fn check_rigid_body(&self, body: &RigidBody) -> Result<()> {
         self.check_node(body.node)?;
         let n = body.node;
-        if !(body.mass.is_finite() && body.mass >= 0.0) {
+        if !(body.mass.is_finite() && (0.0..=MAX_BODY_MASS).contains(&body.mass)) {
             return Err(Error::InvalidParameter(format!(
-                "rigid body at node {n}: mass must be finite and >= 0 (got {})",
+                "rigid body at node {n}: mass must lie in [0, {MAX_BODY_MASS:e}] kg (got {})",
                 body.mass
             )));
         }
-        if !finite3(&body.centre_of_mass) {
+        if !(finite3(&body.centre_of_mass) && body.centre_of_mass.amax() <= MAX_COORDINATE) {
             return Err(Error::InvalidParameter(format!(
-                "rigid body at node {n}: centre of mass must be finite"
+                "rigid body at node {n}: centre of mass must be finite and within {MAX_COORDINATE:e} m \
+                 (got {:?})",
+                body.centre_of_mass.as_slice()
             )));
         }
         let j = &body.inertia;
         let scale = j.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if scale > MAX_BODY_INERTIA {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: the inertia tensor's entries must be at most \
+                 {MAX_BODY_INERTIA:e} kg m^2 (got {scale:e})"
+            )));
+        }
         if !j.iter().all(|v| v.is_finite()) || (j - j.transpose()).amax() > 1e-12 * scale {
             return Err(Error::InvalidParameter(format!(
                 "rigid body at node {n}: the inertia tensor must be finite and symmetric"
@@ -525,6 +546,13 @@ impl Model {
             return Err(Error::InvalidModel(format!(
                 "the initial velocity of node {} is not finite",
                 v.node
+            )));
+        }
+        if v.velocity.norm() > SPEED_OF_LIGHT {
+            return Err(Error::InvalidModel(format!(
+                "the initial velocity of node {} is faster than light ({:e} m/s)",
+                v.node,
+                v.velocity.norm()
             )));
         }
         if let Some(t) = self.ties.iter().find(|t| t.nodes.contains(&v.node)) {

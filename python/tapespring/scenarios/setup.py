@@ -47,6 +47,7 @@ __all__ = [
     "check_sample_rate",
     "check_sampling",
     "check_sense",
+    "check_thin",
     "check_youngs_modulus",
     "shown",
 ]
@@ -102,6 +103,20 @@ PAPER_TAPE = TapeSpring()
 #: stiffest material known (the paper's steel: 1.5e11). Beyond it the value is a typing error,
 #: refused here before a mesh is built.
 MAX_YOUNGS_MODULUS = 1e13
+
+
+def check_thin(thickness: float, radius: float, prefix: str = "") -> None:
+    """Raise ValueError unless a tape of `thickness` and section `radius` [m] is a thin shell.
+
+    A shell as thick as its radius of curvature has no inner surface: the Mindlin shell (and
+    eqs. (2)-(3)) describe thin walls, t / R of 0.01 for the paper's tape. `prefix` names the
+    fields (``"tape."`` in the set-up's spec).
+    """
+    if thickness >= 0.5 * radius:
+        raise ValueError(
+            f"{prefix}thickness = {thickness} m is not thin against the {prefix}radius {radius} m "
+            f"(a shell model needs thickness < radius / 2)"
+        )
 
 
 def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
@@ -479,6 +494,7 @@ class SetupSpec:
             check_number(f"tape.{name}", value, positive=True)
         check_youngs_modulus(self.tape.youngs_modulus, "tape.youngs_modulus")
         check_poisson(self.tape.poisson, "tape.poisson")
+        check_thin(self.tape.thickness, self.tape.radius, "tape.")
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
