@@ -20,25 +20,8 @@ import re
 
 import numpy as np
 import pytest
-from tapespring import Model, Outputs, Results, Step, run, shell
-
-
-def plate(**section):
-    """A clamped 3 x 2 steel plate, 200 x 20 x 1 mm; node 5 is a corner of the free end."""
-    nodes, quads, sets = shell.flat_plate_mesh(0.2, 0.02, 3, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=2e11,
-        poisson=0.3,
-        density=7850.0,
-        **section,
-    )
-    model.fix("x0")
-    return model
-
+from _plate import plate
+from tapespring import Outputs, Results, Step, run
 
 # ---------------------------------------------------------------------------------------------
 # D13: Results.load checks what it reads before anything uses it

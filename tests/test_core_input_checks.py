@@ -22,24 +22,9 @@ import json
 
 import numpy as np
 import pytest
+from _plate import plate
 from tapespring import ConvergenceError, Model, Outputs, Step, run, shell
 from tapespring.analysis import ramp, table
-
-
-def plate(youngs_modulus=2e11):
-    """A clamped 3 x 2 steel plate, 200 x 20 x 1 mm; node 5 is a corner of the free end."""
-    nodes, quads, sets = shell.flat_plate_mesh(0.2, 0.02, 3, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=youngs_modulus,
-        poisson=0.3,
-        density=7850.0,
-    )
-    model.fix("x0")
-    return model
 
 
 def test_a_modal_shift_that_loses_the_stiffness_is_refused_by_name():
