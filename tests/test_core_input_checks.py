@@ -156,3 +156,15 @@ def test_absurd_magnitudes_are_refused_where_they_are_given():
         model.set_initial_velocity(5, velocity=[0, 0, 1e200])
     # A heavy but plausible body is fine: a thousand tonnes.
     model.add_rigid_body(5, 1e6, inertia=np.diag([1e6, 1e6, 1e6]))
+
+
+def test_a_massless_free_dof_is_refused_before_the_first_step_runs():
+    # Found when the dynamic or modal step was reached, it came after the static steps' work: a
+    # ValueError that dropped their results (dynamic) or a ConvergenceError (modal).
+    model = plate(density=0.0)
+    model.add_load(5, "uz", 1.0)
+    calls = []
+    for later in (Step.dynamic("d", duration=1e-3), Step.modal("m", modes=2)):
+        with pytest.raises(ValueError, match=rf"step 1 '{later.name}': node 1 has free DOFs"):
+            run(model, [Step.static("s", increments=50), later], progress=calls.append)
+    assert calls == []

@@ -295,3 +295,12 @@ def test_damaged_analog_rate_is_refused_naming_the_parameter(pull_c3d, tmp_path,
         TrialError, match=rf"ANALOG:RATE {rate:g} Hz disagrees with the header's 5 analog samples"
     ):
         read_c3d(path)
+
+
+@pytest.mark.parametrize("scale", [1e9, 1e-7])
+def test_trial_refuses_a_sampling_rate_that_is_no_laboratory_recording(pull, scale):
+    # Times in microhertz steps gave a 99.8 % damping ratio from a fit of r^2 = 0.05 (review F15);
+    # the pull's 800 Hz markers scaled to 0.8 uHz and 8 GHz are both refused by name.
+    with pytest.raises(TrialError, match=r"sampling rate .* is outside \[1, 1e\+06\] Hz"):
+        Trial(time=pull.time * scale, markers=dict(pull.markers))
+    Trial(time=pull.time, markers=dict(pull.markers))

@@ -268,6 +268,55 @@ fn check_initial_velocities(model: &Model, dofs: &DofMap) -> Result<()> {
     Ok(())
 }
 
+/// Refuses, before any step runs, a dynamic or modal step in which a node has free DOFs without
+/// mass or rotary inertia (a density of zero, a reference node carrying nothing): found when the
+/// step was reached, the error came after the earlier steps' work, as a ValueError that dropped
+/// their results (dynamic) or as a ConvergenceError (modal). Checked in the reference
+/// orientation; the dynamic step checks its own start again.
+fn check_masses(model: &Model, system: &System, steps: &[Step]) -> Result<()> {
+    let mut activity = Activity::initial(model);
+    for (k, step) in steps.iter().enumerate() {
+        for id in &step.activate {
+            activity.switch(model, id, true)?;
+        }
+        for id in &step.deactivate {
+            activity.switch(model, id, false)?;
+        }
+        if matches!(step.kind, StepKind::Static(_)) {
+            continue;
+        }
+        let dofs = DofMap::try_with(model, &activity)?;
+        for (i, slots) in dofs.slots.iter().enumerate() {
+            if dofs.master[i].is_some() {
+                continue;
+            }
+            let free: Vec<usize> = (0..6)
+                .filter(|&d| matches!(slots[d], Slot::Free(_)))
+                .collect();
+            if free.is_empty() {
+                continue;
+            }
+            let m = system.inertia[i].mass_matrix(&nalgebra::Matrix3::identity());
+            let restricted = nalgebra::DMatrix::from_fn(free.len(), free.len(), |a, b| m[(free[a], free[b])]);
+            if restricted.cholesky().is_none() {
+                let names: Vec<&str> = free.iter().map(|&d| Dof::ALL[d].name()).collect();
+                return Err(Error::InvalidModel(format!(
+                    "step {k} '{}': node {i} has free DOFs {names:?} without mass or rotary inertia: a \
+                     {} step needs mass on every free DOF (give its part a density, or attach a rigid \
+                     body)",
+                    step.name,
+                    if matches!(step.kind, StepKind::Modal(_)) {
+                        "modal"
+                    } else {
+                        "dynamic"
+                    }
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Gives the model's initial velocities to `state` (spatial, as the model's).
 fn apply_initial_velocities(model: &Model, state: &mut State) {
     for iv in &model.initial_velocities {
@@ -399,6 +448,7 @@ pub fn run(
         activity.switch(model, id, false)?;
     }
     let mut system = System::try_with(model, &activity)?;
+    check_masses(model, &system, steps)?;
     system.probes.clone_from(&reaction_dofs);
     let mut state = system.initial_state();
     let wait = velocities_wait(steps);

@@ -93,6 +93,15 @@ def _first_infinite(values: np.ndarray) -> tuple[int, int] | None:
     return int(sample), int(column)
 
 
+#: Sampling rates of a trial's markers or force plates [Hz]. Motion capture records at tens to
+#: thousands of hertz, force plates up to tens of kilohertz, and simulated trials at most at the
+#: scenarios' 1 MHz (`tapespring.scenarios.setup.MAX_SAMPLE_RATE`); beyond these the times are
+#: not in seconds (a recording sampled in microhertz gave a 99.8 % damping ratio from a fit of
+#: r^2 = 0.05, one in 1e-300 s steps an SVD failure).
+MIN_RATE = 1.0
+MAX_RATE = 1e6
+
+
 def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
     """Validate a uniformly sampled time vector and return its rate [Hz]."""
     if time.ndim != 1 or time.size < 2:
@@ -110,6 +119,13 @@ def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
             source,
             f"{what} time vector: steps of {mean_dt:.3g} s are below the resolution of its times "
             "(no finite sampling rate)",
+        )
+    rate = 1.0 / mean_dt
+    if not MIN_RATE <= rate <= MAX_RATE:
+        raise TrialError(
+            source,
+            f"{what} sampling rate {rate:.6g} Hz is outside [{MIN_RATE:g}, {MAX_RATE:g}] Hz: "
+            "no recording of a laboratory test (its times are probably not in seconds)",
         )
     worst = np.max(np.abs(dt - mean_dt)) / mean_dt
     if worst > _RATE_RTOL:
