@@ -284,13 +284,10 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
             assert!(f.iter().all(|f| f.abs() < 1e-3 * f7), "{f:?}");
         }
     }
-    // No density: no mass.
+    // No density: no mass, refused before any step runs (an invalid model, not a failed step).
     let massless = Model::try_new(flat_plate(1.0, 1.0, 2, 2)?, common::section(0.01, E, 0.3))?;
-    let result = run(&massless, &[modal(3)], &Outputs::default(), &mut |_| true)?;
-    assert!(result
-        .error
-        .expect("no mass")
-        .to_string()
-        .contains("without mass"));
+    let err = run(&massless, &[modal(3)], &Outputs::default(), &mut |_| true).expect_err("no mass");
+    assert!(matches!(err, tape_core::Error::InvalidModel(_)));
+    assert!(err.to_string().contains("without mass"));
     Ok(())
 }
