@@ -23,7 +23,7 @@ import pytest
 from hypothesis import assume, example, given
 from hypothesis import strategies as st
 from property_settings import examples
-from tapespring import Model, Step, run, shell
+from tapespring import Model, Step, TapeError, run, shell
 from tapespring.analysis import (
     ConvergenceError,
     dynamic_step_options,
@@ -195,6 +195,79 @@ def test_a_bad_section_value_is_refused_naming_it(key, value):
     else:
         # Some values are admissible for some keys (a density of 0, Poisson's ratio of 0 ...).
         assert not isinstance(value, (str, list)) and math.isfinite(value)
+
+
+# Any finite magnitude, tiny to near overflow: values a typing error or a unit slip produce.
+MAGNITUDES = st.one_of(
+    _log_uniform(1e-300, 1e300), st.sampled_from([1e-300, 1e300, 1.7e308, 1e3, 1e13, 1e12])
+)
+
+
+@examples(ci=25, long=300)
+@given(
+    key=st.sampled_from(
+        ["thickness", "youngs_modulus", "density", "eta", "shear_factor", "drilling_factor"]
+    ),
+    value=MAGNITUDES,
+)
+def test_a_section_value_of_any_magnitude_is_refused_by_name_or_gives_finite_records(key, value):
+    """A thickness of 1e300 m or a shear factor of 1e300 once built a model whose first record
+    held NaN reactions; E = 1e30 Pa made a static step accept reactions thousands of times its
+    load. Now a value is refused by name, or the model runs with finite records (or stops with a
+    clear error: a tangent too soft or too stiff to factorise)."""
+    section = {**SECTION, "density": 7850.0, key: value}
+    try:
+        model = Model(NODES, QUADS, node_sets=SETS, **section)
+    except ValueError as exc:
+        assert key in str(exc), str(exc)
+        return
+    assert math.isfinite(model.total_mass)
+    model.fix("x0")
+    model.add_load(NODES.shape[0] - 1, "uz", 1e-3)
+    try:
+        r = run(model, [Step.static("s", increments=1)], raise_on_error=False)
+    except TapeError:
+        return
+    assert np.all(np.isfinite(r.reactions)) and np.all(np.isfinite(r.kinetic_energy))
+    if r.error is None:
+        # Equilibrium: the clamp carries the load.
+        assert r.total_reaction("uz")[-1] == pytest.approx(-1e-3, rel=1e-6)
+
+
+@examples(ci=25, long=300)
+@given(
+    what=st.sampled_from(["mass", "centre_of_mass", "inertia", "velocity"]),
+    value=MAGNITUDES,
+)
+def test_a_body_or_velocity_of_any_magnitude_is_refused_by_name_or_kept_finite(what, value):
+    """A point mass of 1e300 kg, a centre of mass 1e200 m away or a velocity of 1e200 m/s made
+    the first record's energies non-finite, or an error blamed a limit point."""
+    model = Model(NODES, QUADS, node_sets=SETS, **SECTION, density=7850.0)
+    model.fix("x0")
+    tip = NODES.shape[0] - 1
+    calls = {
+        "mass": lambda: model.add_point_mass(tip, value),
+        "centre_of_mass": lambda: model.add_rigid_body(tip, 1.0, centre_of_mass=[value, 0, 0]),
+        "inertia": lambda: model.add_rigid_body(tip, 1.0, inertia=np.eye(3) * value),
+        "velocity": lambda: model.set_initial_velocity(tip, velocity=[0, 0, value]),
+    }
+    words = {
+        "mass": "mass",
+        "centre_of_mass": "centre of mass",
+        "inertia": "inertia",
+        "velocity": "velocity",
+    }
+    try:
+        calls[what]()
+    except ValueError as exc:
+        assert words[what] in str(exc), str(exc)
+        return
+    assert math.isfinite(model.total_mass)
+    try:
+        r = run(model, [Step.dynamic("d", duration=1e-4)], raise_on_error=False)
+    except TapeError:
+        return
+    assert np.all(np.isfinite(r.kinetic_energy[:1])) and np.all(np.isfinite(r.reactions[:1]))
 
 
 INDEX_CALLS = {
