@@ -1,5 +1,5 @@
 """Inputs the core took and then answered wrongly, or refused late with a message naming
-something else (a robustness review, D01-D05, D07-D09, D11, D12, D15): each is now refused by
+something else (a robustness review, D01-D05, D07-D12, D15, D16): each is now refused by
 name before the run, or, for the modal shift, when its modes are found wrong.
 
 * a modal ``shift`` so far from the spectrum that ``K - sigma M`` loses ``K``'s digits gave wrong
@@ -168,3 +168,19 @@ def test_a_massless_free_dof_is_refused_before_the_first_step_runs():
         with pytest.raises(ValueError, match=rf"step 1 '{later.name}': node 1 has free DOFs"):
             run(model, [Step.static("s", increments=50), later], progress=calls.append)
     assert calls == []
+
+
+def test_a_static_step_that_cannot_move_the_load_factor_is_refused():
+    # Such a step computed nothing: a constant load it switched on at the load factor it started
+    # from was silently left out (the clamp carried 1 N of 2), and a range of 1e-12 recorded
+    # nothing (review D16).
+    model = plate()
+    model.add_load(5, "uz", 1.0)
+    model.add_load(5, "uz", 1.0, id="b", function="constant", active=False)
+    first = Step.static("s", increments=1)
+    with pytest.raises(ValueError, match=r"step 1 't': lambda_end = 1 does not move the load"):
+        run(model, [first, Step.static("t", activate=["b"], lambda_end=1.0)])
+    with pytest.raises(ValueError, match="does not move the load factor from the 0"):
+        run(model, [Step.static("s", increments=2, lambda_end=1e-12)])
+    r = run(model, [first, Step.static("t", activate=["b"], lambda_end=2.0)])
+    assert r.total_reaction("uz")[-1] == pytest.approx(-3.0, rel=1e-6)

@@ -194,6 +194,9 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
         return Err(Error::InvalidParameter("an analysis needs at least one step".into()));
     }
     let mut activity = Activity::initial(model);
+    // The load factor (or time) each step starts from, where it is known before the run: a
+    // displacement-controlled step ends wherever its path takes the load factor.
+    let mut t = Some(0.0);
     for (k, step) in steps.iter().enumerate() {
         let name = &step.name;
         let context = format!("step {k} '{name}'");
@@ -203,6 +206,29 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
             StepKind::Modal(p) => p.validate(),
         }
         .map_err(|e| e.context(&context))?;
+        t = match &step.kind {
+            StepKind::Static(p) => match p.control {
+                Control::Load { lambda_end, .. } | Control::ArcLength { lambda_end, .. } => {
+                    // A step that cannot move the load factor computed nothing and applied nothing
+                    // it switched on (a constant load activated at the same load factor was
+                    // silently left out).
+                    if let Some(t0) = t {
+                        if (lambda_end - t0).abs() <= 1e-12 * lambda_end.abs().max(1.0) {
+                            return Err(Error::InvalidParameter(format!(
+                                "{context}: lambda_end = {lambda_end} does not move the load factor \
+                                 from the {t0} the step starts at (a static step applies what it \
+                                 switches on along its range: give it one, e.g. lambda_end = {})",
+                                t0 + 1.0
+                            )));
+                        }
+                    }
+                    Some(lambda_end)
+                }
+                Control::Displacement { .. } => None,
+            },
+            StepKind::Dynamic(p) => t.map(|t0| t0 + p.duration),
+            StepKind::Modal(_) => t,
+        };
         for id in &step.activate {
             activity
                 .switch(model, id, true)
