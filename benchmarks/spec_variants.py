@@ -13,7 +13,7 @@ asked for, on the paper's meshes (the pull on 3 mm), and prints one line per tes
   1.73e-4 s and gone with 2.1e-4 s in the paper's model (Sec. 6.1, Figs. 29-32).
 
 Named variants (``--variant``) move mass within the free end's 77 g, which the paper gives whole;
-``--set NAME=VALUE`` builds one from any fields. About 90 s per deployment run.
+``--set NAME=VALUE`` builds one from any fields. About 60 to 90 s per deployment run.
 
     python benchmarks/spec_variants.py --tests equal                      # the spec as it is
     python benchmarks/spec_variants.py --variant earlier --tests table6 pull modal opposite equal
