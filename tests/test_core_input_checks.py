@@ -184,3 +184,18 @@ def test_a_static_step_that_cannot_move_the_load_factor_is_refused():
         run(model, [Step.static("s", increments=2, lambda_end=1e-12)])
     r = run(model, [first, Step.static("t", activate=["b"], lambda_end=2.0)])
     assert r.total_reaction("uz")[-1] == pytest.approx(-3.0, rel=1e-6)
+
+
+def test_absurd_loads_gravity_and_prescribed_motions_are_refused_by_name():
+    # At 1e300 each overflowed in the first residual and the error blamed a limit point.
+    model = plate()
+    with pytest.raises(ValueError, match=r"load on uz at node 5 is 1e300, beyond 1e15"):
+        model.add_load(5, "uz", 1e300)
+    with pytest.raises(ValueError, match=r"gravity acceleration must be finite and at most 1e8"):
+        model.set_gravity([0, 0, -1e300])
+    with pytest.raises(ValueError, match=r"prescribed value of ry at node 5 is 1e300, beyond 1e6"):
+        model.prescribe(5, "ry", 1e300)
+    model.add_load(5, "uz", 1.0)
+    step = Step.static("s", control="displacement", node=5, dof="uz", delta=1e300)
+    with pytest.raises(ValueError, match=r"delta 1e300 is beyond 1e50"):
+        run(model, [step])

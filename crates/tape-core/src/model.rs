@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::material::ShellSection;
-use crate::mesh::{Mesh, Placement, MAX_COORDINATE};
+use crate::mesh::{Mesh, Placement, MAX_COORDINATE, MAX_ROTATION};
 use crate::time_function::TimeFunction;
 
 pub use crate::dof::Dof;
@@ -54,6 +54,25 @@ pub const MAX_BODY_MASS: f64 = 1e12;
 /// Largest entry of a rigid body's inertia tensor \[kg m^2\]: [`MAX_BODY_MASS`] at 30 m from its
 /// centre.
 pub const MAX_BODY_INERTIA: f64 = 1e15;
+
+/// Largest nodal load \[N, or N m for a moment\]: ten million times the largest presses'. Beyond
+/// it the value is a typing error (at 1e300 N the first residual overflowed, and the error blamed
+/// a limit point).
+pub const MAX_LOAD: f64 = 1e15;
+
+/// Largest gravitational acceleration [m/s^2]: ten times an ultracentrifuge's million g.
+pub const MAX_GRAVITY: f64 = 1e8;
+
+/// Largest prescribed motion of a DOF \[m, or rad for a rotation\]: the coordinate bound, or the
+/// placement's rotation bound.
+#[must_use]
+pub fn max_motion(dof: Dof) -> f64 {
+    if dof.is_rotation() {
+        MAX_ROTATION
+    } else {
+        MAX_COORDINATE
+    }
+}
 
 /// Speed of light [m/s]: the bound on an initial velocity (at 1e200 m/s the first record's
 /// kinetic energy overflowed).
@@ -344,14 +363,7 @@ impl Model {
     /// [`Error::InvalidModel`] for an unknown node, a non-finite value or an invalid function.
     pub fn add_constraint(&mut self, c: Constraint) -> Result<()> {
         self.check_node(c.node)?;
-        if !c.value.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "prescribed value of {} at node {} is not finite",
-                c.dof.name(),
-                c.node
-            )));
-        }
-        c.function.validate()?;
+        self.check_constraint(&c)?;
         self.constraints
             .retain(|o| !(o.node == c.node && o.dof == c.dof && o.id == c.id));
         self.constraints.push(c);
@@ -412,6 +424,60 @@ impl Model {
         Ok(())
     }
 
+    /// Checks a constraint's node, value (finite, within [`max_motion`]) and function.
+    fn check_constraint(&self, c: &Constraint) -> Result<()> {
+        self.check_node(c.node)?;
+        if !c.value.is_finite() {
+            return Err(Error::InvalidModel(format!(
+                "prescribed value of {} at node {} is not finite",
+                c.dof.name(),
+                c.node
+            )));
+        }
+        let bound = max_motion(c.dof);
+        if c.value.abs() > bound {
+            return Err(Error::InvalidModel(format!(
+                "prescribed value of {} at node {} is {:e}, beyond {bound:e} (m or rad)",
+                c.dof.name(),
+                c.node,
+                c.value
+            )));
+        }
+        c.function.validate()
+    }
+
+    /// Checks a load's node, value (finite, at most [`MAX_LOAD`]) and function.
+    fn check_load(&self, load: &Load) -> Result<()> {
+        self.check_node(load.node)?;
+        if !load.value.is_finite() {
+            return Err(Error::InvalidModel(format!(
+                "load on {} at node {} is not finite",
+                load.dof.name(),
+                load.node
+            )));
+        }
+        if load.value.abs() > MAX_LOAD {
+            return Err(Error::InvalidModel(format!(
+                "load on {} at node {} is {:e}, beyond {MAX_LOAD:e} N (or N m)",
+                load.dof.name(),
+                load.node,
+                load.value
+            )));
+        }
+        load.function.validate()
+    }
+
+    /// Checks a gravity: finite, at most [`MAX_GRAVITY`], with a valid function.
+    fn check_gravity(gravity: &Gravity) -> Result<()> {
+        if !(finite3(&gravity.acceleration) && gravity.acceleration.norm() <= MAX_GRAVITY) {
+            return Err(Error::InvalidParameter(format!(
+                "gravity acceleration must be finite and at most {MAX_GRAVITY:e} m/s^2 (got {:?})",
+                gravity.acceleration.as_slice()
+            )));
+        }
+        gravity.function.validate()
+    }
+
     /// Checks one tie on its own: known nodes, not empty, none repeated or tied to itself.
     fn check_tie(&self, nodes: &[usize], reference: usize) -> Result<()> {
         self.check_node(reference)?;
@@ -437,15 +503,7 @@ impl Model {
     /// # Errors
     /// [`Error::InvalidModel`] for an unknown node, a non-finite value or an invalid function.
     pub fn add_load_with(&mut self, load: Load) -> Result<()> {
-        self.check_node(load.node)?;
-        if !load.value.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "load on {} at node {} is not finite",
-                load.dof.name(),
-                load.node
-            )));
-        }
-        load.function.validate()?;
+        self.check_load(&load)?;
         self.loads.push(load);
         Ok(())
     }
@@ -569,13 +627,7 @@ impl Model {
     /// # Errors
     /// [`Error::InvalidParameter`] for a non-finite acceleration or an invalid function.
     pub fn set_gravity(&mut self, gravity: Gravity) -> Result<()> {
-        if !finite3(&gravity.acceleration) {
-            return Err(Error::InvalidParameter(format!(
-                "gravity acceleration must be finite (got {:?})",
-                gravity.acceleration.as_slice()
-            )));
-        }
-        gravity.function.validate()?;
+        Self::check_gravity(&gravity)?;
         self.gravity = Some(gravity);
         Ok(())
     }
@@ -665,21 +717,10 @@ impl Model {
             }
         }
         for c in &self.constraints {
-            self.check_node(c.node)?;
-            if !c.value.is_finite() {
-                return Err(Error::InvalidModel(format!(
-                    "constraint at node {} is not finite",
-                    c.node
-                )));
-            }
-            c.function.validate()?;
+            self.check_constraint(c)?;
         }
         for l in &self.loads {
-            self.check_node(l.node)?;
-            if !l.value.is_finite() {
-                return Err(Error::InvalidModel(format!("load at node {} is not finite", l.node)));
-            }
-            l.function.validate()?;
+            self.check_load(l)?;
         }
         for (i, b) in self.rigid_bodies.iter().enumerate() {
             self.check_rigid_body(b)?;
@@ -688,10 +729,7 @@ impl Model {
             }
         }
         if let Some(g) = &self.gravity {
-            if !finite3(&g.acceleration) {
-                return Err(Error::InvalidParameter("gravity acceleration must be finite".into()));
-            }
-            g.function.validate()?;
+            Self::check_gravity(g)?;
         }
         for (i, v) in self.initial_velocities.iter().enumerate() {
             self.check_initial_velocity(v)?;

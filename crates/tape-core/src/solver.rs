@@ -231,7 +231,15 @@ impl StaticParams {
                     ));
                 }
             }
-            Control::Displacement { delta, increments, .. } => {
+            Control::Displacement {
+                dof, delta, increments, ..
+            } => {
+                let bound = crate::model::max_motion(*dof);
+                if delta.abs() > bound {
+                    return Err(Error::InvalidParameter(format!(
+                        "displacement control's delta {delta:e} is beyond {bound:e} (m or rad)"
+                    )));
+                }
                 if !delta.is_finite() || *delta == 0.0 || !(1..=MAX_INCREMENTS).contains(increments) {
                     return bad(format!(
                         "displacement control needs a finite non-zero delta and increments in [1, {MAX_INCREMENTS}] (got {delta}, {increments})"
