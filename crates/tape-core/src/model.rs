@@ -74,6 +74,19 @@ pub fn max_motion(dof: Dof) -> f64 {
     }
 }
 
+/// Refuses a nodal value (`what`, in `unit`) that is not finite or whose magnitude exceeds `bound`.
+fn check_nodal_value(what: &str, value: f64, bound: f64, unit: &str) -> Result<()> {
+    if !value.is_finite() {
+        return Err(Error::InvalidModel(format!("{what} is not finite")));
+    }
+    if value.abs() > bound {
+        return Err(Error::InvalidModel(format!(
+            "{what} is {value:e}, beyond {bound:e} ({unit})"
+        )));
+    }
+    Ok(())
+}
+
 /// Speed of light [m/s]: the bound on an initial velocity (at 1e200 m/s the first record's
 /// kinetic energy overflowed).
 const SPEED_OF_LIGHT: f64 = 299_792_458.0;
@@ -427,43 +440,16 @@ impl Model {
     /// Checks a constraint's node, value (finite, within [`max_motion`]) and function.
     fn check_constraint(&self, c: &Constraint) -> Result<()> {
         self.check_node(c.node)?;
-        if !c.value.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "prescribed value of {} at node {} is not finite",
-                c.dof.name(),
-                c.node
-            )));
-        }
-        let bound = max_motion(c.dof);
-        if c.value.abs() > bound {
-            return Err(Error::InvalidModel(format!(
-                "prescribed value of {} at node {} is {:e}, beyond {bound:e} (m or rad)",
-                c.dof.name(),
-                c.node,
-                c.value
-            )));
-        }
+        let what = format!("prescribed value of {} at node {}", c.dof.name(), c.node);
+        check_nodal_value(&what, c.value, max_motion(c.dof), "m or rad")?;
         c.function.validate()
     }
 
     /// Checks a load's node, value (finite, at most [`MAX_LOAD`]) and function.
     fn check_load(&self, load: &Load) -> Result<()> {
         self.check_node(load.node)?;
-        if !load.value.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "load on {} at node {} is not finite",
-                load.dof.name(),
-                load.node
-            )));
-        }
-        if load.value.abs() > MAX_LOAD {
-            return Err(Error::InvalidModel(format!(
-                "load on {} at node {} is {:e}, beyond {MAX_LOAD:e} N (or N m)",
-                load.dof.name(),
-                load.node,
-                load.value
-            )));
-        }
+        let what = format!("load on {} at node {}", load.dof.name(), load.node);
+        check_nodal_value(&what, load.value, MAX_LOAD, "N or N m")?;
         load.function.validate()
     }
 
