@@ -239,9 +239,6 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                 .switch(model, id, false)
                 .map_err(|e| e.context(&context))?;
         }
-        if matches!(step.kind, StepKind::Dynamic(_)) && k == first_dynamic(steps).unwrap_or(usize::MAX) {
-            check_initial_velocities(model, &DofMap::try_with(model, &activity)?).map_err(|e| e.context(&context))?;
-        }
         let releases = !step.deactivate.is_empty() && k > 0;
         if releases
             && step
@@ -295,11 +292,13 @@ fn check_initial_velocities(model: &Model, dofs: &DofMap) -> Result<()> {
 }
 
 /// Refuses, before any step runs, a dynamic or modal step in which a node has free DOFs without
-/// mass or rotary inertia (a density of zero, a reference node carrying nothing): found when the
-/// step was reached, the error came after the earlier steps' work, as a ValueError that dropped
-/// their results (dynamic) or as a ConvergenceError (modal). Checked in the reference
-/// orientation; the dynamic step checks its own start again.
+/// mass or rotary inertia (a density of zero, a reference node carrying nothing), and an initial
+/// velocity on a DOF that the first dynamic step constrains. Found when the step was reached,
+/// the mass error came after the earlier steps' work, as a ValueError that dropped their results
+/// (dynamic) or as a ConvergenceError (modal). Masses are checked in the reference orientation;
+/// the dynamic step checks its own start again.
 fn check_masses(model: &Model, system: &System, steps: &[Step]) -> Result<()> {
+    let first = first_dynamic(steps);
     let mut activity = Activity::initial(model);
     for (k, step) in steps.iter().enumerate() {
         for id in &step.activate {
@@ -312,6 +311,9 @@ fn check_masses(model: &Model, system: &System, steps: &[Step]) -> Result<()> {
             continue;
         }
         let dofs = DofMap::try_with(model, &activity)?;
+        if first == Some(k) {
+            check_initial_velocities(model, &dofs).map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?;
+        }
         for (i, slots) in dofs.slots.iter().enumerate() {
             if dofs.master[i].is_some() {
                 continue;

@@ -406,22 +406,19 @@ pub fn solve_modal(system: &mut System, state: &State, params: &ModalParams) -> 
             }
         }
     }
+    // Diagonal ratios K_ii / M_ii: their smallest places the default shift below the spectrum,
+    // their largest scales the check of the modes found.
+    let (smallest_ratio, largest_ratio) = (0..n)
+        .filter_map(|i| {
+            let p = pattern.find(i, i)?;
+            let (k, m) = (asm.k_ff[p], m_values[p]);
+            (k > 0.0 && m > 0.0).then(|| k / m)
+        })
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| (lo.min(r), hi.max(r)));
     let shift = match params.shift {
         Some(f) => shift_from_hz(f),
-        None => {
-            let ratio = (0..n)
-                .filter_map(|i| {
-                    let p = pattern.find(i, i)?;
-                    let (k, m) = (asm.k_ff[p], m_values[p]);
-                    (k > 0.0 && m > 0.0).then(|| k / m)
-                })
-                .fold(f64::INFINITY, f64::min);
-            if ratio.is_finite() {
-                -AUTO_SHIFT_FACTOR * ratio
-            } else {
-                -1.0
-            }
-        }
+        None if smallest_ratio.is_finite() => -AUTO_SHIFT_FACTOR * smallest_ratio,
+        None => -1.0,
     };
     let residual = System::force_norm(&asm.residual(), &system.free_weights());
     let mut pencil = FePencil {
@@ -460,13 +457,6 @@ pub fn solve_modal(system: &mut System, state: &State, params: &ModalParams) -> 
         },
         other => other,
     })?;
-    let largest_ratio = (0..n)
-        .filter_map(|i| {
-            let p = pattern.find(i, i)?;
-            let (k, m) = (asm.k_ff[p], m_values[p]);
-            (k > 0.0 && m > 0.0).then(|| k / m)
-        })
-        .fold(0.0, f64::max);
     check_unshifted(
         pattern,
         &asm.k_ff,
