@@ -192,3 +192,24 @@ def test_json_summary_has_the_peaks_of_each_trial(tmp_path, capsys):
         maxima = t["peaks"]["maxima"]
         assert len(maxima["time"]) == len(maxima["amplitude"]) == 4
         assert maxima["amplitude_deg"][0] == pytest.approx(np.rad2deg(maxima["amplitude"][0]))
+
+
+def test_peaks_beyond_those_found_have_no_table_rows(tmp_path, capsys):
+    # 1000 peaks asked of 4 s deployments that hold far fewer: the printed and CSV tables list
+    # the peaks found (each with its trial count), not hundreds of rows of "nan"; the JSON keeps
+    # the padded statistics, one entry per peak asked.
+    folder = _deployments(tmp_path / "d")
+    out = tmp_path / "r"
+    argv = [str(folder), "--kind", "deployment", "--out", str(out), "--no-progress"]
+    assert _run([*argv, "--no-figures", "--n-peaks", "1000"]) == 0
+    table = capsys.readouterr().out
+    assert "nan" not in table
+    peak_rows = [line for line in table.splitlines() if " peak " in line]
+    assert 2 <= len(peak_rows) < 100
+    csv_rows = (out / "summary.csv").read_text().splitlines()
+    assert not any(",nan" in r or r.endswith(",") for r in csv_rows[1:])
+    assert _run([*argv, "--no-figures", "--json", "--n-peaks", "1000"]) == 0
+    group = json.loads(capsys.readouterr().out)["groups"][0]
+    counts = group["peaks"]["max_amplitude"]["count"]
+    assert len(counts) == 1000 and counts[-1] == 0
+    assert sum(1 for c in counts if c > 0) == sum(r.startswith("max peak ") for r in peak_rows)

@@ -482,6 +482,8 @@ def _combine(
 
 
 def _table_rows(analysis: TrialsAnalysis[DeploymentResult]) -> list[list[str]]:
+    # A peak that no trial of the group reached (n_peaks beyond the peaks found) has no row: the
+    # statistics keep its NaN padding, the printed and CSV tables would be rows of "nan".
     rows = []
     for g in analysis.groups:
         tag = g.sense or "unknown sense"
@@ -490,6 +492,8 @@ def _table_rows(analysis: TrialsAnalysis[DeploymentResult]) -> list[list[str]]:
         for k in range(np.size(g.peaks.max_amplitude.mean)):
             for field, label in (("max_amplitude", "max"), ("min_amplitude", "min")):
                 s = getattr(g.peaks, field)
+                if s.count[k] == 0:
+                    continue
                 sk = Summary(s.mean[k], s.std[k], s.max_diff[k], s.cv[k], int(s.count[k]))
                 rows.append(summary_row(f"{label} peak {k + 1} ({tag})", "deg", sk, 180 / np.pi))
     return rows

@@ -61,7 +61,8 @@ _MODULES = {"deployment": "deployment", "vibration": "vibration", "quasi-static"
 KINDS = tuple(_MODULES)
 
 #: Largest ``n_peaks`` (deployment): the peak statistics have one row per peak and kind, padded
-#: with NaN beyond the peaks a trial has, and the report writes and plots each row. A deployment
+#: with NaN beyond the peaks a trial has (the summary tables leave out the peaks no trial has),
+#: and the report plots each row. A deployment
 #: holds tens of peaks (the paper analyses 10; a noise-free simulated one decaying at 0.5 %
 #: damping to the 0.1 % prominence floor, about 200 of each kind); 1e6 ran for minutes.
 MAX_N_PEAKS = 1000
