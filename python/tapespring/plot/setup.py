@@ -62,7 +62,8 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
             label="peak at a zero crossing (phases I-II)",
         )
         if x.time.size:
-            bottom.legend(loc="lower right", frameon=False, fontsize="small")
+            # Framed: the force fills the panel, and an unframed handle reads as a data point.
+            bottom.legend(loc="best", fontsize="small", framealpha=0.9)
     bottom.set_ylabel("clamp force $F_z$ [N]")
     bottom.set_xlabel("time from release [s]")
     for ax in (top, bottom):
