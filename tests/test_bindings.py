@@ -321,7 +321,6 @@ def test_no_constraint_is_rejected():
         ({"max_iterations": 0}, "max_iterations must lie in"),
         ({"max_cutbacks": -1}, "option max_cutbacks = -1"),
         ({"max_cutbacks": 2**70}, r"\['max_cutbacks'\] = \d+ does not fit"),
-        ({"progress": 3}, "progress must be callable"),
     ],
 )
 def test_bad_control_options_raise_value_error_before_solving(options, match):
@@ -330,6 +329,14 @@ def test_bad_control_options_raise_value_error_before_solving(options, match):
     model.add_load(2, "uz", 1.0)
     with pytest.raises(ValueError, match=match):
         solve_static(model, **options)
+
+
+def test_a_progress_that_is_not_callable_is_a_type_error_before_solving():
+    model = core.Model(*square(), **SECTION)
+    model.fix([0, 3], "all")
+    model.add_load(2, "uz", 1.0)
+    with pytest.raises(TypeError, match=r"progress must be a callable .* or None, not int"):
+        solve_static(model, progress=3)
 
 
 def test_options_are_keyword_only():

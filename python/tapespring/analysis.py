@@ -106,7 +106,8 @@ def dynamic_step_options() -> dict[str, Any]:
     """Every option of a dynamic step, with its default value.
 
     ``duration`` [s]; ``rho_inf`` (spectral radius at infinite frequency, 0.7); ``initial_step``,
-    ``max_step``, ``min_step`` [s] (0: ``duration/1000``, ``duration/20``, ``1e-12 duration``);
+    ``max_step``, ``min_step`` [s] (0: ``duration/1000``, ``duration/20`` or the fixed step,
+    ``1e-12 duration``);
     ``adaptive`` (time steps from the local error estimate); ``tolerance`` [m] (local error per
     step; 0: 1e-5 times the model's characteristic length); ``output_interval`` [s] (steps land on
     its multiples; 0: none); ``max_steps``; ``max_cutbacks``; ``viscous_tangent`` (the exact
@@ -381,8 +382,10 @@ def run(
         layer's dict form is not accepted here).
     progress : bool or callable, optional
         True shows a tqdm bar on stderr; a callable ``progress(step_index, step_name, t)`` is
-        called after each converged state and stops the run by returning False. Ctrl-C stops it
-        too.
+        called after each converged state and stops the run by returning a false value other
+        than None (the results then have ``cancelled`` set). Ctrl-C stops the run too: the
+        ``KeyboardInterrupt`` (like any exception the callback raises) propagates with the states
+        recorded until then in its ``result`` attribute (a `Results`).
     raise_on_error : bool, optional
         If True (default), an analysis that stops early (no convergence after all cut-backs, a
         singular tangent, the step limit) raises :class:`ConvergenceError` whose ``result``
@@ -396,7 +399,7 @@ def run(
     Raises
     ------
     TypeError
-        If `outputs` is not an `Outputs`.
+        If `outputs` is not an `Outputs`, or `progress` is neither a bool, None nor callable.
     ValueError
         For an invalid model, step or output request (unknown or inapplicable options, unknown
         ids, ...), before anything runs.
@@ -412,18 +415,31 @@ def run(
             f"{type(outputs).__name__}"
         )
     out = outputs.to_dict()
-    if progress is True:
-        from tqdm import tqdm
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(
+            "progress must be True, False, None or a callable (step, name, t), not "
+            f"{type(progress).__name__}"
+        )
+    try:
+        if progress is True:
+            from tqdm import tqdm
 
-        with tqdm(desc="analysis", unit=" states", file=sys.stderr, leave=False) as bar:
+            with tqdm(desc="analysis", unit=" states", file=sys.stderr, leave=False) as bar:
 
-            def tick(step: int, name: str, t: float) -> None:
-                bar.update(1)
-                bar.set_postfix_str(f"step {step} '{name}', t = {t:.4g}", refresh=False)
+                def tick(step: int, name: str, t: float) -> None:
+                    bar.update(1)
+                    bar.set_postfix_str(f"step {step} '{name}', t = {t:.4g}", refresh=False)
 
-            raw = _core.run(model, raw_steps, outputs=out, progress=tick)
-    else:
-        raw = _core.run(model, raw_steps, outputs=out, progress=progress or None)
+                raw = _core.run(model, raw_steps, outputs=out, progress=tick)
+        else:
+            raw = _core.run(model, raw_steps, outputs=out, progress=progress or None)
+    except BaseException as exc:
+        # Ctrl-C or the callback's exception: what was computed until then goes with it.
+        partial = getattr(exc, "_tapespring_partial", None)
+        if partial is not None:
+            delattr(exc, "_tapespring_partial")
+            exc.result = Results.from_dict(partial)  # type: ignore[attr-defined]
+        raise
     results = Results.from_dict(raw)
     if raise_on_error and results.error is not None:
         err = ConvergenceError(

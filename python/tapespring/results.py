@@ -96,9 +96,10 @@ class Results:
         Kinetic energy [J] (0 in static steps).
     work_loads, work_prescribed, viscous_dissipation, numerical_dissipation : ndarray, shape (n,)
         Energy balance of dynamic steps, cumulated from the start of each dynamic step [J]: work
-        of the nodal loads, work of the prescribed motions (the supports), energy dissipated by
-        Kelvin-Voigt damping, and the remainder dissipated by the time integrator (NaN in static
-        steps).
+        of the nodal loads (with, while gravity changes in time, the part of its work that the
+        change of `gravity_energy` misses), work of the prescribed motions (the supports),
+        energy dissipated by Kelvin-Voigt damping, and the remainder dissipated by the time
+        integrator (NaN in static steps).
     marker_names : tuple of str
         Marker names.
     marker_positions, marker_rotations : ndarray, shape (n, n_markers, 3)

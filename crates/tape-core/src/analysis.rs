@@ -229,6 +229,12 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
             StepKind::Dynamic(p) => t.map(|t0| t0 + p.duration),
             StepKind::Modal(_) => t,
         };
+        if let Some(id) = step.activate.iter().find(|id| step.deactivate.contains(id)) {
+            // Deactivation is applied last: the activation would be silently void.
+            return Err(Error::InvalidParameter(format!(
+                "{context}: id '{id}' is both activated and deactivated"
+            )));
+        }
         for id in &step.activate {
             activity
                 .switch(model, id, true)

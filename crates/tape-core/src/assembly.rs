@@ -67,6 +67,10 @@ pub struct Assembled {
     pub energy: f64,
     /// Potential energy of gravity `-sum m g(t) . x` \[J\].
     pub gravity_energy: f64,
+    /// First moment of the mass that gravity acts on, `sum m x` over the nodes and the rigid
+    /// bodies' centres of mass \[kg m\] (zero without active gravity): `-g . P` is
+    /// [`Self::gravity_energy`] for any `g`.
+    pub mass_moment: Vector3<f64>,
 }
 
 /// Nodal velocities of every node (tied nodes included), spatial, for the viscous stresses.
@@ -843,6 +847,7 @@ impl System {
             apply(load.node, force, rate);
         }
         out.gravity_energy = 0.0;
+        out.mass_moment = Vector3::zeros();
         let mut body_terms = Vec::new();
         if let Some((g, function)) = &self.gravity {
             let (gt, dg) = (g * function.value(t), g * function.derivative(t, dir));
@@ -854,6 +859,7 @@ impl System {
                 let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
                 apply(n, force, rate);
                 out.gravity_energy -= m * gt.dot(&state.x[n]);
+                out.mass_moment += m * state.x[n];
             }
             for body in &self.bodies {
                 let r = body.node;
@@ -867,6 +873,7 @@ impl System {
                     df_ext[r][3 + i] += dm[i];
                 }
                 out.gravity_energy -= w.dot(&(state.x[r] + lever));
+                out.mass_moment += body.mass * (state.x[r] + lever);
                 body_terms.push((r, lever, -w));
             }
         }
@@ -1108,6 +1115,14 @@ impl System {
     #[must_use]
     pub fn force_floor(&self) -> f64 {
         1e-13 * self.membrane_stiffness() * self.char_length
+    }
+
+    /// Gravity \[m/s^2\] at time or load factor `t` (zero when none is active).
+    #[must_use]
+    pub fn gravity_at(&self, t: f64) -> Vector3<f64> {
+        self.gravity
+            .as_ref()
+            .map_or_else(Vector3::zeros, |(g, function)| g * function.value(t))
     }
 
     /// Kinetic energy \[J\] of `state` (every independent node carries its tied nodes' inertia).

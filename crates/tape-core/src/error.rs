@@ -47,11 +47,12 @@ pub enum Error {
     },
     /// A step ran out of increments before reaching its end.
     #[error(
-        "step limit reached{}: {steps} increments brought {} to {}, short of {}; raise the step's max_steps (or its initial increment)",
+        "step limit reached{}: {steps} increments brought {} to {}, short of {}; raise the step's max_steps{}",
         in_step(.step),
         clock.name(),
         at_value(*.t),
-        at_value(*.target)
+        at_value(*.target),
+        clock.step_hint()
     )]
     StepLimit {
         /// Name of the analysis step, when run by [`crate::analysis::run`].
@@ -83,6 +84,15 @@ impl Clock {
         match self {
             Self::Time => "t",
             Self::LoadFactor => "the load factor",
+        }
+    }
+
+    /// The other setting that bounds a step's count of increments, for messages.
+    #[must_use]
+    pub fn step_hint(self) -> &'static str {
+        match self {
+            Self::Time => " (steps that stay far below max_step point to a motion the time steps cannot follow)",
+            Self::LoadFactor => " (or its initial increment)",
         }
     }
 }

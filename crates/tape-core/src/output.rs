@@ -106,8 +106,9 @@ pub struct History {
     pub gravity_energy: Vec<f64>,
     /// Kinetic energy \[J\] (0 in static steps).
     pub kinetic_energy: Vec<f64>,
-    /// Work of the nodal loads since the start of the record's dynamic step \[J\] (NaN in static
-    /// steps).
+    /// Work of the nodal loads since the start of the record's dynamic step, with the part of
+    /// gravity's work that the change of its potential misses while `g` changes in time \[J\]
+    /// (NaN in static steps).
     pub work_loads: Vec<f64>,
     /// Work of the prescribed motions since the start of the dynamic step \[J\] (NaN in static steps).
     pub work_prescribed: Vec<f64>,

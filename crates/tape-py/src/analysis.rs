@@ -42,7 +42,7 @@ pub fn run<'py>(
     };
     // A copy, so that the model can be used (even changed) by other threads during the run.
     let model = model.borrow().inner.clone();
-    let result = run_detached(py, progress.as_ref(), |ticker| {
+    let (result, stopped_by) = run_detached(py, progress.as_ref(), |ticker| {
         to_py(run_core(&model, &steps, &outputs, &mut |p| {
             ticker.tick(|py, cb| cb.bind(py).call1((p.step, p.name, p.t)))
         }))
@@ -68,6 +68,12 @@ pub fn run<'py>(
     let model_json = serde_json::to_value(&model).unwrap_or(Value::Null);
     settings.set_item("model", convert::from_json(py, &model_json)?)?;
     d.set_item("settings", settings)?;
+    if let Some(e) = stopped_by {
+        // Ctrl-C or the callback's exception: re-raised with the states recorded until then
+        // (`tapespring.run` makes them the exception's `result`).
+        e.value(py).setattr("_tapespring_partial", &d)?;
+        return Err(e);
+    }
     Ok(d)
 }
 

@@ -11,7 +11,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyMemoryError, PyValueError};
+use pyo3::exceptions::{PyException, PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use tape_core::Error;
 
@@ -101,28 +101,33 @@ impl Ticker<'_> {
 }
 
 /// The one way the binding runs tape-core: with the GIL released (other Python threads keep
-/// running), panics turned into `TapeError`, and a [`Ticker`] for progress and Ctrl-C; an
-/// exception raised by the callback or a signal handler is re-raised after `f` returns; the
+/// running), panics turned into `TapeError`, and a [`Ticker`] for progress and Ctrl-C; the
 /// core's log records go to Python's `logging` at every tick and at the end ([`crate::logging`]).
+/// Returns what `f` returned and the exception raised by the callback or a signal handler, if
+/// any (it stopped the run: the caller re-raises it, with what was computed until then).
 ///
 /// # Errors
-/// The error of `f`, of the callback, or a `ValueError` if `callback` is not callable.
+/// The error of `f`, or a `TypeError` if `callback` is not callable.
 pub fn run_detached<T: Send>(
     py: Python<'_>,
     callback: Option<&Py<PyAny>>,
     f: impl for<'a> FnOnce(&mut Ticker<'a>) -> PyResult<T> + Send,
-) -> PyResult<T> {
+) -> PyResult<(T, Option<PyErr>)> {
     if let Some(cb) = callback {
         if !cb.bind(py).is_callable() {
-            return Err(PyValueError::new_err("progress must be callable or None"));
+            return Err(PyTypeError::new_err(format!(
+                "progress must be a callable (step, name, t) or None, not {}",
+                cb.bind(py).get_type().name()?
+            )));
         }
     }
     crate::logging::sync_level(py);
     let mut ticker = Ticker { callback, error: None };
     let out = py.detach(|| guard(|| f(&mut ticker)));
     crate::logging::forward(py);
-    if let Some(e) = ticker.error {
-        return Err(e);
+    match (out, ticker.error) {
+        (Ok(out), error) => Ok((out, error)),
+        // The callback's exception stopped the run, which then failed for it.
+        (Err(_), Some(e)) | (Err(e), None) => Err(e),
     }
-    out
 }

@@ -170,6 +170,7 @@ def _selected_records(results: Results, steps: Sequence[int] | None) -> NDArray[
                 f"the analysis has no dynamic step (steps: {kinds}); "
                 "choose the records with steps=[...]"
             )
+    _check_continuous(results, steps)
     wanted = np.zeros(n, dtype=bool)
     wanted[1:] = np.isin(results.step[1:], np.asarray(list(steps), dtype=np.int64))
     if not wanted.any():
@@ -179,6 +180,24 @@ def _selected_records(results: Results, steps: Sequence[int] | None) -> NDArray[
     first = np.flatnonzero(wanted[1:] & ~wanted[:-1]) + 1
     wanted[first - 1] = True
     return np.flatnonzero(wanted)
+
+
+def _check_continuous(results: Results, steps: Sequence[int]) -> None:
+    """Refuse `steps` with a static step of the analysis between two of them: its ``t`` is a load
+    factor, and a trial would interpolate markers and forces across it as if it were time. A
+    modal step in between is fine (it changes nothing)."""
+    chosen = sorted({int(k) for k in steps})
+    kinds = [s.get("kind") for s in results.settings.get("steps", [])]
+    names = [s.get("name", "") for s in results.settings.get("steps", [])]
+    if len(chosen) < 2 or not kinds:
+        return
+    for k in range(chosen[0] + 1, chosen[-1]):
+        if k not in chosen and k < len(kinds) and kinds[k] != "modal":
+            raise ValueError(
+                f"steps {chosen} are not one continuous history: step {k} ('{names[k]}', "
+                f"{kinds[k]}) lies between them and would be interpolated as time; choose "
+                "consecutive steps with steps=[...] (one trial per run of dynamic steps)"
+            )
 
 
 def _uniform_grid(t0: float, t1: float, rate: float, what: str) -> NDArray[np.float64]:
