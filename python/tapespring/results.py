@@ -430,6 +430,7 @@ class Results:
             if clash:
                 raise ValueError(f"meta holds keys of the file's arrays ({', '.join(clash)})")
             d.update({k: v for k, v in meta.items() if k != "modes"})
+            _check_meta(d)
             _check_records(d)
             # Files of formats 1 and 2 have no modes.
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
@@ -461,6 +462,33 @@ def _check_array(name: str, a: Any, dtype: Any, shape: tuple[int | None, ...]) -
         sizes = ["any" if e is None else str(e) for e in shape]
         want = f"({sizes[0]},)" if len(sizes) == 1 else "(" + ", ".join(sizes) + ")"
         raise ValueError(f"{name} has shape {a.shape}, not {want}")
+
+
+#: Types of the meta's scalar and container fields, as :meth:`Results.save` writes them: a
+#: hand-edited ``"cancelled": "no"`` would otherwise load as True, ``"error": 5`` as an error.
+_META_TYPES: dict[str, tuple[tuple[type, ...], str]] = {
+    "error": ((str, type(None)), "a string or null"),
+    "cancelled": ((bool,), "true or false"),
+    "steps_completed": ((int,), "an integer >= 0"),
+    "stats": ((dict,), "an object"),
+    "step_stats": ((list,), "a list of objects"),
+    "settings": ((dict,), "an object"),
+}
+
+
+def _check_meta(d: Mapping[str, Any]) -> None:
+    """Raise ValueError naming the first meta field of the wrong type (see `_META_TYPES`)."""
+    for key, (types, what) in _META_TYPES.items():
+        if key not in d:
+            continue  # a missing field is reported as such by `from_dict`
+        value = d[key]
+        wrong = not isinstance(value, types) or (bool not in types and isinstance(value, bool))
+        if not wrong and key == "steps_completed":
+            wrong = value < 0
+        if not wrong and key == "step_stats":
+            wrong = not all(isinstance(v, dict) for v in value)
+        if wrong:
+            raise ValueError(f"meta field {key} must be {what} (got {value!r})")
 
 
 def _check_records(d: Mapping[str, Any]) -> None:
@@ -509,6 +537,10 @@ def _check_records(d: Mapping[str, Any]) -> None:
     }
     for key, dtype in _ARRAYS.items():
         _check_array(key, d[key], dtype, shapes.get(key, (n,)))
+    # A run records converged states only: their times and markers are finite.
+    for key in ("t", "marker_positions", "marker_rotations"):
+        if not np.all(np.isfinite(np.asarray(d[key], dtype=float))):
+            raise ValueError(f"{key} holds non-finite values (a run records finite states only)")
     records = np.asarray(d["field_records"])
     if records.size and not (records.min() >= 0 and records.max() < n):
         raise ValueError(f"field_records holds records outside [0, {n})")

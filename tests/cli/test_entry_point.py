@@ -3,6 +3,7 @@ paths they could not write before they run."""
 
 import pytest
 from _cli import refused
+from tapespring._core import TapeError
 from tapespring.cli import main
 
 
@@ -63,8 +64,8 @@ def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
 @pytest.mark.parametrize(
     ("argv", "code", "message"),
     [
-        # The solver's own errors (TapeError): a tangent that underflows.
-        (["bend", "--mesh-size", "4.5e-3", "-E", "1e-300", "--no-progress"], 1, "factorisation"),
+        # (The solver's own TapeError, once reached here by `bend -E 1e-300`, a tangent that
+        # underflowed, is stood in for below: the parser now refuses a modulus below 1 MPa.)
         # Found by the bend tape's validation before the first run (the solver's element counts
         # once); the solver's own ValueError reaching `main` is stood in for below.
         (
@@ -73,9 +74,10 @@ def test_an_image_format_matplotlib_cannot_write_is_refused_before_the_run(
             "over 1e+308 elements",
         ),
         # A failure in a scenario's first (static) step, which has no scenario result to show:
-        # a tape of 1e-300 Pa cannot carry the set-up's weight (its tangent underflows).
+        # a tape of 1 MPa, the smallest modulus taken (setup.MIN_YOUNGS_MODULUS; 1e-300 Pa is
+        # refused by the parser now), cannot carry the set-up's weight.
         (
-            ["vibrate", "--duration", "0.02", "--youngs-modulus=1e-300", "--no-progress"],
+            ["vibrate", "--duration", "0.02", "--youngs-modulus=1e6", "--no-progress"],
             1,
             "gravity",
         ),
@@ -97,6 +99,8 @@ def test_errors_found_while_running_are_messages_not_tracebacks(argv, code, mess
         # `bend --length 1e3` once reached this (4.7 million elements); the bend tape's element
         # bound now refuses it before the mesh is built.
         (["bend"], "bending.bend", MemoryError("not enough memory"), 1),
+        # The solver's own errors (TapeError), e.g. a tangent without a factorisation.
+        (["bend"], "bending.bend", TapeError("no LDL^T factorisation available"), 1),
         (["max-mass", "--n-modulus=1"], "max_mass.max_mass", ValueError("invalid: counts"), 2),
     ],
 )

@@ -38,7 +38,10 @@ SETTINGS = VibrationSettings(
 
 @pytest.fixture(scope="module")
 def study() -> NumericalDampingStudy:
-    return numerical_damping_study(SETTINGS, (0.7, 0.0))
+    # The 5 ms steps are cut back a few times (measured: 2 at rho_inf 0.7, 1 at 0), which the
+    # study reports with a warning; the comparisons below hold all the same.
+    with pytest.warns(UserWarning, match="cut back"):
+        return numerical_damping_study(SETTINGS, (0.7, 0.0))
 
 
 def test_lowering_rho_inf_adds_the_predicted_damping(study: NumericalDampingStudy) -> None:

@@ -12,6 +12,7 @@ import argparse
 import json
 import os
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn
@@ -94,20 +95,54 @@ def _input_file(text: str) -> str:
     return text
 
 
+def _writable(folder: Path) -> bool:
+    """Whether a file can be created in the existing `folder`: its permissions allow it
+    (``os.access``) and a probe file can actually be created and removed there. The probe
+    catches what the permissions do not tell root: a folder such as ``/proc`` accepts no new
+    file whatever its mode (the run used to end with a raw ``Errno`` after the simulation)."""
+    if not os.access(folder, os.W_OK):
+        return False
+    try:
+        handle, probe = tempfile.mkstemp(dir=folder, prefix=".tapespring-write-check-")
+    except OSError:
+        return False
+    os.close(handle)
+    os.unlink(probe)
+    return True
+
+
 def _output_file(text: str) -> str:
-    """An argparse type: a file the command will write, in a folder that exists (checked before
-    anything runs, so that a mistyped path does not cost the run)."""
+    """An argparse type: a file the command will write, in a folder that exists and is writable
+    (checked before anything runs, so that a mistyped path does not cost the run)."""
     path = Path(text)
     if text == "" or path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is not a file name")
     folder = path.parent
     if not folder.is_dir():
         raise argparse.ArgumentTypeError(f"cannot write {text}: no folder {str(folder)!r}")
-    if not os.access(folder, os.W_OK):
+    if not _writable(folder):
         raise argparse.ArgumentTypeError(
             f"cannot write {text}: folder {str(folder)!r} is not writable"
         )
     return text
+
+
+def _output_folder(text: str) -> Path:
+    """An argparse type: a folder the command will write into (created with its parents if
+    missing) whose nearest existing folder is writable (checked before anything runs, as
+    `_output_file` checks a file's folder). A path through an existing file is left to the
+    writer, whose message ("File exists", exit 1) docs/errors.md gives."""
+    path = Path(text)
+    if text == "":
+        raise argparse.ArgumentTypeError("an empty folder name")
+    existing = path.absolute()
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.is_dir() and not _writable(existing):
+        raise argparse.ArgumentTypeError(
+            f"cannot write into {text}: folder {str(existing)!r} is not writable"
+        )
+    return path
 
 
 def _image_file(text: str) -> str:
@@ -134,7 +169,14 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     `tape_fields`.
     """
     from tapespring.scenarios.bending import check_alpha_deg
-    from tapespring.scenarios.setup import MAX_YOUNGS_MODULUS, check_poisson, check_youngs_modulus
+    from tapespring.scenarios.setup import (
+        MAX_YOUNGS_MODULUS,
+        MIN_THICKNESS,
+        MIN_YOUNGS_MODULUS,
+        check_poisson,
+        check_thickness,
+        check_youngs_modulus,
+    )
 
     p.add_argument("--length", type=_field("length"), default=d.length, help="L [m]")
     p.add_argument("--radius", type=_field("radius"), default=d.radius, help="R [m]")
@@ -144,13 +186,18 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
         default=d.alpha_deg,
         help="subtended angle of the cross-section [deg], in (0, 360)",
     )
-    p.add_argument("--thickness", type=_field("thickness"), default=d.thickness, help="t [m]")
+    p.add_argument(
+        "--thickness",
+        type=_checked("thickness", check_thickness),
+        default=d.thickness,
+        help=f"t [m], at least {MIN_THICKNESS:g}",
+    )
     p.add_argument(
         "--youngs-modulus",
         "-E",
         type=_checked("Young's modulus", check_youngs_modulus),
         default=d.youngs_modulus,
-        help=f"E [Pa], at most {MAX_YOUNGS_MODULUS:.0e}",
+        help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e}",
     )
     p.add_argument(
         "--poisson",

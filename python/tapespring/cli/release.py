@@ -33,15 +33,17 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         The ``release`` parser.
     """
     from tapespring.scenarios.release import (
+        MAX_DURATION,
         MAX_TIP_INERTIA,
         MAX_TIP_MASS,
         ReleaseSetup,
+        check_duration,
         check_fold_deg,
         check_gravity,
         check_tip_inertia,
         check_tip_mass,
     )
-    from tapespring.scenarios.setup import MAX_GRAVITY, check_rho_inf
+    from tapespring.scenarios.setup import MAX_ETA, MAX_GRAVITY, check_eta, check_rho_inf
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -77,12 +79,16 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--duration",
-        type=_field("duration"),
+        type=_checked("duration", check_duration),
         default=d.duration,
-        help="free motion after the release [s]",
+        help=f"free motion after the release [s], at most {MAX_DURATION:g} (the solver's step "
+        "limit times the largest step)",
     )
     p.add_argument(
-        "--eta", type=_field("eta", zero=True), default=d.eta, help="Kelvin-Voigt eta [s]"
+        "--eta",
+        type=_checked("eta", check_eta),
+        default=d.eta,
+        help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
     )
     p.add_argument(
         "--rho-inf",

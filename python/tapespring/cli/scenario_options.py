@@ -41,10 +41,16 @@ def add_spec_options(
     """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
     viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
     for a viscosity to act on: it leaves ``--eta`` out."""
+    from functools import partial
+
     from tapespring.scenarios.setup import (
+        MAX_ETA,
         MAX_YOUNGS_MODULUS,
+        MIN_THICKNESS,
+        MIN_YOUNGS_MODULUS,
         PAPER_SETUP,
         check_eta,
+        check_thickness,
         check_youngs_modulus,
     )
 
@@ -63,17 +69,23 @@ def add_spec_options(
         help=f"element size of the rod and appendix [m] (paper: 3e-3; default {mesh_plates:g})",
     )
     g.add_argument(
-        "--thickness", type=_field("tape.thickness"), default=s.tape.thickness, help="t [m]"
+        "--thickness",
+        type=_checked("tape.thickness", partial(check_thickness, name="tape.thickness")),
+        default=s.tape.thickness,
+        help=f"t [m], at least {MIN_THICKNESS:g}",
     )
     g.add_argument(
         "--youngs-modulus",
         type=_checked("Young's modulus", check_youngs_modulus),
         default=s.tape.youngs_modulus,
-        help=f"E [Pa], at most {MAX_YOUNGS_MODULUS:.0e}",
+        help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e}",
     )
     if eta:
         g.add_argument(
-            "--eta", type=_checked("eta", check_eta), default=s.eta, help="Kelvin-Voigt eta [s]"
+            "--eta",
+            type=_checked("eta", check_eta),
+            default=s.eta,
+            help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
         )
 
 

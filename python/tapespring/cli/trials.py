@@ -29,7 +29,7 @@ from tapespring.protocols.registry import KINDS, MAX_N_PEAKS, check_n_peaks, che
 from tapespring.trials.common import LENGTH
 from tapespring.trials.trial import check_max_gap
 
-from .bend import _checked, _count, refuse
+from .bend import _checked, _count, _output_folder, refuse
 
 __all__ = ["main", "register", "run_analyze"]
 
@@ -114,7 +114,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--kind", required=True, choices=KINDS, help="kind of test")
     p.add_argument(
         "--out",
-        type=Path,
+        type=_output_folder,
         default=Path("tapespring-report"),
         help="report folder (default: ./tapespring-report)",
     )

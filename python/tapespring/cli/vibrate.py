@@ -5,9 +5,10 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import functools
+import warnings
 from typing import TYPE_CHECKING, Any
 
-from .bend import _checked, _field, refuse
+from .bend import _checked, _field, refuse, warn
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -61,7 +62,12 @@ VTU_RATE = 50.0
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
-    from tapespring.scenarios.vibration import VibrationSettings, check_time_step
+    from tapespring.scenarios.vibration import (
+        MAX_INITIAL_DISPLACEMENT,
+        VibrationSettings,
+        check_initial_displacement,
+        check_time_step,
+    )
 
     d = VibrationSettings()
     p = sub.add_parser(
@@ -81,9 +87,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--duration", type=_field("duration"), default=d.duration, help="free decay [s]")
     p.add_argument(
         "--initial-displacement",
-        type=_field("initial_displacement"),
+        type=_checked("initial_displacement", check_initial_displacement),
         default=d.initial_displacement,
-        help="push before the release [m] (paper: about 8e-3)",
+        help="push before the release [m] (paper: about 8e-3), below "
+        f"{MAX_INITIAL_DISPLACEMENT:g} (small vibrations)",
     )
     p.add_argument(
         "--rho-inf",
@@ -224,7 +231,16 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
             **_given(args, "tolerance", "sample_rate"),
         )
         rho = tuple(args.rho_inf_study)
-        return numerical_damping_study(settings, rho, progress=not (args.no_progress or args.json))
+        # The study warns when fixed steps were cut back (its prediction then does not apply to
+        # every step): a "warning: ..." line on stderr, as the other commands' notes.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            study = numerical_damping_study(
+                settings, rho, progress=not (args.no_progress or args.json)
+            )
+        for note in caught:
+            warn(str(note.message))
+        return study
 
     def plot(result: NumericalDampingStudy, path: str) -> None:
         from tapespring.plot.numerical_damping import plot_numerical_damping

@@ -39,10 +39,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
+    MIN_ROTATION_DEG,
     PAPER_TAPE,
     check_element_count,
     check_number,
     check_poisson,
+    check_thickness,
     check_thin,
     check_youngs_modulus,
     shown,
@@ -77,11 +79,8 @@ MAX_ELEMENT_ANGLE_DEG = 20.0
 #: branch at a bifurcation (the equal-sense runs use 0.1), not a pre-twisted tape.
 MAX_IMPERFECTION_DEG = 10.0
 
-#: Smallest magnitude of the rotation driven at the tape's end [deg] (the bending's
-#: ``theta_max_deg``, the release's ``fold_deg``): a millionth of a degree. A smaller rotation
-#: moves nothing the solver can resolve (1e-300 reached it as "the loads and prescribed motions
-#: act on no free DOF").
-MIN_ROTATION_DEG = 1e-6
+# MIN_ROTATION_DEG, the smallest rotation driven at a tape's end [deg], lives in
+# tapespring.scenarios.setup (with the set-up's initial angles, which it bounds too).
 
 
 def check_rotation_deg(name: str, value: float, limit: float) -> None:
@@ -217,6 +216,7 @@ class BendingSetup:
         # refused by the same check.
         for name in ("mesh_size", "length", "radius", "thickness"):
             check_number(name, getattr(self, name), positive=True)
+        check_thickness(self.thickness)
         check_youngs_modulus(self.youngs_modulus)
         check_poisson(self.poisson)
         check_alpha_deg(self.alpha_deg)

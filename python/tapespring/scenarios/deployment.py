@@ -51,6 +51,7 @@ from tapespring.scenarios.setup import (
     buckling_step,
     build_setup,
     check_count,
+    check_min_samples,
     check_number,
     check_rho_inf,
     check_sampling,
@@ -92,7 +93,9 @@ class DeploymentSettings:
         Rate of the recorded histories [Hz] (the steps land on its multiples; the paper's motion
         capture runs at 800 Hz), at most :data:`~tapespring.scenarios.setup.MAX_SAMPLE_RATE`
         (1 MHz), and at most :data:`~tapespring.scenarios.setup.MAX_DYNAMIC_STEPS` samples in
-        `duration` (and in `settle`).
+        `duration` (and in `settle`); at least
+        :data:`~tapespring.scenarios.setup.MIN_SAMPLE_INTERVALS` (2) sample intervals in
+        `duration`, the fewest the peak analysis reads.
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default).
     n_peaks : int
@@ -123,6 +126,10 @@ class DeploymentSettings:
             check_sampling(
                 (step, getattr(self, step)), sample_rate=self.sample_rate, rate_name="sample_rate"
             )
+        # The motion is analysed (peaks, phases): at least 3 samples; the settle is not.
+        check_min_samples(
+            ("duration", self.duration), rate=self.sample_rate, rate_name="sample_rate"
+        )
         check_rho_inf(self.rho_inf)
         check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_count("field_interval", self.field_interval, minimum=0)

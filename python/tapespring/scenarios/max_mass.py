@@ -52,7 +52,9 @@ from tapespring.scenarios.setup import (
     SENSES,
     IdentificationBounds,
     TapeSpring,
+    check_density,
     check_number,
+    check_thickness,
     shown,
 )
 
@@ -103,11 +105,16 @@ def check_angle_deg(value: object) -> None:
 
 def check_grid_value(name: str, value: object) -> None:
     """Raise ValueError unless `value` is one of the grid values `name` (``"thicknesses"`` [m] or
-    ``"youngs_moduli"`` [Pa]): a finite number > 0."""
+    ``"youngs_moduli"`` [Pa]): a finite number > 0; a thickness at least 1 um
+    (:func:`~tapespring.scenarios.setup.check_thickness`). (A modulus's bounds, 1 MPa to
+    1e13 Pa, are those of each run's :meth:`BendingSetup.validate`, and of the command line's
+    ``--modulus-range``.)"""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
         raise ValueError(f"{name} must hold numbers (got {value!r})")
     if not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} must be finite and > 0 (got {value})")
+    if name == "thicknesses":
+        check_thickness(float(value), name)
 
 
 def _check_within(name: str, value: object, bounds: tuple[float, float], unit: str) -> None:
@@ -286,8 +293,9 @@ class MaxMassSettings:
             raise ValueError(
                 f"switch_branches must be True or False (got {self.switch_branches!r})"
             )
-        if not math.isfinite(self.tape.density) or self.tape.density < 0.0:
-            raise ValueError(f"tape.density must be finite and >= 0 (got {self.tape.density})")
+        # The tapes' weight is reported beside m_max (tape_weight_equivalent_mass): a physical
+        # density, as the set-up's (0: massless tapes).
+        check_density(self.tape.density, "tape.density", zero=True)
         # Geometry, material and mesh of every run, checked before the first one starts.
         for s in self.senses:
             for t in self.thicknesses:

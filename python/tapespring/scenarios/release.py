@@ -22,11 +22,20 @@ from tapespring.scenarios.bending import (
     bending_steps,
     check_rotation_deg,
 )
-from tapespring.scenarios.setup import MAX_GRAVITY, check_number, check_rho_inf, shown
+from tapespring.scenarios.setup import (
+    MAX_DYNAMIC_STEPS,
+    MAX_GRAVITY,
+    check_density,
+    check_eta,
+    check_number,
+    check_rho_inf,
+    shown,
+)
 
 __all__ = [
     "ReleaseResult",
     "ReleaseSetup",
+    "check_duration",
     "check_fold_deg",
     "check_gravity",
     "check_tip_inertia",
@@ -82,9 +91,36 @@ def check_gravity(value: object) -> None:
 
 def check_fold_deg(value: object) -> None:
     """Raise ValueError unless `value` is the fold angle ``fold_deg`` [deg]: a number within
-    (-180, 180), at least :data:`tapespring.scenarios.bending.MIN_ROTATION_DEG` in magnitude."""
+    (-180, 180), at least :data:`tapespring.scenarios.setup.MIN_ROTATION_DEG` in magnitude."""
     number = check_number("fold_deg", value, positive=False)
     check_rotation_deg("fold_deg", number, 180.0)
+
+
+#: First and largest time steps of the release [s], fixed rather than the solver's defaults (a
+#: thousandth and a twentieth of the duration): the step sequence, and with it the numerical
+#: dissipation of the snap (large without damping), is then the same whatever the duration, so
+#: a shorter run is the beginning of a longer one. The steps the error estimate chooses stay
+#: far below the largest (1e-5 to 1e-3 s).
+RELEASE_FIRST_STEP = 1e-5
+RELEASE_MAX_STEP = 5e-3
+
+#: Longest free motion of a release [s]: the solver's step limit (``max_steps``, its default
+#: :data:`tapespring.scenarios.setup.MAX_DYNAMIC_STEPS`) times the largest step
+#: (:data:`RELEASE_MAX_STEP`), 500 s. A longer motion needs more steps than the solver takes, so
+#: it cannot finish: 1e3 s ran for minutes into the step limit, 1e10 s into a native error.
+MAX_DURATION = MAX_DYNAMIC_STEPS * RELEASE_MAX_STEP
+
+
+def check_duration(value: object) -> None:
+    """Raise ValueError unless `value` is the release's free motion ``duration`` [s]: a number
+    > 0 and at most :data:`MAX_DURATION`."""
+    number = check_number("duration", value, positive=True)
+    if number > MAX_DURATION:
+        raise ValueError(
+            f"duration must be at most {MAX_DURATION:g} s (got {shown(number)} s): the release "
+            f"takes steps of at most {RELEASE_MAX_STEP:g} s (RELEASE_MAX_STEP) and the solver at "
+            f"most {MAX_DYNAMIC_STEPS} of them (max_steps), so a longer motion cannot finish"
+        )
 
 
 @dataclass(frozen=True)
@@ -96,7 +132,8 @@ class ReleaseSetup:
     tape : BendingSetup
         Tape geometry, material and mesh (its ``theta_max_deg`` is replaced by `fold_deg`).
     density : float
-        Density of the tape [kg/m^3].
+        Density of the tape [kg/m^3], in [0, 1e5]
+        (:data:`~tapespring.scenarios.setup.MAX_DENSITY`).
     fold_deg : float
         Fold angle [deg]: positive for opposite sense, negative for equal sense. Within
         (-180, 180), at least 1e-6 in magnitude (:func:`check_fold_deg`).
@@ -106,16 +143,19 @@ class ReleaseSetup:
         Its moment of inertia about each axis through the end section's centroid [kg m^2], > 0
         and at most :data:`MAX_TIP_INERTIA`.
     duration : float
-        Free motion after the release [s].
+        Free motion after the release [s], at most :data:`MAX_DURATION` (500 s: the solver's
+        step limit times the largest step).
     eta : float
-        Kelvin-Voigt viscosity of the tape [s].
+        Kelvin-Voigt viscosity of the tape [s], in [0, 1]
+        (:data:`~tapespring.scenarios.setup.MAX_ETA`).
     rho_inf : float
         Spectral radius at infinity of the generalised-alpha scheme.
     gravity : float
         Gravitational acceleration along -z [m/s^2], of magnitude at most
         :data:`tapespring.scenarios.setup.MAX_GRAVITY` (100).
     planar : bool
-        After the release, keep the free end in the x-z plane (held in y and about x and z).
+        After the release, keep the free end in the x-z plane (held in y and about x and z); a
+        bool (``"no"`` is refused, not taken as true).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default, 1e-5 of the model's
         half diagonal). The default 1e-4 m (0.1 mm per step, under 1e-3 of the tape's length)
@@ -148,14 +188,24 @@ class ReleaseSetup:
         ValueError
             Naming the bad value.
         """
-        for name in ("density", "eta", "tolerance"):
-            check_number(name, getattr(self, name), positive=True, zero=True)
+        if not isinstance(self.tape, BendingSetup):
+            raise ValueError(
+                f"tape must be a BendingSetup (tapespring.scenarios.bending) with the tape's "
+                f"geometry, material and mesh (got {self.tape!r})"
+            )
+        check_density(self.density, zero=True)
+        check_eta(self.eta)
+        check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_tip_mass(self.tip_mass)
         check_tip_inertia(self.tip_inertia)
-        check_number("duration", self.duration, positive=True)
+        check_duration(self.duration)
         check_rho_inf(self.rho_inf)
         check_gravity(self.gravity)
         check_fold_deg(self.fold_deg)
+        if not isinstance(self.planar, (bool, np.bool_)):
+            raise ValueError(f"planar must be True or False (got {self.planar!r})")
+        # The tape, as the fold bends it (its theta_max_deg is fold_deg, checked above).
+        self.folding_tape.validate()
 
 
 def release_model(setup: ReleaseSetup) -> tuple[Any, int, int]:
@@ -175,15 +225,6 @@ def release_model(setup: ReleaseSetup) -> tuple[Any, int, int]:
         model.set_gravity([0.0, 0.0, -setup.gravity], function="constant")
     model.add_marker("tip", tip)
     return model, clamped, tip
-
-
-#: First and largest time steps of the release [s], fixed rather than the solver's defaults (a
-#: thousandth and a twentieth of the duration): the step sequence, and with it the numerical
-#: dissipation of the snap (large without damping), is then the same whatever the duration, so
-#: a shorter run is the beginning of a longer one. The steps the error estimate chooses stay
-#: far below the largest (1e-5 to 1e-3 s).
-RELEASE_FIRST_STEP = 1e-5
-RELEASE_MAX_STEP = 5e-3
 
 
 def release_steps(setup: ReleaseSetup, tip: int) -> list[Any]:

@@ -17,12 +17,20 @@ from numpy.typing import NDArray
 
 __all__ = [
     "CONFIGURATIONS",
+    "MAX_DENSITY",
     "MAX_DYNAMIC_STEPS",
     "MAX_ELEMENTS",
+    "MAX_ETA",
     "MAX_GRAVITY",
+    "MAX_LENGTH",
+    "MAX_MASS",
     "MAX_SAMPLE_RATE",
     "MAX_YOUNGS_MODULUS",
     "MIN_DISPLACEMENT",
+    "MIN_ROTATION_DEG",
+    "MIN_SAMPLE_INTERVALS",
+    "MIN_THICKNESS",
+    "MIN_YOUNGS_MODULUS",
     "PAPER_BOUNDS",
     "PAPER_MODEL",
     "PAPER_SETUP",
@@ -38,15 +46,21 @@ __all__ = [
     "add_flexible_support",
     "build_setup",
     "check_count",
+    "check_density",
     "check_displacement",
     "check_element_count",
     "check_eta",
+    "check_initial_angle",
+    "check_length",
+    "check_mass",
+    "check_min_samples",
     "check_number",
     "check_poisson",
     "check_rho_inf",
     "check_sample_rate",
     "check_sampling",
     "check_sense",
+    "check_thickness",
     "check_thin",
     "check_youngs_modulus",
     "shown",
@@ -104,6 +118,16 @@ PAPER_TAPE = TapeSpring()
 #: refused here before a mesh is built.
 MAX_YOUNGS_MODULUS = 1e13
 
+#: Smallest Young's modulus of a tape or plate [Pa]: 1 MPa, a soft rubber's (the paper's steel:
+#: 1.5e11). Below it a shell of these sizes carries no load the solver can resolve against its
+#: own weight (1e-300 Pa ran into "singular tangent" and a failed stability check).
+MIN_YOUNGS_MODULUS = 1e6
+
+#: Smallest thickness of a tape or plate [m]: 1 um, a thin metal foil's (the paper's tape:
+#: 0.138 mm). Below it the shell's stiffness (t^3) and mass (t) vanish in round-off (1e-300 m
+#: ran into "node 1 has free DOFs without mass" and a singular tangent).
+MIN_THICKNESS = 1e-6
+
 
 def check_thin(thickness: float, radius: float, prefix: str = "") -> None:
     """Raise ValueError unless a tape of `thickness` and section `radius` [m] is a thin shell.
@@ -120,13 +144,30 @@ def check_thin(thickness: float, radius: float, prefix: str = "") -> None:
 
 
 def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
-    """Raise ValueError naming `name` unless `value` is a Young's modulus: a finite number > 0 and
-    at most :data:`MAX_YOUNGS_MODULUS` [Pa]."""
+    """Raise ValueError naming `name` unless `value` is a Young's modulus: a finite number in
+    [:data:`MIN_YOUNGS_MODULUS`, :data:`MAX_YOUNGS_MODULUS`] [Pa]."""
     number = check_number(name, value, positive=True)
     if number > MAX_YOUNGS_MODULUS:
         raise ValueError(
             f"{name} must be at most {MAX_YOUNGS_MODULUS:.0e} Pa, ten times diamond's (got "
             f"{shown(number)} Pa; see MAX_YOUNGS_MODULUS)"
+        )
+    if number < MIN_YOUNGS_MODULUS:
+        raise ValueError(
+            f"{name} must be at least {MIN_YOUNGS_MODULUS:.0e} Pa, a soft rubber's (got "
+            f"{shown(number)} Pa; see MIN_YOUNGS_MODULUS)"
+        )
+
+
+def check_thickness(value: object, name: str = "thickness") -> None:
+    """Raise ValueError naming `name` unless `value` is a shell's thickness [m]: a finite number
+    of at least :data:`MIN_THICKNESS` (its upper bound is the part's: below half a tape's radius,
+    :func:`check_thin`; a plate's at most :data:`MAX_LENGTH`)."""
+    number = check_number(name, value, positive=True)
+    if number < MIN_THICKNESS:
+        raise ValueError(
+            f"{name} must be at least {MIN_THICKNESS:g} m, a thin foil's (got {shown(number)} m; "
+            "see MIN_THICKNESS)"
         )
 
 
@@ -492,8 +533,12 @@ class SetupSpec:
             raise ValueError(f"tape must be a TapeSpring (got {self.tape!r})")
         for name, value in vars(self.tape).items():
             check_number(f"tape.{name}", value, positive=True)
+        for name in ("length", "radius"):
+            check_length(f"tape.{name}", getattr(self.tape, name))
+        check_thickness(self.tape.thickness, "tape.thickness")
         check_youngs_modulus(self.tape.youngs_modulus, "tape.youngs_modulus")
         check_poisson(self.tape.poisson, "tape.poisson")
+        check_density(self.tape.density, "tape.density")
         check_thin(self.tape.thickness, self.tape.radius, "tape.")
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
@@ -502,12 +547,30 @@ class SetupSpec:
                 continue
             positive = not name.startswith("initial_angle")
             check_number(name, value, positive=positive)
+            # Each kind of value within its physical bound (see MAX_LENGTH, MAX_MASS, ...).
+            if name in _SPEC_LENGTHS:
+                check_length(name, value)
+            elif name.endswith("_mass"):
+                check_mass(name, value)
+        for name in _SPEC_THICKNESSES:
+            check_thickness(getattr(self, name), name)
+        for name in ("plate_youngs_modulus", "support_youngs_modulus"):
+            check_youngs_modulus(getattr(self, name), name)
+        check_density(self.support_density, "support_density")
+        for sense in SENSES:
+            name = f"initial_angle_{sense}_deg"
+            check_initial_angle(name, getattr(self, name), sense)
         if not isinstance(self.support_marker, tuple | list) or len(self.support_marker) != 3:
             raise ValueError(
                 f"support_marker must have 3 coordinates (got {self.support_marker!r})"
             )
         for value in self.support_marker:
-            check_number("support_marker", value, positive=False)
+            number = check_number("support_marker", value, positive=False)
+            if abs(number) > MAX_LENGTH:
+                raise ValueError(
+                    f"support_marker coordinates must lie within [-{MAX_LENGTH:g}, "
+                    f"{MAX_LENGTH:g}] m (got {self.support_marker!r}; see MAX_LENGTH)"
+                )
         if self.gravity > MAX_GRAVITY:
             raise ValueError(
                 f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {shown(self.gravity)}; see "
@@ -543,6 +606,12 @@ class SetupSpec:
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
             check_element_count(name, size, self.tape.length, width)
+        # The plates' elements, counted before they are built (parts up to MAX_LENGTH long).
+        plates = [(self.rod_width, self.rod_length), (self.appendix_length, self.appendix_width)]
+        if self.support == "flexible":
+            plates.append((self.support_height + self.support_length, self.support_width))
+        for length, plate_width in plates:
+            check_element_count("mesh_plates", self.mesh_plates, length, plate_width)
 
     def _validate_support(self) -> None:
         """Check the flexible support's values: each one always (like every value), against
@@ -569,6 +638,22 @@ class SetupSpec:
                     f"mesh_plates {self.mesh_plates} m is too coarse for {name} (at most a "
                     "quarter of it)"
                 )
+
+
+#: Fields of :class:`SetupSpec` that are lengths [m] (each at most :data:`MAX_LENGTH`).
+_SPEC_LENGTHS = frozenset(
+    {
+        "tape_spacing", "mesh_tape", "mesh_plates", "interface_length", "interface_width",
+        "interface_height", "rod_length", "rod_width", "rod_thickness", "appendix_width",
+        "appendix_thickness", "setup_length", "weight_length", "weight_width", "weight_height",
+        "marker_height", "support_height", "support_length", "support_width",
+        "support_thickness", "clamp_interface_length", "clamp_interface_width",
+        "clamp_interface_height",
+    }
+)  # fmt: skip
+
+#: Fields of :class:`SetupSpec` that are shells' thicknesses [m] (at least :data:`MIN_THICKNESS`).
+_SPEC_THICKNESSES = ("rod_thickness", "appendix_thickness", "support_thickness")
 
 
 #: Most elements a tape may have, in the set-up or alone (bending, release): 6 million DOFs,
@@ -676,12 +761,118 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
     return value
 
 
+#: Largest length of the set-up's parts and of a tape [m]: 10 m, forty times the set-up's 0.24 m
+#: (a tape 0.1 m long, markers 16 mm above it). Beyond it a length is a typing error, which used
+#: to fail deep in the build ("ny = 5000... out of range", numpy's "Maximum allowed size
+#: exceeded", "node 0 lies 5e299 m from the origin") or, for ``marker_height``, to flip the
+#: reported bending angle silently (1e6 m).
+MAX_LENGTH = 10.0
+
+#: Largest mass of a part of the set-up [kg]: a tonne, ten thousand times the 77 g free end
+#: (the tapes lift about 80 g). Beyond it a mass is a typing error: 1e300 kg ended in a
+#: misleading "residual became non-finite ... limit point" instead of a message on the mass
+#: (the core refuses bodies above 1e12 kg).
+MAX_MASS = 1e3
+
+#: Largest density of a tape or plate [kg/m^3]: 1e5, four times osmium's 22590, the densest
+#: element. Beyond it a density is a typing error (1e300 ended as a non-finite residual, and
+#: the max-mass study printed a 300-digit tape mass).
+MAX_DENSITY = 1e5
+
+#: Largest Kelvin-Voigt viscosity eta [s]: 1 s. eta is the material's relaxation time; a mode of
+#: pulsation omega gets the damping ratio eta omega / 2, so at 1 s the set-up's 9 Hz mode is
+#: already 28 times over-damped (the paper's eta: 1.73e-4 s); a larger one is longer than the
+#: motions simulated, a typing error (1e300 failed after the run).
+MAX_ETA = 1.0
+
+#: Smallest magnitude of a rotation driven at a tape's end or the set-up's free end [deg] (the
+#: bending's ``theta_max_deg``, the release's ``fold_deg``, the set-up's initial angles): a
+#: millionth of a degree. A smaller rotation moves nothing the solver can resolve (1e-300 reached
+#: it as "the loads and prescribed motions act on no free DOF").
+MIN_ROTATION_DEG = 1e-6
+
+#: Fewest sample intervals in a dynamic run that is analysed [-]: 2, three samples with the
+#: release's, the fewest in which the peak analysis (``signals.peaks.extract_peaks``) can find an
+#: extremum and a decay can be sampled as a trial; fewer made a run that reported nothing.
+MIN_SAMPLE_INTERVALS = 2
+
+
+def check_length(name: str, value: object) -> float:
+    """Raise ValueError naming `name` unless `value` is a length of the set-up [m]: a finite
+    number > 0 and at most :data:`MAX_LENGTH`. Returns it."""
+    number = check_number(name, value, positive=True)
+    if number > MAX_LENGTH:
+        raise ValueError(
+            f"{name} must be at most {MAX_LENGTH:g} m, forty times the set-up's length (got "
+            f"{shown(number)} m; see MAX_LENGTH)"
+        )
+    return number
+
+
+def check_mass(name: str, value: object) -> None:
+    """Raise ValueError naming `name` unless `value` is a mass of a part of the set-up [kg]: a
+    finite number > 0 and at most :data:`MAX_MASS`."""
+    number = check_number(name, value, positive=True)
+    if number > MAX_MASS:
+        raise ValueError(
+            f"{name} must be at most {MAX_MASS:g} kg, a tonne (got {shown(number)} kg; see "
+            "MAX_MASS)"
+        )
+
+
+def check_density(value: object, name: str = "density", *, zero: bool = False) -> None:
+    """Raise ValueError naming `name` unless `value` is a density [kg/m^3]: a finite number > 0
+    (>= 0 with `zero`, a massless tape where the settings allow it) and at most
+    :data:`MAX_DENSITY`."""
+    number = check_number(name, value, positive=True, zero=zero)
+    if number > MAX_DENSITY:
+        raise ValueError(
+            f"{name} must be at most {MAX_DENSITY:.0e} kg/m^3, four times osmium's (got "
+            f"{shown(number)} kg/m^3; see MAX_DENSITY)"
+        )
+
+
 def check_eta(value: object, name: str = "eta") -> None:
     """Raise ValueError naming `name` unless `value` is a Kelvin-Voigt viscosity eta [s]: a
-    finite number >= 0 (0: no viscous damping)."""
+    finite number in [0, :data:`MAX_ETA`] (0: no viscous damping)."""
     number = check_number(name, value, positive=False)
     if number < 0.0:
         raise ValueError(f"{name} must be >= 0 s (got {number})")
+    if number > MAX_ETA:
+        raise ValueError(
+            f"{name} must be at most {MAX_ETA:g} s, a relaxation time longer than the motions "
+            f"simulated (got {shown(number)} s; the paper's tapes: 1.73e-4; see MAX_ETA)"
+        )
+
+
+def check_initial_angle(name: str, value: object, sense: str) -> None:
+    """Raise ValueError naming `name` unless `value` is an initial bending angle of a deployment
+    in `sense` [deg]: within (0, 180) in opposite sense, (-180, 0) in equal sense (the sign
+    convention of Sec. 2: the paper's +95.5 and -91.2), at least :data:`MIN_ROTATION_DEG` in
+    magnitude. At 180 degrees the free end folds back onto the tapes; beyond, an angle wraps
+    (400 folded to 40)."""
+    number = check_number(name, value, positive=False)
+    sign = 1.0 if sense == "opposite" else -1.0
+    if not (MIN_ROTATION_DEG <= sign * number < 180.0):
+        interval = "(0, 180)" if sense == "opposite" else "(-180, 0)"
+        raise ValueError(
+            f"{name} must lie in {interval} degrees in {sense} sense, at least "
+            f"{MIN_ROTATION_DEG:g} in magnitude (got {shown(number)})"
+        )
+
+
+def check_min_samples(duration: tuple[str, float], *, rate: float, rate_name: str) -> None:
+    """Raise ValueError unless a dynamic run of `duration` (name, value [s]) recorded at `rate`
+    [Hz] (named `rate_name`) holds at least :data:`MIN_SAMPLE_INTERVALS` sample intervals (both
+    finite and > 0, checked before)."""
+    name, value = duration
+    if value * rate < MIN_SAMPLE_INTERVALS * (1.0 - 1e-9):
+        raise ValueError(
+            f"{name} = {shown(value)} s at {rate_name} = {rate:.6g} Hz makes fewer than "
+            f"{MIN_SAMPLE_INTERVALS} sample intervals, too few for the peak analysis; lengthen "
+            f"the {name} to at least {MIN_SAMPLE_INTERVALS / rate:.3g} s or raise the {rate_name} "
+            "(see MIN_SAMPLE_INTERVALS)"
+        )
 
 
 def check_poisson(value: object, name: str = "poisson") -> None:

@@ -35,11 +35,14 @@ from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
     MAX_SAMPLE_RATE,
+    MIN_SAMPLE_INTERVALS,
     PAPER_MODEL,
     PAPER_SETUP,
     SetupSpec,
     build_setup,
     check_count,
+    check_displacement,
+    check_min_samples,
     check_number,
     check_rho_inf,
     check_sampling,
@@ -55,9 +58,42 @@ __all__ = [
     "VibrationComparison",
     "VibrationSettings",
     "VibrationSimulation",
+    "check_initial_displacement",
+    "check_modes",
     "check_time_step",
     "vibrate",
 ]
+
+#: Largest push of the weight's tip before the release [m]: 50 mm, six times the paper's 8 mm and
+#: a fifth of the set-up's 0.24 m length. The test is one of small vibrations about the loaded
+#: equilibrium; a push of metres (1 m, 1e300 m) failed late in the push's static step with a
+#: solver message instead of being refused.
+MAX_INITIAL_DISPLACEMENT = 0.05
+
+#: Most vibration modes computed about the loaded equilibrium: 100, twenty-five times the
+#: default 4. The decay's comparison uses the first; each further mode costs the modal step's
+#: solver more iterations, and more modes than the model's free DOFs (10000 on the coarse
+#: meshes) failed with a ConvergenceError after the static step.
+MAX_MODES = 100
+
+
+def check_initial_displacement(value: object) -> None:
+    """Raise ValueError unless `value` is the push of the weight's tip ``initial_displacement``
+    [m]: a number in [:data:`~tapespring.scenarios.setup.MIN_DISPLACEMENT`,
+    :data:`MAX_INITIAL_DISPLACEMENT`)."""
+    check_displacement("initial_displacement", value, MAX_INITIAL_DISPLACEMENT)
+
+
+def check_modes(value: object) -> None:
+    """Raise ValueError unless `value` is the number of modes ``modes``: an integer from 1 to
+    :data:`MAX_MODES`."""
+    check_count("modes", value, minimum=1)
+    if isinstance(value, int) and value > MAX_MODES:
+        raise ValueError(
+            f"modes must be at most {MAX_MODES} (got {value}; the decay is compared with the "
+            "first: see MAX_MODES)"
+        )
+
 
 #: Trial marker names of the set-up's markers (marker 3 on the additional weight is analysed).
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
@@ -86,7 +122,7 @@ class VibrationSettings:
         The set-up (configuration ``"weight"``); its ``eta`` is the tapes' viscosity.
     initial_displacement : float
         Downward displacement of marker 3, at the tip of the weight, before the release [m]
-        (paper: about 8 mm).
+        (paper: about 8 mm), in [1e-6, :data:`MAX_INITIAL_DISPLACEMENT`).
     duration : float
         Free decay simulated [s] (default 8 s, as the paper's recordings: with its eta the peaks
         decay from 4 to 0.4 mm in about 7 s). A shorter run fits the peaks it has (at least 3 in
@@ -112,7 +148,7 @@ class VibrationSettings:
         :data:`~tapespring.scenarios.setup.MAX_DYNAMIC_STEPS` records in `duration`. The
         numerical damping study uses it.
     modes : int
-        Vibration modes computed about the loaded equilibrium.
+        Vibration modes computed about the loaded equilibrium, 1 to :data:`MAX_MODES`.
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th record, for
         ParaView series (0: none; the last record is always kept when > 0).
@@ -138,22 +174,33 @@ class VibrationSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
-        for name in ("initial_displacement", "duration", "sample_rate"):
+        check_initial_displacement(self.initial_displacement)
+        for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
         check_rho_inf(self.rho_inf)
         check_number("tolerance", self.tolerance, positive=True, zero=True)
         check_time_step(self.time_step)
-        # Every fixed step is a record: the same bounds as the samples.
+        # Every fixed step is a record: the same bounds as the samples (a fixed step longer than
+        # half the duration leaves fewer than 2 of them).
         rate_name = "1/time_step" if self.time_step > 0.0 else "sample_rate"
         check_sampling(
             ("duration", self.duration), sample_rate=self.record_rate, rate_name=rate_name
         )
+        if self.time_step > 0.0 and self.duration < MIN_SAMPLE_INTERVALS * self.time_step * (
+            1.0 - 1e-9
+        ):
+            raise ValueError(
+                f"time_step = {shown(self.time_step)} s must be at most duration / "
+                f"{MIN_SAMPLE_INTERVALS} = {self.duration / MIN_SAMPLE_INTERVALS:.6g} s: the "
+                f"decay needs at least {MIN_SAMPLE_INTERVALS} steps (see MIN_SAMPLE_INTERVALS)"
+            )
+        check_min_samples(("duration", self.duration), rate=self.record_rate, rate_name=rate_name)
         from tapespring.signals.damping import check_window
 
         if not isinstance(self.window, tuple | list):
             raise ValueError(f"window must be a pair (low, high) [m] (got {self.window!r})")
         check_window(self.window)
-        check_count("modes", self.modes, minimum=1)
+        check_modes(self.modes)
         check_count("field_interval", self.field_interval, minimum=0)
 
 
@@ -271,6 +318,7 @@ class VibrationSimulation:
         r = self.results
         fit = self.fit
         stats = r.step_stats[-1] if len(r.step_stats) else {}
+        rejected = int(stats.get("cutbacks", 0))
         out: dict[str, Any] = {
             "damping_ratio": None if fit is None else fit.damping_ratio,
             "damping_ratio_std": None if fit is None else fit.damping_ratio_std,
@@ -287,7 +335,10 @@ class VibrationSimulation:
             "time_s": self.time_s.tolist(),
             "displacement_m": self.displacement_m.tolist(),
             "steps": int(stats.get("steps", 0)),
-            "rejected_steps": int(stats.get("cutbacks", 0)),
+            "rejected_steps": rejected,
+            # With a fixed time_step: the steps rejected and cut back (after which the steps
+            # regrow only slowly, so not every step is time_step long); None with adaptive steps.
+            "fixed_step_cutbacks": rejected if self.settings.time_step > 0.0 else None,
             "newton_iterations": int(r.stats.get("iterations", 0)),
             "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
             "wall_s": self.wall_s,
@@ -308,6 +359,17 @@ class VibrationSimulation:
             f"  modal period about the loaded equilibrium {s['modal_period_s']:.4f} s; "
             f"Kelvin-Voigt eta omega/2 = {s['kelvin_voigt_damping_ratio']:.3%}",
         ]
+        if s["fixed_step_cutbacks"] is not None:
+            cut = s["fixed_step_cutbacks"]
+            step = self.settings.time_step
+            lines.append(
+                f"  fixed steps of {step:.3g} s: {cut} rejected and cut back"
+                + (
+                    f" (the steps regrow slowly after a cut-back: not every step was {step:.3g} s)"
+                    if cut
+                    else ""
+                )
+            )
         if self.fit is not None:
             ratio = s["period_s"] / s["modal_period_s"] - 1.0
             lines.append(
