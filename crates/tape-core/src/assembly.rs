@@ -858,7 +858,6 @@ impl System {
                 let force = [m * gt.x, m * gt.y, m * gt.z, 0.0, 0.0, 0.0];
                 let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
                 apply(n, force, rate);
-                out.gravity_energy -= m * gt.dot(&state.x[n]);
                 out.mass_moment += m * state.x[n];
             }
             for body in &self.bodies {
@@ -872,10 +871,10 @@ impl System {
                     f_ext[r][3 + i] += m[i];
                     df_ext[r][3 + i] += dm[i];
                 }
-                out.gravity_energy -= w.dot(&(state.x[r] + lever));
                 out.mass_moment += body.mass * (state.x[r] + lever);
                 body_terms.push((r, lever, -w));
             }
+            out.gravity_energy = -gt.dot(&out.mass_moment);
         }
 
         if tangent {
