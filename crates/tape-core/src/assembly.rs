@@ -185,6 +185,26 @@ struct Numbering {
     has_slave: Vec<bool>,
 }
 
+/// The free DOFs of the reference nodes of rigid ties: the only links between the parts they
+/// join (the set-up's tapes, rod and appendix), hence the separator of the bordered
+/// factorisation that factorises those parts in parallel ([`LinearSolver::with_separator`]).
+fn separator(dofs: &DofMap) -> Vec<usize> {
+    let mut is_reference = vec![false; dofs.master.len()];
+    for &r in dofs.master.iter().flatten() {
+        is_reference[r] = true;
+    }
+    let mut sep: Vec<usize> = (0..dofs.master.len())
+        .filter(|&i| is_reference[i])
+        .flat_map(|i| dofs.slots[i].iter())
+        .filter_map(|slot| match slot {
+            Slot::Free(k) => Some(*k),
+            Slot::Constrained(_) => None,
+        })
+        .collect();
+    sep.sort_unstable();
+    sep
+}
+
 fn numbering(elements: &[ShellElement], dofs: &DofMap) -> Numbering {
     let owners: Vec<[usize; 4]> = elements
         .iter()
@@ -339,7 +359,7 @@ impl System {
             inertia[b.node].add(b.mass, &b.centre_of_mass, &b.inertia);
         }
         let num = numbering(&elements, &dofs);
-        let linear = LinearSolver::try_new(&num.pattern_ff)?;
+        let linear = LinearSolver::with_separator(&num.pattern_ff, &separator(&dofs))?;
         let reference = State::at_rest(model.mesh.nodes.clone(), triads);
         let (loads, gravity) = active_loads(model, activity);
         let n_el = elements.len();
@@ -387,7 +407,7 @@ impl System {
         let renumber = !dofs.same_numbering(&self.dofs);
         if renumber {
             let num = numbering(&self.elements, &dofs);
-            self.linear = LinearSolver::try_new(&num.pattern_ff)?;
+            self.linear = LinearSolver::with_separator(&num.pattern_ff, &separator(&dofs))?;
             self.pattern_ff = num.pattern_ff;
             self.pattern_fc = num.pattern_fc;
             self.slots = num.slots;

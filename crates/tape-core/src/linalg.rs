@@ -25,6 +25,20 @@
 //! permutation would lay them out, so the factors are bit-identical to faer's own. Solves permute
 //! the right-hand side and the solution (`P b`, `P^T x`); the inertia is unchanged by a symmetric
 //! permutation; products with `K` (GMRES) and the LU fallback use `K` in its original order.
+//!
+//! # Bordered factorisation
+//!
+//! Faer's supernodal factorisation runs serially over the supernodes; only its dense kernels
+//! take threads, and on shell models' supernodes (tens of columns) that is slower. Where a small
+//! separator splits the unknowns into groups that no entry couples (in a shell model: the free
+//! DOFs of the rigid ties' reference nodes, which alone join the set-up's tapes, rod and
+//! appendix), [`LinearSolver::with_separator`] orders the separator last and factorises the
+//! groups, binned in two, as independent bordered blocks in parallel, then the separator's dense
+//! Schur complement (private module `bordered`). Measured on the set-up's deployment model
+//! (paper's meshes, 10578 DOFs, 18 separator DOFs, bins of 55 and 45 % of the flops): a
+//! factorisation in 3.8 ms on 2 cores instead of 7.0 ms, a solve in 0.52 ms instead of 0.63 ms
+//! (the vibration's 7206 DOFs: 1.7 and 0.23 ms instead of 3.2 and 0.33 ms); on one core 6.4 ms
+//! instead of 6.2 ms.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -40,6 +54,9 @@ use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+
+mod bordered;
+use bordered::Bordered;
 
 /// Compressed-column pattern.
 #[derive(Clone, Debug, Default)]
@@ -153,10 +170,8 @@ fn permuted_triangle(
     )
 }
 
-/// Solver for matrices with a fixed, structurally symmetric pattern.
-pub struct LinearSolver {
-    /// Pattern of `K`, in its original order (products with `K`, LU fallback).
-    symbolic: SymbolicSparseColMat<usize>,
+/// The whole symmetric part's LDL^T, pre-permuted (see the module's documentation).
+struct Whole {
     /// Fill-reducing permutation: row/column `i` of `P S P^T` is row/column `perm_fwd[i]` of `S`.
     perm_fwd: Vec<usize>,
     /// The triangle of `P S P^T` that the factorisation reads: lower (supernodal) or upper
@@ -170,12 +185,26 @@ pub struct LinearSolver {
     ldlt: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     work: MemBuffer,
-    /// Values of `K`, kept when it is not symmetric (GMRES) or for the LU fallback.
-    values: Vec<f64>,
     /// Values of `triangle`.
     sym: Vec<f64>,
     /// Permuted right-hand side / solution of the LDL^T solve.
     permuted: Vec<f64>,
+}
+
+/// The LDL^T of the symmetric part: of the whole matrix, or bordered (groups of unknowns
+/// coupled through a separator, factorised in parallel: `bordered`).
+enum SymFactor {
+    Whole(Box<Whole>),
+    Bordered(Bordered),
+}
+
+/// Solver for matrices with a fixed, structurally symmetric pattern.
+pub struct LinearSolver {
+    /// Pattern of `K`, in its original order (products with `K`, LU fallback).
+    symbolic: SymbolicSparseColMat<usize>,
+    factor: SymFactor,
+    /// Values of `K`, kept when it is not symmetric (GMRES) or for the LU fallback.
+    values: Vec<f64>,
     skew_free: bool,
     /// Largest column sum of |K| (the 1-norm).
     k_norm: f64,
@@ -191,62 +220,18 @@ pub struct LinearSolver {
     pub refinement_sweeps: usize,
 }
 
-impl LinearSolver {
-    /// Symbolic analysis of `pattern`, done once: AMD ordering, pattern of the permuted symmetric
-    /// part and its symbolic LDL^T.
-    ///
-    /// # Errors
-    /// [`Error::Factorisation`] if faer rejects the pattern or it is not structurally symmetric;
-    /// [`Error::InvalidModel`] if it is empty.
-    pub fn try_new(pattern: &Pattern) -> Result<Self> {
-        // Supernodal at every size. Faer's automatic choice (a flop-count ratio) takes the
-        // simplicial factorisation for shell models of up to a few thousand DOFs, where the
-        // supernodes of the 6 x 6 nodal blocks make the supernodal one about twice as fast.
-        // Measured: the 4 mm release (1014 DOFs), 3700 factorisations and 5500 solves in 5.4 s
-        // instead of 10.2 s; the default deployment (1614 DOFs) 13.8 s instead of 19.4 s on the
-        // same path. Above that size faer already chose it.
-        Self::with_threshold(pattern, SupernodalThreshold::FORCE_SUPERNODAL)
-    }
-
-    /// [`Self::try_new`] with the simplicial LDL^T instead of the supernodal one: the same
-    /// factors up to round-off, about twice as slow on shell models (kept to measure that choice:
-    /// `cargo bench -p tape-core --bench assembly -- "4 mm"`).
-    ///
-    /// # Errors
-    /// As [`Self::try_new`].
-    pub fn with_simplicial(pattern: &Pattern) -> Result<Self> {
-        Self::with_threshold(pattern, SupernodalThreshold::FORCE_SIMPLICIAL)
-    }
-
-    /// [`Self::try_new`] with faer's simplicial/supernodal selection threshold.
-    fn with_threshold(pattern: &Pattern, threshold: SupernodalThreshold) -> Result<Self> {
+impl Whole {
+    /// AMD ordering, and simplicial or supernodal factorisation as `threshold` asks (with the
+    /// identity ordering faer would count the flops exactly instead of using AMD's estimate, and
+    /// sometimes choose the other kind). The symbolic factorisation itself is redone on the
+    /// permuted pattern.
+    fn try_new(
+        pattern: &Pattern,
+        symbolic: &SymbolicSparseColMat<usize>,
+        transpose_of: &[usize],
+        threshold: SupernodalThreshold,
+    ) -> Result<Self> {
         let n = pattern.nrows;
-        if n == 0 {
-            return Err(Error::InvalidModel("the model has no free degree of freedom".into()));
-        }
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
-        let nnz = pattern.nnz();
-        // Position of the transpose of each entry: walking the columns in order, the entries
-        // (j, i) of each column i are met in increasing j, i.e. in the stored (sorted) order. Every
-        // entry finding its transpose makes the pattern symmetric (the map is injective).
-        let not_symmetric = || Error::Factorisation("the tangent pattern is not structurally symmetric".into());
-        let mut transpose_of = vec![0; nnz];
-        let mut next: Vec<usize> = pattern.col_ptr[..n].to_vec();
-        for j in 0..n {
-            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                let i = pattern.row_idx[p];
-                let t = next[i];
-                if t >= pattern.col_ptr[i + 1] || pattern.row_idx[t] != j {
-                    return Err(not_symmetric());
-                }
-                transpose_of[p] = t;
-                next[i] += 1;
-            }
-        }
-        // AMD ordering, and simplicial or supernodal factorisation as `threshold` asks (with the
-        // identity ordering faer would count the flops exactly instead of using AMD's estimate,
-        // and sometimes choose the other kind). The symbolic factorisation itself is redone below
-        // on the permuted pattern.
         let params = || CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: threshold,
             ..Default::default()
@@ -258,7 +243,7 @@ impl LinearSolver {
             Some(perm) => (perm.arrays().0.to_vec(), perm.arrays().1.to_vec()),
             None => ((0..n).collect(), (0..n).collect()),
         };
-        let (upper, upper_src) = permuted_triangle(pattern, &perm_inv, &transpose_of, false);
+        let (upper, upper_src) = permuted_triangle(pattern, &perm_inv, transpose_of, false);
         let ldlt = factorize_symbolic_cholesky(
             upper.as_ref(),
             Side::Upper,
@@ -275,7 +260,7 @@ impl LinearSolver {
         .map_err(|e| Error::Factorisation(format!("symbolic LDLT: {e:?}")))?;
         // The triangle that faer's factorisation reads without copying it.
         let (side, (triangle, src)) = if supernodal {
-            (Side::Lower, permuted_triangle(pattern, &perm_inv, &transpose_of, true))
+            (Side::Lower, permuted_triangle(pattern, &perm_inv, transpose_of, true))
         } else {
             (Side::Upper, (upper, upper_src))
         };
@@ -284,60 +269,23 @@ impl LinearSolver {
             ldlt.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]);
         // The exact size of the factor is known before its values are allocated.
-        crate::memory::check_factor(n, nnz, ldlt.len_val(), req.unaligned_bytes_required())?;
-        let work = MemBuffer::new(req);
+        crate::memory::check_factor(n, pattern.nnz(), ldlt.len_val(), req.unaligned_bytes_required())?;
         Ok(Self {
             l_values: vec![0.0; ldlt.len_val()],
-            symbolic,
             perm_fwd,
             sym: vec![0.0; src.len()],
             triangle,
             side,
             src,
             ldlt,
-            work,
-            values: Vec::new(),
+            work: MemBuffer::new(req),
             permuted: vec![0.0; n],
-            skew_free: true,
-            k_norm: 0.0,
-            negative: 0,
-            lu_symbolic: None,
-            lu: None,
-            factorised: false,
-            factorisations: 0,
-            lu_fallbacks: 0,
-            refinement_sweeps: 0,
         })
     }
 
-    /// Number of entries of the factor (values of `L` in the LDL^T factorisation).
-    #[must_use]
-    pub fn factor_entries(&self) -> usize {
-        self.ldlt.len_val()
-    }
-
-    /// Numeric factorisation of the matrix with `values` (in pattern order).
-    ///
-    /// # Errors
-    /// [`Error::Factorisation`] for a non-finite entry, a wrong number of values or a failed
-    /// factorisation.
-    pub fn factorize(&mut self, values: &[f64]) -> Result<()> {
-        self.factorised = false;
-        self.lu = None;
-        if values.len() != self.symbolic.row_idx().len() {
-            return Err(Error::Factorisation(format!(
-                "{} values for a pattern of {} entries",
-                values.len(),
-                self.symbolic.row_idx().len()
-            )));
-        }
-        // One pass over the stored triangle of P S P^T (each entry of K is read once, as k_ij or
-        // k_ji): symmetric part, largest |k_ij| and largest |k_ij - k_ji|. The maxima are taken on
-        // the bit patterns of the absolute values, which order non-negative floats as the values
-        // do, with infinities and NaNs above every finite value: one integer max per entry (half
-        // the time of `f64::max` chains, which the NaN rules make long), and finiteness for free.
-        // In parallel chunks: the transposed reads are scattered and latency-bound, so two
-        // threads overlap their cache misses (the maxima do not depend on the order).
+    /// Writes the symmetric part's triangle from `values`; returns the bit patterns of the
+    /// largest `|k_ij|` and `|k_ij - k_ji|` (see [`LinearSolver::factorize`]).
+    fn fill(&mut self, values: &[f64]) -> (u64, u64) {
         let pass = |(sym, src): (&mut [f64], &[[usize; 2]])| {
             let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
             for (s, &[p, t]) in sym.iter_mut().zip(src) {
@@ -349,7 +297,7 @@ impl LinearSolver {
             (max_bits, skew_bits)
         };
         // Small matrices in one go: waking the pool would cost more than it saves.
-        let (max_bits, skew_bits) = if self.sym.len() < 4 * SYM_CHUNK {
+        if self.sym.len() < 4 * SYM_CHUNK {
             pass((&mut self.sym, &self.src))
         } else {
             self.sym
@@ -357,34 +305,14 @@ impl LinearSolver {
                 .zip(self.src.par_chunks(SYM_CHUNK))
                 .map(pass)
                 .reduce(|| (0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)))
-        };
-        let (max, skew) = (f64::from_bits(max_bits), f64::from_bits(skew_bits));
-        if max_bits >= f64::INFINITY.to_bits() {
-            let p = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
-            return Err(Error::Factorisation(format!(
-                "the tangent has a non-finite entry (position {p})"
-            )));
         }
-        self.skew_free = 0.5 * skew <= 1e-15 * max;
-        // K itself and its 1-norm are only needed by GMRES (non-symmetric matrices).
-        self.values.clear();
-        self.k_norm = 0.0;
-        if !self.skew_free {
-            self.values.extend_from_slice(values);
-            let cp = self.symbolic.col_ptr();
-            self.k_norm = (0..self.symbolic.ncols())
-                .map(|j| {
-                    values[cp[j]..cp[j + 1]]
-                        .iter()
-                        .map(|v| v.abs())
-                        .sum::<f64>()
-                })
-                .fold(0.0, f64::max);
-        }
-        self.factorisations += 1;
+    }
+
+    /// Numeric factorisation of the filled triangle; the number of negative pivots, `None` for a
+    /// zero or non-finite pivot.
+    fn factorize(&mut self) -> Option<usize> {
         let mat = SparseColMatRef::new(self.triangle.as_ref(), &self.sym);
-        let factorised = self
-            .ldlt
+        self.ldlt
             .factorize_numeric_ldlt(
                 &mut self.l_values,
                 mat,
@@ -394,35 +322,8 @@ impl LinearSolver {
                 MemStack::new(&mut self.work),
                 Default::default(),
             )
-            .is_ok();
-        if let Some(negative) = factorised.then(|| self.negative_pivots()).flatten() {
-            self.negative = negative;
-            self.factorised = true;
-            Ok(())
-        } else {
-            // A zero pivot of the symmetric part: fall back to LU for the solves.
-            if self.values.is_empty() {
-                self.values.extend_from_slice(values);
-            }
-            self.factorize_lu()?;
-            self.negative = usize::MAX;
-            self.factorised = true;
-            Ok(())
-        }
-    }
-
-    fn factorize_lu(&mut self) -> Result<()> {
-        if self.lu_symbolic.is_none() {
-            self.lu_symbolic = Some(
-                SymbolicLu::try_new(self.symbolic.as_ref())
-                    .map_err(|e| Error::Factorisation(format!("symbolic LU: {e:?}")))?,
-            );
-        }
-        let mat = SparseColMatRef::new(self.symbolic.as_ref(), &self.values);
-        let lu = Lu::try_new_with_symbolic(self.lu_symbolic.clone().expect("set above"), mat)
-            .map_err(|e| Error::Factorisation(format!("numeric LU: {e:?}")))?;
-        self.lu = Some(lu);
-        Ok(())
+            .ok()?;
+        self.negative_pivots()
     }
 
     /// Number of negative pivots, or `None` if a pivot is not finite. Finite pivots imply a
@@ -461,6 +362,222 @@ impl LinearSolver {
             }
         }
         Some(negative)
+    }
+
+    /// `x <- S^{-1} x`: `P^T (P S P^T)^{-1} P x`.
+    fn solve(&mut self, x: &mut [f64]) {
+        let n = x.len();
+        for (y, &f) in self.permuted.iter_mut().zip(&self.perm_fwd) {
+            *y = x[f];
+        }
+        LdltRef::new(&self.ldlt, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut self.permuted, n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.work),
+        );
+        for (y, &f) in self.permuted.iter().zip(&self.perm_fwd) {
+            x[f] = *y;
+        }
+    }
+}
+
+impl LinearSolver {
+    /// Symbolic analysis of `pattern`, done once: AMD ordering, pattern of the permuted symmetric
+    /// part and its symbolic LDL^T.
+    ///
+    /// # Errors
+    /// [`Error::Factorisation`] if faer rejects the pattern or it is not structurally symmetric;
+    /// [`Error::InvalidModel`] if it is empty.
+    pub fn try_new(pattern: &Pattern) -> Result<Self> {
+        // Supernodal at every size. Faer's automatic choice (a flop-count ratio) takes the
+        // simplicial factorisation for shell models of up to a few thousand DOFs, where the
+        // supernodes of the 6 x 6 nodal blocks make the supernodal one about twice as fast.
+        // Measured: the 4 mm release (1014 DOFs), 3700 factorisations and 5500 solves in 5.4 s
+        // instead of 10.2 s; the default deployment (1614 DOFs) 13.8 s instead of 19.4 s on the
+        // same path. Above that size faer already chose it.
+        Self::with_threshold(pattern, SupernodalThreshold::FORCE_SUPERNODAL)
+    }
+
+    /// [`Self::try_new`] with the simplicial LDL^T instead of the supernodal one: the same
+    /// factors up to round-off, about twice as slow on shell models (kept to measure that choice:
+    /// `cargo bench -p tape-core --bench assembly -- "4 mm"`).
+    ///
+    /// # Errors
+    /// As [`Self::try_new`].
+    pub fn with_simplicial(pattern: &Pattern) -> Result<Self> {
+        Self::with_threshold(pattern, SupernodalThreshold::FORCE_SIMPLICIAL)
+    }
+
+    /// [`Self::try_new`] with the unknowns `separator` as the border of a bordered block-diagonal
+    /// LDL^T when they split the others into groups (see the module's documentation): the
+    /// groups are factorised in parallel. In a shell model, the free DOFs of the rigid ties' reference
+    /// nodes. The whole matrix's LDL^T when they do not split it usefully.
+    ///
+    /// # Errors
+    /// As [`Self::try_new`].
+    pub fn with_separator(pattern: &Pattern, separator: &[usize]) -> Result<Self> {
+        Self::build(pattern, SupernodalThreshold::FORCE_SUPERNODAL, separator)
+    }
+
+    /// [`Self::try_new`] with faer's simplicial/supernodal selection threshold.
+    fn with_threshold(pattern: &Pattern, threshold: SupernodalThreshold) -> Result<Self> {
+        Self::build(pattern, threshold, &[])
+    }
+
+    fn build(pattern: &Pattern, threshold: SupernodalThreshold, separator: &[usize]) -> Result<Self> {
+        let n = pattern.nrows;
+        if n == 0 {
+            return Err(Error::InvalidModel("the model has no free degree of freedom".into()));
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
+        let nnz = pattern.nnz();
+        // Position of the transpose of each entry: walking the columns in order, the entries
+        // (j, i) of each column i are met in increasing j, i.e. in the stored (sorted) order. Every
+        // entry finding its transpose makes the pattern symmetric (the map is injective).
+        let not_symmetric = || Error::Factorisation("the tangent pattern is not structurally symmetric".into());
+        let mut transpose_of = vec![0; nnz];
+        let mut next: Vec<usize> = pattern.col_ptr[..n].to_vec();
+        for j in 0..n {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let i = pattern.row_idx[p];
+                let t = next[i];
+                if t >= pattern.col_ptr[i + 1] || pattern.row_idx[t] != j {
+                    return Err(not_symmetric());
+                }
+                transpose_of[p] = t;
+                next[i] += 1;
+            }
+        }
+        let factor = match Bordered::try_new(pattern, &transpose_of, separator)? {
+            Some(b) => {
+                crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes())?;
+                SymFactor::Bordered(b)
+            }
+            None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &symbolic, &transpose_of, threshold)?)),
+        };
+        Ok(Self {
+            symbolic,
+            factor,
+            values: Vec::new(),
+            skew_free: true,
+            k_norm: 0.0,
+            negative: 0,
+            lu_symbolic: None,
+            lu: None,
+            factorised: false,
+            factorisations: 0,
+            lu_fallbacks: 0,
+            refinement_sweeps: 0,
+        })
+    }
+
+    /// Number of entries of the factor (values of `L` in the LDL^T factorisation).
+    #[must_use]
+    pub fn factor_entries(&self) -> usize {
+        match &self.factor {
+            SymFactor::Whole(w) => w.ldlt.len_val(),
+            SymFactor::Bordered(b) => b.len_val(),
+        }
+    }
+
+    /// Whether the symmetric part is factorised as a bordered block-diagonal matrix, its groups
+    /// in parallel ([`Self::with_separator`]).
+    #[must_use]
+    pub fn is_bordered(&self) -> bool {
+        matches!(self.factor, SymFactor::Bordered(_))
+    }
+
+    /// Numeric factorisation of the matrix with `values` (in pattern order).
+    ///
+    /// # Errors
+    /// [`Error::Factorisation`] for a non-finite entry, a wrong number of values or a failed
+    /// factorisation.
+    pub fn factorize(&mut self, values: &[f64]) -> Result<()> {
+        self.factorised = false;
+        self.lu = None;
+        if values.len() != self.symbolic.row_idx().len() {
+            return Err(Error::Factorisation(format!(
+                "{} values for a pattern of {} entries",
+                values.len(),
+                self.symbolic.row_idx().len()
+            )));
+        }
+        // One pass over the stored triangle of the symmetric part (each entry of K is read once,
+        // as k_ij or k_ji): symmetric part, largest |k_ij| and largest |k_ij - k_ji|. The maxima
+        // are taken on the bit patterns of the absolute values, which order non-negative floats as
+        // the values do, with infinities and NaNs above every finite value: one integer max per
+        // entry (half the time of `f64::max` chains, which the NaN rules make long), and
+        // finiteness for free. In parallel chunks (whole) or groups (bordered): the transposed
+        // reads are scattered and latency-bound, so two threads overlap their cache misses (the
+        // maxima do not depend on the order). The bordered factorisation fills and factorises
+        // each group in one task, before the checks below.
+        let (max_bits, skew_bits, bordered) = match &mut self.factor {
+            SymFactor::Whole(w) => {
+                let (m, s) = w.fill(values);
+                (m, s, None)
+            }
+            SymFactor::Bordered(b) => {
+                let (m, s, negative) = b.factorize(values);
+                (m, s, Some(negative))
+            }
+        };
+        let (max, skew) = (f64::from_bits(max_bits), f64::from_bits(skew_bits));
+        if max_bits >= f64::INFINITY.to_bits() {
+            let p = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+            return Err(Error::Factorisation(format!(
+                "the tangent has a non-finite entry (position {p})"
+            )));
+        }
+        self.skew_free = 0.5 * skew <= 1e-15 * max;
+        // K itself and its 1-norm are only needed by GMRES (non-symmetric matrices).
+        self.values.clear();
+        self.k_norm = 0.0;
+        if !self.skew_free {
+            self.values.extend_from_slice(values);
+            let cp = self.symbolic.col_ptr();
+            self.k_norm = (0..self.symbolic.ncols())
+                .map(|j| {
+                    values[cp[j]..cp[j + 1]]
+                        .iter()
+                        .map(|v| v.abs())
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max);
+        }
+        self.factorisations += 1;
+        let pivots = match (&mut self.factor, bordered) {
+            (SymFactor::Whole(w), _) => w.factorize(),
+            (SymFactor::Bordered(_), negative) => negative.flatten(),
+        };
+        if let Some(negative) = pivots {
+            self.negative = negative;
+            self.factorised = true;
+            Ok(())
+        } else {
+            // A zero pivot of the symmetric part: fall back to LU for the solves.
+            if self.values.is_empty() {
+                self.values.extend_from_slice(values);
+            }
+            self.factorize_lu()?;
+            self.negative = usize::MAX;
+            self.factorised = true;
+            Ok(())
+        }
+    }
+
+    fn factorize_lu(&mut self) -> Result<()> {
+        if self.lu_symbolic.is_none() {
+            self.lu_symbolic = Some(
+                SymbolicLu::try_new(self.symbolic.as_ref())
+                    .map_err(|e| Error::Factorisation(format!("symbolic LU: {e:?}")))?,
+            );
+        }
+        let mat = SparseColMatRef::new(self.symbolic.as_ref(), &self.values);
+        let lu = Lu::try_new_with_symbolic(self.lu_symbolic.clone().expect("set above"), mat)
+            .map_err(|e| Error::Factorisation(format!("numeric LU: {e:?}")))?;
+        self.lu = Some(lu);
+        Ok(())
     }
 
     /// Number of negative eigenvalues of the symmetric part of the last factorised matrix.
@@ -577,20 +694,11 @@ impl LinearSolver {
         res <= tol
     }
 
-    /// `x <- S^{-1} x`: `P^T (P S P^T)^{-1} P x`.
+    /// `x <- S^{-1} x`.
     fn solve_sym(&mut self, x: &mut [f64]) {
-        let n = x.len();
-        for (y, &f) in self.permuted.iter_mut().zip(&self.perm_fwd) {
-            *y = x[f];
-        }
-        LdltRef::new(&self.ldlt, &self.l_values).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut self.permuted, n, 1),
-            Par::Seq,
-            MemStack::new(&mut self.work),
-        );
-        for (y, &f) in self.permuted.iter().zip(&self.perm_fwd) {
-            x[f] = *y;
+        match &mut self.factor {
+            SymFactor::Whole(w) => w.solve(x),
+            SymFactor::Bordered(b) => b.solve(x),
         }
     }
 
@@ -600,7 +708,7 @@ impl LinearSolver {
     /// # Errors
     /// [`Error::Factorisation`] before a factorisation, for a wrong length or a singular `S`.
     pub fn solve_symmetric_part_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
-        if !self.factorised || rhs.len() != self.permuted.len() {
+        if !self.factorised || rhs.len() != self.symbolic.nrows() {
             return Err(Error::Factorisation(
                 "symmetric solve without a factorisation of this size".into(),
             ));
@@ -639,11 +747,11 @@ impl LinearSolver {
         if !self.factorised {
             return Err(Error::Factorisation("solve before factorisation".into()));
         }
-        if rhs.len() != self.permuted.len() {
+        if rhs.len() != self.symbolic.nrows() {
             return Err(Error::Factorisation(format!(
                 "right-hand side of length {} for {} unknowns",
                 rhs.len(),
-                self.permuted.len()
+                self.symbolic.nrows()
             )));
         }
         let singular = || {
@@ -771,8 +879,15 @@ mod tests {
         );
     }
 
+    fn whole(solver: &LinearSolver) -> &Whole {
+        match &solver.factor {
+            SymFactor::Whole(w) => w,
+            SymFactor::Bordered(_) => panic!("bordered factorisation"),
+        }
+    }
+
     fn is_supernodal(solver: &LinearSolver) -> bool {
-        matches!(solver.ldlt.raw(), SymbolicCholeskyRaw::Supernodal(_))
+        matches!(whole(solver).ldlt.raw(), SymbolicCholeskyRaw::Supernodal(_))
     }
 
     #[test]
@@ -789,7 +904,11 @@ mod tests {
                 let mut solver = LinearSolver::with_threshold(&pattern, threshold).expect("symbolic");
                 assert_eq!(is_supernodal(&solver), supernodal);
                 assert!(
-                    solver.perm_fwd.iter().enumerate().any(|(i, &p)| i != p),
+                    whole(&solver)
+                        .perm_fwd
+                        .iter()
+                        .enumerate()
+                        .any(|(i, &p)| i != p),
                     "identity ordering"
                 );
                 solver.factorize(&values).expect("factorisation");
@@ -907,5 +1026,176 @@ mod tests {
             assert!(solver.negative_eigenvalues().is_err());
         }
         solver.factorize(&values).expect("finite values");
+    }
+
+    /// A structurally symmetric matrix whose unknowns form groups of `sizes` coupled only through
+    /// `ns` separator unknowns, numbered in a shuffled order. Within a group: a band of half-width
+    /// 3 plus random couplings; each separator unknown couples to three unknowns of every group
+    /// and to the next separator unknown. Values as in [`random_matrix`], but with the diagonal
+    /// raised by `shift` (a large shift makes the symmetric part positive definite). Returns the
+    /// pattern, the values, the dense matrix and the separator's unknowns.
+    fn bordered_matrix(
+        sizes: &[usize],
+        ns: usize,
+        skew: f64,
+        shift: f64,
+        seed: u64,
+    ) -> (Pattern, Vec<f64>, DMatrix<f64>, Vec<usize>) {
+        let mut rng = Lcg(seed);
+        let n = sizes.iter().sum::<usize>() + ns;
+        // Shuffled numbering: label[k] is the unknown of the k-th (group-ordered) one.
+        let mut label: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
+            label.swap(i, j);
+        }
+        let mut dense = DMatrix::<f64>::zeros(n, n);
+        let mut filled = vec![vec![false; n]; n];
+        let mut couple = |a: usize, b: usize, rng: &mut Lcg| {
+            let (i, j) = (label[a], label[b]);
+            let (s, w) = (rng.next(), if i == j { 0.0 } else { skew * rng.next() });
+            dense[(i, j)] = s + w;
+            dense[(j, i)] = s - w;
+            filled[i][j] = true;
+            filled[j][i] = true;
+        };
+        let mut start = 0;
+        for &m in sizes {
+            for a in 0..m {
+                for b in a + 1..(a + 4).min(m) {
+                    couple(start + a, start + b, &mut rng);
+                }
+                let b = ((rng.next() + 1.0) * 0.5 * m as f64) as usize % m;
+                if b != a {
+                    couple(start + a, start + b, &mut rng);
+                }
+            }
+            start += m;
+        }
+        let first_sep = start;
+        for k in 0..ns {
+            let mut g0 = 0;
+            for &m in sizes {
+                for _ in 0..3 {
+                    let b = g0 + ((rng.next() + 1.0) * 0.5 * m as f64) as usize % m;
+                    couple(first_sep + k, b, &mut rng);
+                }
+                g0 += m;
+            }
+            if k + 1 < ns {
+                couple(first_sep + k, first_sep + k + 1, &mut rng);
+            }
+        }
+        for i in 0..n {
+            dense[(i, i)] = 3.0 * rng.next() + shift;
+            filled[i][i] = true;
+        }
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in 0..n {
+                if filled[i][j] {
+                    row_idx.push(i);
+                    values.push(dense[(i, j)]);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let sep = (first_sep..n).map(|k| label[k]).collect();
+        (
+            Pattern {
+                nrows: n,
+                col_ptr,
+                row_idx,
+            },
+            values,
+            dense,
+            sep,
+        )
+    }
+
+    /// The bordered factorisation solves `S` and `K` as the whole one does and gives the same
+    /// inertia: positive definite, indefinite (negative pivots in the groups and in the Schur
+    /// complement) and non-symmetric (GMRES on top of it) matrices.
+    #[test]
+    fn bordered_factorisation_solves_and_counts_negative_eigenvalues() {
+        for (skew, shift, seed) in [
+            (0.0, 12.0, 21),
+            (0.0, 0.0, 22),
+            (0.0, -1.0, 23),
+            (1e-2, 0.0, 24),
+            (1e-2, 12.0, 25),
+        ] {
+            let (pattern, values, k, sep) = bordered_matrix(&[70, 50, 40], 7, skew, shift, seed);
+            let n = k.nrows();
+            let negative = negative_eigenvalues_dense(&k);
+            if shift > 10.0 {
+                assert_eq!(negative, 0);
+            } else {
+                assert!(negative > 5 && negative < n - 5, "{negative} negative eigenvalues");
+            }
+            let mut solver = LinearSolver::with_separator(&pattern, &sep).expect("symbolic");
+            assert!(solver.is_bordered());
+            solver.factorize(&values).expect("factorisation");
+            assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
+            let s = (&k + k.transpose()) * 0.5;
+            let b = DVector::from_fn(n, |i, _| (0.7 * i as f64).sin());
+            let mut x = b.as_slice().to_vec();
+            solver.solve_sym(&mut x);
+            let x = DVector::from_vec(x);
+            let backward = (&b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
+            assert!(backward < 1e-14, "backward error of the symmetric solve {backward:e}");
+            check_solve(&mut solver, &k, seed + 100);
+            check_solve(&mut solver, &k, seed + 200);
+            assert_eq!(solver.lu_fallbacks, 0);
+            // The same matrix factorised whole: the same solution to round-off.
+            let mut whole = LinearSolver::try_new(&pattern).expect("symbolic");
+            assert!(!whole.is_bordered());
+            whole.factorize(&values).expect("factorisation");
+            let mut y = b.as_slice().to_vec();
+            whole.solve_sym(&mut y);
+            let diff = (DVector::from_vec(y) - &x).norm() / x.norm();
+            assert!(diff < 1e-11, "bordered and whole solutions differ by {diff:e}");
+        }
+    }
+
+    /// No split without groups to share: a separator that leaves one group, no separator, or a
+    /// group with most of the flops.
+    #[test]
+    fn bordered_factorisation_only_where_the_groups_share_the_work() {
+        let (pattern, _, _, sep) = bordered_matrix(&[60, 50], 6, 0.0, 12.0, 31);
+        assert!(LinearSolver::with_separator(&pattern, &sep)
+            .expect("symbolic")
+            .is_bordered());
+        assert!(!LinearSolver::with_separator(&pattern, &[])
+            .expect("symbolic")
+            .is_bordered());
+        assert!(!LinearSolver::with_separator(&pattern, &sep[..3])
+            .expect("symbolic")
+            .is_bordered());
+        let (pattern, _, _, sep) = bordered_matrix(&[400, 20], 6, 0.0, 12.0, 32);
+        assert!(!LinearSolver::with_separator(&pattern, &sep)
+            .expect("symbolic")
+            .is_bordered());
+    }
+
+    /// The groups are factorised in parallel; the factors and solutions are the same bits with
+    /// one thread or two.
+    #[test]
+    fn bordered_factorisation_does_not_depend_on_the_threads() {
+        let (pattern, values, _, sep) = bordered_matrix(&[80, 60, 50], 8, 1e-3, 0.0, 41);
+        let go = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool")
+                .install(|| {
+                    let mut solver = LinearSolver::with_separator(&pattern, &sep).expect("symbolic");
+                    solver.factorize(&values).expect("factorisation");
+                    let mut x: Vec<f64> = (0..pattern.nrows).map(|i| (i as f64).cos()).collect();
+                    solver.solve_in_place(&mut x).expect("solve");
+                    x.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+                })
+        };
+        assert_eq!(go(1), go(2));
     }
 }

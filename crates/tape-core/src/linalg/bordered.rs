@@ -1,0 +1,651 @@
+//! LDL^T of the symmetric part `S` in bordered block-diagonal form, the groups of unknowns
+//! factorised in parallel.
+//!
+//! When removing a small set of unknowns (the separator: in a shell model, the free DOFs of the
+//! reference nodes of rigid ties) splits the others into groups that no entry couples, `S`
+//! ordered group by group with the separator last is
+//!
+//! ```text
+//! [ A_1        B_1 ]
+//! [     ...    ... ]
+//! [        A_k B_k ]
+//! [ B_1^T ...  C   ]
+//! ```
+//!
+//! Its LDL^T is that of each bordered block `M_i = [A_i B_i; B_i^T X_i]` (the same `L_i`,
+//! `D_i` for `A_i`, the same rows `B_i^T L_i^-T D_i^-1`) but for the trailing block, plus the
+//! LDL^T of the Schur complement `C - sum_i B_i^T A_i^-1 B_i = sum_i T_i`, where
+//! `T_i = X_i - B_i^T A_i^-1 B_i` is what the factor of `M_i` holds in its trailing block
+//! (`L_t D_t L_t^T`), whenever the `X_i` sum to `C`. The `M_i` are independent sparse
+//! factorisations: faer's supernodal factorisation runs serially over the supernodes, so this is
+//! the way to use the second core. The groups are binned in two (largest first, each to the
+//! lighter bin, by the flops of their own symbolic factor) and each bin is one `M_i`.
+//!
+//! Choice of the `X_i`: `X_1 = C + sigma I`, `X_2 = -sigma I`, with `sigma` the largest diagonal
+//! entry of `C` in magnitude. For a positive definite `S` (every dynamic iteration matrix and
+//! every stable static tangent) `T_1 >= C - B_1^T A_1^-1 B_1 - (sum of the others)`, the Schur
+//! complement, is positive definite and `T_2 <= -sigma I` negative definite: neither trailing
+//! block meets a small pivot, and summing them loses no more than round-off of `sigma`, the size
+//! of `C`'s own entries.
+//!
+//! The inertia (Sylvester's law) is that of the `A_i` (the pivots of the non-trailing columns)
+//! plus that of the Schur complement. The result does not depend on the number of threads: the
+//! binning depends on the pattern only, and the `T_i` are summed in bin order.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{solve_unit_lower_triangular_in_place, solve_unit_upper_triangular_in_place};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, supernodal::SupernodalLdltRef, supernodal::SymbolicSupernodalCholesky,
+    CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+use rayon::prelude::*;
+
+use super::Pattern;
+use crate::error::{Error, Result};
+
+/// Marks an entry of a bin's triangle that has no entry of `K` (a separator's diagonal in the
+/// second bin, which holds `-sigma` only).
+const NONE: usize = usize::MAX;
+
+/// Largest share of the flops one bin may carry for the split to be used: above it the second
+/// core would save too little to pay for the separator's dense work.
+const MAX_BIN_SHARE: f64 = 0.85;
+
+/// Largest separator: its dense Schur complement is factorised serially at every factorisation.
+const MAX_SEPARATOR: usize = 240;
+
+fn symbolic_params() -> CholeskySymbolicParams<'static> {
+    CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    }
+}
+
+fn symbolic_error(e: impl std::fmt::Debug) -> Error {
+    Error::Factorisation(format!("symbolic LDLT of a group: {e:?}"))
+}
+
+/// The supernodal structure of a symbolic factor (forced supernodal).
+fn supernodal(ldlt: &SymbolicCholesky<usize>) -> &SymbolicSupernodalCholesky<usize> {
+    match ldlt.raw() {
+        SymbolicCholeskyRaw::Supernodal(s) => s,
+        SymbolicCholeskyRaw::Simplicial(_) => unreachable!("the factorisation is forced supernodal"),
+    }
+}
+
+/// Flops of a supernodal factorisation, up to a constant: `sum ncols * nrows^2` over supernodes.
+#[allow(clippy::cast_precision_loss)]
+fn flops(s: &SymbolicSupernodalCholesky<usize>) -> f64 {
+    (0..s.n_supernodes())
+        .map(|k| {
+            let ncols = (s.supernode_end()[k] - s.supernode_begin()[k]) as f64;
+            let nrows = ncols + s.supernode(k).pattern().len() as f64;
+            ncols * nrows * nrows
+        })
+        .sum()
+}
+
+/// Symmetric pattern of the unknowns `dofs` of `pattern` (both triangles), numbered in the order
+/// of `dofs`; `local` maps an unknown of `pattern` to its position in `dofs` (`NONE` if absent).
+fn sub_pattern(pattern: &Pattern, dofs: &[usize], local: &[usize]) -> SymbolicSparseColMat<usize> {
+    let mut col_ptr = Vec::with_capacity(dofs.len() + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for &g in dofs {
+        let start = row_idx.len();
+        row_idx.extend(
+            pattern.row_idx[pattern.col_ptr[g]..pattern.col_ptr[g + 1]]
+                .iter()
+                .map(|&i| local[i])
+                .filter(|&l| l != NONE),
+        );
+        row_idx[start..].sort_unstable();
+        col_ptr.push(row_idx.len());
+    }
+    SymbolicSparseColMat::new_checked(dofs.len(), dofs.len(), col_ptr, None, row_idx)
+}
+
+/// AMD order of `dofs` (a fill-reducing order of their own pattern), and the flops of the
+/// factor in that order.
+fn amd_order(pattern: &Pattern, dofs: &[usize], local: &mut [usize]) -> Result<(Vec<usize>, f64)> {
+    for (l, &g) in dofs.iter().enumerate() {
+        local[g] = l;
+    }
+    let sub = sub_pattern(pattern, dofs, local);
+    for &g in dofs {
+        local[g] = NONE;
+    }
+    let ldlt = factorize_symbolic_cholesky(sub.as_ref(), Side::Lower, SymmetricOrdering::Amd, symbolic_params())
+        .map_err(symbolic_error)?;
+    let order = match ldlt.perm() {
+        Some(perm) => perm.arrays().0.iter().map(|&i| dofs[i]).collect(),
+        None => dofs.to_vec(),
+    };
+    Ok((order, flops(supernodal(&ldlt))))
+}
+
+/// Connected components of the unknowns that are not in the separator (`is_sep`), each as the
+/// list of its unknowns in increasing order.
+fn components(pattern: &Pattern, is_sep: &[bool]) -> Vec<Vec<usize>> {
+    let n = pattern.nrows;
+    let mut comp = vec![NONE; n];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut stack = Vec::new();
+    for seed in 0..n {
+        if is_sep[seed] || comp[seed] != NONE {
+            continue;
+        }
+        let id = groups.len();
+        let mut members = Vec::new();
+        comp[seed] = id;
+        stack.push(seed);
+        while let Some(j) = stack.pop() {
+            members.push(j);
+            for &i in &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]] {
+                if !is_sep[i] && comp[i] == NONE {
+                    comp[i] = id;
+                    stack.push(i);
+                }
+            }
+        }
+        members.sort_unstable();
+        groups.push(members);
+    }
+    groups
+}
+
+/// One bordered block `M_i`: a bin's interior unknowns (in AMD order), then the separator.
+struct Bin {
+    /// Unknown of `K` of each row of `M_i`: the `n_int` interior ones, then the separator's.
+    dofs: Vec<usize>,
+    n_int: usize,
+    /// Lower triangle of `M_i`.
+    triangle: SymbolicSparseColMat<usize>,
+    /// For each entry of `triangle`: position in `K` of the entry and of its transpose (`NONE`
+    /// for a separator diagonal of the second bin).
+    src: Vec<[usize; 2]>,
+    /// Positions in `sym` of the separator's diagonal entries, in separator order.
+    sep_diag: Vec<usize>,
+    ldlt: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    sym: Vec<f64>,
+    work: MemBuffer,
+    /// Local right-hand side / solution.
+    x: Vec<f64>,
+    /// Gathered rows below a supernode's diagonal block.
+    tmp: Vec<f64>,
+    /// The trailing block `T_i` (dense, lower triangle filled).
+    trailing: Mat<f64>,
+    /// Negative pivots of the interior columns.
+    negative: usize,
+}
+
+impl Bin {
+    /// `interior`: the bin's unknowns in AMD order; `first`: whether the bin holds `C`.
+    fn try_new(
+        pattern: &Pattern,
+        transpose_of: &[usize],
+        interior: Vec<usize>,
+        sep: &[usize],
+        first: bool,
+        local: &mut [usize],
+    ) -> Result<Self> {
+        let n_int = interior.len();
+        let mut dofs = interior;
+        dofs.extend_from_slice(sep);
+        let m = dofs.len();
+        for (l, &g) in dofs.iter().enumerate() {
+            local[g] = l;
+        }
+        // Entries (row, column, source) of the lower triangle, walking K's lower triangle.
+        let mut entries: Vec<(usize, usize, [usize; 2])> = Vec::new();
+        for (lj, &g) in dofs.iter().enumerate() {
+            for p in pattern.col_ptr[g]..pattern.col_ptr[g + 1] {
+                let li = local[pattern.row_idx[p]];
+                if li == NONE || li < lj || (li >= n_int && lj >= n_int && !first) {
+                    continue;
+                }
+                entries.push((li, lj, [p, transpose_of[p]]));
+            }
+            if lj >= n_int && !first {
+                entries.push((lj, lj, [NONE, NONE]));
+            }
+        }
+        for &g in &dofs {
+            local[g] = NONE;
+        }
+        let mut col_ptr = vec![0usize; m + 1];
+        for &(_, c, _) in &entries {
+            col_ptr[c + 1] += 1;
+        }
+        for j in 0..m {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let mut next = col_ptr[..m].to_vec();
+        let mut row_idx = vec![0; entries.len()];
+        let mut src = vec![[0; 2]; entries.len()];
+        let mut sep_diag = vec![0; sep.len()];
+        for &(r, c, s) in &entries {
+            row_idx[next[c]] = r;
+            src[next[c]] = s;
+            if r == c && r >= n_int {
+                sep_diag[r - n_int] = next[c];
+            }
+            next[c] += 1;
+        }
+        let triangle = SymbolicSparseColMat::new_unsorted_checked(m, m, col_ptr, None, row_idx);
+        // The symbolic analysis reads the upper triangle (as `LinearSolver`'s whole factorisation
+        // does: faer's supernodal numeric factorisation of a lower triangle expects the symbolic
+        // factor of its transpose's pattern).
+        let upper = triangle
+            .as_ref()
+            .transpose()
+            .to_col_major()
+            .map_err(symbolic_error)?;
+        let ldlt = factorize_symbolic_cholesky(
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            symbolic_params(),
+        )
+        .map_err(symbolic_error)?;
+        let s = supernodal(&ldlt);
+        let max_pattern = (0..s.n_supernodes())
+            .map(|k| s.supernode(k).pattern().len() + s.supernode_end()[k] - s.supernode_begin()[k])
+            .max()
+            .unwrap_or(0);
+        let work = MemBuffer::new(ldlt.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
+        Ok(Self {
+            n_int,
+            l_values: vec![0.0; ldlt.len_val()],
+            sym: vec![0.0; src.len()],
+            triangle,
+            src,
+            sep_diag,
+            ldlt,
+            work,
+            x: vec![0.0; m],
+            tmp: vec![0.0; max_pattern],
+            trailing: Mat::zeros(sep.len(), sep.len()),
+            negative: 0,
+            dofs,
+        })
+    }
+
+    /// Writes `M_i`'s symmetric values from `values` (`K`, in pattern order) with `shift` on the
+    /// separator's diagonal; returns the bit patterns of the largest `|k_ij|` and `|k_ij - k_ji|`
+    /// read (see `LinearSolver::factorize`).
+    fn fill(&mut self, values: &[f64], shift: f64) -> (u64, u64) {
+        let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
+        for (s, &[p, t]) in self.sym.iter_mut().zip(&self.src) {
+            if p == NONE {
+                *s = 0.0;
+                continue;
+            }
+            let (v, vt) = (values[p], values[t]);
+            max_bits = max_bits.max(v.abs().to_bits().max(vt.abs().to_bits()));
+            skew_bits = skew_bits.max((v - vt).abs().to_bits());
+            *s = 0.5 * (v + vt);
+        }
+        for &d in &self.sep_diag {
+            self.sym[d] += shift;
+        }
+        (max_bits, skew_bits)
+    }
+
+    /// Numeric factorisation of `M_i`; fills `trailing` and `negative`. Returns false on a zero
+    /// or non-finite pivot.
+    fn factorize(&mut self) -> bool {
+        let mat = SparseColMatRef::new(self.triangle.as_ref(), &self.sym);
+        if self
+            .ldlt
+            .factorize_numeric_ldlt(
+                &mut self.l_values,
+                mat,
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut self.work),
+                Default::default(),
+            )
+            .is_err()
+        {
+            return false;
+        }
+        let s = supernodal(&self.ldlt);
+        let l = SupernodalLdltRef::new(s, &self.l_values);
+        let (n_int, ns) = (self.n_int, self.trailing.nrows());
+        // Trailing factor L_t (unit lower, in `lt`) and D_t, read from the supernodes that hold
+        // separator columns (a supernode may straddle the interior and the separator).
+        let mut lt = Mat::<f64>::zeros(ns, ns);
+        let mut dt = vec![0.0; ns];
+        self.negative = 0;
+        for k in 0..s.n_supernodes() {
+            let sn = l.supernode(k);
+            let (start, v) = (sn.start(), sn.val());
+            let size = v.ncols();
+            for c in 0..size {
+                let j = start + c;
+                let d = v[(c, c)];
+                if !d.is_finite() {
+                    return false;
+                }
+                if j < n_int {
+                    self.negative += usize::from(d < 0.0);
+                    continue;
+                }
+                dt[j - n_int] = d;
+                lt[(j - n_int, j - n_int)] = 1.0;
+                for r in c + 1..v.nrows() {
+                    let i = if r < size { start + r } else { sn.pattern()[r - size] };
+                    lt[(i - n_int, j - n_int)] = v[(r, c)];
+                }
+            }
+        }
+        // T = L_t D_t L_t^T.
+        let mut ld = lt.clone();
+        for (j, &d) in dt.iter().enumerate() {
+            for i in 0..ns {
+                ld[(i, j)] *= d;
+            }
+        }
+        matmul(
+            self.trailing.as_mut(),
+            Accum::Replace,
+            ld.as_ref(),
+            lt.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        true
+    }
+
+    /// Forward substitution over the interior columns and `D^-1` on them: with `x` the
+    /// interior's right-hand side and zeros on the separator, leaves `D_A^-1 L_A^-1 b` on the
+    /// interior and `-L_s z` (`L_s` the separator rows, `z = L_A^-1 b`) on the separator.
+    fn forward(&mut self, rhs: &[f64]) {
+        let n_int = self.n_int;
+        for (y, &g) in self.x[..n_int].iter_mut().zip(&self.dofs) {
+            *y = rhs[g];
+        }
+        self.x[n_int..].fill(0.0);
+        let s = supernodal(&self.ldlt);
+        let l = SupernodalLdltRef::new(s, &self.l_values);
+        for k in 0..s.n_supernodes() {
+            let sn = l.supernode(k);
+            let (start, v) = (sn.start(), sn.val());
+            if start >= n_int {
+                break;
+            }
+            let size = v.ncols();
+            let ki = size.min(n_int - start);
+            let below = v.nrows() - ki;
+            let (head, tail) = self.x.split_at_mut(start + ki);
+            let mut top = MatMut::from_column_major_slice_mut(&mut head[start..], ki, 1);
+            solve_unit_lower_triangular_in_place(v.submatrix(0, 0, ki, ki), top.rb_mut(), Par::Seq);
+            let tmp = MatMut::from_column_major_slice_mut(&mut self.tmp[..below], below, 1);
+            matmul(
+                tmp,
+                Accum::Replace,
+                v.submatrix(ki, 0, below, ki),
+                top.rb(),
+                1.0,
+                Par::Seq,
+            );
+            let off = start + ki;
+            for (r, t) in self.tmp[..below].iter().enumerate() {
+                let i = if r + ki < size {
+                    start + ki + r
+                } else {
+                    sn.pattern()[r + ki - size]
+                };
+                tail[i - off] -= t;
+            }
+            for c in 0..ki {
+                head[start + c] /= v[(c, c)];
+            }
+        }
+    }
+
+    /// Backward substitution over the interior columns, the separator's unknowns already in
+    /// `x`: leaves `L_A^-T (y - L_s^T x_s)` on the interior.
+    fn backward(&mut self) {
+        let n_int = self.n_int;
+        let s = supernodal(&self.ldlt);
+        let l = SupernodalLdltRef::new(s, &self.l_values);
+        for k in (0..s.n_supernodes()).rev() {
+            let sn = l.supernode(k);
+            let (start, v) = (sn.start(), sn.val());
+            if start >= n_int {
+                continue;
+            }
+            let size = v.ncols();
+            let ki = size.min(n_int - start);
+            let below = v.nrows() - ki;
+            let (head, tail) = self.x.split_at_mut(start + ki);
+            let off = start + ki;
+            for (r, t) in self.tmp[..below].iter_mut().enumerate() {
+                let i = if r + ki < size {
+                    start + ki + r
+                } else {
+                    sn.pattern()[r + ki - size]
+                };
+                *t = tail[i - off];
+            }
+            let mut top = MatMut::from_column_major_slice_mut(&mut head[start..], ki, 1);
+            let tmp = MatRef::from_column_major_slice(&self.tmp[..below], below, 1);
+            matmul(
+                top.rb_mut(),
+                Accum::Add,
+                v.submatrix(ki, 0, below, ki).transpose(),
+                tmp,
+                -1.0,
+                Par::Seq,
+            );
+            solve_unit_upper_triangular_in_place(v.submatrix(0, 0, ki, ki).transpose(), top, Par::Seq);
+        }
+    }
+}
+
+/// The bordered LDL^T (see the module's documentation).
+pub(super) struct Bordered {
+    /// Unknowns of the separator, in increasing order.
+    sep: Vec<usize>,
+    /// Position in `K` of each separator unknown's diagonal entry.
+    sep_diag_k: Vec<usize>,
+    bins: Vec<Bin>,
+    /// The Schur complement's LDL^T, in place (`L` below the diagonal, `D` on it).
+    schur: Mat<f64>,
+    schur_work: MemBuffer,
+    /// Right-hand side / solution on the separator.
+    x_sep: Vec<f64>,
+}
+
+impl Bordered {
+    /// The bordered factorisation of the symmetric part of matrices with `pattern` (structurally
+    /// symmetric; `transpose_of[p]` the position of entry `p`'s transpose), split by the unknowns
+    /// `separator`; `None` when it does not split them into groups whose factorisation can share
+    /// the work (a single group, a bin with more than 85 % of the flops, or a separator of more
+    /// than 240 unknowns).
+    ///
+    /// # Errors
+    /// [`Error::Factorisation`] if faer rejects a group's pattern.
+    pub(super) fn try_new(pattern: &Pattern, transpose_of: &[usize], separator: &[usize]) -> Result<Option<Self>> {
+        let n = pattern.nrows;
+        let mut sep: Vec<usize> = separator.iter().copied().filter(|&i| i < n).collect();
+        sep.sort_unstable();
+        sep.dedup();
+        if sep.is_empty() || sep.len() > MAX_SEPARATOR {
+            return Ok(None);
+        }
+        let mut is_sep = vec![false; n];
+        for &i in &sep {
+            is_sep[i] = true;
+        }
+        let groups = components(pattern, &is_sep);
+        if groups.len() < 2 {
+            return Ok(None);
+        }
+        let mut local = vec![NONE; n];
+        let mut costs = Vec::with_capacity(groups.len());
+        for g in &groups {
+            costs.push(amd_order(pattern, g, &mut local)?.1);
+        }
+        // Largest first, each to the lighter bin.
+        let mut by_cost: Vec<usize> = (0..groups.len()).collect();
+        by_cost.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]).then(a.cmp(&b)));
+        let (mut members, mut load) = ([Vec::new(), Vec::new()], [0.0_f64; 2]);
+        for g in by_cost {
+            let b = usize::from(load[1] < load[0]);
+            members[b].push(g);
+            load[b] += costs[g];
+        }
+        let total = load[0] + load[1];
+        if load[0].max(load[1]) > MAX_BIN_SHARE * total {
+            return Ok(None);
+        }
+        let mut bins = Vec::with_capacity(2);
+        for (b, mut ids) in members.into_iter().enumerate() {
+            ids.sort_unstable();
+            let mut interior: Vec<usize> = ids
+                .iter()
+                .flat_map(|&g| groups[g].iter().copied())
+                .collect();
+            interior.sort_unstable();
+            let (order, _) = amd_order(pattern, &interior, &mut local)?;
+            bins.push(Bin::try_new(pattern, transpose_of, order, &sep, b == 0, &mut local)?);
+        }
+        let sep_diag_k = sep
+            .iter()
+            .map(|&j| {
+                let col = &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]];
+                col.binary_search(&j)
+                    .map(|k| pattern.col_ptr[j] + k)
+                    .map_err(|_| Error::Factorisation("the pattern lacks a diagonal entry".into()))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let ns = sep.len();
+        let schur_work = MemBuffer::new(StackReq::any_of(&[
+            faer::linalg::cholesky::ldlt::factor::cholesky_in_place_scratch::<f64>(ns, Par::Seq, Default::default()),
+            faer::linalg::cholesky::ldlt::solve::solve_in_place_scratch::<f64>(ns, 1, Par::Seq),
+        ]));
+        Ok(Some(Self {
+            sep_diag_k,
+            bins,
+            schur: Mat::zeros(ns, ns),
+            schur_work,
+            x_sep: vec![0.0; ns],
+            sep,
+        }))
+    }
+
+    /// Entries of the factors (sparse and dense).
+    pub(super) fn len_val(&self) -> usize {
+        self.bins.iter().map(|b| b.ldlt.len_val()).sum::<usize>() + self.sep.len() * self.sep.len()
+    }
+
+    /// Bytes of the numeric factorisations' workspaces.
+    pub(super) fn workspace_bytes(&self) -> usize {
+        self.bins
+            .iter()
+            .map(|b| {
+                b.ldlt
+                    .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+                    .unaligned_bytes_required()
+            })
+            .sum()
+    }
+
+    /// Factorises the symmetric part of `values` (`K` in pattern order). Returns the bit patterns
+    /// of the largest `|k_ij|` and `|k_ij - k_ji|`, and the number of negative pivots (`None`
+    /// for a zero or non-finite pivot).
+    pub(super) fn factorize(&mut self, values: &[f64]) -> (u64, u64, Option<usize>) {
+        let mut sigma = self
+            .sep_diag_k
+            .iter()
+            .map(|&p| values[p].abs())
+            .fold(0.0, f64::max);
+        if !(sigma.is_finite() && sigma > 0.0) {
+            sigma = 1.0;
+        }
+        let results: Vec<(u64, u64, bool)> = self
+            .bins
+            .par_iter_mut()
+            .enumerate()
+            .map(|(b, bin)| {
+                let (m, s) = bin.fill(values, if b == 0 { sigma } else { -sigma });
+                (m, s, bin.factorize())
+            })
+            .collect();
+        let max_bits = results.iter().map(|r| r.0).max().unwrap_or(0);
+        let skew_bits = results.iter().map(|r| r.1).max().unwrap_or(0);
+        if !results.iter().all(|r| r.2) {
+            return (max_bits, skew_bits, None);
+        }
+        let ns = self.sep.len();
+        self.schur.fill(0.0);
+        for bin in &self.bins {
+            for j in 0..ns {
+                for i in j..ns {
+                    self.schur[(i, j)] += bin.trailing[(i, j)];
+                }
+            }
+        }
+        if faer::linalg::cholesky::ldlt::factor::cholesky_in_place(
+            self.schur.as_mut(),
+            LdltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut self.schur_work),
+            Default::default(),
+        )
+        .is_err()
+        {
+            return (max_bits, skew_bits, None);
+        }
+        let mut negative: usize = self.bins.iter().map(|b| b.negative).sum();
+        for j in 0..ns {
+            let d = self.schur[(j, j)];
+            if !d.is_finite() {
+                return (max_bits, skew_bits, None);
+            }
+            negative += usize::from(d < 0.0);
+        }
+        (max_bits, skew_bits, Some(negative))
+    }
+
+    /// `x <- S^-1 x` with the last factorisation.
+    pub(super) fn solve(&mut self, x: &mut [f64]) {
+        self.bins.par_iter_mut().for_each(|bin| bin.forward(x));
+        for (j, (y, &g)) in self.x_sep.iter_mut().zip(&self.sep).enumerate() {
+            *y = x[g] + self.bins.iter().map(|b| b.x[b.n_int + j]).sum::<f64>();
+        }
+        let ns = self.sep.len();
+        faer::linalg::cholesky::ldlt::solve::solve_in_place_with_conj(
+            self.schur.as_ref(),
+            self.schur.as_ref().diagonal(),
+            faer::Conj::No,
+            MatMut::from_column_major_slice_mut(&mut self.x_sep, ns, 1),
+            Par::Seq,
+            MemStack::new(&mut self.schur_work),
+        );
+        let x_sep = &self.x_sep;
+        self.bins.par_iter_mut().for_each(|bin| {
+            bin.x[bin.n_int..].copy_from_slice(x_sep);
+            bin.backward();
+        });
+        for bin in &self.bins {
+            for (&g, &v) in bin.dofs[..bin.n_int].iter().zip(&bin.x) {
+                x[g] = v;
+            }
+        }
+        for (&g, &v) in self.sep.iter().zip(&self.x_sep) {
+            x[g] = v;
+        }
+    }
+}
