@@ -209,6 +209,8 @@ pub struct LinearSolver {
     /// Largest column sum of |K| (the 1-norm).
     k_norm: f64,
     negative: usize,
+    /// Whether the last factorisation kept `K` for exact solves ([`Self::factorize_for_approx`]).
+    kept: bool,
     lu_symbolic: Option<SymbolicLu<usize>>,
     lu: Option<Lu<usize, f64>>,
     factorised: bool,
@@ -463,6 +465,7 @@ impl LinearSolver {
             skew_free: true,
             k_norm: 0.0,
             negative: 0,
+            kept: false,
             lu_symbolic: None,
             lu: None,
             factorised: false,
@@ -494,7 +497,22 @@ impl LinearSolver {
     /// [`Error::Factorisation`] for a non-finite entry, a wrong number of values or a failed
     /// factorisation.
     pub fn factorize(&mut self, values: &[f64]) -> Result<()> {
+        self.factorize_keeping(values, true)
+    }
+
+    /// [`Self::factorize`] for [`Self::solve_approx_in_place`] alone: a non-symmetric `K` is not
+    /// kept for GMRES (a copy of its values and its 1-norm, about 0.7 ms per factorisation on the
+    /// set-up's 10578 DOFs), so [`Self::solve_in_place`] then refuses it.
+    ///
+    /// # Errors
+    /// As [`Self::factorize`].
+    pub fn factorize_for_approx(&mut self, values: &[f64]) -> Result<()> {
+        self.factorize_keeping(values, false)
+    }
+
+    fn factorize_keeping(&mut self, values: &[f64], keep: bool) -> Result<()> {
         self.factorised = false;
+        self.kept = keep;
         self.lu = None;
         if values.len() != self.symbolic.row_idx().len() {
             return Err(Error::Factorisation(format!(
@@ -533,7 +551,7 @@ impl LinearSolver {
         // K itself and its 1-norm are only needed by GMRES (non-symmetric matrices).
         self.values.clear();
         self.k_norm = 0.0;
-        if !self.skew_free {
+        if !self.skew_free && keep {
             self.values.extend_from_slice(values);
             let cp = self.symbolic.col_ptr();
             self.k_norm = (0..self.symbolic.ncols())
@@ -768,6 +786,11 @@ impl LinearSolver {
                     Err(singular())
                 };
             }
+            if !self.kept {
+                return Err(Error::Factorisation(
+                    "exact solve after a factorisation for approximate solves (K not kept)".into(),
+                ));
+            }
             let b = rhs.to_vec();
             let b_norm = b.iter().map(|v| v * v).sum::<f64>().sqrt();
             self.solve_sym(rhs);
@@ -947,6 +970,14 @@ mod tests {
             let backward = (&b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
             assert!(backward < 1e-14, "backward error against S {backward:e}");
             assert_eq!(solver.refinement_sweeps, 0);
+            // Factorised for approximate solves only: the same solve; an exact one is refused
+            // when K is not symmetric (it was not kept for GMRES).
+            solver.factorize_for_approx(&values).expect("factorisation");
+            let mut y = b.as_slice().to_vec();
+            solver.solve_approx_in_place(&mut y).expect("solve");
+            assert_eq!(y, x.as_slice());
+            let mut z = b.as_slice().to_vec();
+            assert_eq!(solver.solve_in_place(&mut z).is_err(), skew > 0.0);
         }
     }
 

@@ -763,7 +763,13 @@ impl Integrator<'_> {
                     self.assemble(start, state, h, true, &mut r);
                 }
                 self.factor_h = None;
-                if let Err(e) = self.system.linear.factorize(&self.asm.k_ff) {
+                // Modified Newton solves with the symmetric part alone: no copy of K for GMRES.
+                let factorised = if params.reuse_factorisation {
+                    self.system.linear.factorize_for_approx(&self.asm.k_ff)
+                } else {
+                    self.system.linear.factorize(&self.asm.k_ff)
+                };
+                if let Err(e) = factorised {
                     return Attempt::Failed {
                         iterations: it,
                         residual,
