@@ -370,3 +370,102 @@ def test_a_vanishing_thickness_or_modulus_is_refused(capsys):
 def test_every_setup_field_is_still_accepted_at_its_default():
     for f in dataclasses.fields(SetupSpec):
         replace(S, **{f.name: getattr(PAPER_SETUP, f.name)}).validate()
+
+
+# 14. Settings left unbounded by the review above ---------------------------------------------
+#
+# Each was checked only as a number (> 0 or >= 0): 1e300 was accepted. The bounds and their
+# reasons are in tapespring.scenarios.setup (MAX_QUASI_STATIC_RATE, MAX_HOLD, MAX_TOLERANCE,
+# check_alpha_deg), tapespring.scenarios.bending (MAX_LOCATE_TOLERANCE_DEG) and
+# tapespring.protocols.registry (MAX_N_PEAKS); docs/scenarios.md lists them.
+
+NON_FINITE = (float("nan"), float("inf"), float("-inf"))
+
+
+@pytest.mark.parametrize("name", ["fold_rate", "pull_rate"])
+def test_the_setups_drive_rates_are_quasi_static(name):
+    for value in (0.0100001, 1.0, 1e300):
+        _refused(replace(S, **{name: value}), name, "must lie in (0, 0.01] m/s", "quasi-static")
+    for value in (0.0, -1e-3, *NON_FINITE, "1e-3", None, True):
+        _refused(replace(S, **{name: value}), name)
+    replace(S, **{name: 0.01}).validate()
+    replace(S, **{name: 1e-9}).validate()
+
+
+def test_the_hold_before_the_release_lies_within_500_s():
+    replace(S, hold=0.0).validate()  # released at once (it was refused as "hold must be > 0")
+    replace(S, hold=500.0).validate()
+    for value in (500.001, 1e4, 1e300):
+        _refused(replace(S, hold=value), "hold", "must lie in [0, 500] s")
+    for value in (-1e-9, *NON_FINITE, "5", None, True):
+        _refused(replace(S, hold=value), "hold")
+    # The same 500 s as the release's cap on its free motion.
+    from tapespring.scenarios.setup import MAX_HOLD
+
+    assert MAX_HOLD == MAX_DURATION
+
+
+def test_the_setups_tape_section_is_an_open_arc():
+    def spec(alpha_deg):
+        return replace(S, tape=replace(S.tape, alpha_deg=alpha_deg))
+
+    for value in (360.0, 400.0, 720.0):
+        _refused(spec(value), "tape.alpha_deg", "must lie in (0, 360) degrees")
+    for value in (0.0, -69.85, *NON_FINITE, "69.85", None):
+        _refused(spec(value), "tape.alpha_deg")
+    spec(359.0).validate()
+    # One home: the bending scenario's check, which `tapespring bend|release --alpha` call.
+    from tapespring.scenarios import bending, setup
+
+    assert bending.check_alpha_deg is setup.check_alpha_deg
+
+
+#: The settings of each command with a --tolerance, with a given tolerance.
+WITH_TOLERANCE = {
+    "deploy": lambda v: DeploymentSettings(spec=S, tolerance=v),
+    "vibrate": lambda v: VibrationSettings(spec=S, tolerance=v),
+    "release": lambda v: ReleaseSetup(tolerance=v),
+}
+
+
+@pytest.mark.parametrize("command", sorted(WITH_TOLERANCE))
+def test_the_time_steps_tolerance_is_at_most_a_centimetre(command, capsys):
+    from tapespring.cli import build_parser
+
+    settings = WITH_TOLERANCE[command]
+
+    for value in (0.0100001, 1.0, 1e300):
+        message = _refused(settings(value), "tolerance", "must lie in [0, 0.01] m")
+        line = refused([command, f"--tolerance={value!r}"], capsys)
+        assert line.endswith(f": {message}"), line
+    for value in (-1e-6, *NON_FINITE):
+        message = _refused(settings(value), "tolerance")
+        line = refused([command, f"--tolerance={value!r}"], capsys)
+        assert line.endswith(f": {message}"), line
+    for value in ("1e-4", None, True):
+        _refused(settings(value), "tolerance")
+    assert "tolerance must be a number" in refused([command, "--tolerance", "fine"], capsys)
+    for value in (0.0, 0.01):
+        settings(value).validate()
+        assert build_parser().parse_args([command, "--tolerance", repr(value)]).tolerance == value
+
+
+def test_limit_points_are_located_to_at_most_a_degree():
+    for value in (1.0001, 10.0, 1e300):
+        message = _refused(BendingSetup(locate_tolerance_deg=value), "locate_tolerance_deg")
+        assert "must lie in (0, 1] degrees" in message, message
+    for value in (0.0, -0.005, *NON_FINITE, "0.005", None):
+        _refused(BendingSetup(locate_tolerance_deg=value), "locate_tolerance_deg")
+    BendingSetup(locate_tolerance_deg=1.0).validate()
+    BendingSetup(locate_tolerance_deg=1e-9).validate()
+    # The release's fold is a bending run, checked alike.
+    _refused(ReleaseSetup(tape=BendingSetup(locate_tolerance_deg=10.0)), "locate_tolerance_deg")
+
+
+def test_a_deployment_reports_at_most_1000_peaks():
+    # compare() pads its peak-by-peak table to n_peaks rows: 1e12 failed after the run.
+    for value in (1001, 10**12):
+        _refused(DeploymentSettings(spec=S, n_peaks=value), "n_peaks", "<= 1000")
+    for value in (0, -1, 2.5, *NON_FINITE, "10", None, True):
+        _refused(DeploymentSettings(spec=S, n_peaks=value), "n_peaks")
+    DeploymentSettings(spec=S, n_peaks=1000).validate()

@@ -168,11 +168,11 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     Shared by the commands that build a tape spring (``bend``, ``release``); read back by
     `tape_fields`.
     """
-    from tapespring.scenarios.bending import check_alpha_deg
     from tapespring.scenarios.setup import (
         MAX_YOUNGS_MODULUS,
         MIN_THICKNESS,
         MIN_YOUNGS_MODULUS,
+        check_alpha_deg,
         check_poisson,
         check_thickness,
         check_youngs_modulus,

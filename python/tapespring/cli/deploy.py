@@ -46,8 +46,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
     from tapespring.scenarios.setup import (
+        MAX_TOLERANCE,
         SUPPORTS,
         check_rho_inf,
+        check_tolerance,
     )
 
     d = DeploymentSettings()
@@ -93,9 +95,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_field("tolerance", zero=True),
+        type=_checked("tolerance", check_tolerance),
         default=d.tolerance,
-        help="local error tolerance of the time steps [m] (0: the solver's default)",
+        help="local error tolerance of the time steps [m], in [0, "
+        f"{MAX_TOLERANCE:g}] (0: the solver's default)",
     )
     p.add_argument(
         "--experiment",

@@ -14,7 +14,7 @@ import json
 import sys
 from typing import Any
 
-from .bend import _checked, _field, _image_file, _output_file, add_tape_options, tape_fields
+from .bend import _checked, _image_file, _output_file, add_tape_options, tape_fields
 
 __all__ = ["register", "run"]
 
@@ -43,7 +43,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_tip_inertia,
         check_tip_mass,
     )
-    from tapespring.scenarios.setup import MAX_ETA, MAX_GRAVITY, check_eta, check_rho_inf
+    from tapespring.scenarios.setup import (
+        MAX_ETA,
+        MAX_GRAVITY,
+        MAX_TOLERANCE,
+        check_eta,
+        check_rho_inf,
+        check_tolerance,
+    )
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -109,9 +116,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_field("tolerance", zero=True),
+        type=_checked("tolerance", check_tolerance),
         default=d.tolerance,
-        help="local error tolerance of the time steps [m] (0: the solver's default)",
+        help="local error tolerance of the time steps [m], in [0, "
+        f"{MAX_TOLERANCE:g}] (0: the solver's default)",
     )
     add_tape_options(p, d.tape)
     p.add_argument(

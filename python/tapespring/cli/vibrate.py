@@ -61,7 +61,12 @@ VTU_RATE = 50.0
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
-    from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
+    from tapespring.scenarios.setup import (
+        MAX_SAMPLE_RATE,
+        MAX_TOLERANCE,
+        check_rho_inf,
+        check_tolerance,
+    )
     from tapespring.scenarios.vibration import (
         MAX_INITIAL_DISPLACEMENT,
         VibrationSettings,
@@ -107,10 +112,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--tolerance",
-        type=_field("tolerance", zero=True),
+        type=_checked("tolerance", check_tolerance),
         default=None,
-        help="local error tolerance of the adaptive time steps [m] (default "
-        f"{d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
+        help=f"local error tolerance of the adaptive time steps [m], in [0, {MAX_TOLERANCE:g}] "
+        f"(default {d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
     )
     add_sample_rate_option(
         p,

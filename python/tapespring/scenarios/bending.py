@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 from tapespring.scenarios.setup import (
     MIN_ROTATION_DEG,
     PAPER_TAPE,
+    check_alpha_deg,
     check_element_count,
     check_number,
     check_poisson,
@@ -60,6 +61,7 @@ __all__ = [
     "bending_steps",
     "check_alpha_deg",
     "check_imperfection_deg",
+    "check_locate_tolerance_deg",
     "check_rotation_deg",
     "check_theta_max_deg",
     "summarize",
@@ -82,6 +84,15 @@ MAX_IMPERFECTION_DEG = 10.0
 # MIN_ROTATION_DEG, the smallest rotation driven at a tape's end [deg], lives in
 # tapespring.scenarios.setup (with the set-up's initial angles, which it bounds too).
 
+#: Largest tolerance to which a bending run locates the limit points of the angle and the
+#: extrema of the moment [deg] (``locate_tolerance_deg``): a degree, the length of the path's
+#: steps where the moment changes fast (``refine_span``: a step longer than a degree that changes
+#: the moment by more than 5 % is refined). A coarser location is no finer than the path's own
+#: states, so it locates nothing, and a larger value is a typing error (1e300 was accepted). The
+#: default is 0.005 deg; a finer one costs at most the search's 12 evaluations (tape-core's
+#: events), so any tolerance > 0 is accepted.
+MAX_LOCATE_TOLERANCE_DEG = 1.0
+
 
 def check_rotation_deg(name: str, value: float, limit: float) -> None:
     """Raise ValueError naming `name` unless the end rotation `value` [deg] lies within
@@ -94,13 +105,20 @@ def check_rotation_deg(name: str, value: float, limit: float) -> None:
         )
 
 
-def check_alpha_deg(value: float) -> None:
-    """Raise ValueError unless `value` [deg], the section's subtended angle, lies in (0, 360): an
-    open section (at 360 degrees the arc closes into a tube)."""
-    if not 0.0 < value < 360.0:
+# check_alpha_deg, the bound on the section's subtended angle, lives in
+# tapespring.scenarios.setup (the set-up's tape.alpha_deg is bounded by it too); it is
+# re-exported here.
+
+
+def check_locate_tolerance_deg(value: object) -> None:
+    """Raise ValueError unless `value` is ``locate_tolerance_deg`` [deg]: a finite number in
+    (0, :data:`MAX_LOCATE_TOLERANCE_DEG`]."""
+    number = check_number("locate_tolerance_deg", value, positive=True)
+    if number > MAX_LOCATE_TOLERANCE_DEG:
         raise ValueError(
-            f"alpha_deg (the section's subtended angle) must lie in (0, 360) degrees "
-            f"(got {shown(value)})"
+            f"locate_tolerance_deg must lie in (0, {MAX_LOCATE_TOLERANCE_DEG:g}] degrees (got "
+            f"{shown(number)}): the path's steps are refined to a degree where the moment changes "
+            "fast, so a coarser location locates nothing (see MAX_LOCATE_TOLERANCE_DEG)"
         )
 
 
@@ -137,7 +155,8 @@ class BendingSetup:
     radius : float
         Transverse radius of curvature R [m].
     alpha_deg : float
-        Subtended angle of the cross-section [deg].
+        Subtended angle of the cross-section [deg], in (0, 360)
+        (:func:`~tapespring.scenarios.setup.check_alpha_deg`).
     thickness : float
         Thickness t [m].
     youngs_modulus : float
@@ -163,7 +182,8 @@ class BendingSetup:
         bifurcation, as that of the perfect tape in equal sense, where it twists), locate it and
         follow the stable branch leaving it instead of the unstable one.
     locate_tolerance_deg : float
-        Limit points of the angle and extrema of the moment are located to this [deg], > 0.
+        Limit points of the angle and extrema of the moment are located to this [deg], in
+        (0, :data:`MAX_LOCATE_TOLERANCE_DEG`] (a degree, the path's refined steps).
     """
 
     length: float = PAPER_TAPE.length
@@ -238,8 +258,7 @@ class BendingSetup:
             )
         check_element_count("mesh_size", self.mesh_size, self.length, width)
         check_imperfection_deg(self.imperfection_deg)
-        if self.locate_tolerance_deg <= 0.0:
-            raise ValueError(f"locate_tolerance_deg must be > 0 (got {self.locate_tolerance_deg})")
+        check_locate_tolerance_deg(self.locate_tolerance_deg)
 
 
 def analytical_residual_moment(setup: BendingSetup, sense: int) -> float:

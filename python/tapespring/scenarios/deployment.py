@@ -56,6 +56,7 @@ from tapespring.scenarios.setup import (
     check_rho_inf,
     check_sampling,
     check_sense,
+    check_tolerance,
     drive,
     dynamic_options,
     gravity_step,
@@ -97,9 +98,11 @@ class DeploymentSettings:
         :data:`~tapespring.scenarios.setup.MIN_SAMPLE_INTERVALS` (2) sample intervals in
         `duration`, the fewest the peak analysis reads.
     tolerance : float
-        Local error tolerance of the time steps [m] (0: the solver's default).
+        Local error tolerance of the time steps [m] (0: the solver's default), at most
+        :data:`~tapespring.scenarios.setup.MAX_TOLERANCE` (1 cm per step).
     n_peaks : int
-        Maxima and minima of the bending angle reported (paper: 10).
+        Maxima and minima of the bending angle reported (paper: 10), from 1 to the trial
+        analysis's :data:`~tapespring.protocols.registry.MAX_N_PEAKS` (1000).
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th record, for
         ParaView series and snapshots (0: none; the last record is always kept when > 0).
@@ -131,9 +134,13 @@ class DeploymentSettings:
             ("duration", self.duration), rate=self.sample_rate, rate_name="sample_rate"
         )
         check_rho_inf(self.rho_inf)
-        check_number("tolerance", self.tolerance, positive=True, zero=True)
+        check_tolerance(self.tolerance)
         check_count("field_interval", self.field_interval, minimum=0)
-        check_count("n_peaks", self.n_peaks, minimum=1)
+        # The trial analysis's bound (MAX_N_PEAKS): compare() pads its peak-by-peak table to
+        # n_peaks rows (compare_peaks), which at 1e12 failed after the run instead of before it.
+        from tapespring.protocols.registry import check_n_peaks
+
+        check_n_peaks(self.n_peaks)
 
     def check_recording(self, measured: Any) -> None:
         """Raise ValueError unless the measured deployment `measured` (a

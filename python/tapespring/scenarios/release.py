@@ -29,6 +29,7 @@ from tapespring.scenarios.setup import (
     check_eta,
     check_number,
     check_rho_inf,
+    check_tolerance,
     shown,
 )
 
@@ -158,9 +159,11 @@ class ReleaseSetup:
         bool (``"no"`` is refused, not taken as true).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default, 1e-5 of the model's
-        half diagonal). The default 1e-4 m (0.1 mm per step, under 1e-3 of the tape's length)
-        lets the steps follow the snap without the solver's tight default costing ten times the
-        steps; the test of this scenario checks that halving it leaves the history unchanged.
+        half diagonal), at most :data:`~tapespring.scenarios.setup.MAX_TOLERANCE` (1 cm per
+        step, from where the error estimate rejects no step). The default 1e-4 m (0.1 mm per
+        step, under 1e-3 of the tape's length) lets the steps follow the snap without the
+        solver's tight default costing ten times the steps; the test of this scenario checks
+        that halving it leaves the history unchanged.
     """
 
     tape: BendingSetup = BendingSetup()
@@ -195,7 +198,7 @@ class ReleaseSetup:
             )
         check_density(self.density, zero=True)
         check_eta(self.eta)
-        check_number("tolerance", self.tolerance, positive=True, zero=True)
+        check_tolerance(self.tolerance)
         check_tip_mass(self.tip_mass)
         check_tip_inertia(self.tip_inertia)
         check_duration(self.duration)

@@ -22,9 +22,12 @@ __all__ = [
     "MAX_ELEMENTS",
     "MAX_ETA",
     "MAX_GRAVITY",
+    "MAX_HOLD",
     "MAX_LENGTH",
     "MAX_MASS",
+    "MAX_QUASI_STATIC_RATE",
     "MAX_SAMPLE_RATE",
+    "MAX_TOLERANCE",
     "MAX_YOUNGS_MODULUS",
     "MIN_DISPLACEMENT",
     "MIN_ROTATION_DEG",
@@ -45,23 +48,27 @@ __all__ = [
     "TapeSpring",
     "add_flexible_support",
     "build_setup",
+    "check_alpha_deg",
     "check_count",
     "check_density",
     "check_displacement",
     "check_element_count",
     "check_eta",
+    "check_hold",
     "check_initial_angle",
     "check_length",
     "check_mass",
     "check_min_samples",
     "check_number",
     "check_poisson",
+    "check_quasi_static_rate",
     "check_rho_inf",
     "check_sample_rate",
     "check_sampling",
     "check_sense",
     "check_thickness",
     "check_thin",
+    "check_tolerance",
     "check_youngs_modulus",
     "shown",
 ]
@@ -401,11 +408,16 @@ class SetupSpec:
     initial_angle_opposite_deg, initial_angle_equal_deg : float
         Initial bending angles of the deployment tests [deg] (Sec. 4.1).
     fold_rate : float
-        Speed at which marker 2 is driven to its folded position [m/s] (paper: under 2 mm/s).
+        Speed at which marker 2 is driven to its folded position [m/s] (paper: under 2 mm/s),
+        in (0, :data:`MAX_QUASI_STATIC_RATE`] (10 mm/s, a quasi-static drive). The paper's
+        protocol: the fold is a static step here, its slow limit, so the rate is not simulated.
     hold : float
-        Time the folded set-up is held before the release [s] (paper: 5 s).
+        Time the folded set-up is held before the release [s] (paper: 5 s), in
+        [0, :data:`MAX_HOLD`] (500 s). The paper's protocol: a static fold is the state the hold
+        leads to (``DeploymentSettings.settle`` simulates one).
     pull_rate : float
-        Speed of the quasi-static pull [m/s] (paper: 1 mm/s).
+        Speed of the quasi-static pull [m/s] (paper: 1 mm/s), in
+        (0, :data:`MAX_QUASI_STATIC_RATE`]. The pull is a static path here, its slow limit.
     support : str
         ``"rigid"`` (the clamped ends fixed) or ``"flexible"`` (the shell model of the support);
         see :data:`SUPPORTS`.
@@ -539,11 +551,12 @@ class SetupSpec:
         check_youngs_modulus(self.tape.youngs_modulus, "tape.youngs_modulus")
         check_poisson(self.tape.poisson, "tape.poisson")
         check_density(self.tape.density, "tape.density")
+        check_alpha_deg(self.tape.alpha_deg, "tape.alpha_deg")
         check_thin(self.tape.thickness, self.tape.radius, "tape.")
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
-            if name in ("tape", "support_marker", "support", "eta", "support_eta"):
+            if name in ("tape", "support_marker", "support", "eta", "support_eta", "hold"):
                 continue
             positive = not name.startswith("initial_angle")
             check_number(name, value, positive=positive)
@@ -560,6 +573,9 @@ class SetupSpec:
         for sense in SENSES:
             name = f"initial_angle_{sense}_deg"
             check_initial_angle(name, getattr(self, name), sense)
+        for name in ("fold_rate", "pull_rate"):
+            check_quasi_static_rate(name, getattr(self, name))
+        check_hold(self.hold)
         if not isinstance(self.support_marker, tuple | list) or len(self.support_marker) != 3:
             raise ValueError(
                 f"support_marker must have 3 coordinates (got {self.support_marker!r})"
@@ -796,6 +812,33 @@ MIN_ROTATION_DEG = 1e-6
 #: extremum and a decay can be sampled as a trial; fewer made a run that reported nothing.
 MIN_SAMPLE_INTERVALS = 2
 
+#: Fastest drive of the set-up's quasi-static tests [m/s] (``SetupSpec.fold_rate`` and
+#: ``pull_rate``): 10 mm/s, five times the paper's fold (under 2 mm/s) and ten times its pull
+#: (1 mm/s). Both are static steps here, the slow limit of the drive, which holds while the drive
+#: is slow against the set-up's vibration: a drive starting at speed v sets it vibrating about the
+#: static path with an amplitude v / omega, at 10 mm/s and the set-up's longest first period
+#: (0.11 s, with the additional weight, Table 8) 0.18 mm, under 2 % of the 10 mm to the pull's
+#: buckling (Table 9); the tapes' viscous stress, eta v / d, is then 2e-4 of the elastic one
+#: (eta = 1.73e-4 s over d = 10 mm). Faster, a static step no longer models the test (0.1 m/s:
+#: 18 %), and a rate of metres a second is a typing error.
+MAX_QUASI_STATIC_RATE = 1e-2
+
+#: Longest hold of the folded set-up before the release [s] (``SetupSpec.hold``): 500 s, a
+#: hundred times the paper's 5 s. The hold lets the fold's vibration die out: at the set-up's
+#: damping ratio (0.5 % at a period of 0.11 s, Table 8) it decays by a factor e in 3.5 s, so
+#: 500 s is 140 times that, and a longer hold is a typing error. Equal (by test) to the release's
+#: ``MAX_DURATION``, the cap on its free motion (the solver's 100 000 steps of at most 5 ms).
+MAX_HOLD = 500.0
+
+#: Largest local error tolerance of a dynamic step's time steps [m] (``tolerance`` of the
+#: deployment, the vibration test and the release): a centimetre per step, a tenth of the
+#: paper's tape and a hundred times the scenarios' default 1e-4 m. From there up the error
+#: estimate rejects no step, so the value no longer controls anything: the release (0.3 s, 4 mm
+#: mesh) took the same 4181 steps to the same history at 1e-2, 1e-1 and 1e300 m, the deployment
+#: (0.3 s, 10 mm tapes) the same steps at 1e-3, 1e-2 and 1e300 m. A larger value is a typing
+#: error (1e300 was accepted).
+MAX_TOLERANCE = 1e-2
+
 
 def check_length(name: str, value: object) -> float:
     """Raise ValueError naming `name` unless `value` is a length of the set-up [m]: a finite
@@ -858,6 +901,55 @@ def check_initial_angle(name: str, value: object, sense: str) -> None:
         raise ValueError(
             f"{name} must lie in {interval} degrees in {sense} sense, at least "
             f"{MIN_ROTATION_DEG:g} in magnitude (got {shown(number)})"
+        )
+
+
+def check_alpha_deg(value: object, name: str = "alpha_deg") -> None:
+    """Raise ValueError naming `name` unless `value` [deg], a tape section's subtended angle, is
+    a number in (0, 360): an open section (at 360 degrees the arc closes into a tube; beyond, an
+    angle wraps). The bending scenario's ``alpha_deg`` and the set-up's ``tape.alpha_deg``."""
+    number = check_number(name, value, positive=False)
+    if not 0.0 < number < 360.0:
+        raise ValueError(
+            f"{name} (the section's subtended angle) must lie in (0, 360) degrees "
+            f"(got {shown(number)})"
+        )
+
+
+def check_quasi_static_rate(name: str, value: object) -> None:
+    """Raise ValueError naming `name` unless `value` is the speed of a quasi-static drive of the
+    set-up [m/s] (``fold_rate``, ``pull_rate``): a finite number in
+    (0, :data:`MAX_QUASI_STATIC_RATE`]."""
+    number = check_number(name, value, positive=True)
+    if number > MAX_QUASI_STATIC_RATE:
+        raise ValueError(
+            f"{name} must lie in (0, {MAX_QUASI_STATIC_RATE:g}] m/s, a quasi-static drive (got "
+            f"{shown(number)} m/s; the paper folds at under 0.002 and pulls at 0.001; see "
+            "MAX_QUASI_STATIC_RATE)"
+        )
+
+
+def check_hold(value: object, name: str = "hold") -> None:
+    """Raise ValueError naming `name` unless `value` is the hold of the folded set-up before the
+    release [s]: a finite number in [0, :data:`MAX_HOLD`] (0: released at once)."""
+    number = check_number(name, value, positive=True, zero=True)
+    if number > MAX_HOLD:
+        raise ValueError(
+            f"{name} must lie in [0, {MAX_HOLD:g}] s (got {shown(number)} s; the paper holds 5 s, "
+            "long enough for the fold's vibration to die out; see MAX_HOLD)"
+        )
+
+
+def check_tolerance(value: object, name: str = "tolerance") -> None:
+    """Raise ValueError naming `name` unless `value` is the local error tolerance of a dynamic
+    step's time steps [m]: a finite number in [0, :data:`MAX_TOLERANCE`] (0: the solver's
+    default)."""
+    number = check_number(name, value, positive=True, zero=True)
+    if number > MAX_TOLERANCE:
+        raise ValueError(
+            f"{name} must lie in [0, {MAX_TOLERANCE:g}] m (got {shown(number)} m): from a "
+            "centimetre per step up the error estimate rejects no step (0: the solver's "
+            "default; see MAX_TOLERANCE)"
         )
 
 

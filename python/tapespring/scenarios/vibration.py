@@ -46,6 +46,7 @@ from tapespring.scenarios.setup import (
     check_number,
     check_rho_inf,
     check_sampling,
+    check_tolerance,
     drive,
     dynamic_options,
     gravity_step,
@@ -140,7 +141,8 @@ class VibrationSettings:
         meshes, 8 s, with the spec's earlier mass split: 0.493 % at either rate, a period of
         0.1144 s against 0.1143 s, 52 s of wall time against 97 s).
     tolerance : float
-        Local error tolerance of the time steps [m] (0: the solver's default).
+        Local error tolerance of the time steps [m] (0: the solver's default), at most
+        :data:`~tapespring.scenarios.setup.MAX_TOLERANCE` (1 cm per step).
     time_step : float
         Fixed time step of the decay [s], recorded at every step (`sample_rate` and `tolerance`
         then do not apply; 0: adaptive steps), at least 1 us (as `sample_rate` is at most
@@ -178,7 +180,7 @@ class VibrationSettings:
         for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)
         check_rho_inf(self.rho_inf)
-        check_number("tolerance", self.tolerance, positive=True, zero=True)
+        check_tolerance(self.tolerance)
         check_time_step(self.time_step)
         # Every fixed step is a record: the same bounds as the samples (a fixed step longer than
         # half the duration leaves fewer than 2 of them).
