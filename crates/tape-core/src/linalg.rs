@@ -170,6 +170,33 @@ fn permuted_triangle(
     )
 }
 
+/// Position in `pattern` of the transpose of each entry.
+///
+/// # Errors
+/// [`Error::Factorisation`] if the pattern is not structurally symmetric.
+fn transpose_positions(pattern: &Pattern) -> Result<Vec<usize>> {
+    // Walking the columns in order, the entries (j, i) of each column i are met in increasing j,
+    // i.e. in the stored (sorted) order. Every entry finding its transpose makes the pattern
+    // symmetric (the map is injective).
+    let n = pattern.nrows;
+    let mut transpose_of = vec![0; pattern.nnz()];
+    let mut next: Vec<usize> = pattern.col_ptr[..n].to_vec();
+    for j in 0..n {
+        for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+            let i = pattern.row_idx[p];
+            let t = next[i];
+            if t >= pattern.col_ptr[i + 1] || pattern.row_idx[t] != j {
+                return Err(Error::Factorisation(
+                    "the tangent pattern is not structurally symmetric".into(),
+                ));
+            }
+            transpose_of[p] = t;
+            next[i] += 1;
+        }
+    }
+    Ok(transpose_of)
+}
+
 /// The whole symmetric part's LDL^T, pre-permuted (see the module's documentation).
 struct Whole {
     /// Fill-reducing permutation: row/column `i` of `P S P^T` is row/column `perm_fwd[i]` of `S`.
@@ -195,7 +222,7 @@ struct Whole {
 /// coupled through a separator, factorised in parallel: `bordered`).
 enum SymFactor {
     Whole(Box<Whole>),
-    Bordered(Bordered),
+    Bordered(Box<Bordered>),
 }
 
 /// Solver for matrices with a fixed, structurally symmetric pattern.
@@ -203,6 +230,10 @@ pub struct LinearSolver {
     /// Pattern of `K`, in its original order (products with `K`, LU fallback).
     symbolic: SymbolicSparseColMat<usize>,
     factor: SymFactor,
+    /// The whole LDL^T for the matrices a bordered `factor` fails on, and whether the last
+    /// factorisation is that one.
+    fallback: Option<Box<Whole>>,
+    use_fallback: bool,
     /// Values of `K`, kept when it is not symmetric (GMRES) or for the LU fallback.
     values: Vec<f64>,
     skew_free: bool,
@@ -434,33 +465,22 @@ impl LinearSolver {
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
         let nnz = pattern.nnz();
-        // Position of the transpose of each entry: walking the columns in order, the entries
-        // (j, i) of each column i are met in increasing j, i.e. in the stored (sorted) order. Every
-        // entry finding its transpose makes the pattern symmetric (the map is injective).
-        let not_symmetric = || Error::Factorisation("the tangent pattern is not structurally symmetric".into());
-        let mut transpose_of = vec![0; nnz];
-        let mut next: Vec<usize> = pattern.col_ptr[..n].to_vec();
-        for j in 0..n {
-            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                let i = pattern.row_idx[p];
-                let t = next[i];
-                if t >= pattern.col_ptr[i + 1] || pattern.row_idx[t] != j {
-                    return Err(not_symmetric());
-                }
-                transpose_of[p] = t;
-                next[i] += 1;
-            }
-        }
-        let factor = match Bordered::try_new(pattern, &transpose_of, separator)? {
-            Some(b) => {
-                crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes())?;
-                SymFactor::Bordered(b)
-            }
+        let transpose_of = transpose_positions(pattern)?;
+        // The bordered factorisation is an optimisation: where it cannot be set up (or the memory
+        // check refuses its factors), the whole one is tried.
+        let bordered = Bordered::try_new(pattern, &transpose_of, separator)
+            .ok()
+            .flatten()
+            .filter(|b| crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes()).is_ok());
+        let factor = match bordered {
+            Some(b) => SymFactor::Bordered(Box::new(b)),
             None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &symbolic, &transpose_of, threshold)?)),
         };
         Ok(Self {
             symbolic,
             factor,
+            fallback: None,
+            use_fallback: false,
             values: Vec::new(),
             skew_free: true,
             k_norm: 0.0,
@@ -564,10 +584,23 @@ impl LinearSolver {
                 .fold(0.0, f64::max);
         }
         self.factorisations += 1;
-        let pivots = match (&mut self.factor, bordered) {
+        self.use_fallback = false;
+        let mut pivots = match (&mut self.factor, bordered) {
             (SymFactor::Whole(w), _) => w.factorize(),
             (SymFactor::Bordered(_), negative) => negative.flatten(),
         };
+        if pivots.is_none() && self.is_bordered() {
+            // A bordered block met a zero pivot (possible only for an indefinite matrix, at its
+            // trailing block or where the whole matrix has one too): the whole LDL^T, built the
+            // first time it is needed, for this matrix.
+            if self.fallback.is_none() {
+                self.fallback = Some(Box::new(self.whole_for_fallback()?));
+            }
+            let whole = self.fallback.as_mut().expect("built above");
+            whole.fill(values);
+            pivots = whole.factorize();
+            self.use_fallback = pivots.is_some();
+        }
         if let Some(negative) = pivots {
             self.negative = negative;
             self.factorised = true;
@@ -714,10 +747,28 @@ impl LinearSolver {
 
     /// `x <- S^{-1} x`.
     fn solve_sym(&mut self, x: &mut [f64]) {
-        match &mut self.factor {
-            SymFactor::Whole(w) => w.solve(x),
-            SymFactor::Bordered(b) => b.solve(x),
+        match (&mut self.factor, &mut self.fallback) {
+            (_, Some(w)) if self.use_fallback => w.solve(x),
+            (SymFactor::Whole(w), _) => w.solve(x),
+            (SymFactor::Bordered(b), _) => b.solve(x),
         }
+    }
+
+    /// The whole symmetric part's LDL^T of this pattern (supernodal), for the matrices the
+    /// bordered factorisation fails on.
+    fn whole_for_fallback(&self) -> Result<Whole> {
+        let pattern = Pattern {
+            nrows: self.symbolic.nrows(),
+            col_ptr: self.symbolic.col_ptr().to_vec(),
+            row_idx: self.symbolic.row_idx().to_vec(),
+        };
+        let transpose_of = transpose_positions(&pattern)?;
+        Whole::try_new(
+            &pattern,
+            &self.symbolic,
+            &transpose_of,
+            SupernodalThreshold::FORCE_SUPERNODAL,
+        )
     }
 
     /// Solves `S x = b` in place with the LDL^T of the symmetric part `S = (K + K^T)/2` only (the
@@ -729,6 +780,11 @@ impl LinearSolver {
         if !self.factorised || rhs.len() != self.symbolic.nrows() {
             return Err(Error::Factorisation(
                 "symmetric solve without a factorisation of this size".into(),
+            ));
+        }
+        if self.negative == usize::MAX {
+            return Err(Error::Factorisation(
+                "the symmetric part of the tangent is singular (zero pivot; solves use LU)".into(),
             ));
         }
         self.solve_sym(rhs);
@@ -1062,14 +1118,17 @@ mod tests {
     /// A structurally symmetric matrix whose unknowns form groups of `sizes` coupled only through
     /// `ns` separator unknowns, numbered in a shuffled order. Within a group: a band of half-width
     /// 3 plus random couplings; each separator unknown couples to three unknowns of every group
-    /// and to the next separator unknown. Values as in [`random_matrix`], but with the diagonal
-    /// raised by `shift` (a large shift makes the symmetric part positive definite). Returns the
-    /// pattern, the values, the dense matrix and the separator's unknowns.
+    /// and to the next separator unknown (with `lonely`: the first one to the first group only,
+    /// the last one to nothing, its diagonal the separator's largest, negative). Values as in
+    /// [`random_matrix`], but with the diagonal raised by `shift` (a large shift makes the
+    /// symmetric part positive definite). Returns the pattern, the values, the dense matrix and
+    /// the separator's unknowns.
     fn bordered_matrix(
         sizes: &[usize],
         ns: usize,
         skew: f64,
         shift: f64,
+        lonely: bool,
         seed: u64,
     ) -> (Pattern, Vec<f64>, DMatrix<f64>, Vec<usize>) {
         let mut rng = Lcg(seed);
@@ -1105,21 +1164,33 @@ mod tests {
         }
         let first_sep = start;
         for k in 0..ns {
+            // With `lonely`, the first separator unknown couples to the first group only and the
+            // last to nothing.
+            let last = lonely && k + 1 == ns;
             let mut g0 = 0;
-            for &m in sizes {
+            for (g, &m) in sizes.iter().enumerate() {
                 for _ in 0..3 {
                     let b = g0 + ((rng.next() + 1.0) * 0.5 * m as f64) as usize % m;
-                    couple(first_sep + k, b, &mut rng);
+                    if !(last || (lonely && k == 0 && g > 0)) {
+                        couple(first_sep + k, b, &mut rng);
+                    }
                 }
                 g0 += m;
             }
-            if k + 1 < ns {
+            if k + 2 < ns || (k + 1 < ns && !lonely) {
                 couple(first_sep + k, first_sep + k + 1, &mut rng);
             }
         }
         for i in 0..n {
             dense[(i, i)] = 3.0 * rng.next() + shift;
             filled[i][i] = true;
+        }
+        if lonely {
+            // The isolated unknown's diagonal, the separator's largest in magnitude, negative.
+            let largest = (first_sep..n)
+                .map(|k| dense[(label[k], label[k])].abs())
+                .fold(0.0, f64::max);
+            dense[(label[n - 1], label[n - 1])] = -2.0 * largest;
         }
         let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
         for j in 0..n {
@@ -1144,29 +1215,46 @@ mod tests {
         )
     }
 
+    fn bordered(solver: &LinearSolver) -> &Bordered {
+        match &solver.factor {
+            SymFactor::Bordered(b) => b,
+            SymFactor::Whole(_) => panic!("whole factorisation"),
+        }
+    }
+
     /// The bordered factorisation solves `S` and `K` as the whole one does and gives the same
     /// inertia: positive definite, indefinite (negative pivots in the groups and in the Schur
-    /// complement) and non-symmetric (GMRES on top of it) matrices.
+    /// complement) and non-symmetric (GMRES on top of it) matrices; with separator unknowns
+    /// coupled to one group only or to nothing, one of them with the separator's largest diagonal
+    /// entry, negative (a uniform shift by the largest `|c_jj|` gave it an exact zero pivot). The
+    /// groups' supernodes straddle the interior and the separator in some of these cases (the
+    /// substitutions' index mapping is exercised).
     #[test]
     fn bordered_factorisation_solves_and_counts_negative_eigenvalues() {
-        for (skew, shift, seed) in [
-            (0.0, 12.0, 21),
-            (0.0, 0.0, 22),
-            (0.0, -1.0, 23),
-            (1e-2, 0.0, 24),
-            (1e-2, 12.0, 25),
+        let mut straddling = 0;
+        for (skew, shift, lonely, seed) in [
+            (0.0, 12.0, false, 21),
+            (0.0, 0.0, false, 22),
+            (0.0, -1.0, false, 23),
+            (1e-2, 0.0, false, 24),
+            (1e-2, 12.0, false, 25),
+            (0.0, 12.0, true, 26),
+            (0.0, 0.0, true, 27),
+            (1e-2, 0.0, true, 28),
         ] {
-            let (pattern, values, k, sep) = bordered_matrix(&[70, 50, 40], 7, skew, shift, seed);
+            let (pattern, values, k, sep) = bordered_matrix(&[70, 50, 40], 7, skew, shift, lonely, seed);
             let n = k.nrows();
             let negative = negative_eigenvalues_dense(&k);
-            if shift > 10.0 {
+            if shift > 10.0 && !lonely {
                 assert_eq!(negative, 0);
             } else {
-                assert!(negative > 5 && negative < n - 5, "{negative} negative eigenvalues");
+                assert!(negative > 0 && negative < n - 5, "{negative} negative eigenvalues");
             }
             let mut solver = LinearSolver::with_separator(&pattern, &sep).expect("symbolic");
             assert!(solver.is_bordered());
+            straddling += bordered(&solver).straddling();
             solver.factorize(&values).expect("factorisation");
+            assert!(!solver.use_fallback, "the bordered factorisation failed");
             assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
             let s = (&k + k.transpose()) * 0.5;
             let b = DVector::from_fn(n, |i, _| (0.7 * i as f64).sin());
@@ -1186,14 +1274,74 @@ mod tests {
             whole.solve_sym(&mut y);
             let diff = (DVector::from_vec(y) - &x).norm() / x.norm();
             assert!(diff < 1e-11, "bordered and whole solutions differ by {diff:e}");
+            // Factorised for approximate solves: the symmetric part's solve, the same bits.
+            solver.factorize_for_approx(&values).expect("factorisation");
+            let mut z = b.as_slice().to_vec();
+            solver.solve_approx_in_place(&mut z).expect("solve");
+            assert_eq!(z, x.as_slice());
         }
+        assert!(straddling > 0, "no supernode straddles the interior and the separator");
+    }
+
+    /// A bordered matrix whose symmetric part is singular (two unknowns of a group coupled by a
+    /// skew pair only): the bordered factorisation fails, so does the whole one, and the solves
+    /// use LU; the symmetric solve is refused, not answered from the failed factors. Non-finite
+    /// entries, read directly or as a transpose, are refused.
+    #[test]
+    fn bordered_factorisation_fails_over_and_refuses_non_finite_entries() {
+        let (pattern, mut values, mut k, sep) = bordered_matrix(&[40, 30], 5, 0.0, 0.0, false, 51);
+        let mut solver = LinearSolver::with_separator(&pattern, &sep).expect("symbolic");
+        assert!(solver.is_bordered());
+        solver.factorize(&values).expect("factorisation");
+        assert!(solver.negative_eigenvalues().is_ok());
+        // Non-finite entries: an off-diagonal one (read as k_ij and as k_ji) and a diagonal one.
+        for p in [pattern.col_ptr[3] + 1, pattern.col_ptr[7]] {
+            for bad in [f64::NAN, f64::INFINITY] {
+                let mut v = values.clone();
+                v[p] = bad;
+                assert!(solver.factorize(&v).is_err());
+                assert!(solver.negative_eigenvalues().is_err());
+            }
+        }
+        // Unknown 0 and its first neighbour r coupled by a skew pair only.
+        let r = pattern.row_idx[pattern.col_ptr[0]..pattern.col_ptr[1]]
+            .iter()
+            .copied()
+            .find(|&i| i != 0)
+            .expect("an off-diagonal entry in column 0");
+        let n = pattern.nrows;
+        for j in 0..n {
+            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                let i = pattern.row_idx[p];
+                if [0, r].contains(&i) || [0, r].contains(&j) {
+                    let v = if (i, j) == (0, r) {
+                        1.0
+                    } else if (i, j) == (r, 0) {
+                        -1.0
+                    } else {
+                        0.0
+                    };
+                    values[p] = v;
+                    k[(i, j)] = v;
+                }
+            }
+        }
+        solver.factorize(&values).expect("factorisation");
+        assert!(solver.negative_eigenvalues().is_err());
+        let mut x = vec![1.0; n];
+        assert!(solver.solve_symmetric_part_in_place(&mut x).is_err());
+        check_solve(&mut solver, &k, 52);
+        assert_eq!(
+            solver.lu_fallbacks, 0,
+            "LU from the factorisation, not from a failed GMRES"
+        );
     }
 
     /// No split without groups to share: a separator that leaves one group, no separator, or a
     /// group with most of the flops.
     #[test]
     fn bordered_factorisation_only_where_the_groups_share_the_work() {
-        let (pattern, _, _, sep) = bordered_matrix(&[60, 50], 6, 0.0, 12.0, 31);
+        let (pattern, _, _, sep) = bordered_matrix(&[60, 50], 6, 0.0, 12.0, false, 31);
         assert!(LinearSolver::with_separator(&pattern, &sep)
             .expect("symbolic")
             .is_bordered());
@@ -1203,7 +1351,7 @@ mod tests {
         assert!(!LinearSolver::with_separator(&pattern, &sep[..3])
             .expect("symbolic")
             .is_bordered());
-        let (pattern, _, _, sep) = bordered_matrix(&[400, 20], 6, 0.0, 12.0, 32);
+        let (pattern, _, _, sep) = bordered_matrix(&[400, 20], 6, 0.0, 12.0, false, 32);
         assert!(!LinearSolver::with_separator(&pattern, &sep)
             .expect("symbolic")
             .is_bordered());
@@ -1213,7 +1361,7 @@ mod tests {
     /// one thread or two.
     #[test]
     fn bordered_factorisation_does_not_depend_on_the_threads() {
-        let (pattern, values, _, sep) = bordered_matrix(&[80, 60, 50], 8, 1e-3, 0.0, 41);
+        let (pattern, values, _, sep) = bordered_matrix(&[80, 60, 50], 8, 1e-3, 0.0, true, 41);
         let go = |threads: usize| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

@@ -21,12 +21,18 @@
 //! the way to use the second core. The groups are binned in two (largest first, each to the
 //! lighter bin, by the flops of their own symbolic factor) and each bin is one `M_i`.
 //!
-//! Choice of the `X_i`: `X_1 = C + sigma I`, `X_2 = -sigma I`, with `sigma` the largest diagonal
-//! entry of `C` in magnitude. For a positive definite `S` (every dynamic iteration matrix and
-//! every stable static tangent) `T_1 >= C - B_1^T A_1^-1 B_1 - (sum of the others)`, the Schur
-//! complement, is positive definite and `T_2 <= -sigma I` negative definite: neither trailing
-//! block meets a small pivot, and summing them loses no more than round-off of `sigma`, the size
-//! of `C`'s own entries.
+//! Choice of the `X_i`: `X_1 = C + Sigma`, `X_2 = -Sigma`, with `Sigma` diagonal, `sigma_j =
+//! 2 |c_jj|` (the largest `|c_jj|` where `c_jj = 0`): each separator unknown shifted on its own
+//! scale (rotations beside translations), and `X_1`'s diagonal `c_jj + sigma_j >= |c_jj| > 0`.
+//! For a positive definite `S` (every dynamic iteration matrix and every stable static tangent)
+//! `T_1` is the Schur complement plus `Sigma` plus `B_2^T A_2^-1 B_2`, positive definite, and
+//! `T_2 <= -Sigma` negative definite: no trailing pivot comes near zero. The `T_i` are not read
+//! back from the trailing factors (whose pivots an indefinite `A_i` can make small, and whose
+//! product would then carry their growth) but accumulated from the interior columns, as the
+//! whole matrix's factorisation accumulates them: `T_i = X_i - sum_c d_c l_c l_c^T` over the
+//! interior pivots `d_c` and the separator rows `l_c` of their columns. A bin whose factorisation
+//! fails (an exact zero trailing pivot of an indefinite matrix) leaves the matrix to the whole
+//! LDL^T (`LinearSolver`).
 //!
 //! The inertia (Sylvester's law) is that of the `A_i` (the pivots of the non-trailing columns)
 //! plus that of the Schur complement. The result does not depend on the number of threads: the
@@ -59,6 +65,9 @@ const MAX_BIN_SHARE: f64 = 0.85;
 
 /// Largest separator: its dense Schur complement is factorised serially at every factorisation.
 const MAX_SEPARATOR: usize = 240;
+
+/// Largest ratio of the separator's dense work (`n_s^3`) to the groups' factorisations.
+const MAX_DENSE_SHARE: f64 = 0.05;
 
 fn symbolic_params() -> CholeskySymbolicParams<'static> {
     CholeskySymbolicParams {
@@ -172,6 +181,9 @@ struct Bin {
     src: Vec<[usize; 2]>,
     /// Positions in `sym` of the separator's diagonal entries, in separator order.
     sep_diag: Vec<usize>,
+    /// The separator-separator entries of `triangle` (`X_i`'s lower triangle): position in
+    /// `sym`, row and column in separator order.
+    sep_entries: Vec<(usize, usize, usize)>,
     ldlt: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     sym: Vec<f64>,
@@ -231,11 +243,15 @@ impl Bin {
         let mut row_idx = vec![0; entries.len()];
         let mut src = vec![[0; 2]; entries.len()];
         let mut sep_diag = vec![0; sep.len()];
+        let mut sep_entries = Vec::new();
         for &(r, c, s) in &entries {
             row_idx[next[c]] = r;
             src[next[c]] = s;
-            if r == c && r >= n_int {
-                sep_diag[r - n_int] = next[c];
+            if c >= n_int {
+                sep_entries.push((next[c], r - n_int, c - n_int));
+                if r == c {
+                    sep_diag[r - n_int] = next[c];
+                }
             }
             next[c] += 1;
         }
@@ -268,6 +284,7 @@ impl Bin {
             triangle,
             src,
             sep_diag,
+            sep_entries,
             ldlt,
             work,
             x: vec![0.0; m],
@@ -278,10 +295,10 @@ impl Bin {
         })
     }
 
-    /// Writes `M_i`'s symmetric values from `values` (`K`, in pattern order) with `shift` on the
-    /// separator's diagonal; returns the bit patterns of the largest `|k_ij|` and `|k_ij - k_ji|`
-    /// read (see `LinearSolver::factorize`).
-    fn fill(&mut self, values: &[f64], shift: f64) -> (u64, u64) {
+    /// Writes `M_i`'s symmetric values from `values` (`K`, in pattern order), `shifts` added to
+    /// the separator's diagonal; returns the bit patterns of the largest `|k_ij|` and
+    /// `|k_ij - k_ji|` read (see `LinearSolver::factorize`).
+    fn fill(&mut self, values: &[f64], shifts: &[f64]) -> (u64, u64) {
         let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
         for (s, &[p, t]) in self.sym.iter_mut().zip(&self.src) {
             if p == NONE {
@@ -293,7 +310,7 @@ impl Bin {
             skew_bits = skew_bits.max((v - vt).abs().to_bits());
             *s = 0.5 * (v + vt);
         }
-        for &d in &self.sep_diag {
+        for (&d, shift) in self.sep_diag.iter().zip(shifts) {
             self.sym[d] += shift;
         }
         (max_bits, skew_bits)
@@ -321,48 +338,50 @@ impl Bin {
         let s = supernodal(&self.ldlt);
         let l = SupernodalLdltRef::new(s, &self.l_values);
         let (n_int, ns) = (self.n_int, self.trailing.nrows());
-        // Trailing factor L_t (unit lower, in `lt`) and D_t, read from the supernodes that hold
-        // separator columns (a supernode may straddle the interior and the separator).
-        let mut lt = Mat::<f64>::zeros(ns, ns);
-        let mut dt = vec![0.0; ns];
+        // T = X - sum over the interior columns c of d_c l_c l_c^T (l_c: column c's separator
+        // rows), beginning with X's lower triangle.
+        self.trailing.fill(0.0);
+        for &(pos, r, c) in &self.sep_entries {
+            self.trailing[(r, c)] += self.sym[pos];
+        }
         self.negative = 0;
+        let mut rows: Vec<(usize, usize)> = Vec::with_capacity(ns);
         for k in 0..s.n_supernodes() {
             let sn = l.supernode(k);
             let (start, v) = (sn.start(), sn.val());
             let size = v.ncols();
             for c in 0..size {
-                let j = start + c;
                 let d = v[(c, c)];
                 if !d.is_finite() {
                     return false;
                 }
-                if j < n_int {
+                if start + c < n_int {
                     self.negative += usize::from(d < 0.0);
-                    continue;
                 }
-                dt[j - n_int] = d;
-                lt[(j - n_int, j - n_int)] = 1.0;
-                for r in c + 1..v.nrows() {
-                    let i = if r < size { start + r } else { sn.pattern()[r - size] };
-                    lt[(i - n_int, j - n_int)] = v[(r, c)];
+            }
+            if start >= n_int {
+                continue;
+            }
+            let ki = size.min(n_int - start);
+            // The separator rows of this supernode: (separator index, row in `v`).
+            rows.clear();
+            for r in ki..v.nrows() {
+                let i = if r < size { start + r } else { sn.pattern()[r - size] };
+                if i >= n_int {
+                    rows.push((i - n_int, r));
+                }
+            }
+            for c in 0..ki {
+                let d = v[(c, c)];
+                for (a, &(sa, ra)) in rows.iter().enumerate() {
+                    let la = d * v[(ra, c)];
+                    for &(sb, rb) in &rows[..=a] {
+                        // Rows in increasing order: sa >= sb, the lower triangle.
+                        self.trailing[(sa, sb)] -= la * v[(rb, c)];
+                    }
                 }
             }
         }
-        // T = L_t D_t L_t^T.
-        let mut ld = lt.clone();
-        for (j, &d) in dt.iter().enumerate() {
-            for i in 0..ns {
-                ld[(i, j)] *= d;
-            }
-        }
-        matmul(
-            self.trailing.as_mut(),
-            Accum::Replace,
-            ld.as_ref(),
-            lt.transpose(),
-            1.0,
-            Par::Seq,
-        );
         true
     }
 
@@ -465,6 +484,9 @@ pub(super) struct Bordered {
     schur_work: MemBuffer,
     /// Right-hand side / solution on the separator.
     x_sep: Vec<f64>,
+    /// `sigma_j` and `-sigma_j` of the last factorisation.
+    shifts: Vec<f64>,
+    minus_shifts: Vec<f64>,
 }
 
 impl Bordered {
@@ -507,7 +529,10 @@ impl Bordered {
             load[b] += costs[g];
         }
         let total = load[0] + load[1];
-        if load[0].max(load[1]) > MAX_BIN_SHARE * total {
+        // The separator's dense work (three n_s^3 products and factorisations) must stay small
+        // beside the groups' factorisations (both `flops` up to the same order of constant).
+        let dense = (sep.len() as f64).powi(3);
+        if load[0].max(load[1]) > MAX_BIN_SHARE * total || dense > MAX_DENSE_SHARE * total {
             return Ok(None);
         }
         let mut bins = Vec::with_capacity(2);
@@ -541,8 +566,24 @@ impl Bordered {
             schur: Mat::zeros(ns, ns),
             schur_work,
             x_sep: vec![0.0; ns],
+            shifts: vec![0.0; ns],
+            minus_shifts: vec![0.0; ns],
             sep,
         }))
+    }
+
+    /// Supernodes that hold both interior and separator columns (the substitutions' mixed case).
+    #[cfg(test)]
+    pub(super) fn straddling(&self) -> usize {
+        self.bins
+            .iter()
+            .map(|b| {
+                let s = supernodal(&b.ldlt);
+                (0..s.n_supernodes())
+                    .filter(|&k| s.supernode_begin()[k] < b.n_int && s.supernode_end()[k] > b.n_int)
+                    .count()
+            })
+            .sum()
     }
 
     /// Entries of the factors (sparse and dense).
@@ -559,27 +600,41 @@ impl Bordered {
                     .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
                     .unaligned_bytes_required()
             })
-            .sum()
+            .sum::<usize>()
+            + 8 * 3 * self.sep.len() * self.sep.len()
     }
 
     /// Factorises the symmetric part of `values` (`K` in pattern order). Returns the bit patterns
     /// of the largest `|k_ij|` and `|k_ij - k_ji|`, and the number of negative pivots (`None`
     /// for a zero or non-finite pivot).
     pub(super) fn factorize(&mut self, values: &[f64]) -> (u64, u64, Option<usize>) {
-        let mut sigma = self
+        // A failed factorisation leaves NaN in the Schur complement: no later solve can return a
+        // finite answer from the groups' new factors and an old Schur complement.
+        self.schur.fill(f64::NAN);
+        // sigma_j = 2 |c_jj| (see the module's documentation).
+        let fallback = self
             .sep_diag_k
             .iter()
             .map(|&p| values[p].abs())
             .fold(0.0, f64::max);
-        if !(sigma.is_finite() && sigma > 0.0) {
-            sigma = 1.0;
+        let fallback = if fallback > 0.0 { fallback } else { 1.0 };
+        for ((shift, minus), &p) in self
+            .shifts
+            .iter_mut()
+            .zip(self.minus_shifts.iter_mut())
+            .zip(&self.sep_diag_k)
+        {
+            let c = values[p].abs();
+            *shift = if c > 0.0 { 2.0 * c } else { fallback };
+            *minus = -*shift;
         }
+        let (shifts, minus) = (&self.shifts, &self.minus_shifts);
         let results: Vec<(u64, u64, bool)> = self
             .bins
             .par_iter_mut()
             .enumerate()
             .map(|(b, bin)| {
-                let (m, s) = bin.fill(values, if b == 0 { sigma } else { -sigma });
+                let (m, s) = bin.fill(values, if b == 0 { shifts } else { minus });
                 (m, s, bin.factorize())
             })
             .collect();
