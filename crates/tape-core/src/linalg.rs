@@ -886,6 +886,29 @@ mod tests {
         }
     }
 
+    /// The compressed-column pattern and values of the entries of `dense` marked `filled`.
+    fn compressed(dense: &DMatrix<f64>, filled: &[Vec<bool>]) -> (Pattern, Vec<f64>) {
+        let n = dense.nrows();
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in 0..n {
+                if filled[i][j] {
+                    row_idx.push(i);
+                    values.push(dense[(i, j)]);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        (
+            Pattern {
+                nrows: n,
+                col_ptr,
+                row_idx,
+            },
+            values,
+        )
+    }
+
     /// A random structurally symmetric pattern of size `n` with a full diagonal, and values
     /// `K = S + skew * W`: `S` symmetric with entries in [-1, 1] and diagonal in [-3, 3]
     /// (indefinite), `W` skew-symmetric with entries in [-1, 1].
@@ -907,21 +930,7 @@ mod tests {
                 }
             }
         }
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
-        for j in 0..n {
-            for i in 0..n {
-                if filled[i][j] {
-                    row_idx.push(i);
-                    values.push(dense[(i, j)]);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
-        let pattern = Pattern {
-            nrows: n,
-            col_ptr,
-            row_idx,
-        };
+        let (pattern, values) = compressed(&dense, &filled);
         (pattern, values, dense)
     }
 
@@ -965,6 +974,18 @@ mod tests {
         }
     }
 
+    /// Solves `S x = b` with the LDL^T alone (`S` the symmetric part of `k`), checks the backward
+    /// error at round-off and returns `x`.
+    fn check_symmetric_solve(solver: &mut LinearSolver, k: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+        let s = (k + k.transpose()) * 0.5;
+        let mut x = b.as_slice().to_vec();
+        solver.solve_sym(&mut x);
+        let x = DVector::from_vec(x);
+        let backward = (b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
+        assert!(backward < 1e-14, "backward error of the symmetric solve {backward:e}");
+        x
+    }
+
     fn is_supernodal(solver: &LinearSolver) -> bool {
         matches!(whole(solver).ldlt.raw(), SymbolicCholeskyRaw::Supernodal(_))
     }
@@ -994,13 +1015,7 @@ mod tests {
                 assert_eq!(solver.skew_free, skew == 0.0);
                 assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
                 // The LDL^T alone solves the symmetric part.
-                let s = (&k + k.transpose()) * 0.5;
-                let b = DVector::from_fn(n, |i, _| (i as f64).sin());
-                let mut x = b.as_slice().to_vec();
-                solver.solve_sym(&mut x);
-                let x = DVector::from_vec(x);
-                let backward = (&b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
-                assert!(backward < 1e-14, "backward error of the symmetric solve {backward:e}");
+                check_symmetric_solve(&mut solver, &k, &DVector::from_fn(n, |i, _| (i as f64).sin()));
                 check_solve(&mut solver, &k, seed + 100);
                 check_solve(&mut solver, &k, seed + 200);
                 assert_eq!(solver.lu_fallbacks, 0);
@@ -1050,17 +1065,15 @@ mod tests {
         assert_eq!(solver.lu_fallbacks, 1);
     }
 
-    #[test]
-    fn zero_pivot_of_the_symmetric_part_falls_back_to_lu() {
-        // Degrees of freedom 0 and r (the first neighbour of 0) are coupled by a skew pair only:
-        // S has two zero rows, K is regular.
-        let (pattern, mut values, mut k) = random_matrix(40, 0.0, 7);
+    /// Couples unknown 0 and its first neighbour `r` by a skew pair only (`k_0r = 1`,
+    /// `k_r0 = -1`, their other entries zero): `S` has two zero rows, `K` stays regular.
+    fn couple_by_a_skew_pair_only(pattern: &Pattern, values: &mut [f64], k: &mut DMatrix<f64>) {
         let r = pattern.row_idx[pattern.col_ptr[0]..pattern.col_ptr[1]]
             .iter()
             .copied()
             .find(|&i| i != 0)
             .expect("an off-diagonal entry in column 0");
-        for j in 0..40 {
+        for j in 0..pattern.nrows {
             for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
                 let i = pattern.row_idx[p];
                 if [0, r].contains(&i) || [0, r].contains(&j) {
@@ -1076,6 +1089,14 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn zero_pivot_of_the_symmetric_part_falls_back_to_lu() {
+        // Degrees of freedom 0 and r (the first neighbour of 0) are coupled by a skew pair only:
+        // S has two zero rows, K is regular.
+        let (pattern, mut values, mut k) = random_matrix(40, 0.0, 7);
+        couple_by_a_skew_pair_only(&pattern, &mut values, &mut k);
         let mut solver = LinearSolver::try_new(&pattern).expect("symbolic");
         solver.factorize(&values).expect("factorisation");
         assert!(solver.negative_eigenvalues().is_err());
@@ -1192,27 +1213,9 @@ mod tests {
                 .fold(0.0, f64::max);
             dense[(label[n - 1], label[n - 1])] = -2.0 * largest;
         }
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
-        for j in 0..n {
-            for i in 0..n {
-                if filled[i][j] {
-                    row_idx.push(i);
-                    values.push(dense[(i, j)]);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
         let sep = (first_sep..n).map(|k| label[k]).collect();
-        (
-            Pattern {
-                nrows: n,
-                col_ptr,
-                row_idx,
-            },
-            values,
-            dense,
-            sep,
-        )
+        let (pattern, values) = compressed(&dense, &filled);
+        (pattern, values, dense, sep)
     }
 
     fn bordered(solver: &LinearSolver) -> &Bordered {
@@ -1256,13 +1259,8 @@ mod tests {
             solver.factorize(&values).expect("factorisation");
             assert!(!solver.use_fallback, "the bordered factorisation failed");
             assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
-            let s = (&k + k.transpose()) * 0.5;
             let b = DVector::from_fn(n, |i, _| (0.7 * i as f64).sin());
-            let mut x = b.as_slice().to_vec();
-            solver.solve_sym(&mut x);
-            let x = DVector::from_vec(x);
-            let backward = (&b - &s * &x).norm() / (s.norm() * x.norm() + b.norm());
-            assert!(backward < 1e-14, "backward error of the symmetric solve {backward:e}");
+            let x = check_symmetric_solve(&mut solver, &k, &b);
             check_solve(&mut solver, &k, seed + 100);
             check_solve(&mut solver, &k, seed + 200);
             assert_eq!(solver.lu_fallbacks, 0);
@@ -1303,29 +1301,8 @@ mod tests {
                 assert!(solver.negative_eigenvalues().is_err());
             }
         }
-        // Unknown 0 and its first neighbour r coupled by a skew pair only.
-        let r = pattern.row_idx[pattern.col_ptr[0]..pattern.col_ptr[1]]
-            .iter()
-            .copied()
-            .find(|&i| i != 0)
-            .expect("an off-diagonal entry in column 0");
+        couple_by_a_skew_pair_only(&pattern, &mut values, &mut k);
         let n = pattern.nrows;
-        for j in 0..n {
-            for p in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                let i = pattern.row_idx[p];
-                if [0, r].contains(&i) || [0, r].contains(&j) {
-                    let v = if (i, j) == (0, r) {
-                        1.0
-                    } else if (i, j) == (r, 0) {
-                        -1.0
-                    } else {
-                        0.0
-                    };
-                    values[p] = v;
-                    k[(i, j)] = v;
-                }
-            }
-        }
         solver.factorize(&values).expect("factorisation");
         assert!(solver.negative_eigenvalues().is_err());
         let mut x = vec![1.0; n];

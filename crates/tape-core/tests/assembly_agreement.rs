@@ -11,6 +11,8 @@
 //! the non-symmetric rotation terms) is non-zero. The scatter is serial in element order in both
 //! paths, so the results must be identical, not merely close: no tolerance.
 
+mod common;
+
 use tape_core::assembly::Assembled;
 use tape_core::mesh::generate::{tape_spring, TapeGeometry};
 use tape_core::samples::paper_tape_section;
@@ -35,23 +37,7 @@ fn model() -> Result<Model> {
 }
 
 fn deformed(system: &System) -> State {
-    let mut state = system.initial_state();
-    let dq: Vec<f64> = system
-        .dofs
-        .free_dofs
-        .iter()
-        .enumerate()
-        .map(|(k, (node, dof))| {
-            let s = (*node as f64 * 0.37 + dof.index() as f64 * 1.3 + k as f64 * 1e-3).sin();
-            if dof.is_rotation() {
-                0.3 * s
-            } else {
-                2e-3 * s
-            }
-        })
-        .collect();
-    system.update(&mut state, &dq, 0.7);
-    state
+    common::smoothly_deformed(system, 2e-3, 0.3, 0.7)
 }
 
 fn same(a: &Assembled, b: &Assembled) -> bool {

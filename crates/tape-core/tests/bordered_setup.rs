@@ -114,23 +114,7 @@ fn setup() -> Result<Model> {
 /// five negative eigenvalues (larger fields make the skew part so large that both solvers fall
 /// back to LU).
 fn deformed(system: &System) -> State {
-    let mut state = system.initial_state();
-    let dq: Vec<f64> = system
-        .dofs
-        .free_dofs
-        .iter()
-        .enumerate()
-        .map(|(k, (node, dof))| {
-            let s = (*node as f64 * 0.37 + dof.index() as f64 * 1.3 + k as f64 * 1e-3).sin();
-            if dof.is_rotation() {
-                1e-3 * s
-            } else {
-                2e-6 * s
-            }
-        })
-        .collect();
-    system.update(&mut state, &dq, 1.0);
-    state
+    common::smoothly_deformed(system, 2e-6, 1e-3, 1.0)
 }
 
 /// `|b - K x| / (|K| |x| + |b|)` (Frobenius norm of `K`): round-off for a backward-stable solve.

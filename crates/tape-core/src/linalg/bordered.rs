@@ -139,6 +139,17 @@ fn amd_order(pattern: &Pattern, dofs: &[usize], local: &mut [usize]) -> Result<(
     Ok((order, flops(supernodal(&ldlt))))
 }
 
+/// The row of the factor held in row `r` of a supernode's values: the supernode's own columns
+/// `start..start + size` (its diagonal block), then its `pattern`.
+#[inline]
+fn factor_row(start: usize, size: usize, pattern: &[usize], r: usize) -> usize {
+    if r < size {
+        start + r
+    } else {
+        pattern[r - size]
+    }
+}
+
 /// Connected components of the unknowns that are not in the separator (`is_sep`), each as the
 /// list of its unknowns in increasing order.
 fn components(pattern: &Pattern, is_sep: &[bool]) -> Vec<Vec<usize>> {
@@ -366,7 +377,7 @@ impl Bin {
             // The separator rows of this supernode: (separator index, row in `v`).
             rows.clear();
             for r in ki..v.nrows() {
-                let i = if r < size { start + r } else { sn.pattern()[r - size] };
+                let i = factor_row(start, size, sn.pattern(), r);
                 if i >= n_int {
                     rows.push((i - n_int, r));
                 }
@@ -419,11 +430,7 @@ impl Bin {
             );
             let off = start + ki;
             for (r, t) in self.tmp[..below].iter().enumerate() {
-                let i = if r + ki < size {
-                    start + ki + r
-                } else {
-                    sn.pattern()[r + ki - size]
-                };
+                let i = factor_row(start, size, sn.pattern(), ki + r);
                 tail[i - off] -= t;
             }
             for c in 0..ki {
@@ -450,11 +457,7 @@ impl Bin {
             let (head, tail) = self.x.split_at_mut(start + ki);
             let off = start + ki;
             for (r, t) in self.tmp[..below].iter_mut().enumerate() {
-                let i = if r + ki < size {
-                    start + ki + r
-                } else {
-                    sn.pattern()[r + ki - size]
-                };
+                let i = factor_row(start, size, sn.pattern(), ki + r);
                 *t = tail[i - off];
             }
             let mut top = MatMut::from_column_major_slice_mut(&mut head[start..], ki, 1);

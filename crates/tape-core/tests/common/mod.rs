@@ -10,7 +10,7 @@ use tape_core::assembly::Assembled;
 use tape_core::linalg::LinearSolver;
 use tape_core::material::ShellSection;
 use tape_core::mesh::Mesh;
-use tape_core::{Dof, Model, Result, System};
+use tape_core::{Dof, Model, Result, State, System};
 
 /// Homogeneous isotropic section; the other fields (drilling factor, shear factor) keep their defaults.
 pub fn section(thickness: f64, youngs_modulus: f64, poisson: f64) -> ShellSection {
@@ -430,4 +430,27 @@ pub mod strip {
         }
         (up, peaks)
     }
+}
+
+/// The initial state of `system` moved by a smooth, deterministic field over every free DOF
+/// (`sin(0.37 node + 1.3 dof + 1e-3 k)` times `translation` [m] or `rotation` [rad]) at load
+/// factor `lambda`: a state where every term of the tangent is non-zero.
+pub fn smoothly_deformed(system: &System, translation: f64, rotation: f64, lambda: f64) -> State {
+    let mut state = system.initial_state();
+    let dq: Vec<f64> = system
+        .dofs
+        .free_dofs
+        .iter()
+        .enumerate()
+        .map(|(k, (node, dof))| {
+            let s = (*node as f64 * 0.37 + dof.index() as f64 * 1.3 + k as f64 * 1e-3).sin();
+            if dof.is_rotation() {
+                rotation * s
+            } else {
+                translation * s
+            }
+        })
+        .collect();
+    system.update(&mut state, &dq, lambda);
+    state
 }
