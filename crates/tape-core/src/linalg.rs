@@ -49,7 +49,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 
@@ -258,18 +258,14 @@ impl Whole {
     /// identity ordering faer would count the flops exactly instead of using AMD's estimate, and
     /// sometimes choose the other kind). The symbolic factorisation itself is redone on the
     /// permuted pattern.
-    fn try_new(
-        pattern: &Pattern,
-        symbolic: &SymbolicSparseColMat<usize>,
-        transpose_of: &[usize],
-        threshold: SupernodalThreshold,
-    ) -> Result<Self> {
+    fn try_new(pattern: &Pattern, transpose_of: &[usize], threshold: SupernodalThreshold) -> Result<Self> {
         let n = pattern.nrows;
+        let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
         let params = || CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: threshold,
             ..Default::default()
         };
-        let amd = factorize_symbolic_cholesky(symbolic.as_ref(), Side::Lower, SymmetricOrdering::Amd, params())
+        let amd = factorize_symbolic_cholesky(symbolic, Side::Lower, SymmetricOrdering::Amd, params())
             .map_err(|e| Error::Factorisation(format!("symbolic LDLT: {e:?}")))?;
         let supernodal = matches!(amd.raw(), SymbolicCholeskyRaw::Supernodal(_));
         let (perm_fwd, perm_inv) = match amd.perm() {
@@ -474,7 +470,7 @@ impl LinearSolver {
             .filter(|b| crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes()).is_ok());
         let factor = match bordered {
             Some(b) => SymFactor::Bordered(Box::new(b)),
-            None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &symbolic, &transpose_of, threshold)?)),
+            None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &transpose_of, threshold)?)),
         };
         Ok(Self {
             symbolic,
@@ -763,12 +759,7 @@ impl LinearSolver {
             row_idx: self.symbolic.row_idx().to_vec(),
         };
         let transpose_of = transpose_positions(&pattern)?;
-        Whole::try_new(
-            &pattern,
-            &self.symbolic,
-            &transpose_of,
-            SupernodalThreshold::FORCE_SUPERNODAL,
-        )
+        Whole::try_new(&pattern, &transpose_of, SupernodalThreshold::FORCE_SUPERNODAL)
     }
 
     /// Solves `S x = b` in place with the LDL^T of the symmetric part `S = (K + K^T)/2` only (the

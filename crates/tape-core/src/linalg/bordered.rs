@@ -153,23 +153,22 @@ fn factor_row(start: usize, size: usize, pattern: &[usize], r: usize) -> usize {
 /// Connected components of the unknowns that are not in the separator (`is_sep`), each as the
 /// list of its unknowns in increasing order.
 fn components(pattern: &Pattern, is_sep: &[bool]) -> Vec<Vec<usize>> {
-    let n = pattern.nrows;
-    let mut comp = vec![NONE; n];
+    // The separator counts as seen: the walks never enter it.
+    let mut seen = is_sep.to_vec();
     let mut groups: Vec<Vec<usize>> = Vec::new();
     let mut stack = Vec::new();
-    for seed in 0..n {
-        if is_sep[seed] || comp[seed] != NONE {
+    for seed in 0..pattern.nrows {
+        if seen[seed] {
             continue;
         }
-        let id = groups.len();
         let mut members = Vec::new();
-        comp[seed] = id;
+        seen[seed] = true;
         stack.push(seed);
         while let Some(j) = stack.pop() {
             members.push(j);
             for &i in &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]] {
-                if !is_sep[i] && comp[i] == NONE {
-                    comp[i] = id;
+                if !seen[i] {
+                    seen[i] = true;
                     stack.push(i);
                 }
             }
@@ -306,10 +305,10 @@ impl Bin {
         })
     }
 
-    /// Writes `M_i`'s symmetric values from `values` (`K`, in pattern order), `shifts` added to
-    /// the separator's diagonal; returns the bit patterns of the largest `|k_ij|` and
+    /// Writes `M_i`'s symmetric values from `values` (`K`, in pattern order), `sign * shifts`
+    /// added to the separator's diagonal; returns the bit patterns of the largest `|k_ij|` and
     /// `|k_ij - k_ji|` read (see `LinearSolver::factorize`).
-    fn fill(&mut self, values: &[f64], shifts: &[f64]) -> (u64, u64) {
+    fn fill(&mut self, values: &[f64], shifts: &[f64], sign: f64) -> (u64, u64) {
         let (mut max_bits, mut skew_bits) = (0_u64, 0_u64);
         for (s, &[p, t]) in self.sym.iter_mut().zip(&self.src) {
             if p == NONE {
@@ -322,7 +321,7 @@ impl Bin {
             *s = 0.5 * (v + vt);
         }
         for (&d, shift) in self.sep_diag.iter().zip(shifts) {
-            self.sym[d] += shift;
+            self.sym[d] += sign * shift;
         }
         (max_bits, skew_bits)
     }
@@ -487,9 +486,8 @@ pub(super) struct Bordered {
     schur_work: MemBuffer,
     /// Right-hand side / solution on the separator.
     x_sep: Vec<f64>,
-    /// `sigma_j` and `-sigma_j` of the last factorisation.
+    /// `sigma_j` of the last factorisation.
     shifts: Vec<f64>,
-    minus_shifts: Vec<f64>,
 }
 
 impl Bordered {
@@ -518,9 +516,11 @@ impl Bordered {
             return Ok(None);
         }
         let mut local = vec![NONE; n];
-        let mut costs = Vec::with_capacity(groups.len());
+        let (mut orders, mut costs) = (Vec::with_capacity(groups.len()), Vec::with_capacity(groups.len()));
         for g in &groups {
-            costs.push(amd_order(pattern, g, &mut local)?.1);
+            let (order, cost) = amd_order(pattern, g, &mut local)?;
+            orders.push(order);
+            costs.push(cost);
         }
         // Largest first, each to the lighter bin.
         let mut by_cost: Vec<usize> = (0..groups.len()).collect();
@@ -540,14 +540,13 @@ impl Bordered {
         }
         let mut bins = Vec::with_capacity(2);
         for (b, mut ids) in members.into_iter().enumerate() {
+            // No entry couples two groups: their own AMD orders one after the other order the bin.
             ids.sort_unstable();
-            let mut interior: Vec<usize> = ids
+            let interior: Vec<usize> = ids
                 .iter()
-                .flat_map(|&g| groups[g].iter().copied())
+                .flat_map(|&g| orders[g].iter().copied())
                 .collect();
-            interior.sort_unstable();
-            let (order, _) = amd_order(pattern, &interior, &mut local)?;
-            bins.push(Bin::try_new(pattern, transpose_of, order, &sep, b == 0, &mut local)?);
+            bins.push(Bin::try_new(pattern, transpose_of, interior, &sep, b == 0, &mut local)?);
         }
         let sep_diag_k = sep
             .iter()
@@ -570,7 +569,6 @@ impl Bordered {
             schur_work,
             x_sep: vec![0.0; ns],
             shifts: vec![0.0; ns],
-            minus_shifts: vec![0.0; ns],
             sep,
         }))
     }
@@ -621,23 +619,17 @@ impl Bordered {
             .map(|&p| values[p].abs())
             .fold(0.0, f64::max);
         let fallback = if fallback > 0.0 { fallback } else { 1.0 };
-        for ((shift, minus), &p) in self
-            .shifts
-            .iter_mut()
-            .zip(self.minus_shifts.iter_mut())
-            .zip(&self.sep_diag_k)
-        {
+        for (shift, &p) in self.shifts.iter_mut().zip(&self.sep_diag_k) {
             let c = values[p].abs();
             *shift = if c > 0.0 { 2.0 * c } else { fallback };
-            *minus = -*shift;
         }
-        let (shifts, minus) = (&self.shifts, &self.minus_shifts);
+        let shifts = &self.shifts;
         let results: Vec<(u64, u64, bool)> = self
             .bins
             .par_iter_mut()
             .enumerate()
             .map(|(b, bin)| {
-                let (m, s) = bin.fill(values, if b == 0 { shifts } else { minus });
+                let (m, s) = bin.fill(values, shifts, if b == 0 { 1.0 } else { -1.0 });
                 (m, s, bin.factorize())
             })
             .collect();
