@@ -78,6 +78,8 @@ def test_initial_angles_lie_within_their_senses_half_turn(name, value, interval)
 
 
 def test_the_papers_initial_angles_are_accepted():
+    # The paper's +95.5 and -91.2 deg, and the largest the bound allows.
+    replace(S, initial_angle_opposite_deg=95.5, initial_angle_equal_deg=-91.2).validate()
     replace(S, initial_angle_opposite_deg=179.0, initial_angle_equal_deg=-179.0).validate()
 
 

@@ -13,6 +13,7 @@ import json
 import os
 import sys
 import tempfile
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn
@@ -65,6 +66,12 @@ def warn(message: str) -> None:
     """Print ``warning: message`` on stderr (an option accepted, whose effect is not what its
     name may suggest)."""
     print(f"warning: {message}", file=sys.stderr)
+
+
+def print_warnings(caught: list[warnings.WarningMessage]) -> None:
+    """:func:`warn` each warning recorded by :func:`warnings.catch_warnings`."""
+    for note in caught:
+        warn(str(note.message))
 
 
 def _count(name: str, what: str = "an integer >= 1"):

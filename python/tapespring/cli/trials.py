@@ -29,7 +29,7 @@ from tapespring.protocols.registry import KINDS, MAX_N_PEAKS, check_n_peaks, che
 from tapespring.trials.common import LENGTH
 from tapespring.trials.trial import check_max_gap
 
-from .bend import _checked, _count, _output_folder, refuse
+from .bend import _checked, _count, _output_folder, print_warnings, refuse
 
 __all__ = ["main", "register", "run_analyze"]
 
@@ -290,10 +290,10 @@ def run_analyze(args: argparse.Namespace) -> int:
         except (TrialError, OSError, ValueError) as exc:
             # OSError: a path that cannot be read, or a report folder that cannot be written
             # (--out an existing file, no permission): a message, under either entry point.
-            _print_warnings(caught)
+            print_warnings(caught)
             print(f"error: {exc}", file=sys.stderr)
             return 1
-    _print_warnings(caught)
+    print_warnings(caught)
     notes = [str(w.message) for w in caught]
     if args.json:
         data = summary_dict(analysis) | {"report": str(args.out), "warnings": notes}
@@ -302,11 +302,6 @@ def run_analyze(args: argparse.Namespace) -> int:
         print(format_summary(analysis))
         print(f"report written to {args.out}")
     return 0
-
-
-def _print_warnings(caught: list[warnings.WarningMessage]) -> None:
-    for w in caught:
-        print(f"warning: {w.message}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

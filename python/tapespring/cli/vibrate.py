@@ -8,7 +8,7 @@ import functools
 import warnings
 from typing import TYPE_CHECKING, Any
 
-from .bend import _checked, _field, refuse, warn
+from .bend import _checked, _field, print_warnings, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -243,8 +243,7 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
             study = numerical_damping_study(
                 settings, rho, progress=not (args.no_progress or args.json)
             )
-        for note in caught:
-            warn(str(note.message))
+        print_warnings(caught)
         return study
 
     def plot(result: NumericalDampingStudy, path: str) -> None:

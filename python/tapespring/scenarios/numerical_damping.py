@@ -93,7 +93,7 @@ class NumericalDampingStudy:
             "fit_errors": [r.fit_error for r in self.runs],
             "errors": [r.results.error for r in self.runs],
             "steps": [int(r.results.step_stats[-1].get("steps", 0)) for r in self.runs],
-            "fixed_step_cutbacks": [r.summary()["fixed_step_cutbacks"] for r in self.runs],
+            "fixed_step_cutbacks": [r.fixed_step_cutbacks for r in self.runs],
             "wall_s": self.wall_s,
             "settings": asdict(self.settings),
         }
@@ -171,10 +171,7 @@ def numerical_damping_study(
             done.append(exc.result)
     runs = tuple(done)
     if settings.time_step > 0.0:
-        cut = [
-            (float(r), run.summary()["fixed_step_cutbacks"])
-            for r, run in zip(rho, runs, strict=True)
-        ]
+        cut = [(float(r), run.fixed_step_cutbacks) for r, run in zip(rho, runs, strict=True)]
         cut = [(r, n) for r, n in cut if n]
         if cut:
             which = ", ".join(f"{n} at rho_inf {r:g}" for r, n in cut)
