@@ -42,13 +42,13 @@ from tapespring.scenarios.setup import (
     MIN_ROTATION_DEG,
     PAPER_TAPE,
     check_alpha_deg,
+    check_bounded,
     check_element_count,
     check_number,
     check_poisson,
     check_thickness,
     check_thin,
     check_youngs_modulus,
-    shown,
 )
 
 __all__ = [
@@ -113,13 +113,12 @@ def check_rotation_deg(name: str, value: float, limit: float) -> None:
 def check_locate_tolerance_deg(value: object) -> None:
     """Raise ValueError unless `value` is ``locate_tolerance_deg`` [deg]: a finite number in
     (0, :data:`MAX_LOCATE_TOLERANCE_DEG`]."""
-    number = check_number("locate_tolerance_deg", value, positive=True)
-    if number > MAX_LOCATE_TOLERANCE_DEG:
-        raise ValueError(
-            f"locate_tolerance_deg must lie in (0, {MAX_LOCATE_TOLERANCE_DEG:g}] degrees (got "
-            f"{shown(number)}): the path's steps are refined to a degree where the moment changes "
-            "fast, so a coarser location locates nothing (see MAX_LOCATE_TOLERANCE_DEG)"
-        )
+    check_bounded(
+        "locate_tolerance_deg", value, positive=True, low=0.0, high=MAX_LOCATE_TOLERANCE_DEG,
+        low_open=True, unit="degrees",
+        note="the path's steps are refined to a degree where the moment changes fast, so a "
+        "coarser location locates nothing; see MAX_LOCATE_TOLERANCE_DEG",
+    )  # fmt: skip
 
 
 def check_theta_max_deg(value: object) -> None:

@@ -52,10 +52,10 @@ from tapespring.scenarios.setup import (
     SENSES,
     IdentificationBounds,
     TapeSpring,
+    check_bounded,
     check_density,
     check_number,
     check_thickness,
-    shown,
 )
 
 __all__ = [
@@ -95,12 +95,10 @@ LEVER_ARM_RANGE = (1e-3, 10.0)
 def check_angle_deg(value: object) -> None:
     """Raise ValueError unless `value` is the fold angle at which M* is taken [deg]: a number in
     (0, 180), the magnitude of the angle in either sense."""
-    number = check_number("angle_deg", value, positive=False)
-    if not 0.0 < number < 180.0:
-        raise ValueError(
-            f"angle_deg must lie in (0, 180) degrees, the magnitude of the fold angle "
-            f"(got {number}; the paper's is 90)"
-        )
+    check_bounded(
+        "angle_deg", value, low=0.0, high=180.0, low_open=True, high_open=True, unit="degrees",
+        why="the magnitude of the fold angle", note="the paper's is 90",
+    )  # fmt: skip
 
 
 def check_grid_value(name: str, value: object) -> None:
@@ -117,24 +115,16 @@ def check_grid_value(name: str, value: object) -> None:
         check_thickness(float(value), name)
 
 
-def _check_within(name: str, value: object, bounds: tuple[float, float], unit: str) -> None:
-    number = check_number(name, value, positive=False)
-    low, high = bounds
-    if not low <= number <= high:
-        raise ValueError(
-            f"{name} must lie in [{low:g}, {high:g}] {unit} (got {shown(number)}; see "
-            f"{name.upper()}_RANGE)"
-        )
-
-
 def check_gravity(value: object) -> None:
     """Raise ValueError unless `value` [m/s^2] is a number within :data:`GRAVITY_RANGE`."""
-    _check_within("gravity", value, GRAVITY_RANGE, "m/s^2")
+    low, high = GRAVITY_RANGE
+    check_bounded("gravity", value, low=low, high=high, unit="m/s^2", note="see GRAVITY_RANGE")
 
 
 def check_lever_arm(value: object) -> None:
     """Raise ValueError unless `value` [m] is a number within :data:`LEVER_ARM_RANGE`."""
-    _check_within("lever_arm", value, LEVER_ARM_RANGE, "m")
+    low, high = LEVER_ARM_RANGE
+    check_bounded("lever_arm", value, low=low, high=high, unit="m", note="see LEVER_ARM_RANGE")
 
 
 def _linspace(lo: float, hi: float, n: int) -> tuple[float, ...]:

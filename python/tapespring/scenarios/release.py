@@ -25,12 +25,12 @@ from tapespring.scenarios.bending import (
 from tapespring.scenarios.setup import (
     MAX_DYNAMIC_STEPS,
     MAX_GRAVITY,
+    check_bounded,
     check_density,
     check_eta,
     check_number,
     check_rho_inf,
     check_tolerance,
-    shown,
 )
 
 __all__ = [
@@ -58,36 +58,28 @@ MAX_TIP_MASS = 1e3
 MAX_TIP_INERTIA = 1.0
 
 
-def _check_tip(name: str, value: object, bound: float) -> None:
-    # The free end needs inertia: a massless tip body leaves its rotations without mass.
-    number = check_number(name, value, positive=True)
-    if number > bound:
-        raise ValueError(
-            f"{name} must be at most {bound:g} (got {shown(number)}; see MAX_{name.upper()})"
-        )
-
-
 def check_tip_mass(value: object) -> None:
-    """Raise ValueError unless `value` is a tip mass ``tip_mass`` [kg]: a number > 0 and at most
+    """Raise ValueError unless `value` is a tip mass ``tip_mass`` [kg]: a number > 0 (the free
+    end needs inertia: a massless tip body leaves its rotations without mass) and at most
     :data:`MAX_TIP_MASS`."""
-    _check_tip("tip_mass", value, MAX_TIP_MASS)
+    check_bounded("tip_mass", value, positive=True, high=MAX_TIP_MASS, note="see MAX_TIP_MASS")
 
 
 def check_tip_inertia(value: object) -> None:
     """Raise ValueError unless `value` is a tip inertia ``tip_inertia`` [kg m^2]: a number > 0
     and at most :data:`MAX_TIP_INERTIA`."""
-    _check_tip("tip_inertia", value, MAX_TIP_INERTIA)
+    check_bounded(
+        "tip_inertia", value, positive=True, high=MAX_TIP_INERTIA, note="see MAX_TIP_INERTIA"
+    )
 
 
 def check_gravity(value: object) -> None:
     """Raise ValueError unless `value` is the release's gravity along -z [m/s^2]: a number of
     magnitude at most :data:`tapespring.scenarios.setup.MAX_GRAVITY`, of either sign."""
-    number = check_number("gravity", value, positive=False)
-    if abs(number) > MAX_GRAVITY:
-        raise ValueError(
-            f"gravity must lie in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2 (got "
-            f"{shown(number)}; see setup.MAX_GRAVITY)"
-        )
+    check_bounded(
+        "gravity", value, low=-MAX_GRAVITY, high=MAX_GRAVITY, unit="m/s^2",
+        note="see setup.MAX_GRAVITY",
+    )  # fmt: skip
 
 
 def check_fold_deg(value: object) -> None:
@@ -115,13 +107,12 @@ MAX_DURATION = MAX_DYNAMIC_STEPS * RELEASE_MAX_STEP
 def check_duration(value: object) -> None:
     """Raise ValueError unless `value` is the release's free motion ``duration`` [s]: a number
     > 0 and at most :data:`MAX_DURATION`."""
-    number = check_number("duration", value, positive=True)
-    if number > MAX_DURATION:
-        raise ValueError(
-            f"duration must be at most {MAX_DURATION:g} s (got {shown(number)} s): the release "
-            f"takes steps of at most {RELEASE_MAX_STEP:g} s (RELEASE_MAX_STEP) and the solver at "
-            f"most {MAX_DYNAMIC_STEPS} of them (max_steps), so a longer motion cannot finish"
-        )
+    check_bounded(
+        "duration", value, positive=True, high=MAX_DURATION, unit="s",
+        note=f"the release takes steps of at most {RELEASE_MAX_STEP:g} s (RELEASE_MAX_STEP) and "
+        f"the solver at most {MAX_DYNAMIC_STEPS} of them (max_steps), so a longer motion cannot "
+        "finish",
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -49,6 +49,7 @@ __all__ = [
     "add_flexible_support",
     "build_setup",
     "check_alpha_deg",
+    "check_bounded",
     "check_count",
     "check_density",
     "check_displacement",
@@ -153,29 +154,24 @@ def check_thin(thickness: float, radius: float, prefix: str = "") -> None:
 def check_youngs_modulus(value: object, name: str = "youngs_modulus") -> None:
     """Raise ValueError naming `name` unless `value` is a Young's modulus: a finite number in
     [:data:`MIN_YOUNGS_MODULUS`, :data:`MAX_YOUNGS_MODULUS`] [Pa]."""
-    number = check_number(name, value, positive=True)
-    if number > MAX_YOUNGS_MODULUS:
-        raise ValueError(
-            f"{name} must be at most {MAX_YOUNGS_MODULUS:.0e} Pa, ten times diamond's (got "
-            f"{shown(number)} Pa; see MAX_YOUNGS_MODULUS)"
-        )
-    if number < MIN_YOUNGS_MODULUS:
-        raise ValueError(
-            f"{name} must be at least {MIN_YOUNGS_MODULUS:.0e} Pa, a soft rubber's (got "
-            f"{shown(number)} Pa; see MIN_YOUNGS_MODULUS)"
-        )
+    check_bounded(
+        name, value, positive=True, high=MAX_YOUNGS_MODULUS, unit="Pa",
+        why="ten times diamond's", note="see MAX_YOUNGS_MODULUS",
+    )  # fmt: skip
+    check_bounded(
+        name, value, positive=True, low=MIN_YOUNGS_MODULUS, unit="Pa", why="a soft rubber's",
+        note="see MIN_YOUNGS_MODULUS",
+    )  # fmt: skip
 
 
 def check_thickness(value: object, name: str = "thickness") -> None:
     """Raise ValueError naming `name` unless `value` is a shell's thickness [m]: a finite number
     of at least :data:`MIN_THICKNESS` (its upper bound is the part's: below half a tape's radius,
     :func:`check_thin`; a plate's at most :data:`MAX_LENGTH`)."""
-    number = check_number(name, value, positive=True)
-    if number < MIN_THICKNESS:
-        raise ValueError(
-            f"{name} must be at least {MIN_THICKNESS:g} m, a thin foil's (got {shown(number)} m; "
-            "see MIN_THICKNESS)"
-        )
+    check_bounded(
+        name, value, positive=True, low=MIN_THICKNESS, unit="m", why="a thin foil's",
+        note="see MIN_THICKNESS",
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -587,11 +583,10 @@ class SetupSpec:
                     f"support_marker coordinates must lie within [-{MAX_LENGTH:g}, "
                     f"{MAX_LENGTH:g}] m (got {self.support_marker!r}; see MAX_LENGTH)"
                 )
-        if self.gravity > MAX_GRAVITY:
-            raise ValueError(
-                f"gravity must be at most {MAX_GRAVITY:g} m/s^2 (got {shown(self.gravity)}; see "
-                "setup.MAX_GRAVITY)"
-            )
+        check_bounded(
+            "gravity", self.gravity, positive=True, high=MAX_GRAVITY, unit="m/s^2",
+            note="see setup.MAX_GRAVITY",
+        )  # fmt: skip
         check_eta(self.eta)
         check_poisson(self.plate_poisson, "plate_poisson")
         self._validate_support()
@@ -713,12 +708,7 @@ MIN_DISPLACEMENT = 1e-6
 def check_displacement(name: str, value: object, upper: float) -> None:
     """Raise ValueError naming `name` unless `value` is a displacement a static scenario
     prescribes [m]: a number in [:data:`MIN_DISPLACEMENT`, `upper`)."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float))
-        or not MIN_DISPLACEMENT <= value < upper
-    ):
-        raise ValueError(f"{name} must lie in [{MIN_DISPLACEMENT:g}, {upper:g}) m (got {value!r})")
+    check_bounded(name, value, low=MIN_DISPLACEMENT, high=upper, high_open=True, unit="m")
 
 
 def _shown_count(n: float) -> str:
@@ -775,6 +765,50 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
     if positive and not zero and value <= 0.0:
         raise ValueError(f"{name} must be > 0 (got {value})")
     return value
+
+
+def check_bounded(
+    name: str,
+    value: object,
+    *,
+    positive: bool = False,
+    zero: bool = False,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    unit: str = "",
+    why: str = "",
+    note: str = "",
+) -> float:
+    """Raise ValueError naming `name` unless `value` is a finite number within its bounds.
+
+    The number is checked by :func:`check_number` first (`positive`, `zero`: its sign, refused
+    with its message). Then with both `low` and `high` it must lie between them, each end open
+    if `low_open`, `high_open` ("`name` must lie in (low, high] `unit`"); with one of them, be
+    at most `high` or at least `low`. The message goes on with `why`, what the bound is ("ten
+    times diamond's", after which the refused value repeats the `unit`), and ends with the
+    refused value and `note` (a remark, the constant to see): "(got 2e+13 Pa; see MAX_...)".
+    Bounds are shown to 5 digits (``1e+05``, ``0.001``, ``500``), the value by :func:`shown`.
+
+    Returns `value`, typed as a number (as :func:`check_number` does).
+    """
+    number = check_number(name, value, positive=positive, zero=zero)
+    above = high is not None and (number >= high if high_open else number > high)
+    below = low is not None and (number <= low if low_open else number < low)
+    if not (above or below):
+        return number
+    if high is None:
+        bound = f"be {'above' if low_open else 'at least'} {low:.5g}"
+    elif low is None:
+        bound = f"be {'below' if high_open else 'at most'} {high:.5g}"
+    else:
+        bound = f"lie in {'(' if low_open else '['}{low:.5g}, {high:.5g}{')' if high_open else ']'}"
+    units = f" {unit}" if unit else ""
+    reason = f", {why}" if why else ""
+    got = shown(number) + (units if why else "")
+    remark = f"; {note}" if note else ""
+    raise ValueError(f"{name} must {bound}{units}{reason} (got {got}{remark})")
 
 
 #: Largest length of the set-up's parts and of a tape [m]: 10 m, forty times the set-up's 0.24 m
@@ -843,49 +877,38 @@ MAX_TOLERANCE = 1e-2
 def check_length(name: str, value: object) -> float:
     """Raise ValueError naming `name` unless `value` is a length of the set-up [m]: a finite
     number > 0 and at most :data:`MAX_LENGTH`. Returns it."""
-    number = check_number(name, value, positive=True)
-    if number > MAX_LENGTH:
-        raise ValueError(
-            f"{name} must be at most {MAX_LENGTH:g} m, forty times the set-up's length (got "
-            f"{shown(number)} m; see MAX_LENGTH)"
-        )
-    return number
+    return check_bounded(
+        name, value, positive=True, high=MAX_LENGTH, unit="m",
+        why="forty times the set-up's length", note="see MAX_LENGTH",
+    )  # fmt: skip
 
 
 def check_mass(name: str, value: object) -> None:
     """Raise ValueError naming `name` unless `value` is a mass of a part of the set-up [kg]: a
     finite number > 0 and at most :data:`MAX_MASS`."""
-    number = check_number(name, value, positive=True)
-    if number > MAX_MASS:
-        raise ValueError(
-            f"{name} must be at most {MAX_MASS:g} kg, a tonne (got {shown(number)} kg; see "
-            "MAX_MASS)"
-        )
+    check_bounded(
+        name, value, positive=True, high=MAX_MASS, unit="kg", why="a tonne", note="see MAX_MASS"
+    )
 
 
 def check_density(value: object, name: str = "density", *, zero: bool = False) -> None:
     """Raise ValueError naming `name` unless `value` is a density [kg/m^3]: a finite number > 0
     (>= 0 with `zero`, a massless tape where the settings allow it) and at most
     :data:`MAX_DENSITY`."""
-    number = check_number(name, value, positive=True, zero=zero)
-    if number > MAX_DENSITY:
-        raise ValueError(
-            f"{name} must be at most {MAX_DENSITY:.0e} kg/m^3, four times osmium's (got "
-            f"{shown(number)} kg/m^3; see MAX_DENSITY)"
-        )
+    check_bounded(
+        name, value, positive=True, zero=zero, high=MAX_DENSITY, unit="kg/m^3",
+        why="four times osmium's", note="see MAX_DENSITY",
+    )  # fmt: skip
 
 
 def check_eta(value: object, name: str = "eta") -> None:
     """Raise ValueError naming `name` unless `value` is a Kelvin-Voigt viscosity eta [s]: a
     finite number in [0, :data:`MAX_ETA`] (0: no viscous damping)."""
-    number = check_number(name, value, positive=False)
-    if number < 0.0:
-        raise ValueError(f"{name} must be >= 0 s (got {number})")
-    if number > MAX_ETA:
-        raise ValueError(
-            f"{name} must be at most {MAX_ETA:g} s, a relaxation time longer than the motions "
-            f"simulated (got {shown(number)} s; the paper's tapes: 1.73e-4; see MAX_ETA)"
-        )
+    check_bounded(
+        name, value, positive=True, zero=True, high=MAX_ETA, unit="s",
+        why="a relaxation time longer than the motions simulated",
+        note="the paper's tapes: 1.73e-4; see MAX_ETA",
+    )  # fmt: skip
 
 
 def check_initial_angle(name: str, value: object, sense: str) -> None:
@@ -920,37 +943,31 @@ def check_quasi_static_rate(name: str, value: object) -> None:
     """Raise ValueError naming `name` unless `value` is the speed of a quasi-static drive of the
     set-up [m/s] (``fold_rate``, ``pull_rate``): a finite number in
     (0, :data:`MAX_QUASI_STATIC_RATE`]."""
-    number = check_number(name, value, positive=True)
-    if number > MAX_QUASI_STATIC_RATE:
-        raise ValueError(
-            f"{name} must lie in (0, {MAX_QUASI_STATIC_RATE:g}] m/s, a quasi-static drive (got "
-            f"{shown(number)} m/s; the paper folds at under 0.002 and pulls at 0.001; see "
-            "MAX_QUASI_STATIC_RATE)"
-        )
+    check_bounded(
+        name, value, positive=True, low=0.0, high=MAX_QUASI_STATIC_RATE, low_open=True,
+        unit="m/s", why="a quasi-static drive",
+        note="the paper folds at under 0.002 and pulls at 0.001; see MAX_QUASI_STATIC_RATE",
+    )  # fmt: skip
 
 
 def check_hold(value: object, name: str = "hold") -> None:
     """Raise ValueError naming `name` unless `value` is the hold of the folded set-up before the
     release [s]: a finite number in [0, :data:`MAX_HOLD`] (0: released at once)."""
-    number = check_number(name, value, positive=True, zero=True)
-    if number > MAX_HOLD:
-        raise ValueError(
-            f"{name} must lie in [0, {MAX_HOLD:g}] s (got {shown(number)} s; the paper holds 5 s, "
-            "long enough for the fold's vibration to die out; see MAX_HOLD)"
-        )
+    check_bounded(
+        name, value, positive=True, zero=True, low=0.0, high=MAX_HOLD, unit="s",
+        note="the paper holds 5 s, long enough for the fold's vibration to die out; see MAX_HOLD",
+    )  # fmt: skip
 
 
 def check_tolerance(value: object, name: str = "tolerance") -> None:
     """Raise ValueError naming `name` unless `value` is the local error tolerance of a dynamic
     step's time steps [m]: a finite number in [0, :data:`MAX_TOLERANCE`] (0: the solver's
     default)."""
-    number = check_number(name, value, positive=True, zero=True)
-    if number > MAX_TOLERANCE:
-        raise ValueError(
-            f"{name} must lie in [0, {MAX_TOLERANCE:g}] m (got {shown(number)} m): from a "
-            "centimetre per step up the error estimate rejects no step (0: the solver's "
-            "default; see MAX_TOLERANCE)"
-        )
+    check_bounded(
+        name, value, positive=True, zero=True, low=0.0, high=MAX_TOLERANCE, unit="m",
+        note="from a centimetre per step up the error estimate rejects no step; 0: the solver's "
+        "default; see MAX_TOLERANCE",
+    )  # fmt: skip
 
 
 def check_min_samples(duration: tuple[str, float], *, rate: float, rate_name: str) -> None:
@@ -978,9 +995,7 @@ def check_poisson(value: object, name: str = "poisson") -> None:
 
 def check_rho_inf(value: float) -> None:
     """Raise ValueError unless `value` is a spectral radius at infinity, a number in [0, 1]."""
-    check_number("rho_inf", value, positive=False)
-    if not 0.0 <= value <= 1.0:
-        raise ValueError(f"rho_inf must lie in [0, 1] (got {value})")
+    check_bounded("rho_inf", value, low=0.0, high=1.0)
 
 
 def check_count(name: str, value: object, *, minimum: int) -> None:
@@ -1497,12 +1512,10 @@ def sample_rows(time_s: NDArray[np.float64], sample_rate: float) -> NDArray[np.i
 def check_sample_rate(value: object, name: str = "sample_rate") -> None:
     """Raise ValueError naming `name` unless `value` is a sample rate: a finite number > 0 and at
     most :data:`MAX_SAMPLE_RATE` [Hz]."""
-    number = check_number(name, value, positive=True)
-    if number > MAX_SAMPLE_RATE:
-        raise ValueError(
-            f"{name} must be at most {MAX_SAMPLE_RATE:.0e} Hz, an output every microsecond "
-            f"(got {shown(number)} Hz; see MAX_SAMPLE_RATE)"
-        )
+    check_bounded(
+        name, value, positive=True, high=MAX_SAMPLE_RATE, unit="Hz",
+        why="an output every microsecond", note="see MAX_SAMPLE_RATE",
+    )  # fmt: skip
 
 
 def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name: str) -> None:
