@@ -33,7 +33,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         The ``release`` parser.
     """
     from tapespring.scenarios.release import (
-        MAX_DURATION,
         MAX_TIP_INERTIA,
         MAX_TIP_MASS,
         ReleaseSetup,
@@ -44,6 +43,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_tip_mass,
     )
     from tapespring.scenarios.setup import (
+        MAX_DURATION,
         MAX_ETA,
         MAX_GRAVITY,
         MAX_TOLERANCE,

@@ -23,8 +23,10 @@ from tapespring.scenarios.bending import (
     check_rotation_deg,
 )
 from tapespring.scenarios.setup import (
+    MAX_DURATION,
     MAX_DYNAMIC_STEPS,
     MAX_GRAVITY,
+    RELEASE_MAX_STEP,
     check_bounded,
     check_density,
     check_eta,
@@ -89,24 +91,16 @@ def check_fold_deg(value: object) -> None:
     check_rotation_deg("fold_deg", number, 180.0)
 
 
-#: First and largest time steps of the release [s], fixed rather than the solver's defaults (a
-#: thousandth and a twentieth of the duration): the step sequence, and with it the numerical
-#: dissipation of the snap (large without damping), is then the same whatever the duration, so
-#: a shorter run is the beginning of a longer one. The steps the error estimate chooses stay
-#: far below the largest (1e-5 to 1e-3 s).
+#: First time step of the release [s], fixed rather than the solver's default (a thousandth of
+#: the duration) for the reason the largest is
+#: (:data:`~tapespring.scenarios.setup.RELEASE_MAX_STEP`): the same step sequence whatever the
+#: duration.
 RELEASE_FIRST_STEP = 1e-5
-RELEASE_MAX_STEP = 5e-3
-
-#: Longest free motion of a release [s]: the solver's step limit (``max_steps``, its default
-#: :data:`tapespring.scenarios.setup.MAX_DYNAMIC_STEPS`) times the largest step
-#: (:data:`RELEASE_MAX_STEP`), 500 s. A longer motion needs more steps than the solver takes, so
-#: it cannot finish: 1e3 s ran for minutes into the step limit, 1e10 s into a native error.
-MAX_DURATION = MAX_DYNAMIC_STEPS * RELEASE_MAX_STEP
 
 
 def check_duration(value: object) -> None:
     """Raise ValueError unless `value` is the release's free motion ``duration`` [s]: a number
-    > 0 and at most :data:`MAX_DURATION`."""
+    > 0 and at most :data:`~tapespring.scenarios.setup.MAX_DURATION`."""
     check_bounded(
         "duration", value, positive=True, high=MAX_DURATION, unit="s",
         note=f"the release takes steps of at most {RELEASE_MAX_STEP:g} s (RELEASE_MAX_STEP) and "
@@ -135,8 +129,9 @@ class ReleaseSetup:
         Its moment of inertia about each axis through the end section's centroid [kg m^2], > 0
         and at most :data:`MAX_TIP_INERTIA`.
     duration : float
-        Free motion after the release [s], at most :data:`MAX_DURATION` (500 s: the solver's
-        step limit times the largest step).
+        Free motion after the release [s], at most
+        :data:`~tapespring.scenarios.setup.MAX_DURATION` (500 s: the solver's step limit times
+        the largest step).
     eta : float
         Kelvin-Voigt viscosity of the tape [s], in [0, 1]
         (:data:`~tapespring.scenarios.setup.MAX_ETA`).

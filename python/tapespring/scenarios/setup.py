@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 __all__ = [
     "CONFIGURATIONS",
     "MAX_DENSITY",
+    "MAX_DURATION",
     "MAX_DYNAMIC_STEPS",
     "MAX_ELEMENTS",
     "MAX_ETA",
@@ -38,6 +39,7 @@ __all__ = [
     "PAPER_MODEL",
     "PAPER_SETUP",
     "PAPER_TAPE",
+    "RELEASE_MAX_STEP",
     "SENSES",
     "SUPPORTS",
     "FlexibleSupport",
@@ -857,13 +859,6 @@ MIN_SAMPLE_INTERVALS = 2
 #: 18 %), and a rate of metres a second is a typing error.
 MAX_QUASI_STATIC_RATE = 1e-2
 
-#: Longest hold of the folded set-up before the release [s] (``SetupSpec.hold``): 500 s, a
-#: hundred times the paper's 5 s. The hold lets the fold's vibration die out: at the set-up's
-#: damping ratio (0.5 % at a period of 0.11 s, Table 8) it decays by a factor e in 3.5 s, so
-#: 500 s is 140 times that, and a longer hold is a typing error. Equal (by test) to the release's
-#: ``MAX_DURATION``, the cap on its free motion (the solver's 100 000 steps of at most 5 ms).
-MAX_HOLD = 500.0
-
 #: Largest local error tolerance of a dynamic step's time steps [m] (``tolerance`` of the
 #: deployment, the vibration test and the release): a centimetre per step, a tenth of the
 #: paper's tape and a hundred times the scenarios' default 1e-4 m. From there up the error
@@ -1496,6 +1491,28 @@ MAX_SAMPLE_RATE = 1e6
 #: (tape-core ``DynamicParams``), which it checks against ``duration / output_interval`` when the
 #: step starts (after the static steps before it). Every sample is a step.
 MAX_DYNAMIC_STEPS = 100_000
+
+#: Largest time step of the release's free motion [s] (``release.release_steps``; its first step
+#: is ``release.RELEASE_FIRST_STEP``), fixed rather than the solver's default (a twentieth of the
+#: duration): the step sequence, and with it the numerical dissipation of the snap (large
+#: without damping), is then the same whatever the duration, so a shorter run is the beginning
+#: of a longer one. The steps the error estimate chooses stay far below it (1e-5 to 1e-3 s).
+#: Here, beside :data:`MAX_DYNAMIC_STEPS`, because with it it bounds the free motions
+#: (:data:`MAX_DURATION`).
+RELEASE_MAX_STEP = 5e-3
+
+#: Longest free motion of a release [s] (``release.ReleaseSetup.duration``): the solver's step
+#: limit (``max_steps``, its default :data:`MAX_DYNAMIC_STEPS`) times the largest step
+#: (:data:`RELEASE_MAX_STEP`), 500 s. A longer motion needs more steps than the solver takes, so
+#: it cannot finish: 1e3 s ran for minutes into the step limit, 1e10 s into a native error.
+MAX_DURATION = MAX_DYNAMIC_STEPS * RELEASE_MAX_STEP
+
+#: Longest hold of the folded set-up before the release [s] (``SetupSpec.hold``): the release's
+#: cap on its free motion, :data:`MAX_DURATION` (500 s), a hundred times the paper's 5 s. The
+#: hold lets the fold's vibration die out: at the set-up's damping ratio (0.5 % at a period of
+#: 0.11 s, Table 8) it decays by a factor e in 3.5 s, so 500 s is 140 times that, and a longer
+#: hold is a typing error.
+MAX_HOLD = MAX_DURATION
 
 
 def sample_rows(time_s: NDArray[np.float64], sample_rate: float) -> NDArray[np.int64]:
