@@ -157,6 +157,12 @@ def test_a_value_just_out_of_range_is_refused_with_its_exact_value(argv, got, ca
             ["equilibrium", "--thickness", "0"],
             dataclasses.replace(PAPER_SETUP, tape=dataclasses.replace(PAPER_TAPE, thickness=0.0)),
         ),
+        (
+            ["pull", "--youngs-modulus", "1e300"],
+            dataclasses.replace(
+                PAPER_SETUP, tape=dataclasses.replace(PAPER_TAPE, youngs_modulus=1e300)
+            ),
+        ),
         # The spectral radius, a plain float checked only by validate() (rho_inf = 2 ran to the
         # settings' ValueError after the parser had accepted it).
         (["release", "--rho-inf", "2"], ReleaseSetup(rho_inf=2.0)),

@@ -175,15 +175,10 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     Shared by the commands that build a tape spring (``bend``, ``release``); read back by
     `tape_fields`.
     """
-    from tapespring.scenarios.setup import (
-        MAX_YOUNGS_MODULUS,
-        MIN_THICKNESS,
-        MIN_YOUNGS_MODULUS,
-        check_alpha_deg,
-        check_poisson,
-        check_thickness,
-        check_youngs_modulus,
-    )
+    from tapespring.scenarios.setup import check_alpha_deg, check_poisson
+
+    # scenario_options imports this module: its options are imported when the parser is built.
+    from .scenario_options import add_thickness_option, add_youngs_modulus_option
 
     p.add_argument("--length", type=_field("length"), default=d.length, help="L [m]")
     p.add_argument("--radius", type=_field("radius"), default=d.radius, help="R [m]")
@@ -193,19 +188,8 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
         default=d.alpha_deg,
         help="subtended angle of the cross-section [deg], in (0, 360)",
     )
-    p.add_argument(
-        "--thickness",
-        type=_checked("thickness", check_thickness),
-        default=d.thickness,
-        help=f"t [m], at least {MIN_THICKNESS:g}",
-    )
-    p.add_argument(
-        "--youngs-modulus",
-        "-E",
-        type=_checked("Young's modulus", check_youngs_modulus),
-        default=d.youngs_modulus,
-        help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e}",
-    )
+    add_thickness_option(p, d.thickness)
+    add_youngs_modulus_option(p, d.youngs_modulus, short=True)
     p.add_argument(
         "--poisson",
         type=_checked("poisson", check_poisson),

@@ -6,7 +6,6 @@ import argparse
 from typing import TYPE_CHECKING
 
 from .bend import (
-    _checked,
     _count,
     _field,
     _image_file,
@@ -16,8 +15,10 @@ from .bend import (
 )
 from .scenario_options import (
     add_output_options,
+    add_rho_inf_option,
     add_sample_rate_option,
     add_spec_options,
+    add_tolerance_option,
     analyze_experiment,
     finish,
     spec_from_args,
@@ -45,12 +46,7 @@ FLEXIBLE_SAMPLE_RATE = 2000.0
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
     from tapespring.scenarios.deployment import DeploymentSettings
-    from tapespring.scenarios.setup import (
-        MAX_TOLERANCE,
-        SUPPORTS,
-        check_rho_inf,
-        check_tolerance,
-    )
+    from tapespring.scenarios.setup import SUPPORTS
 
     d = DeploymentSettings()
     p = sub.add_parser(
@@ -87,19 +83,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=DEFAULT_DURATION,
         help=f"motion after the release [s] (default {DEFAULT_DURATION}; paper: 10)",
     )
-    p.add_argument(
-        "--rho-inf",
-        type=_checked("rho_inf", check_rho_inf),
-        default=d.rho_inf,
-        help="spectral radius, in [0, 1]",
-    )
-    p.add_argument(
-        "--tolerance",
-        type=_checked("tolerance", check_tolerance),
-        default=d.tolerance,
-        help="local error tolerance of the time steps [m], in [0, "
-        f"{MAX_TOLERANCE:g}] (0: the solver's default)",
-    )
+    add_rho_inf_option(p, d.rho_inf)
+    add_tolerance_option(p, d.tolerance)
     p.add_argument(
         "--experiment",
         type=_input_file,

@@ -15,6 +15,7 @@ import sys
 from typing import Any
 
 from .bend import _checked, _image_file, _output_file, add_tape_options, tape_fields
+from .scenario_options import add_eta_option, add_rho_inf_option, add_tolerance_option
 
 __all__ = ["register", "run"]
 
@@ -42,15 +43,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_tip_inertia,
         check_tip_mass,
     )
-    from tapespring.scenarios.setup import (
-        MAX_DURATION,
-        MAX_ETA,
-        MAX_GRAVITY,
-        MAX_TOLERANCE,
-        check_eta,
-        check_rho_inf,
-        check_tolerance,
-    )
+    from tapespring.scenarios.setup import MAX_DURATION, MAX_GRAVITY
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -91,18 +84,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help=f"free motion after the release [s], at most {MAX_DURATION:g} (the solver's step "
         "limit times the largest step)",
     )
-    p.add_argument(
-        "--eta",
-        type=_checked("eta", check_eta),
-        default=d.eta,
-        help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
-    )
-    p.add_argument(
-        "--rho-inf",
-        type=_checked("rho_inf", check_rho_inf),
-        default=d.rho_inf,
-        help="spectral radius at infinity, in [0, 1]",
-    )
+    add_eta_option(p, d.eta)
+    add_rho_inf_option(p, d.rho_inf)
     p.add_argument(
         "--gravity",
         type=_checked("gravity", check_gravity),
@@ -114,13 +97,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         action="store_true",
         help="after the release, keep the free end in the x-z plane (held in y, about x and z)",
     )
-    p.add_argument(
-        "--tolerance",
-        type=_checked("tolerance", check_tolerance),
-        default=d.tolerance,
-        help="local error tolerance of the time steps [m], in [0, "
-        f"{MAX_TOLERANCE:g}] (0: the solver's default)",
-    )
+    add_tolerance_option(p, d.tolerance)
     add_tape_options(p, d.tape)
     p.add_argument(
         "--csv",

@@ -1,5 +1,7 @@
-"""Options shared by the set-up's commands (``deploy``, ``pull``, ``vibrate``): the set-up spec's
-main values and the outputs, and the code that writes a scenario's outputs."""
+"""Options shared by the scenarios' commands: the set-up spec's main values and the outputs of
+the set-up's commands (``deploy``, ``pull``, ``vibrate``, ...), one function per option that
+several commands take (``--thickness``, ``--eta``, ``--tolerance``, ...), and the code that
+writes a scenario's outputs."""
 
 from __future__ import annotations
 
@@ -17,9 +19,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "add_comparison_options",
+    "add_eta_option",
     "add_output_options",
+    "add_rho_inf_option",
     "add_sample_rate_option",
     "add_spec_options",
+    "add_thickness_option",
+    "add_tolerance_option",
+    "add_youngs_modulus_option",
     "analyze_experiment",
     "finish",
     "spec_from_args",
@@ -41,18 +48,7 @@ def add_spec_options(
     """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
     viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
     for a viscosity to act on: it leaves ``--eta`` out."""
-    from functools import partial
-
-    from tapespring.scenarios.setup import (
-        MAX_ETA,
-        MAX_YOUNGS_MODULUS,
-        MIN_THICKNESS,
-        MIN_YOUNGS_MODULUS,
-        PAPER_SETUP,
-        check_eta,
-        check_thickness,
-        check_youngs_modulus,
-    )
+    from tapespring.scenarios.setup import PAPER_SETUP
 
     s = PAPER_SETUP
     g = p.add_argument_group("set-up (paper's values and this project's choices by default)")
@@ -68,25 +64,100 @@ def add_spec_options(
         default=mesh_plates,
         help=f"element size of the rod and appendix [m] (paper: 3e-3; default {mesh_plates:g})",
     )
-    g.add_argument(
+    add_thickness_option(g, s.tape.thickness, name="tape.thickness")
+    add_youngs_modulus_option(g, s.tape.youngs_modulus, name="tape.youngs_modulus")
+    if eta:
+        add_eta_option(g, s.eta)
+
+
+# Each option below is checked by the settings' own check of its field, named `name` where the
+# field is a part's (``tape.thickness``), so that the parser refuses a value with the message
+# the settings' ``validate`` gives.
+
+
+def add_thickness_option(
+    p: argparse._ActionsContainer, default: float, *, name: str = "thickness"
+) -> None:
+    """Add ``--thickness`` t [m], the settings' field `name`, to `p` (a parser or a group)."""
+    from functools import partial
+
+    from tapespring.scenarios.setup import MIN_THICKNESS, check_thickness
+
+    p.add_argument(
         "--thickness",
-        type=_checked("tape.thickness", partial(check_thickness, name="tape.thickness")),
-        default=s.tape.thickness,
+        type=_checked(name, partial(check_thickness, name=name)),
+        default=default,
         help=f"t [m], at least {MIN_THICKNESS:g}",
     )
-    g.add_argument(
+
+
+def add_youngs_modulus_option(
+    p: argparse._ActionsContainer,
+    default: float,
+    *,
+    name: str = "youngs_modulus",
+    short: bool = False,
+) -> None:
+    """Add ``--youngs-modulus`` E [Pa] (``-E`` too with `short`), the settings' field `name`."""
+    from functools import partial
+
+    from tapespring.scenarios.setup import (
+        MAX_YOUNGS_MODULUS,
+        MIN_YOUNGS_MODULUS,
+        check_youngs_modulus,
+    )
+
+    p.add_argument(
         "--youngs-modulus",
-        type=_checked("Young's modulus", check_youngs_modulus),
-        default=s.tape.youngs_modulus,
+        *(("-E",) if short else ()),
+        type=_checked("Young's modulus", partial(check_youngs_modulus, name=name)),
+        default=default,
         help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e}",
     )
-    if eta:
-        g.add_argument(
-            "--eta",
-            type=_checked("eta", check_eta),
-            default=s.eta,
-            help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
-        )
+
+
+def add_eta_option(p: argparse._ActionsContainer, default: float) -> None:
+    """Add ``--eta``, the tape's Kelvin-Voigt viscosity [s]."""
+    from tapespring.scenarios.setup import MAX_ETA, check_eta
+
+    p.add_argument(
+        "--eta",
+        type=_checked("eta", check_eta),
+        default=default,
+        help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
+    )
+
+
+def add_rho_inf_option(
+    p: argparse._ActionsContainer, default: float, *, unset: bool = False, caveat: str = ""
+) -> None:
+    """Add ``--rho-inf``, generalised-alpha's spectral radius at infinity; its help names the
+    settings' `default`, and ends with `caveat` (where the option does not apply). With
+    `unset`, the option is None when not given (a command that passes on the options given)."""
+    from tapespring.scenarios.setup import check_rho_inf
+
+    p.add_argument(
+        "--rho-inf",
+        type=_checked("rho_inf", check_rho_inf),
+        default=None if unset else default,
+        help=f"spectral radius at infinity, in [0, 1] (default {default:g}{caveat})",
+    )
+
+
+def add_tolerance_option(
+    p: argparse._ActionsContainer, default: float, *, unset: bool = False, caveat: str = ""
+) -> None:
+    """Add ``--tolerance``, the local error tolerance of the adaptive time steps [m]; `default`,
+    `unset` and `caveat` as in :func:`add_rho_inf_option`."""
+    from tapespring.scenarios.setup import MAX_TOLERANCE, check_tolerance
+
+    p.add_argument(
+        "--tolerance",
+        type=_checked("tolerance", check_tolerance),
+        default=None if unset else default,
+        help=f"local error tolerance of the adaptive time steps [m], in [0, {MAX_TOLERANCE:g}] "
+        f"(default {default:g}; 0: the solver's default{caveat})",
+    )
 
 
 def spec_from_args(args: argparse.Namespace) -> Any:

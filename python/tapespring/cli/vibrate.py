@@ -12,8 +12,10 @@ from .bend import _checked, _field, print_warnings, refuse
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
+    add_rho_inf_option,
     add_sample_rate_option,
     add_spec_options,
+    add_tolerance_option,
     analyze_experiment,
     finish,
     spec_from_args,
@@ -61,12 +63,7 @@ VTU_RATE = 50.0
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``vibrate`` command to a CLI (`sub` from ``add_subparsers``)."""
-    from tapespring.scenarios.setup import (
-        MAX_SAMPLE_RATE,
-        MAX_TOLERANCE,
-        check_rho_inf,
-        check_tolerance,
-    )
+    from tapespring.scenarios.setup import MAX_SAMPLE_RATE, check_rho_inf
     from tapespring.scenarios.vibration import (
         MAX_INITIAL_DISPLACEMENT,
         VibrationSettings,
@@ -97,12 +94,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="push before the release [m] (paper: about 8e-3), below "
         f"{MAX_INITIAL_DISPLACEMENT:g} (small vibrations)",
     )
-    p.add_argument(
-        "--rho-inf",
-        type=_checked("rho_inf", check_rho_inf),
-        default=None,
-        help=f"spectral radius, in [0, 1] (default {d.rho_inf:g}; not with --rho-inf-study)",
-    )
+    add_rho_inf_option(p, d.rho_inf, unset=True, caveat="; not with --rho-inf-study")
     p.add_argument(
         "--window-mm",
         type=float,
@@ -110,13 +102,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=[w * 1e3 for w in d.window],
         help="range of |peak| fitted [mm] (paper: 0.4 4)",
     )
-    p.add_argument(
-        "--tolerance",
-        type=_checked("tolerance", check_tolerance),
-        default=None,
-        help=f"local error tolerance of the adaptive time steps [m], in [0, {MAX_TOLERANCE:g}] "
-        f"(default {d.tolerance:g}; 0: the solver's default; not with a fixed --time-step)",
-    )
+    add_tolerance_option(p, d.tolerance, unset=True, caveat="; not with a fixed --time-step")
     add_sample_rate_option(
         p,
         recorded="decay",
