@@ -140,6 +140,20 @@ def test_a_run_stopped_by_an_exception_keeps_what_it_computed(exception):
     assert not hasattr(caught.value, "_tapespring_partial")
 
 
+def test_a_callable_progress_is_called_whatever_its_truth_value():
+    class Ticks(list):
+        """A callable whose truth value is false until it is first called (an empty list)."""
+
+        def __call__(self, step, name, t):
+            self.append(t)
+
+    model = plate()
+    model.add_load(CORNER, "uz", 1.0)
+    ticks = Ticks()
+    run(model, [Step.static("s", increments=2)], progress=ticks)
+    assert len(ticks) == 2
+
+
 def test_progress_that_is_neither_a_bool_nor_callable_is_a_type_error():
     with pytest.raises(TypeError, match=r"progress must be True, False, None or a callable"):
         run(plate(), [Step.modal("m", modes=1)], progress="yes")

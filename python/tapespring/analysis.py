@@ -415,6 +415,8 @@ def run(
             f"{type(outputs).__name__}"
         )
     out = outputs.to_dict()
+    # Checked here although the core checks its callback too: its message would name only
+    # callables and None, not the True and False that this function takes.
     if not (progress is None or isinstance(progress, bool) or callable(progress)):
         raise TypeError(
             "progress must be True, False, None or a callable (step, name, t), not "
@@ -432,7 +434,10 @@ def run(
 
                 raw = _core.run(model, raw_steps, outputs=out, progress=tick)
         else:
-            raw = _core.run(model, raw_steps, outputs=out, progress=progress or None)
+            # False is no callback; a callable is passed on even if its truth value is false.
+            raw = _core.run(
+                model, raw_steps, outputs=out, progress=None if progress is False else progress
+            )
     except BaseException as exc:
         # Ctrl-C or the callback's exception: what was computed until then goes with it.
         partial = getattr(exc, "_tapespring_partial", None)
