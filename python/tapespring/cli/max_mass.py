@@ -49,6 +49,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         PAPER_BOUNDS,
         PAPER_SETUP,
         PAPER_TAPE,
+        check_thickness,
         check_youngs_modulus,
     )
 
@@ -76,7 +77,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--thickness-range",
         nargs=2,
-        type=_checked("thickness", partial(check_grid_value, "thicknesses")),
+        type=_checked("thickness", partial(check_grid_value, "thicknesses", check=check_thickness)),
         metavar=("MIN", "MAX"),
         default=None,
         help=f"t range [m] (default Table 4: {b.thickness_min:g} {b.thickness_max:g}); with "

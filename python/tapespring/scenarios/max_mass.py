@@ -101,18 +101,23 @@ def check_angle_deg(value: object) -> None:
     )  # fmt: skip
 
 
-def check_grid_value(name: str, value: object) -> None:
-    """Raise ValueError unless `value` is one of the grid values `name` (``"thicknesses"`` [m] or
-    ``"youngs_moduli"`` [Pa]): a finite number > 0; a thickness at least 1 um
-    (:func:`~tapespring.scenarios.setup.check_thickness`). (A modulus's bounds, 1 MPa to
-    1e13 Pa, are those of each run's :meth:`BendingSetup.validate`, and of the command line's
-    ``--modulus-range``.)"""
+def check_grid_value(
+    name: str, value: object, check: Callable[[float, str], object] | None = None
+) -> None:
+    """Raise ValueError unless `value` is one of the grid values `name`: a finite number > 0,
+    which `check` (``check(value, name)``, raising ValueError), if given, accepts too.
+
+    :meth:`MaxMassSettings.validate` checks each thickness with
+    :func:`~tapespring.scenarios.setup.check_thickness` (at least 1 um), each modulus with no
+    more: its bounds, 1 MPa to 1e13 Pa, are those of each run's :meth:`BendingSetup.validate`
+    (and of the command line's ``--modulus-range``).
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
         raise ValueError(f"{name} must hold numbers (got {value!r})")
     if not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} must be finite and > 0 (got {value})")
-    if name == "thicknesses":
-        check_thickness(float(value), name)
+    if check is not None:
+        check(float(value), name)
 
 
 def check_gravity(value: object) -> None:
@@ -248,14 +253,15 @@ class MaxMassSettings:
         ValueError
             Naming the bad value.
         """
-        for name in ("thicknesses", "youngs_moduli"):
+        grids = (("thicknesses", check_thickness), ("youngs_moduli", None))
+        for name, check in grids:
             values = getattr(self, name)
             if isinstance(values, (str, bytes)) or not isinstance(values, Sequence):
                 raise ValueError(f"{name} must be a sequence of numbers (got {values!r})")
             if len(values) == 0:
                 raise ValueError(f"{name} must hold at least one value")
             for v in values:
-                check_grid_value(name, v)
+                check_grid_value(name, v, check)
             if any(b <= a for a, b in zip(values[:-1], values[1:], strict=True)):
                 raise ValueError(f"{name} must be strictly increasing (got {tuple(values)})")
         if isinstance(self.senses, str) or not isinstance(self.senses, Sequence):
