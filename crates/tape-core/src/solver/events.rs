@@ -341,6 +341,29 @@ fn needs_refinement(s: &Driver, b: &Point, c: &Point) -> bool {
     change > 0.0 && dl > span && dm > change * b.monitor.abs().max(c.monitor.abs())
 }
 
+/// Parts a refined step from load factor `tb` to `tc` is split into.
+fn refine_parts(s: &Driver, tb: f64, tc: f64) -> usize {
+    // A margin over the span: the load factor is not exactly uniform along the chord.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let parts = ((1.05 * (tc - tb).abs() / s.params.refine_span).ceil() as usize).clamp(2, MAX_SPLIT);
+    parts
+}
+
+/// Whether the refinement can draw the step from `b` to `c`: an equilibrium lies on the first
+/// plane it would split the step at. The driver's pieces are unchanged on return.
+///
+/// # Errors
+/// The factorisation restoring the driver's pieces fails.
+pub(super) fn drawable(s: &mut Driver, b: &State, c: &State) -> Result<bool> {
+    let saved = s.save();
+    let chord = s.difference(b, c);
+    #[allow(clippy::cast_precision_loss)]
+    let first = 1.0 / refine_parts(s, b.t, c.t) as f64;
+    let found = s.on_plane(b, &chord, first, None).is_some();
+    s.restore(saved)?;
+    Ok(found)
+}
+
 /// Splits the step from `b` to `c` into equal parts along its chord if it needs refinement (see
 /// [`needs_refinement`]), and refines the parts that still need it (up to 3 levels). Returns the
 /// states found.
@@ -348,11 +371,8 @@ fn refine(s: &mut Driver, b: &Point, c: &Point, monitor: Option<usize>, depth: u
     if depth >= 3 || !needs_refinement(s, b, c) {
         return Vec::new();
     }
-    let dl = (c.state.t - b.state.t).abs();
     let chord = s.difference(&b.state, &c.state);
-    // A margin over the span: the load factor is not exactly uniform along the chord.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let parts = ((1.05 * dl / s.params.refine_span).ceil() as usize).clamp(2, MAX_SPLIT);
+    let parts = refine_parts(s, b.state.t, c.state.t);
     let mut found: Vec<Found> = Vec::new();
     for j in 1..parts {
         #[allow(clippy::cast_precision_loss)]

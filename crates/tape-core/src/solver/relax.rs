@@ -34,6 +34,9 @@ const NEUTRAL: f64 = 100.0 * f64::EPSILON;
 /// 1.2e-6 where it slips from one element to the next.
 const NEUTRAL_ENERGY: f64 = 1e-5;
 
+/// Largest growth of the load-factor offset between two trials of a jump (see [`Driver::jump`]).
+const JUMP_GROWTH: f64 = 16.0;
+
 /// Largest translation of a trial push along a critical mode, as a fraction of the model's
 /// characteristic length (half its bounding box's diagonal: 1 mm on the 100 mm tape).
 const PUSH: f64 = 0.02;
@@ -49,7 +52,7 @@ pub(super) struct Switch {
 
 impl Driver<'_> {
     /// From the converged `saved` state before a limit point, finds a stable equilibrium a little
-    /// beyond it (load factor `saved.t + travel * offset`, the offset doubled until the state
+    /// beyond it (load factor `saved.t + travel * offset`, the offset grown until the state
     /// leaves `saved`'s branch by more than half the arc length `ds`); `state` ends there, with
     /// its pieces assembled.
     ///
@@ -67,13 +70,21 @@ impl Driver<'_> {
         for _ in 0..8 {
             *state = saved.clone();
             self.relax(state, saved.t + travel * offset)?;
-            if self.distance(state, saved) > 0.5 * ds {
+            let distance = self.distance(state, saved);
+            log::trace!(
+                "jump from t = {}: offset {offset:.3e}, distance {distance:.3e}, ds {ds:.3e}",
+                saved.t
+            );
+            if distance > 0.5 * ds {
                 self.invalidate();
                 self.assemble(state);
                 return Ok(());
             }
-            // Still on the same branch: the limit lies further on.
-            offset *= 2.0;
+            // Still on the same branch: the limit lies further on. Along a branch the relaxed
+            // state moves in proportion to the offset, so the next offset aims at 0.75 ds (a
+            // doubling from an offset set by a crawling step's tiny increment could stop far
+            // short of it: measured on the equal-sense tape's plateau, 1e-6 doubled seven times).
+            offset *= (0.75 * ds / distance).clamp(2.0, JUMP_GROWTH);
         }
         *state = saved.clone();
         Err(Error::NotConverged {

@@ -35,7 +35,7 @@
 use std::time::Instant;
 
 use super::control::{GiveUp, StepController};
-use super::events::{after_step, before_jump, Point};
+use super::events::{after_step, before_jump, drawable, Point};
 use super::newton::{Convergence, Stall};
 use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
@@ -606,6 +606,18 @@ const CRAWL_STEPS: usize = 5;
 /// than this many times `refine_change` is retried shorter (see `Walk::too_coarse`).
 const COARSE: f64 = 4.0;
 
+/// After a restart from a relaxed state, the arc length is at most this many times the restarting
+/// load increment's, or [`RESTART_FLOOR`] below the path's first arc if longer (see
+/// `Walk::accept`); the step control grows it from there.
+const RESTART_ARC: f64 = 2.0;
+/// See [`RESTART_ARC`]. Measured on the 2 mm equal-sense tape's unloading, twist imperfections
+/// 0.08 to 0.12 deg: at the first arc itself, the arc after the jump near -3.18 deg still went
+/// round the next branch's limit point (a spurious limit and a spurious jump of about 1 deg, in 7
+/// runs of 9); at 1/16 of it, none did (nor at 1/256, in 4 runs). Without a floor, the maximum-mass study's thinnest
+/// tape in equal sense crept on at tiny arcs after a jump from a crawling step (its 1000 steps
+/// used by 0.18 of the load).
+const RESTART_FLOOR: f64 = 16.0;
+
 /// The driver's bookkeeping of one path, between propose, attempt, accept and reject.
 struct PathState {
     control: StepController,
@@ -1084,8 +1096,10 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// On the path of a slowly driven test, a converged step over which the monitored reaction
     /// changes by more than [`COARSE`] times `refine_change` (and the load factor by more than
     /// `refine_span`): it may have stepped over a limit point, whose jump would then be missed,
-    /// and refinement along its chord cannot recover a path that turned in between. It is rolled
-    /// back to `saved` with half the increment (`true`), while half the cut-backs remain.
+    /// and refinement along its chord cannot recover a path that turned in between. So is a step
+    /// that needs refinement (a change above `refine_change`) which the refinement cannot draw.
+    /// It is rolled back to `saved` with half the increment (`true`), while half the cut-backs
+    /// remain.
     fn too_coarse(&mut self, state: &mut State, saved: &State) -> bool {
         let params = self.s.params;
         let (true, Some(i), Some(last)) = (self.switching() && self.locate, self.monitor, self.p.history.last()) else {
@@ -1093,9 +1107,19 @@ impl<'a, 'b> Walk<'a, 'b> {
         };
         let m = self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i];
         let dm = (m - last.monitor).abs();
-        let coarse = (state.t - saved.t).abs() > params.refine_span
-            && dm > COARSE * params.refine_change * m.abs().max(last.monitor.abs());
-        if !coarse || self.p.control.cutbacks >= params.max_cutbacks / 2 || self.p.control.reject().is_err() {
+        let scale = m.abs().max(last.monitor.abs());
+        if (state.t - saved.t).abs() <= params.refine_span
+            || dm <= params.refine_change * scale
+            || self.p.control.cutbacks >= params.max_cutbacks / 2
+        {
+            return false;
+        }
+        // A step the refinement cannot draw (no equilibrium on its first plane: the path curves
+        // away from the chord, as over the equal-sense tape's heel on unloading) is retried
+        // shorter too, or the curve would be left with a long straight segment there.
+        let coarse =
+            dm > COARSE * params.refine_change * scale || !drawable(&mut self.s, saved, state).unwrap_or(false);
+        if !coarse || self.p.control.reject().is_err() {
             return false;
         }
         *state = saved.clone();
@@ -1311,7 +1335,7 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// A converged increment along the path: record it, adapt the next increment (or, where the
     /// steps crawl, go on by relaxation).
     fn accept(&mut self, state: &mut State, saved: &State, out: Outcome) -> Flow {
-        self.p.restart = None;
+        let restarted = self.p.restart.take().is_some();
         self.p.closing_in = false;
         self.s.strict_turns = true;
         self.s.tangent_predictor = true;
@@ -1320,6 +1344,18 @@ impl<'a, 'b> Walk<'a, 'b> {
         };
         // Adapt the increment to the Newton effort.
         self.p.control.accept(out.iterations);
+        if let (true, Some(first)) = (restarted, self.p.arc_ds) {
+            // The path restarted from a relaxed state (a jump, a branch switch) with a load
+            // increment: the arc goes on from that increment's, not from the one inherited from
+            // the branch left behind, which can be far longer (85 times on the equal-sense tape's
+            // unloading, where a jump lands 0.05 deg from the limit point of the branch it
+            // reaches, and an arc that long went round that limit onto the unstable side), but
+            // not below a part of the path's first arc (a restart after crawling steps is tiny).
+            let arc = (RESTART_ARC * self.s.arc_norm(&out.dq, out.dlambda)).max(first / RESTART_FLOOR);
+            if arc < self.p.control.size.abs() {
+                self.p.control.size = self.p.control.size.signum() * arc;
+            }
+        }
         if let (true, Some(end)) = (self.arc_control, self.lambda_end) {
             let reached = (state.t - end) * (saved.t - end) <= 0.0;
             if reached && self.p.last_dlambda.is_some() {
