@@ -389,6 +389,23 @@ def test_equal_sense_unloading_snaps_once_back_to_the_untwisted_branch(imperfect
     assert (np.diff(result.theta_deg[after]) > 0.0).all()
 
 
+def test_equal_sense_path_does_not_step_over_an_instability():
+    # At a 0.12 deg twist the loading path from -15 to -16 deg took one step between two stable
+    # states, and the refinement of that step (the moment changes by 6 %) found an unstable
+    # equilibrium between them at -15.58 deg: the instability where the fold forms, stepped over
+    # and recorded as an unstable state off any located limit point. Such a step is now retried
+    # shorter, and the path meets the instability (a limit point located at -15.70 deg).
+    result = bend(
+        BendingSetup(
+            theta_max_deg=-20.0, imperfection_deg=0.12, jump=True, switch_branches=True, unload=True
+        )
+    )
+    assert result.error is None
+    limit = np.array([e == "limit_point" for e in result.event])
+    assert not (~result.stable & ~limit).any(), result.theta_deg[~result.stable & ~limit]
+    assert result.stable[result.jump].all()
+
+
 def test_perfect_tape_bifurcates_in_equal_sense_and_follows_the_stable_branch():
     # The perfect tape's symmetric path loses its stability at a bifurcation (measured on 2 mm:
     # -3.33 deg, M = -0.152 N m) while the angle keeps growing, and goes on unstable (the peak of

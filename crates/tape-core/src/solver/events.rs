@@ -349,19 +349,30 @@ fn refine_parts(s: &Driver, tb: f64, tc: f64) -> usize {
     parts
 }
 
-/// Whether the refinement can draw the step from `b` to `c`: an equilibrium lies on the first
-/// plane it would split the step at. The driver's pieces are unchanged on return.
+/// What the refinement of the step from `b` to `c` finds on its first plane: nothing (`None`),
+/// or an equilibrium, stable or not (`Some(stable)`; a negative eigenvalue at round-off level, a
+/// neutral mode, does not count). The driver's pieces are unchanged on return.
 ///
 /// # Errors
-/// The factorisation restoring the driver's pieces fails.
-pub(super) fn drawable(s: &mut Driver, b: &State, c: &State) -> Result<bool> {
+/// A failure of the linear algebra.
+pub(super) fn first_plane(s: &mut Driver, b: &State, c: &State) -> Result<Option<bool>> {
     let saved = s.save();
     let chord = s.difference(b, c);
     #[allow(clippy::cast_precision_loss)]
     let first = 1.0 / refine_parts(s, b.t, c.t) as f64;
-    let found = s.on_plane(b, &chord, first, None).is_some();
+    let found = match s.on_plane(b, &chord, first, None) {
+        None => Ok(None),
+        Some(f) => match f.step.negative_eigenvalues {
+            Some(1) => {
+                s.invalidate();
+                s.assemble(&f.state);
+                s.negative_eigenvalues().map(|n| Some(n == 0))
+            }
+            n => Ok(Some(n.is_none_or(|n| n == 0))),
+        },
+    };
     s.restore(saved)?;
-    Ok(found)
+    found
 }
 
 /// Splits the step from `b` to `c` into equal parts along its chord if it needs refinement (see

@@ -35,7 +35,7 @@
 use std::time::Instant;
 
 use super::control::{GiveUp, StepController};
-use super::events::{after_step, before_jump, drawable, Point};
+use super::events::{after_step, before_jump, first_plane, Point};
 use super::newton::{Convergence, Stall};
 use super::retrace::PathMemory;
 use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
@@ -1097,7 +1097,8 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// changes by more than [`COARSE`] times `refine_change` (and the load factor by more than
     /// `refine_span`): it may have stepped over a limit point, whose jump would then be missed,
     /// and refinement along its chord cannot recover a path that turned in between. So is a step
-    /// that needs refinement (a change above `refine_change`) which the refinement cannot draw.
+    /// that needs refinement (a change above `refine_change`) which the refinement cannot draw,
+    /// or whose refinement finds an unstable state between stable ends.
     /// It is rolled back to `saved` with half the increment (`true`), while half the cut-backs
     /// remain.
     fn too_coarse(&mut self, state: &mut State, saved: &State) -> bool {
@@ -1116,9 +1117,16 @@ impl<'a, 'b> Walk<'a, 'b> {
         }
         // A step the refinement cannot draw (no equilibrium on its first plane: the path curves
         // away from the chord, as over the equal-sense tape's heel on unloading) is retried
-        // shorter too, or the curve would be left with a long straight segment there.
-        let coarse =
-            dm > COARSE * params.refine_change * scale || !drawable(&mut self.s, saved, state).unwrap_or(false);
+        // shorter too, or the curve would be left with a long straight segment there; so is a
+        // step between stable states whose first plane finds an unstable one (an instability
+        // stepped over, which a shorter step meets).
+        let coarse = dm > COARSE * params.refine_change * scale || {
+            let ends_stable = self.p.last_negative == Some(0) && self.s.negative_eigenvalues().is_ok_and(|n| n == 0);
+            match first_plane(&mut self.s, saved, state) {
+                Ok(Some(stable)) => ends_stable && !stable,
+                Ok(None) | Err(_) => true,
+            }
+        };
         if !coarse || self.p.control.reject().is_err() {
             return false;
         }
