@@ -172,13 +172,8 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
         if s.params.switch_branches {
             // On a path that switches branches, a neutral mode (a fold free to slide) is not
             // counted, as at the path's own states.
-            for f in found
-                .iter_mut()
-                .filter(|f| f.step.negative_eigenvalues == Some(1))
-            {
-                s.invalidate();
-                s.assemble(&f.state);
-                f.step.negative_eigenvalues = Some(s.negative_eigenvalues()?);
+            for f in &mut found {
+                discount_neutral(s, f)?;
             }
         }
         s.restore(saved)?;
@@ -341,6 +336,17 @@ fn needs_refinement(s: &Driver, b: &Point, c: &Point) -> bool {
     change > 0.0 && dl > span && dm > change * b.monitor.abs().max(c.monitor.abs())
 }
 
+/// Recounts the negative eigenvalues of a state found with one, leaving out a neutral mode (see
+/// [`Driver::negative_eigenvalues`]); the driver's pieces are then those of that state.
+fn discount_neutral(s: &mut Driver, f: &mut Found) -> Result<()> {
+    if f.step.negative_eigenvalues == Some(1) {
+        s.invalidate();
+        s.assemble(&f.state);
+        f.step.negative_eigenvalues = Some(s.negative_eigenvalues()?);
+    }
+    Ok(())
+}
+
 /// Parts a refined step from load factor `tb` to `tc` is split into.
 fn refine_parts(s: &Driver, tb: f64, tc: f64) -> usize {
     // A margin over the span: the load factor is not exactly uniform along the chord.
@@ -362,14 +368,7 @@ pub(super) fn first_plane(s: &mut Driver, b: &State, c: &State) -> Result<Option
     let first = 1.0 / refine_parts(s, b.t, c.t) as f64;
     let found = match s.on_plane(b, &chord, first, None) {
         None => Ok(None),
-        Some(f) => match f.step.negative_eigenvalues {
-            Some(1) => {
-                s.invalidate();
-                s.assemble(&f.state);
-                s.negative_eigenvalues().map(|n| Some(n == 0))
-            }
-            n => Ok(Some(n.is_none_or(|n| n == 0))),
-        },
+        Some(mut f) => discount_neutral(s, &mut f).map(|()| Some(f.step.negative_eigenvalues.is_none_or(|n| n == 0))),
     };
     s.restore(saved)?;
     found

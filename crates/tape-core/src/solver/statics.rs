@@ -613,9 +613,9 @@ const RESTART_ARC: f64 = 2.0;
 /// See [`RESTART_ARC`]. Measured on the 2 mm equal-sense tape's unloading, twist imperfections
 /// 0.08 to 0.12 deg: at the first arc itself, the arc after the jump near -3.18 deg still went
 /// round the next branch's limit point (a spurious limit and a spurious jump of about 1 deg, in 7
-/// runs of 9); at 1/16 of it, none did (nor at 1/256, in 4 runs). Without a floor, the maximum-mass study's thinnest
-/// tape in equal sense crept on at tiny arcs after a jump from a crawling step (its 1000 steps
-/// used by 0.18 of the load).
+/// runs of 9); at 1/16 of it, none did (nor at 1/256, in 4 runs). Without a floor, the
+/// maximum-mass study's thinnest tape in equal sense crept on at tiny arcs after a jump from a
+/// crawling step (its 1000 steps used by 0.18 of the load).
 const RESTART_FLOOR: f64 = 16.0;
 
 /// The driver's bookkeeping of one path, between propose, attempt, accept and reject.
@@ -1120,13 +1120,15 @@ impl<'a, 'b> Walk<'a, 'b> {
         // shorter too, or the curve would be left with a long straight segment there; so is a
         // step between stable states whose first plane finds an unstable one (an instability
         // stepped over, which a shorter step meets).
-        let coarse = dm > COARSE * params.refine_change * scale || {
-            let ends_stable = self.p.last_negative == Some(0) && self.s.negative_eigenvalues().is_ok_and(|n| n == 0);
-            match first_plane(&mut self.s, saved, state) {
-                Ok(Some(stable)) => ends_stable && !stable,
+        let coarse = dm > COARSE * params.refine_change * scale
+            || match first_plane(&mut self.s, saved, state) {
+                Ok(Some(true)) => false,
+                // The ends' stability, only where it matters (the driver's pieces are `state`'s).
+                Ok(Some(false)) => {
+                    self.p.last_negative == Some(0) && self.s.negative_eigenvalues().is_ok_and(|n| n == 0)
+                }
                 Ok(None) | Err(_) => true,
-            }
-        };
+            };
         if !coarse || self.p.control.reject().is_err() {
             return false;
         }
