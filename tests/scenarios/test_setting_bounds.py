@@ -26,7 +26,13 @@ from tapespring.scenarios.bending import BendingSetup
 from tapespring.scenarios.deployment import DeploymentSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
 from tapespring.scenarios.release import ReleaseSetup, release_steps
-from tapespring.scenarios.setup import MAX_DURATION, MAX_DYNAMIC_STEPS, PAPER_SETUP, SetupSpec
+from tapespring.scenarios.setup import (
+    MAX_DURATION,
+    MAX_DYNAMIC_STEPS,
+    PAPER_SETUP,
+    SetupSpec,
+    check_bounded,
+)
 from tapespring.scenarios.vibration import VibrationSettings, VibrationSimulation
 
 S = replace(PAPER_SETUP, mesh_tape=10e-3, mesh_plates=20e-3)
@@ -466,3 +472,12 @@ def test_a_deployment_reports_at_most_1000_peaks():
     for value in (0, -1, 2.5, *NON_FINITE, "10", None, True):
         _refused(DeploymentSettings(spec=S, n_peaks=value), "n_peaks")
     DeploymentSettings(spec=S, n_peaks=1000).validate()
+
+
+def test_a_bound_is_printed_as_compared():
+    # A bound that 5 digits would round (1.2345649 -> 1.2346) is printed in full: the refused
+    # 1.234567 must not read as within "at most 1.2346".
+    with pytest.raises(ValueError, match=r"at most 1\.2345649 m \(got 1\.234567\)"):
+        check_bounded("x", 1.234567, high=1.2345649, unit="m")
+    with pytest.raises(ValueError, match=r"at most 1e\+13 Pa \(got 2e\+13\)"):
+        check_bounded("x", 2e13, high=1e13, unit="Pa")

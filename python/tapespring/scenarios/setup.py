@@ -554,7 +554,7 @@ class SetupSpec:
         if self.support not in SUPPORTS:
             raise ValueError(f"support must be one of {SUPPORTS} (got {self.support!r})")
         for name, value in vars(self).items():
-            if name in ("tape", "support_marker", "support", "eta", "support_eta", "hold"):
+            if name in _SPEC_OWN_CHECKS:
                 continue
             positive = not name.startswith("initial_angle")
             check_number(name, value, positive=positive)
@@ -652,6 +652,11 @@ class SetupSpec:
                     "quarter of it)"
                 )
 
+
+#: SetupSpec fields checked by their own functions, not by the loop over the numbers.
+_SPEC_OWN_CHECKS = (
+    "tape", "support_marker", "support", "eta", "support_eta", "hold", "fold_rate", "pull_rate",
+)  # fmt: skip
 
 #: Fields of :class:`SetupSpec` that are lengths [m] (each at most :data:`MAX_LENGTH`).
 _SPEC_LENGTHS = frozenset(
@@ -769,6 +774,13 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
     return value
 
 
+def _bound_text(bound: float) -> str:
+    """A bound as a message shows it: to 5 digits where that is the bound itself, else in full
+    (:func:`shown`), so a refused value never reads as within the printed bound."""
+    text = f"{bound:.5g}"
+    return text if float(text) == bound else shown(bound)
+
+
 def check_bounded(
     name: str,
     value: object,
@@ -791,7 +803,8 @@ def check_bounded(
     at most `high` or at least `low`. The message goes on with `why`, what the bound is ("ten
     times diamond's", after which the refused value repeats the `unit`), and ends with the
     refused value and `note` (a remark, the constant to see): "(got 2e+13 Pa; see MAX_...)".
-    Bounds are shown to 5 digits (``1e+05``, ``0.001``, ``500``), the value by :func:`shown`.
+    Bounds are shown to 5 digits (``1e+05``, ``0.001``, ``500``) where that is exact, else in
+    full; the value by :func:`shown`.
 
     Returns `value`, typed as a number (as :func:`check_number` does).
     """
@@ -800,12 +813,14 @@ def check_bounded(
     below = low is not None and (number <= low if low_open else number < low)
     if not (above or below):
         return number
-    if high is None:
-        bound = f"be {'above' if low_open else 'at least'} {low:.5g}"
-    elif low is None:
-        bound = f"be {'below' if high_open else 'at most'} {high:.5g}"
+    if low is not None and high is not None:
+        left, right = "(" if low_open else "[", ")" if high_open else "]"
+        bound = f"lie in {left}{_bound_text(low)}, {_bound_text(high)}{right}"
+    elif low is not None:
+        bound = f"be {'above' if low_open else 'at least'} {_bound_text(low)}"
     else:
-        bound = f"lie in {'(' if low_open else '['}{low:.5g}, {high:.5g}{')' if high_open else ']'}"
+        assert high is not None  # a value out of bounds crossed one
+        bound = f"be {'below' if high_open else 'at most'} {_bound_text(high)}"
     units = f" {unit}" if unit else ""
     reason = f", {why}" if why else ""
     got = shown(number) + (units if why else "")
