@@ -109,6 +109,18 @@ def test_summary_is_plain_json(opposite: DeploymentSimulation) -> None:
     assert s["settings"]["spec"]["mesh_tape"] == 5e-3
 
 
+def test_summary_text_says_which_phases_were_found(opposite: DeploymentSimulation) -> None:
+    phases = opposite.summary()["phases"]
+    line = next(s for s in opposite.describe().splitlines() if "phases:" in s)
+    for name in ("ii", "iii"):
+        start = phases[f"phase_{name}_start_s"]
+        label = name.upper()
+        expected = f"{label} not detected" if start is None else f"{label} from {start:.2f} s"
+        assert expected in line
+    # On the fixture's 5 mm mesh no second fold forms (docs/scenarios.md): no phase II.
+    assert "II not detected" in line
+
+
 def test_bad_settings_are_named() -> None:
     with pytest.raises(ValueError, match="sense"):
         deploy(DeploymentSettings(spec=COARSE, sense="sideways"))

@@ -403,10 +403,14 @@ class DeploymentSimulation:
                 lines.append(f"  first {kind}ima: {items}")
         ph = s["phases"]
         lines.append(
-            "  phases: II from "
-            + ("-" if ph["phase_ii_start_s"] is None else f"{ph['phase_ii_start_s']:.2f} s")
-            + ", III from "
-            + ("-" if ph["phase_iii_start_s"] is None else f"{ph['phase_iii_start_s']:.2f} s")
+            "  phases: "
+            + ", ".join(
+                f"{name} not detected" if start is None else f"{name} from {start:.2f} s"
+                for name, start in (
+                    ("II", ph["phase_ii_start_s"]),
+                    ("III", ph["phase_iii_start_s"]),
+                )
+            )
         )
         if s["max_clamp_force_N"] is not None:
             lines.append(f"  largest vertical clamp force {s['max_clamp_force_N']:.2f} N")

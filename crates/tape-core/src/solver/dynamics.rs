@@ -746,7 +746,6 @@ impl Integrator<'_> {
                     ),
                 };
             }
-            let t = Instant::now();
             // A fresh matrix when the last correction contracted the residual too little, or at
             // a predictor far off the last step's equilibrium (a violent step, where corrections
             // from an outdated matrix send a thin shell's membrane strains astray).
@@ -757,11 +756,12 @@ impl Integrator<'_> {
                 res > REUSE_CONTRACTION * previous
             };
             let fresh = refresh || slow;
+            if fresh && !with_tangent {
+                // The same residual, now with the iteration matrix (timed as assembly).
+                self.assemble(start, state, h, true, &mut r);
+            }
+            let t = Instant::now();
             if fresh {
-                if !with_tangent {
-                    // The same residual, now with the iteration matrix.
-                    self.assemble(start, state, h, true, &mut r);
-                }
                 self.factor_h = None;
                 // Modified Newton solves with the symmetric part alone: no copy of K for GMRES.
                 let factorised = if params.reuse_factorisation {
