@@ -161,9 +161,13 @@ def test_free_flight_of_a_curved_strip_keeps_its_energy():
         model.set_initial_velocity(
             i, velocity=np.cross(spin, x - centre) + stretch, angular_velocity=spin
         )
-    r = run(model, [Step.dynamic("fly", duration=0.02, rho_inf=1.0)], outputs=Outputs())
+    # Fields of the last record only (the last is always kept).
+    outputs = Outputs(field_interval=1_000_000)
+    r = run(model, [Step.dynamic("fly", duration=0.02, rho_inf=1.0)], outputs=outputs)
     assert r.error is None
     energy = r.kinetic_energy + r.strain_energy
     assert np.max(np.abs(energy - energy[0])) < 1e-3 * energy[0]
-    # It turns through more than half a radian about z: large rotations.
-    assert r.t[-1] * spin[2] > 0.5
+    # Every node has turned by more than half a radian: large rotations (the spin's 50 rad/s
+    # over 20 ms give 1.0 rad for a rigid strip; measured 0.954 rad at every node).
+    _, rotations = r.field(-1)
+    assert np.linalg.norm(rotations, axis=1).min() > 0.5
