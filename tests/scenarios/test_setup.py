@@ -197,7 +197,7 @@ def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> Non
     # steps at the default 400 Hz, omega h = 0.146: 8.5e-6 of damping ratio against the 5 % of
     # ten times the paper's eta, `_core.generalized_alpha_decay`).
     assert sim.fit.damping_ratio == pytest.approx(sim.kelvin_voigt_damping_ratio, rel=0.03)
-    # Damping ratio proportional to eta: the paper's eta gives a tenth (checked in benchmarks).
+    # Damping ratio proportional to eta: the paper's eta gives a tenth (the next test).
     # The rows `--csv` writes are those of a recording: every 400 Hz sample from the release,
     # none of the steps the error control puts between them.
     assert sim.settings.sample_rate == 400.0
@@ -206,6 +206,30 @@ def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> Non
     summary = sim.summary()
     assert summary["period_s"] == sim.fit.period
     json.dumps(summary)
+
+
+def test_vibration_at_the_papers_eta_gives_its_damping_and_period() -> None:
+    # Issue 9 sec. 4, against Table 8 of the paper (shared/paper/tape-springs-paper.md; its
+    # model: epsilon = 0.505 %, period 0.110 s, with eta = 1.73e-4 s and rho_inf = 0.7, kept in
+    # `PAPER_MODEL`). The paper's 8 s of decay from 8 mm, on 5 mm tapes and plates (1374 DOFs;
+    # about 5.5 s of wall time on 2 cores).
+    assert (COARSE.eta, PAPER_MODEL.rho_inf) == (1.73e-4, 0.7)
+    sim = vibrate(VibrationSettings(spec=COARSE, duration=8.0, rho_inf=PAPER_MODEL.rho_inf))
+    assert sim.fit is not None, sim.fit_error
+    # The peaks of the 0.4-4 mm window: 107 measured, from about 2.5 s on.
+    assert sim.fit.peak_time.size >= 50
+    # Epsilon within the issue's 5 % of the paper's model: 0.516 % measured (+2.2 %); on the
+    # paper's meshes 0.491 % (-2.7 %, docs/scenarios.md), so the 5 % holds on either mesh.
+    assert sim.fit.damping_ratio == pytest.approx(PAPER_MODEL.damping_ratio, rel=0.05)
+    # The period against the paper's model within 5 %: 0.1084 s measured (-1.5 %). The weight was
+    # pinned by Table 6, not by the period, so it is a prediction, and it moves with the mesh:
+    # the modal period is 0.1080 s on 5 mm, 0.1125 s on 3 mm and 0.1143 s on the paper's meshes
+    # (fitted 0.1148 s, +4.4 %; docs/scenarios.md), 5.8 % from the coarsest to the finest. 5 %
+    # holds every mesh's figure; a tighter band would test this mesh's own error.
+    assert sim.fit.period == pytest.approx(PAPER_MODEL.period, rel=0.05)
+    # Transient against modal period: the issue's 1 % (0.39 % measured: the 8 mm start and the
+    # scheme's 0.20 % at 2.5 ms steps).
+    assert sim.fit.period == pytest.approx(sim.modal_periods_s[0], rel=0.01)
 
 
 def test_a_decay_with_fixed_steps_is_sampled_on_its_steps() -> None:
