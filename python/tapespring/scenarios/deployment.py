@@ -223,12 +223,14 @@ class DeploymentSimulation:
     def to_trial(self, *, rate_hz: float | None = None) -> Any:
         """The release and the motion as a :class:`tapespring.trials.Trial`.
 
-        Markers M1 (support), M2 (rod), M3 (appendix tip) resampled at `rate_hz` (default: the
-        run's sample rate), in the set-up's frame for its sense; one force plate under the clamp
-        (1 kHz): the rigid support's clamp, or the flexible support's base (moments about the
-        middle of its base edge), in the laboratory's frame as a plate reads it whatever the
-        sense (the upturned equal-sense block has y and z reversed), so its Fz is
-        `clamp_force_N`.
+        Markers M1 (marker 1, on a small interface), M2 (marker 2, middle of the rod) and M3
+        (marker 3, appendix tip), as :data:`TRIAL_MARKERS` maps them (marker 0, on the support,
+        is not exported: the analysis's bending angle is that of M1 -> M2), resampled at
+        `rate_hz` (default: the run's sample rate), in the set-up's frame for its sense; one
+        force plate under the clamp (1 kHz): the rigid support's clamp, or the flexible
+        support's base (moments about the middle of its base edge), in the laboratory's frame as
+        a plate reads it whatever the sense (the upturned equal-sense block has y and z
+        reversed), so its Fz is `clamp_force_N`.
         """
         import dataclasses
 
