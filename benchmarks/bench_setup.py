@@ -9,17 +9,61 @@ recordings).
 
     python benchmarks/bench_setup.py --quick
     python benchmarks/bench_setup.py --duration 0.5 --only deploy
+
+The deployments are then checked against what issue 9 (section 4) asks the paper's model to show,
+one ``PASS`` or ``FAIL`` line each (the run exits with 1 on a FAIL):
+
+- opposite sense: phases II and III both detected in the bending angle; the first maximum within
+  0.4-0.6 s (`FIRST_MAX_WINDOW_S`); at each zero crossing of the angle in phases I and II (at
+  least one in each) a clamp-force peak at least twice anything else the force does in the
+  flanking half-cycles (`CROSSING_RATIO`, `DeploymentSimulation.clamp_force_at_crossings`);
+- equal sense (the spec's eta, the paper's 1.73e-4 s): a third large minimum (below -20 deg,
+  `LARGE_DEG`), the paper's fourth large peak counting the initial fold, within 1.7-2.3 s
+  (`EXTRA_PEAK_WINDOW_S`); `benchmarks/spec_variants.py --tests equal` checks that it is gone
+  with 2.1e-4 s.
+
+They are the paper's figures on the paper's meshes over its 10 s: with ``--quick`` (5 mm, where
+no phase II forms and the equal sense has two large minima only, docs/scenarios.md) the lines
+are printed as informative and the exit status ignores them; a shorter ``--duration`` on the
+paper's meshes counts them (phase III comes at about 1.2 s, the third large minimum at 2 s).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import replace
 
+import numpy as np
 from tapespring.scenarios.deployment import DeploymentSettings, deploy
 from tapespring.scenarios.pull import PullSettings, pull
-from tapespring.scenarios.setup import PAPER_SETUP
+from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.scenarios.vibration import VibrationSettings, vibrate
+
+#: Window of the first maximum of the opposite-sense deployment [s]: the paper's "around 0.5 s"
+#: (Sec. 6.1) to +-0.1 s, as the test on 5 mm. It gives no finer figure; 0.1 s is under half the
+#: time from the first minimum to the first maximum (0.26 s on the paper's meshes: -44.7 deg at
+#: 0.28 s, +62.1 deg at 0.54 s), so the maximum in it is the first swing's, not a neighbour's.
+FIRST_MAX_WINDOW_S = (
+    PAPER_MODEL.first_max_peak_time_opposite - 0.1,
+    PAPER_MODEL.first_max_peak_time_opposite + 0.1,
+)
+#: Smallest ratio of the clamp force's peak at a zero crossing to its largest deviation elsewhere
+#: in the flanking half-cycles that makes it "a large peak" (the test's criterion on 5 mm, where
+#: 2.7 to 4.5 are measured; 2.5 to 7.3 on the paper's meshes in phases I and II).
+CROSSING_RATIO = 2.0
+#: Large minima of the equal-sense deployment are those below this bending angle [deg], as in
+#: docs/scenarios.md and benchmarks/spec_variants.py: the large folds reach -55 to -82 deg over
+#: every eta and mass split documented there, the swing after the last one -10.3 deg where one is
+#: reported, so -20 deg lies well between them.
+LARGE_DEG = -20.0
+#: Window of the third large minimum of the equal-sense deployment [s]: the paper's "around 2 s"
+#: (Sec. 6.1) to +-0.3 s, under half the 0.64-0.75 s between the large minima (0.60, 1.24 and
+#: 1.99 s on the paper's meshes), so the minimum in it is the third one.
+EXTRA_PEAK_WINDOW_S = (
+    PAPER_MODEL.extra_peak_time_equal - 0.3,
+    PAPER_MODEL.extra_peak_time_equal + 0.3,
+)
 
 
 def line(name: str, result, simulated: float) -> None:
@@ -32,6 +76,77 @@ def line(name: str, result, simulated: float) -> None:
         f"iterations {int(stats.get('iterations', 0)):7d}  "
         f"factorisations {int(stats.get('factorisations', 0)):7d}  wall {result.wall_s:8.1f} s",
         flush=True,
+    )
+
+
+def check(ok: bool, text: str, failures: list[str]) -> None:
+    """Print one PASS or FAIL line; a FAIL is kept in `failures`."""
+    print(f"{'PASS' if ok else 'FAIL'} {text}", flush=True)
+    if not ok:
+        failures.append(text)
+
+
+def check_opposite(sim, failures: list[str]) -> None:
+    """Issue 9 sec. 4, deployment in opposite sense: the three phases, the first maximum near
+    0.5 s, a large clamp-force peak at each zero crossing in phases I and II."""
+    s = sim.summary()
+    ii, iii = s["phases"]["phase_ii_start_s"], s["phases"]["phase_iii_start_s"]
+
+    def at(start: float | None) -> str:
+        return "not detected" if start is None else f"from {start:.2f} s"
+
+    check(
+        ii is not None and iii is not None,
+        f"opposite: three phases (II {at(ii)}, III {at(iii)})",
+        failures,
+    )
+    peaks = s["peaks"]
+    lo, hi = FIRST_MAX_WINDOW_S
+    if peaks["max_time_s"]:
+        t, v = peaks["max_time_s"][0], peaks["max_deg"][0]
+        check(
+            lo <= t <= hi,
+            f"opposite: first maximum {v:+.1f} deg at {t:.3f} s, within {lo:g}-{hi:g} s",
+            failures,
+        )
+    else:
+        check(False, "opposite: no maximum", failures)
+    # The crossings up to phase III (the whole run if it is not detected), as the summary has them.
+    x = sim.clamp_force_at_crossings()
+    in_i = x.time < (ii if ii is not None else np.inf)
+    in_ii = ~in_i
+    large = x.ratio >= CROSSING_RATIO  # inf (nothing else moved) passes, NaN (unknown) fails
+    listed = ", ".join(
+        f"{p:.1f} N at {t:.3f} s ({r:.1f}x)"
+        for t, p, r in zip(x.time, x.peak, x.ratio, strict=True)
+    )
+    check(
+        bool(np.any(in_i)) and bool(np.any(in_ii)) and ii is not None and bool(np.all(large)),
+        f"opposite: clamp-force peak at least {CROSSING_RATIO:g} times the rest at each of the "
+        f"{x.time.size} zero crossings before phase III ({int(np.sum(in_i))} in phase I, "
+        f"{int(np.sum(in_ii))} in phase II): {listed or 'none'}",
+        failures,
+    )
+
+
+def check_equal(sim, failures: list[str]) -> None:
+    """Issue 9 sec. 4, deployment in equal sense with the paper's eta: the fourth large peak
+    (counting the initial fold), a third minimum below `LARGE_DEG`, around 2 s."""
+    eta = sim.settings.spec.eta
+    peaks = sim.summary()["peaks"]
+    large = [
+        (t, v) for t, v in zip(peaks["min_time_s"], peaks["min_deg"], strict=True) if v < LARGE_DEG
+    ]
+    listed = ", ".join(f"{v:+.1f} deg at {t:.2f} s" for t, v in large) or "none"
+    lo, hi = EXTRA_PEAK_WINDOW_S
+    if eta != PAPER_MODEL.eta:
+        print(f"(equal: eta {eta:.2e} s is not the paper's {PAPER_MODEL.eta:.2e} s: no check)")
+        return
+    check(
+        len(large) >= 3 and lo <= large[2][0] <= hi,
+        f"equal: eta {eta:.2e} s, a third large minimum (below {LARGE_DEG:g} deg) within "
+        f"{lo:g}-{hi:g} s: {listed}",
+        failures,
     )
 
 
@@ -59,10 +174,21 @@ def main() -> None:
     if "vibrate" in only:
         s = VibrationSettings(spec=vib_spec, duration=args.vibration_duration)
         line(f"vibrate ({s.sample_rate:g} Hz)", vibrate(s), s.duration)
+    failures: list[str] = []
     if "deploy" in only:
+        runs = {}
         for sense in ("opposite", "equal"):
             settings = DeploymentSettings(spec=deploy_spec, sense=sense, duration=args.duration)
-            line(f"deploy {sense}", deploy(settings), args.duration)
+            runs[sense] = deploy(settings)
+            line(f"deploy {sense}", runs[sense], args.duration)
+        if args.quick:
+            print("checks of issue 9 sec. 4 (coarse meshes: informative, not counted)")
+        else:
+            print(f"checks of issue 9 sec. 4 ({args.duration:g} s on the paper's meshes)")
+        check_opposite(runs["opposite"], failures)
+        check_equal(runs["equal"], failures)
+    if failures and not args.quick:
+        sys.exit(1)
 
 
 if __name__ == "__main__":
