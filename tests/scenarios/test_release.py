@@ -39,6 +39,37 @@ def test_fold_follows_the_static_bending_curve(early):
     assert m_fold == pytest.approx(np.max(np.abs(curve.moment)), rel=0.01)
 
 
+def test_slow_dynamic_fold_follows_the_static_bending_curve():
+    # Issue 8, 6.g: folded slowly by rotating the end, the moment follows the static curve. A
+    # dynamic step turns the end by t * 60 deg over 1 s (the fold's "fold" constraint, its
+    # function linear in time), with the paper's eta to damp the snap's ringing. Measured: the
+    # clamp's largest moment 0.11 % above the static M_max, at 9.2 deg (1.3 s of wall time); a
+    # fold ten times faster peaks 15 % off, and without eta the ringing after the snap reaches
+    # 1.32 M_max.
+    from tapespring.analysis import Outputs, Step, run
+
+    setup = ReleaseSetup(tape=TAPE, eta=1.73e-4)
+    model, clamped, _ = release_model(setup)
+    fold = Step.dynamic("fold", duration=1.0, initial_step=1e-4, max_step=5e-3)
+    r = run(model, [fold], outputs=Outputs(reactions=((clamped, "ry"),)))
+    assert r.error is None
+    curve = bend(replace(TAPE, theta_max_deg=60.0, jump=True))
+    m_static = np.max(np.abs(curve.moment))
+    m = np.abs(r.reaction(clamped, "ry"))
+    assert np.max(m) == pytest.approx(m_static, rel=0.01)
+    # Before the peak the dynamic moment lies on the static loading branch. The end's angular
+    # velocity jumps from 0 to 60 deg/s at t = 0, and the tape rings about the branch (4 % of
+    # M_max at 0.5 deg), damped by eta (about 1 % of critical in the first mode): measured 1.4 %
+    # of M_max at most from 3 deg on, 0.6 % from 5 deg on (the static curve interpolated
+    # linearly between its states, 0.6 to 1 deg apart).
+    peak = int(np.argmax(m))
+    theta = 60.0 * r.t[: peak + 1]
+    branch = np.abs(curve.moment[: int(np.argmax(np.abs(curve.moment))) + 1])
+    on_branch = np.interp(theta, np.abs(curve.theta_deg[: branch.size]), branch)
+    late = theta >= 3.0
+    assert np.max(np.abs(m[: peak + 1] - on_branch)[late]) < 0.02 * m_static
+
+
 def test_release_starts_from_rest_and_deploys(early):
     assert early.results.error is None
     assert early.time_s[0] == 0.0 and early.theta_deg[0] == pytest.approx(60.0, abs=1e-6)
@@ -93,6 +124,46 @@ def test_release_through_the_snap_keeps_the_energy_bounded():
     assert np.all(r.energy["numerical"] > -1e-4 * stored)
     total = r.energy["kinetic"] + r.energy["strain"]
     assert np.all(total <= stored * (1 + 1e-4))
+
+
+@pytest.fixture(scope="module")
+def settled():
+    """A second of free motion with the paper's eta (3.6 s of wall time on 4 mm)."""
+    return release(ReleaseSetup(tape=TAPE, duration=1.0, eta=1.73e-4))
+
+
+def test_damped_release_settles_straight(settled):
+    # Issue 8, 6.g: released with eta > 0 it deploys through the snap and settles straight.
+    # Measured: +0.01 deg at 1 s, 2.4e-6 J of kinetic and strain energy left of the 84 mJ stored
+    # (3e-5 of it), the rest dissipated by the material (95 %) and the scheme (4.8 %).
+    r = settled
+    assert r.results.error is None
+    assert r.theta_deg.min() < 0.0 < r.theta_deg.max()
+    assert abs(r.theta_deg[-1]) < 0.1
+    stored = r.energy["strain"][0]
+    left = r.energy["kinetic"][-1] + r.energy["strain"][-1]
+    assert left < 1e-4 * stored
+    # Energy balance: what the scheme dissipated is small against the material's (the remainder
+    # of the balance, 4.8 % of the stored energy on this mesh at the default tolerance; the
+    # issue's 0.5 % is not reached with rho_inf = 0.7, see docs/dynamics.md).
+    assert r.energy["viscous"][-1] > 0.9 * stored
+    assert 0.0 < r.energy["numerical"][-1] < 0.1 * stored
+
+
+@pytest.mark.slow
+def test_undamped_release_has_not_settled_when_the_damped_one_has(settled):
+    # The same second without material damping (50 s of wall time on 4 mm): only the scheme's
+    # dissipation acts, and after 0.9 s the tape still holds 6.3 % of the stored energy and swings
+    # over 8.0 deg. Early on the difference does not show: at 0.1 s 39 % is left against 56 %
+    # with the paper's eta, whose tape is then folded in equal sense, holding strain energy.
+    free = release(ReleaseSetup(tape=TAPE, duration=1.0))
+    assert free.results.error is None
+    stored = free.energy["strain"][0]
+    late = free.time_s > 0.9
+    left = free.energy["kinetic"][late] + free.energy["strain"][late]
+    assert left.min() > 100.0 * (settled.energy["kinetic"][-1] + settled.energy["strain"][-1])
+    assert left.min() > 1e-3 * stored
+    assert np.ptp(free.theta_deg[late]) > 10.0 * np.ptp(settled.theta_deg[settled.time_s > 0.9])
 
 
 def test_release_command_json(capsys):
