@@ -20,7 +20,8 @@ on 5 mm (``--set mesh_tape=5e-3 --set mesh_plates=10e-3``, 15 s) both etas give 
 only and the first check fails, on 3 mm three and the second fails (docs/scenarios.md).
 
 Named variants (``--variant``) move mass within the free end's 77 g, which the paper gives whole;
-``--set NAME=VALUE`` builds one from any fields. About 60 to 90 s per deployment run.
+``--set NAME=VALUE`` builds one from any fields. About 40 s per equal-sense run (2.6 s of
+motion on the paper's meshes, docs/scenarios.md).
 
     python benchmarks/spec_variants.py --tests equal                      # the spec as it is
     python benchmarks/spec_variants.py --variant earlier --tests table6 pull modal opposite equal
