@@ -150,6 +150,21 @@ def test_damped_release_settles_straight(settled):
     assert 0.0 < r.energy["numerical"][-1] < 0.1 * stored
 
 
+def test_damped_history_through_the_snap_is_stable_when_the_tolerance_is_halved(settled):
+    # Issue 8, 6.g: results stable when the error tolerance is halved. With the paper's eta the
+    # snap's short waves are damped and the history through the snap and the equal-sense fold
+    # (200 ms) moves by 0.13 deg at most (measured; 0.06 deg over the first 50 ms), on a swing
+    # from +60 to -61 deg: 0.5 deg is the bound of the undamped pre-snap test above. Undamped, the
+    # history past the snap is not converged at the default tolerance (docs/dynamics.md). The
+    # steps do not depend on the duration, so the 1 s fixture's first 200 ms are this run's.
+    fine = release(ReleaseSetup(tape=TAPE, duration=0.2, eta=1.73e-4, tolerance=0.5e-4))
+    t = np.linspace(0.0, 0.2, 2001)
+    coarse_theta = np.interp(t, settled.time_s, settled.theta_deg)
+    fine_theta = np.interp(t, fine.time_s, fine.theta_deg)
+    assert fine.theta_deg.min() < -55.0
+    assert np.max(np.abs(coarse_theta - fine_theta)) < 0.5
+
+
 @pytest.mark.slow
 def test_undamped_release_has_not_settled_when_the_damped_one_has(settled):
     # The same second without material damping (50 s of wall time on 4 mm): only the scheme's
