@@ -14,6 +14,9 @@ vibration
     Kind ``"vibration"`` (paper Sec. 5.2): `analyze_vibration`, statistics over sessions.
 pull
     Kind ``"quasi-static"`` (paper Sec. 4.2): `analyze_pull_trial`.
+identification
+    Kind ``"identification"`` (paper Sec. 5.1, Table 3): `analyze_identification`, the markers'
+    displacements between the unfolded and the folded equilibrium.
 
 The names below are imported on first use, so listing `KINDS` imports no protocol.
 """
@@ -31,6 +34,11 @@ if TYPE_CHECKING:
         analyze_deployment,
         analyze_deployment_group,
     )
+    from .identification import (
+        IdentificationResult,
+        analyze_identification,
+        analyze_identification_group,
+    )
     from .markers import DEFAULT_MARKERS
     from .pull import PullTestResult, analyze_pull_group, analyze_pull_trial
     from .registry import KINDS, Protocol, TrialsAnalysis, analyze_trials, protocol_for
@@ -41,12 +49,15 @@ __all__ = [
     "KINDS",
     "DeploymentGroup",
     "DeploymentResult",
+    "IdentificationResult",
     "Protocol",
     "PullTestResult",
     "TrialsAnalysis",
     "VibrationResult",
     "analyze_deployment",
     "analyze_deployment_group",
+    "analyze_identification",
+    "analyze_identification_group",
     "analyze_pull_group",
     "analyze_pull_trial",
     "analyze_trials",
@@ -64,6 +75,11 @@ __getattr__, __dir__ = lazy_exports(
             "DeploymentResult",
             "analyze_deployment",
             "analyze_deployment_group",
+        ],
+        "identification": [
+            "IdentificationResult",
+            "analyze_identification",
+            "analyze_identification_group",
         ],
         "markers": ["DEFAULT_MARKERS"],
         "pull": ["PullTestResult", "analyze_pull_group", "analyze_pull_trial"],

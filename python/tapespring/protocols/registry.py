@@ -8,10 +8,13 @@ statistics across trials:
 - ``vibration``: the statistics of the damping ratio and the period over all
   tests, and over the session means (paper Table 7);
 - ``quasi-static``: the statistics of the maximum force and its displacement
-  (paper Table 2).
+  (paper Table 2);
+- ``identification``: the statistics of the markers' displacements between the
+  unfolded and the folded equilibrium of the static identification test (paper
+  Table 3).
 
 Each kind is a `Protocol` defined in its own module (`deployment`, `vibration`,
-`pull`); `protocol_for` looks it up. A protocol analyses one trial at a time
+`pull`, `identification`); `protocol_for` looks it up. A protocol analyses one trial at a time
 (``analyze_trial``) and then the set (``combine``), so that with
 ``skip_bad=True`` a trial whose analysis fails is left out and listed in
 `TrialsAnalysis.skipped` instead of stopping the others. The module of a kind is imported the first
@@ -40,6 +43,7 @@ if TYPE_CHECKING:
     from tapespring.trials.trial import Trial
 
     from .deployment import DeploymentGroup, DeploymentResult
+    from .identification import IdentificationResult
     from .pull import PullTestResult
     from .vibration import VibrationResult
 
@@ -55,7 +59,12 @@ __all__ = [
 ]
 
 # Kind of test -> module of this package that defines its `PROTOCOL`.
-_MODULES = {"deployment": "deployment", "vibration": "vibration", "quasi-static": "pull"}
+_MODULES = {
+    "deployment": "deployment",
+    "vibration": "vibration",
+    "quasi-static": "pull",
+    "identification": "identification",
+}
 
 #: Kinds of test understood by `analyze_trials`.
 KINDS = tuple(_MODULES)
@@ -67,7 +76,8 @@ KINDS = tuple(_MODULES)
 #: damping to the 0.1 % prominence floor, about 200 of each kind); 1e6 ran for minutes.
 MAX_N_PEAKS = 1000
 
-#: The per-trial result of a kind: `DeploymentResult`, `VibrationResult` or `PullTestResult`.
+#: The per-trial result of a kind: `DeploymentResult`, `VibrationResult`, `PullTestResult` or
+#: `IdentificationResult`.
 ResultT = TypeVar("ResultT")
 
 
@@ -77,16 +87,18 @@ class TrialsAnalysis(Generic[ResultT]):
 
     Attributes
     ----------
-    kind : {"deployment", "vibration", "quasi-static"}
+    kind : {"deployment", "vibration", "quasi-static", "identification"}
         Kind of test.
     results : tuple
-        Per-trial results (`DeploymentResult`, `VibrationResult` or `PullTestResult`).
+        Per-trial results (`DeploymentResult`, `VibrationResult`, `PullTestResult` or
+        `IdentificationResult`).
     groups : tuple of DeploymentGroup
         Deployment only: one group per sense of bending.
     summaries : mapping of str -> Summary
         Scalar statistics (empty for deployment): ``damping_ratio``, ``period``,
         ``session_damping_ratio``, ``session_period`` (vibration);
-        ``max_force``, ``displacement_at_max`` (quasi-static).
+        ``max_force``, ``displacement_at_max`` (quasi-static); ``markers12_dx`` ..
+        ``marker3_dz`` and ``marker0_dx`` .. ``marker0_dz`` [m] (identification).
     sessions : tuple of (str, int, float, float)
         Vibration only: session, number of tests, mean damping ratio, mean period [s].
     skipped : tuple of SkippedTrial
@@ -111,8 +123,8 @@ class Protocol(Generic[ResultT]):
     kind : str
         Kind of test, a key of the registry (one of `KINDS`).
     result_type : type
-        The class of the per-trial results (`DeploymentResult`, `VibrationResult` or
-        `PullTestResult`).
+        The class of the per-trial results (`DeploymentResult`, `VibrationResult`,
+        `PullTestResult` or `IdentificationResult`).
     analyze_trial : callable
         ``analyze_trial(trial, *, markers, **options) -> result``: the analysis of one trial.
     combine : callable
@@ -182,13 +194,15 @@ def protocol_for(kind: Literal["vibration"]) -> Protocol[VibrationResult]: ...
 @overload
 def protocol_for(kind: Literal["quasi-static"]) -> Protocol[PullTestResult]: ...
 @overload
+def protocol_for(kind: Literal["identification"]) -> Protocol[IdentificationResult]: ...
+@overload
 def protocol_for(kind: str) -> Protocol[Any]: ...
 def protocol_for(kind: str) -> Protocol[Any]:
     """The protocol of one kind of test.
 
     Parameters
     ----------
-    kind : {"deployment", "vibration", "quasi-static"}
+    kind : {"deployment", "vibration", "quasi-static", "identification"}
         Kind of test.
 
     Returns
@@ -255,6 +269,21 @@ def analyze_trials(
 @overload
 def analyze_trials(
     trials: Sequence[Trial],
+    kind: Literal["identification"],
+    *,
+    markers: Sequence[str] = ...,
+    n_peaks: int = ...,
+    window: tuple[float, float] = ...,
+    span: int = ...,
+    span_time: float | None = ...,
+    frame: str | np.ndarray | None = ...,
+    progress: bool = ...,
+    skip_bad: bool = ...,
+    skipped: Sequence[SkippedTrial] = ...,
+) -> TrialsAnalysis[IdentificationResult]: ...
+@overload
+def analyze_trials(
+    trials: Sequence[Trial],
     kind: str,
     *,
     markers: Sequence[str] = ...,
@@ -287,10 +316,12 @@ def analyze_trials(
     ----------
     trials : sequence of Trial
         The trials (at least one).
-    kind : {"deployment", "vibration", "quasi-static"}
+    kind : {"deployment", "vibration", "quasi-static", "identification"}
         Kind of test.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip).
+        Names of markers 1 (support), 2 (rod) and 3 (tip). Identification: markers 1-2 averaged,
+        and marker 0 (on the fixation support) is ``"M0"``
+        (`tapespring.protocols.identification.CONTROL_MARKER`).
     n_peaks : int
         Deployment: number of maxima and minima analysed, from 1 to `MAX_N_PEAKS` (1000).
     window : (float, float)
