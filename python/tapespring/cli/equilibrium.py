@@ -4,10 +4,20 @@ Sec. 5.1, Table 6)."""
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
+import functools
+from typing import TYPE_CHECKING, Any
 
 from .bend import _checked
-from .scenario_options import add_output_options, add_spec_options, finish, spec_from_args
+from .scenario_options import (
+    add_comparison_options,
+    add_output_options,
+    add_spec_options,
+    analyze_experiment,
+    finish,
+    spec_from_args,
+    with_comparison,
+    write_vtu,
+)
 
 if TYPE_CHECKING:
     from tapespring.scenarios.equilibrium import EquilibriumResult
@@ -25,7 +35,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description=(
             "The set-up with the additional weight sags under gravity; the weight's tip is "
             "pushed down past the buckling of the tapes; the folded equilibrium is where the "
-            "pushing force vanishes. Prints the marker displacements against Table 6."
+            "pushing force vanishes. Prints the marker displacements against Table 6; with "
+            "--experiment, against a recorded static identification test too, analysed as "
+            "'tapespring trials analyze --kind identification' does."
         ),
     )
     p.add_argument(
@@ -34,20 +46,59 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=EquilibriumSettings.push,
         help="push of the weight's tip [m]",
     )
+    add_comparison_options(
+        p,
+        experiment="a static identification test recorded from the unfolded equilibrium at "
+        "rest to the folded one at rest (markers M0 on the support, M1-M2 averaged, M3 on the "
+        "weight; each rest state the median over the first or last 0.5 s): its marker "
+        "displacements compared with the simulation's and the paper's model (Table 6)",
+        vtu="every state of the push path; the series' time is the path's load factor",
+    )
     add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False)  # static
     add_output_options(p, "push_m and force_N")
     p.set_defaults(func=run, parser=p)
     return p
 
 
+def _analyze_recording(trial: Any) -> Any:
+    """`analyze_identification` of `trial`, its warnings (marker 0 moved) printed as
+    ``warning: ...`` on stderr."""
+    import warnings
+
+    from tapespring.protocols.identification import analyze_identification
+
+    from .bend import print_warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = analyze_identification(trial)
+    print_warnings(caught)
+    return result
+
+
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring equilibrium``; returns the exit code (0, 1 stopped early or no
-    folded equilibrium on the push path, 2 bad input)."""
+    """Handler of ``tapespring equilibrium``; returns the exit code (0; 1 stopped early, no
+    folded equilibrium on the push path, or no comparison; 2 bad input or experiment file)."""
+    import sys
+
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
+    measured = None
+    if args.experiment:
+        measured = analyze_experiment(args.experiment, _analyze_recording)
+        if measured is None:
+            return 2
+    problems: list[str] = []
+
     def simulate() -> EquilibriumResult:
-        settings = EquilibriumSettings(spec=spec_from_args(args), push=args.push)
-        return equilibrium(settings, progress=not (args.no_progress or args.json))
+        settings = EquilibriumSettings(
+            spec=spec_from_args(args), push=args.push, field_interval=1 if args.vtu else 0
+        )
+        result = equilibrium(settings, progress=not (args.no_progress or args.json))
+        if measured is not None:
+            compare = functools.partial(result.compare, measured)
+            result = with_comparison(result, compare, args.experiment, problems)
+        return result
 
     def plot(result: EquilibriumResult, path: str) -> None:
         import matplotlib.pyplot as plt
@@ -71,8 +122,12 @@ def run(args: argparse.Namespace) -> int:
 
     def extra(result: EquilibriumResult) -> None:
         found.append(bool(result.found))
+        if result.setup is not None:
+            write_vtu(args, result.results, result.setup.model)
+        for problem in problems:
+            print(f"error: {problem}", file=sys.stderr)
 
     code = finish(args, simulate, columns, plot, extra=extra)
     # Asked for an equilibrium, the command fails when the push path has none (the summary says
-    # so; the path is still written).
-    return 1 if code == 0 and found == [False] else code
+    # so; the path is still written), or when the comparison asked for cannot be made.
+    return 1 if code == 0 and (found == [False] or problems) else code

@@ -12,13 +12,21 @@ reported (a static release of the push on this set-up has run into limit points 
 push vanished, and on a 3 mm mesh into a collapse: see the issue notes).
 
 Displacements are in absolute values, as in Tables 3 and 6, of markers 1-2 (their mean) and 3.
+
+Comparison with a recorded static identification test (Table 6): :meth:`EquilibriumResult.compare`
+analyses the recording with :func:`tapespring.protocols.identification.analyze_identification`
+(each marker's median position over the first and the last 0.5 s, the unfolded and the folded
+equilibrium at rest; markers 1 and 2 averaged; marker 0 on the support reported as the control
+point) and puts its displacements beside the simulation's and the paper's model
+(:class:`EquilibriumComparison`), with the differences relative to the experiment as Table 6's
+Delta.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,13 +36,32 @@ from tapespring.scenarios.setup import (
     SetupSpec,
     buckling_step,
     build_setup,
+    check_count,
     check_displacement,
     drive,
     gravity_step,
     raise_if_stopped,
 )
 
-__all__ = ["EquilibriumResult", "EquilibriumSettings", "check_push", "equilibrium"]
+if TYPE_CHECKING:
+    from tapespring.protocols.identification import IdentificationResult
+    from tapespring.trials.trial import Trial
+
+__all__ = [
+    "EquilibriumComparison",
+    "EquilibriumResult",
+    "EquilibriumSettings",
+    "check_push",
+    "equilibrium",
+]
+
+#: The displacements Table 6 compares: key (of the summaries, [m]), marker label, axis.
+TABLE6_ROWS = (
+    ("markers12_dx_m", "M. 1-2", "x"),
+    ("markers12_dz_m", "M. 1-2", "z"),
+    ("marker3_dx_m", "M. 3", "x"),
+    ("marker3_dz_m", "M. 3", "z"),
+)
 
 
 def check_push(value: object) -> None:
@@ -54,15 +81,123 @@ class EquilibriumSettings:
     push : float
         Downward displacement imposed on the weight's tip [m]: past the folded equilibrium
         (Table 6: marker 3 about 112 mm down).
+    field_interval : int
+        Keep the nodal displacements and rotations every `field_interval`-th state of the push
+        path, for ParaView series (0: none; the last state is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)
     push: float = 0.125
+    field_interval: int = 0
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         self.spec.validate()
         check_push(self.push)
+        check_count("field_interval", self.field_interval, minimum=0)
+
+
+def _relative(value: float, reference: float) -> float:
+    """``value / reference - 1`` [-] (NaN for a zero reference)."""
+    return value / reference - 1.0 if reference != 0.0 else float("nan")
+
+
+@dataclass(frozen=True)
+class EquilibriumComparison:
+    """A simulated folded equilibrium against a recorded static identification test (Table 6).
+
+    Differences are simulation minus experiment; relative ones are divided by the experiment's
+    value (Table 6's Delta, with its sign). The paper's model (Table 6's Num.) is set beside
+    both, with its own difference relative to this experiment.
+
+    Attributes
+    ----------
+    simulation_markers12_m, simulation_marker3_m : ndarray, shape (3,)
+        The simulation's absolute displacements (x, y, z) [m] of markers 1-2 (mean) and 3.
+    experiment : tapespring.protocols.identification.IdentificationResult
+        The recorded test's analysis (Table 3's figures, marker 0 included).
+    """
+
+    simulation_markers12_m: np.ndarray
+    simulation_marker3_m: np.ndarray
+    experiment: IdentificationResult
+
+    def simulation_figures(self) -> dict[str, float]:
+        """The simulation's displacements [m]: ``markers12_dx_m`` .. ``marker3_dz_m`` (x, y,
+        z)."""
+        out = {}
+        for prefix, values in (
+            ("markers12", self.simulation_markers12_m),
+            ("marker3", self.simulation_marker3_m),
+        ):
+            for i, axis in enumerate("xyz"):
+                out[f"{prefix}_d{axis}_m"] = float(values[i])
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready figures [m]: ``trial``; ``simulation`` (markers 1-2 and 3, x, y, z);
+        ``paper_model`` (Table 6's Num., x and z); ``experiment`` (Table 3's figures, marker 0's
+        too, ``control_moved``, the rest windows); ``difference`` (simulation minus experiment
+        along x and z [m], ``..._m``, and relative to the experiment [-], ``..._relative``:
+        Table 6's Delta); ``paper_model_difference`` (the paper's model relative to this
+        experiment [-])."""
+        sim = self.simulation_figures()
+        paper = _paper_table6()
+        exp = self.experiment.summary()
+        difference: dict[str, float] = {}
+        paper_difference: dict[str, float] = {}
+        for key, _, _ in TABLE6_ROWS:
+            stem = key.removesuffix("_m")
+            difference[key] = sim[key] - exp[key]
+            difference[f"{stem}_relative"] = _relative(sim[key], exp[key])
+            paper_difference[f"{stem}_relative"] = _relative(paper[key], exp[key])
+        experiment = {k: v for k, v in exp.items() if k != "name"}
+        return {
+            "trial": self.experiment.name,
+            "simulation": sim,
+            "paper_model": paper,
+            "experiment": experiment,
+            "difference": difference,
+            "paper_model_difference": paper_difference,
+        }
+
+    def table(self) -> str:
+        """Table 6's layout: for markers 1-2 and 3, x and z, the experiment (Exp.), this
+        simulation (Num.) and its difference relative to the experiment (Delta [%]), then the
+        paper's model and its Delta against the same experiment; marker 0 (the control point)
+        below."""
+        s = self.summary()
+        header = (
+            f"  {'':12}{'Exp. [mm]':>11}{'Num. [mm]':>11}{'Delta [%]':>11}"
+            f"{'paper Num. [mm]':>17}{'paper Delta [%]':>17}"
+        )
+        lines = [f"static identification test against {s['trial']} (Table 6)", header]
+        for key, marker, axis in TABLE6_ROWS:
+            stem = key.removesuffix("_m")
+            lines.append(
+                f"  {marker:8}{axis:4}{s['experiment'][key] * 1e3:11.1f}"
+                f"{s['simulation'][key] * 1e3:11.1f}"
+                f"{100 * s['difference'][f'{stem}_relative']:+11.1f}"
+                f"{s['paper_model'][key] * 1e3:17.1f}"
+                f"{100 * s['paper_model_difference'][f'{stem}_relative']:+17.1f}"
+            )
+        e = self.experiment
+        if e.control_m is not None:
+            shown = ", ".join(f"{v * 1e3:.1f}" for v in e.control_m)
+            moved = " (moved: check the support)" if e.control_moved else ""
+            lines.append(f"  marker 0 (control point): ({shown}) mm along (x, y, z){moved}")
+        return "\n".join(lines)
+
+
+def _paper_table6() -> dict[str, float]:
+    """Table 6's Num. column [m] (`PAPER_MODEL`)."""
+    p = PAPER_MODEL
+    return {
+        "markers12_dx_m": p.markers12_dx,
+        "markers12_dz_m": p.markers12_dz,
+        "marker3_dx_m": p.marker3_dx,
+        "marker3_dz_m": p.marker3_dz,
+    }
 
 
 @dataclass(frozen=True)
@@ -84,6 +219,12 @@ class EquilibriumResult:
     settings : EquilibriumSettings
     results : tapespring.Results
     wall_s : float
+        Wall time [s].
+    setup : SetupModel or None
+        The built set-up (its model, for ParaView series).
+    comparison : EquilibriumComparison or None
+        The comparison with a recorded static identification test (:meth:`compare`), if one
+        was given.
     """
 
     found: bool
@@ -95,16 +236,67 @@ class EquilibriumResult:
     settings: EquilibriumSettings
     results: Any
     wall_s: float
+    setup: Any = None
+    comparison: EquilibriumComparison | None = None
+
+    def compare(
+        self,
+        trial: Trial | IdentificationResult,
+        *,
+        markers: tuple[str, str, str] = ("M1", "M2", "M3"),
+        control: str | None = "M0",
+        rest: float = 0.5,
+    ) -> EquilibriumComparison:
+        """The marker displacements against a recorded static identification test (Table 6).
+
+        Parameters
+        ----------
+        trial : tapespring.trials.Trial or IdentificationResult
+            The recording (from the unfolded equilibrium at rest to the folded one at rest), or
+            its analysis.
+        markers : (str, str, str)
+            Names of markers 1, 2 (averaged) and 3 in the recording.
+        control : str or None
+            Name of marker 0, on the fixation support (None: not analysed).
+        rest : float
+            Length of the rest windows at either end of the recording [s].
+
+        Returns
+        -------
+        EquilibriumComparison
+
+        Raises
+        ------
+        ValueError
+            If this run found no folded equilibrium; a `tapespring.trials.TrialError` (a
+            ValueError) if the recording cannot be analysed
+            (:func:`tapespring.protocols.identification.analyze_identification`).
+        """
+        from tapespring.protocols.identification import (
+            IdentificationResult,
+            analyze_identification,
+        )
+
+        if isinstance(trial, IdentificationResult):
+            measured = trial
+        else:
+            measured = analyze_identification(trial, markers=markers, control=control, rest=rest)
+        if not self.found:
+            raise ValueError(
+                "the simulation found no folded equilibrium on the push path (push further): "
+                "nothing to compare with"
+            )
+        return EquilibriumComparison(
+            simulation_markers12_m=np.array(self.markers12_m, dtype=float),
+            simulation_marker3_m=np.array(self.marker3_m, dtype=float),
+            experiment=measured,
+        )
 
     def summary(self) -> dict[str, Any]:
-        """The figures as JSON-ready values, with Table 6 beside them."""
-        p = PAPER_MODEL
-        paper = {
-            "markers12_dx_m": p.markers12_dx,
-            "markers12_dz_m": p.markers12_dz,
-            "marker3_dx_m": p.marker3_dx,
-            "marker3_dz_m": p.marker3_dz,
-        }
+        """The figures as JSON-ready values [m, N, s], with Table 6 beside them and the
+        comparison with a recording (``comparison``: :meth:`EquilibriumComparison.summary`, or
+        None)."""
+        paper = _paper_table6()
         ours = {
             "markers12_dx_m": float(self.markers12_m[0]),
             "markers12_dz_m": float(self.markers12_m[2]),
@@ -124,6 +316,7 @@ class EquilibriumResult:
             "newton_iterations": int(r.stats.get("iterations", 0)),
             "wall_s": self.wall_s,
             "settings": asdict(self.settings),
+            "comparison": None if self.comparison is None else self.comparison.summary(),
         }
 
     def describe(self) -> str:
@@ -153,6 +346,8 @@ class EquilibriumResult:
             )
         stable = "stable" if self.unstable_modes == 0 else f"{self.unstable_modes} unstable mode(s)"
         lines.append(f"  the equilibrium under the weight: {stable}")
+        if self.comparison is not None:
+            lines += ["", self.comparison.table()]
         return "\n".join(lines)
 
 
@@ -176,7 +371,7 @@ def equilibrium(
     model, tip = built.model, built.tip_node
     drive(model, tip, "uz", built.down * settings.push, "push")
     steps = [gravity_step(), buckling_step("push", activate=("push",))]
-    outputs = Outputs(reactions=((tip, "uz"),))
+    outputs = Outputs(reactions=((tip, "uz"),), field_interval=settings.field_interval)
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
     names = results.marker_names
     gravity = results.in_step(0)
@@ -219,6 +414,7 @@ def equilibrium(
         settings=settings,
         results=results,
         wall_s=time.perf_counter() - start,
+        setup=built,
     )
     raise_if_stopped(results, out, "push")
     return out
