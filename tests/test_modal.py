@@ -1,6 +1,7 @@
 """Modal steps from Python: the native eigensolver against SciPy's on the exported matrices, at a
 deformed, pre-stressed state; rigid-body modes and effective masses of a free plate; the free-DOF
-matrices; results saved and loaded with their modes."""
+matrices; results saved and loaded with their modes; the first modal period against a transient
+free decay's, fitted with the project's damping fit."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from tapespring.analysis import (
 from tapespring.modes import auto_shift, modal_scipy
 from tapespring.results import Results
 from tapespring.shell import flat_plate_mesh
+from tapespring.signals import fit_damping
 
 E, RHO, L, B, T = 2e11, 7850.0, 0.2, 0.02, 2e-3
 
@@ -167,3 +169,53 @@ def test_results_with_modes_round_trip(tmp_path):
     assert a.matrices is not None and b.matrices is not None
     assert abs(a.matrices.stiffness - b.matrices.stiffness).max() == 0.0
     np.testing.assert_array_equal(a.matrices.free_dofs, b.matrices.free_dofs)
+
+
+def test_free_decay_fitted_period_is_the_modal_period():
+    """Issue 8, 6.d: the period of a transient free decay, fitted with the project's damping fit
+    (`tapespring.signals.fit_damping`: the paper's eqs. 5-6 on the peaks), and the first modal
+    period agree within 0.5 %. The cantilever strip (nu = 0) with eta = 7.8e-5 s, a damping
+    ratio eta omega / 2 of 1 % (the higher modes, damped in proportion to their frequency, soon
+    leave the peaks alone), pushed at its tip by 0.15 N (0.15 mm) and released: six periods at
+    fixed steps of a hundredth of the modal period, rho_inf = 0.7."""
+    nodes, quads, sets = flat_plate_mesh(L, B, 16, 2)
+    section = {"thickness": T, "youngs_modulus": E, "poisson": 0.0, "density": RHO}
+    model = Model(nodes, quads, node_sets=sets, eta=7.8e-5, **section)
+    model.fix("x0", "all")
+    for n in sets["x1"]:
+        model.add_load(int(n), "uz", -0.05, id="push", active=False)
+    model.add_marker("tip", model.nearest_node([L, B / 2, 0.0]))
+    period = run(model, [Step.modal("unloaded", modes=1)]).periods_s[0][0]  # 24.555 ms
+    h = period / 100.0
+    steps = [
+        Step.modal("unloaded", modes=1),
+        Step.static("push", activate=["push"], increments=1),
+        Step.dynamic(
+            "release",
+            duration=6.0 * period,
+            deactivate=["push"],
+            adaptive=False,
+            initial_step=h,
+            max_step=h,
+        ),
+    ]
+    results = run(model, steps)
+    assert results.error is None
+    assert results.periods_s[0][0] == period
+    free = results.in_step(2)
+    record = np.concatenate([[free[0] - 1], free])  # from the release
+    t, z = results.t[record], results.marker("tip")[record, 2]
+    amplitude = abs(z[0])
+    fit = fit_damping(t, z, window=(0.2 * amplitude, 1.5 * amplitude))
+    assert fit.success and fit.n_peaks >= 10
+    # A free decay indeed: its damping ratio is eta omega / 2 (measured -1.1 %; issue's 3 %).
+    assert fit.damping_ratio == pytest.approx(7.8e-5 * math.pi / period, rel=0.03)
+    # Measured: +0.016 % (the damped period, 2 pi / omega_d; the undamped 2 pi / omega0, which
+    # the modal period is, +0.011 %; they differ by zeta^2 / 2 = 5e-5), with a standard error of
+    # 0.027 % from the peaks' scatter. The scheme's period error at omega h = 0.063 is of that
+    # order (+0.16 % at 50 steps per period, -0.025 % at 200: the fit's scatter dominates there).
+    # Bound: the issue's 0.5 %. Undamped (eta = 0) the same fit is -0.18 % off with a standard
+    # error of 0.32 %, the higher modes shifting the peaks; with the solver's adaptive steps at
+    # its default tolerance, +1.3 % (20 steps per period).
+    assert fit.period == pytest.approx(period, rel=0.005)
+    assert fit.period_std < 0.001 * period
