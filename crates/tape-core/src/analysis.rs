@@ -589,6 +589,7 @@ pub fn run(
                 records,
             })
         };
+        let mut start_probes = None;
         let (records, mut stats, cancelled, error) = match &step.kind {
             StepKind::Static(p) => {
                 let mut params = p.clone();
@@ -604,10 +605,20 @@ pub fn run(
                     apply_initial_velocities(model, &mut state);
                 }
                 let path = solve_dynamic(&mut system, &mut state, &params, &mut cb).map_err(|e| e.context(&context))?;
+                start_probes = Some(path.start_probes);
                 (path.steps, path.stats, path.cancelled, path.error)
             }
             StepKind::Modal(_) => unreachable!("modal steps are handled above"),
         };
+        // The initial record of a run that starts moving: its reactions with the inertia of the
+        // consistent accelerations (assembled statically they missed it: a pendulum released
+        // swinging showed its weight where its pin felt the centripetal pull).
+        if let (0, Some(p)) = (k, start_probes) {
+            let n = history.reaction_dofs.len();
+            if p.len() == n && history.reactions.len() >= n {
+                history.reactions[..n].copy_from_slice(&p);
+            }
+        }
         stats.symbolic_analyses = std::mem::take(&mut symbolic);
         log::info!(
             "{context}: {} increments ({} cut back), {} Newton iterations, {} factorisations, {} DOFs, \

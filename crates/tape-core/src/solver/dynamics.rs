@@ -369,6 +369,9 @@ pub struct DynamicPath {
     pub stats: Stats,
     /// True if the progress callback asked to stop.
     pub cancelled: bool,
+    /// The recorded reactions ([`System::probe`]) at the step's start, with the inertia of the
+    /// consistent accelerations: what the supports feel as the step begins.
+    pub start_probes: Vec<f64>,
 }
 
 /// Per-node GA quantities: translation and body rotation.
@@ -1032,6 +1035,7 @@ pub fn solve_dynamic(
         .system
         .assemble_dynamic(state, &rates, None, &mut integ.asm);
     integ.add_inertia(state, state, h, false);
+    path.start_probes = integ.system.probe(&integ.asm);
     let mut last = Energies::of(&integ, state);
     let mut last_work = integ.system.viscous_work().to_vec();
     let mech0 = last.kinetic + last.strain + last.gravity;
