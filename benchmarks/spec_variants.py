@@ -35,6 +35,7 @@ import sys
 import time
 from dataclasses import replace
 
+from tapespring.cli.scenario_options import spec_assignment, with_spec_assignments
 from tapespring.scenarios.deployment import DeploymentSettings, deploy
 from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 from tapespring.scenarios.pull import PullSettings, pull
@@ -133,17 +134,23 @@ def run_tests(name: str, spec: SetupSpec, tests: list[str], etas: list[float]) -
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--variant", choices=sorted(VARIANTS), nargs="+", default=[])
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a field")
+    p.add_argument(
+        "--set",
+        type=spec_assignment,
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a field (tape.NAME for the tape's), as the commands' --spec",
+    )
     p.add_argument("--tests", choices=TESTS, nargs="+", default=["equal"])
     p.add_argument("--eta", type=float, nargs="+", default=[1.73e-4, 2.1e-4], help="[s]")
     args = p.parse_args()
-    variants = {name: VARIANTS[name] for name in args.variant}
+    variants = {name: list(VARIANTS[name].items()) for name in args.variant}
     if args.set:
-        fields = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
-        variants[" ".join(args.set)] = fields
+        variants[" ".join(f"{k}={v}" for k, v in args.set)] = args.set
     passed = True
-    for name, fields in (variants or {"spec": {}}).items():
-        spec = replace(PAPER_SETUP, **fields)
+    for name, fields in (variants or {"spec": []}).items():
+        spec = with_spec_assignments(PAPER_SETUP, fields)
         spec.validate()
         passed = run_tests(name, spec, args.tests, args.eta) and passed
     if not passed:

@@ -23,6 +23,7 @@ from .scenario_options import (
     finish,
     spec_from_args,
     with_comparison,
+    with_spec_assignments,
 )
 
 if TYPE_CHECKING:
@@ -151,7 +152,8 @@ def run(args: argparse.Namespace) -> int:
             FLEXIBLE_SAMPLE_RATE if args.support == "flexible" else DeploymentSettings.sample_rate
         )
     settings = DeploymentSettings(
-        spec=replace(spec_from_args(args), support=args.support),
+        # --support, then --spec's assignments (which override the options, support included).
+        spec=with_spec_assignments(replace(spec_from_args(args), support=args.support), args.spec),
         sense=args.sense,
         sample_rate=rate,
         duration=args.duration,

@@ -29,8 +29,10 @@ __all__ = [
     "add_youngs_modulus_option",
     "analyze_experiment",
     "finish",
+    "spec_assignment",
     "spec_from_args",
     "with_comparison",
+    "with_spec_assignments",
     "write_vtu",
 ]
 
@@ -68,6 +70,64 @@ def add_spec_options(
     add_youngs_modulus_option(g, s.tape.youngs_modulus, name="tape.youngs_modulus")
     if eta:
         add_eta_option(g, s.eta)
+    g.add_argument(
+        "--spec",
+        type=spec_assignment,
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="any field of the set-up's spec (SetupSpec, in SI units; tape.NAME for the tape's, "
+        "e.g. --spec appendix_mass=0.018 --spec tape.length=0.12; a tuple's values separated by "
+        "commas); repeatable; it overrides the options above",
+    )
+
+
+def spec_assignment(text: str) -> tuple[str, Any]:
+    """``(name, value)`` of a ``NAME=VALUE`` assignment of a :class:`SetupSpec` field (or
+    ``tape.NAME`` of its :class:`TapeSpring`), the value converted to the field's type; the
+    value's range is checked with the whole spec (``SetupSpec.validate``).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        For a text without ``=``, an unknown field, or a value of the wrong type.
+    """
+    from dataclasses import fields
+
+    from tapespring.scenarios.setup import SetupSpec, TapeSpring
+
+    name, sep, value = (part.strip() for part in text.partition("="))
+    if not sep or not name:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    owner, field = (TapeSpring, name[5:]) if name.startswith("tape.") else (SetupSpec, name)
+    types = {f.name: str(f.type) for f in fields(owner)}
+    if field not in types or types[field] == "TapeSpring":
+        known = [f"tape.{n}" for n in (f.name for f in fields(TapeSpring))] + [
+            n for n, t in ((f.name, str(f.type)) for f in fields(SetupSpec)) if t != "TapeSpring"
+        ]
+        raise argparse.ArgumentTypeError(
+            f"unknown set-up field {name!r}; the fields are {', '.join(known)}"
+        )
+    kind = types[field]
+    try:
+        if kind == "str":
+            return name, value
+        if kind.startswith("tuple"):
+            return name, tuple(float(v) for v in value.split(","))
+        return name, float(value)
+    except ValueError:
+        expected = "numbers separated by commas" if kind.startswith("tuple") else "a number"
+        raise argparse.ArgumentTypeError(f"{name} must be {expected} (got {value!r})") from None
+
+
+def with_spec_assignments(spec: Any, assignments: Sequence[tuple[str, Any]]) -> Any:
+    """`spec` (a :class:`SetupSpec`) with `assignments` from :func:`spec_assignment` applied in
+    order (``tape.NAME`` to its tape)."""
+    from dataclasses import replace
+
+    tape = {n[5:]: v for n, v in assignments if n.startswith("tape.")}
+    own = {n: v for n, v in assignments if not n.startswith("tape.")}
+    return replace(spec, tape=replace(spec.tape, **tape), **own)
 
 
 # Each option below is checked by the settings' own check of its field, named `name` where the
@@ -167,13 +227,14 @@ def spec_from_args(args: argparse.Namespace) -> Any:
     from tapespring.scenarios.setup import PAPER_SETUP
 
     tape = replace(PAPER_SETUP.tape, thickness=args.thickness, youngs_modulus=args.youngs_modulus)
-    return replace(
+    spec = replace(
         PAPER_SETUP,
         tape=tape,
         eta=getattr(args, "eta", PAPER_SETUP.eta),
         mesh_tape=args.mesh_tape,
         mesh_plates=args.mesh_plates,
     )
+    return with_spec_assignments(spec, getattr(args, "spec", []))
 
 
 def add_sample_rate_option(p: argparse.ArgumentParser, *, recorded: str, default: str) -> None:
