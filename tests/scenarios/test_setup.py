@@ -80,6 +80,31 @@ def test_builder_puts_every_mass_in_the_model(configuration: str) -> None:
     assert len(built.model.rigid_bodies) == 2 + (configuration == "weight")
 
 
+@pytest.mark.parametrize("configuration", ["appendix", "weight"])
+@pytest.mark.parametrize("sense", ["opposite", "equal"])
+def test_markers_sit_where_the_spec_puts_them(configuration: str, sense: str) -> None:
+    # Sec. 3 / Fig. 10 of the paper: marker 0 on the support, marker 1 on a small interface,
+    # marker 2 in the middle of the rod, marker 3 at the tip of the appendix (or of the additional
+    # weight); 1-3 on the laboratory's upper side, -z in the upturned equal-sense block. Read at
+    # the reference state (record 0 of a run), in the set-up's frame.
+    from tapespring.analysis import Step, run
+
+    s = COARSE
+    built = build_setup(s, configuration=configuration, sense=sense)
+    r = run(built.model, [Step.static("rest", control="load", increments=1)])
+    at = dict(zip(r.marker_names, r.marker_positions[0], strict=True))
+    up = -built.down * s.marker_height
+    tip = s.setup_length if configuration == "appendix" else s.appendix_x + s.weight_length
+    expected = {
+        "marker0": s.support_marker,
+        "marker1": (s.tape.length + s.interface_length / 2.0, -s.tape_spacing / 2.0, up),
+        "marker2": (s.rod_x + s.rod_width / 2.0, 0.0, up),
+        "marker3": (tip, 0.0, up),
+    }
+    for name, position in expected.items():
+        np.testing.assert_allclose(at[name], position, atol=1e-12, err_msg=name)
+
+
 def test_equal_sense_turns_gravity_and_markers_over() -> None:
     up = build_setup(COARSE, configuration="bare", sense="opposite")
     down = build_setup(COARSE, configuration="bare", sense="equal")
