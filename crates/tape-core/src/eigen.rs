@@ -107,18 +107,31 @@ pub struct Eigenpairs {
 }
 
 /// Block iterations without the worst residual of the wanted pairs halving after which the
-/// iteration is given up as stalled. It stalls where the wanted pairs end inside a cluster of
-/// nearly equal eigenvalues wider than the basis: the Ritz vectors there stay mixtures of the
-/// cluster's eigenvectors. Measured on a shell roof whose drilling rotations give 60 modes within
-/// 0.03 % of one another above its five lowest: the sixth mode's residual stayed at 2e-4 for 1000
-/// iterations (a thousand times the tolerance), where converging pairs halve theirs in a few.
-pub const STALL_ITERATIONS: usize = 100;
+/// iteration is given up as stalled, if that residual is still above [`STALL_RESIDUAL`] times
+/// the tolerance. It stalls where the wanted pairs end inside a cluster of nearly equal
+/// eigenvalues wider than the basis: the Ritz vectors there stay mixtures of the cluster's
+/// eigenvectors. Measured on a shell roof whose drilling rotations give 60 modes within 0.03 % of
+/// one another above its five lowest: asking for 6 to 47 modes, the residuals stayed at 2e-4 to
+/// 5e-4, 2e4 to 5e4 times the tolerance, for the 1000 iterations. Pairs that do converge, slowly,
+/// can take hundreds of iterations with residuals far above the tolerance: a clamped strip's 45
+/// lowest modes, which end at the edge of its drilling cluster, converge in 432 iterations, and
+/// 100 iterations and 100 times the tolerance took them for a stall.
+pub const STALL_ITERATIONS: usize = 300;
+
+/// The worst residual of the wanted pairs, over the tolerance, above which a lack of progress
+/// counts as a stall ([`STALL_ITERATIONS`]).
+pub const STALL_RESIDUAL: f64 = 1e4;
+
+/// Relative distance from the stalled eigenvalue beyond which a converged pair is reported as
+/// usable ([`Stalled::usable`]): outside the cluster (the roof's spans 3e-4, a strip's 3e-3).
+pub const CLUSTER_GAP: f64 = 1e-2;
 
 /// A stalled iteration ([`Eigenpairs::stalled`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stalled {
-    /// Wanted pairs that had converged, nearest the shift first without a gap.
-    pub converged: usize,
+    /// Wanted pairs, nearest the shift first, that had converged and lie farther than
+    /// [`CLUSTER_GAP`] from the stalled eigenvalue: as many as can be asked for.
+    pub usable: usize,
     /// Ritz value of the first pair that had not, in the units of the eigenvalues.
     pub value: f64,
     /// Its relative residual.
@@ -271,8 +284,8 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
     };
     let mut pending: Vec<Vec<f64>> = (0..b).map(|_| rng.vector(n)).collect();
     let tol = params.tolerance;
-    // The smallest worst residual of the wanted pairs so far, and the iteration that halved it.
-    let mut progress = (f64::INFINITY, 0);
+    // The worst residual of the wanted pairs at each iteration since the last (re)start.
+    let mut worst_so_far: Vec<f64> = Vec::new();
     loop {
         out.iterations += 1;
         if out.iterations > params.max_iterations {
@@ -283,7 +296,10 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
                 iterations: out.iterations - 1,
                 residual: f64::NAN,
                 detail: format!(
-                    "the eigensolver did not converge in {} block iterations ({} eigenpairs wanted)",
+                    "the eigensolver did not converge in {} block iterations ({} eigenpairs \
+                     wanted; the wanted ones likely end inside a cluster of nearly equal \
+                     eigenvalues: ask for fewer, or for enough to cover the cluster, or for a \
+                     looser tolerance)",
                     params.max_iterations, target
                 ),
             });
@@ -328,18 +344,30 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
             converged &= k >= target || res <= tol || m == n;
         }
         if !converged {
-            let worst = residuals.iter().copied().fold(0.0, f64::max);
-            if worst <= 0.5 * progress.0 {
-                progress = (worst, out.iterations);
-            } else if residuals.len() == target && out.iterations - progress.1 >= STALL_ITERATIONS {
-                let converged = residuals.iter().take_while(|&&r| r <= tol).count();
-                let (theta, _) = &pairs[converged];
-                out.stalled = Some(Stalled {
-                    converged,
-                    value: sigma + 1.0 / theta,
-                    residual: residuals[converged],
-                });
-                return Ok(out);
+            if residuals.len() == target {
+                let worst = residuals.iter().copied().fold(0.0, f64::max);
+                worst_so_far.push(worst);
+                let k = worst_so_far.len();
+                if k > STALL_ITERATIONS
+                    && worst > STALL_RESIDUAL * tol
+                    && worst > 0.5 * worst_so_far[k - 1 - STALL_ITERATIONS]
+                {
+                    let first = residuals.iter().position(|&r| r > tol).unwrap_or(0);
+                    let value = sigma + 1.0 / pairs[first].0;
+                    let usable = pairs
+                        .iter()
+                        .zip(&residuals)
+                        .take_while(|((theta, _), &r)| {
+                            r <= tol && ((sigma + 1.0 / theta) - value).abs() > CLUSTER_GAP * value.abs()
+                        })
+                        .count();
+                    out.stalled = Some(Stalled {
+                        usable,
+                        value,
+                        residual: residuals[first],
+                    });
+                    return Ok(out);
+                }
             }
             // Thick restart: keep the best Ritz vectors when the basis is full.
             let limit = max_basis(target);
@@ -401,7 +429,7 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
         log::debug!("eigensolver: Sturm count {inside} within {span:e} of the shift, {target} found: restarting");
         out.sturm_restarts += 1;
         target = inside.min(n);
-        progress = (f64::INFINITY, out.iterations);
+        worst_so_far.clear();
         pencil.factorize(sigma)?;
         out.factorisations += 1;
         // The basis was built with the factorisation at sigma: `A V` is still valid.
@@ -591,14 +619,17 @@ mod tests {
         check(&p, &found, &[1.0, 1.0, 4.0, 9.0]);
     }
 
-    /// Five separated eigenvalues below a cluster of 60 within 0.03 % of one another (the
-    /// spectrum of a shell whose drilling modes lie above its lowest ones): the five are found,
-    /// and asking for six stalls instead of running to the iteration limit.
+    /// Five separated eigenvalues below a cluster of 60 within 0.06 % of one another: the
+    /// spectrum of the 8 x 8 hinged roof of `modal_analysis.rs` (its drilling modes span 5e-4 in
+    /// eigenvalue). The five are found, and asking for six stalls instead of running to the
+    /// iteration limit. (The stall test is a heuristic: with the cluster twice as narrow the
+    /// residuals stay below `STALL_RESIDUAL` times the tolerance and the limit is reached, twice
+    /// as wide the sixth converges.)
     #[test]
     fn a_wanted_pair_inside_a_wide_cluster_stalls() {
         let mut lambda = vec![1.0, 2.8, 11.8, 21.4, 25.9];
         #[allow(clippy::cast_precision_loss)]
-        lambda.extend((0..60).map(|i| 62.2 * (1.0 + 3e-4 * f64::from(i) / 60.0)));
+        lambda.extend((0..60).map(|i| 62.2 * (1.0 + 6e-4 * f64::from(i) / 60.0)));
         lambda.extend((0..60).map(|i| 200.0 + f64::from(i)));
         let params = |count| EigenParams {
             count,
@@ -612,10 +643,14 @@ mod tests {
         let mut p = pencil(&lambda, 13);
         let found = eigenpairs_near(&mut p, &params(6)).expect("a stalled result");
         let st = found.stalled.expect("stalled");
-        assert_eq!(st.converged, 5);
+        assert_eq!(st.usable, 5);
         assert!((st.value - 62.2).abs() < 0.1, "stalled near {}", st.value);
         assert!(found.values.is_empty());
-        assert!(found.iterations < 300, "{} iterations", found.iterations);
+        assert!(
+            found.iterations < STALL_ITERATIONS + 100,
+            "{} iterations",
+            found.iterations
+        );
     }
 
     #[test]

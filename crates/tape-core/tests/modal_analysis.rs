@@ -309,8 +309,24 @@ fn modes_beyond_the_drilling_cluster_are_refused_with_the_count_that_converges()
     let result = run(&model, &[modal(6)], &Outputs::default(), &mut |_| true)?;
     let err = result.error.expect("six modes are refused").to_string();
     eprintln!("{err}");
-    assert!(err.contains("stalled") && err.contains("5 of the 6 modes"), "{err}");
-    assert!(err.contains("near 777."), "{err}");
+    assert!(err.contains("stalled") && err.contains("near 777."), "{err}");
     assert!(err.contains("at most 5 modes"), "{err}");
+    Ok(())
+}
+
+/// Modes that converge slowly, near the tolerance, are not taken for a stall: the clamped steel
+/// strip (16 x 2, nu = 0.3) has its drilling cluster, about 45 modes, at 6.89 to 6.90 kHz, and
+/// asking for 46 modes ends at its edge, where the residuals stay within ten times the tolerance
+/// for hundreds of iterations before converging (measured by the review of the stall test: 214
+/// iterations; an earlier stall test refused it). Asking for 70 covers the cluster.
+#[test]
+fn slowly_converging_modes_at_a_clusters_edge_are_found() -> Result<()> {
+    let model = strip::clamped(0.2, 0.3, 0.0)?;
+    for count in [46, 70] {
+        let history = modes_of(&model, &[modal(count)])?;
+        let f = &history.modes[0].frequencies_hz;
+        assert_eq!(f.len(), count);
+        assert!(f[f.len() - 1] > 6800.0, "{count} modes up to {} Hz", f[f.len() - 1]);
+    }
     Ok(())
 }
