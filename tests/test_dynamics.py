@@ -230,6 +230,23 @@ def test_the_pin_of_a_swinging_body_feels_its_inertia():
         assert reaction[record, 2] == pytest.approx(m * g * j / i_pin, rel=1e-6)
 
 
+@pytest.mark.parametrize("modal_first", [False, True])
+def test_record_0_holds_the_inertia_of_the_first_moving_step(modal_first):
+    # A pendulum hanging from its pin (2 kg, 0.5 m below it) and swinging at 3 rad/s: at t = 0
+    # the pin pulls m g + m w^2 r = 28.62 N up, not the weight alone (19.62 N, which record 0
+    # showed when assembled statically, and still showed after a modal step, which records no
+    # state, when only a first step's start was patched). Gravity's load stiffness makes the
+    # hanging pendulum's modal step well posed.
+    m, r, j, g, w = 2.0, 0.5, 0.01, 9.81, 3.0
+    model, pin = body_on_a_pin(m, [0.0, 0.0, -r], np.eye(3) * j)
+    model.set_gravity([0.0, 0.0, -g], function="constant")
+    model.set_initial_velocity(pin, angular_velocity=[0.0, w, 0.0])
+    swing = Step.dynamic("swing", duration=0.01, adaptive=False, initial_step=1e-3, max_step=1e-3)
+    steps = [Step.modal("modes", modes=1), swing] if modal_first else [swing]
+    res = run(model, steps, outputs=Outputs(reactions=[(pin, "uz")]))
+    assert res.reaction(pin, "uz")[0] == pytest.approx(m * g + m * w**2 * r, rel=1e-9)
+
+
 def test_the_pin_of_the_heavy_top_feels_the_centre_of_mass_acceleration():
     # The heavy top of issue 8, 6.b (Bruls, Cardona & Arnold 2012: 15 kg, J = diag(0.234375,
     # 0.46875, 0.234375) kg m^2 about the centre of mass 1 m from the pin, spun at (0, 150,

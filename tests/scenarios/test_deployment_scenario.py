@@ -151,7 +151,7 @@ def test_summary_text_says_which_phases_were_found(opposite: DeploymentSimulatio
         expected = f"{label} not detected" if start is None else f"{label} from {start:.2f} s"
         assert expected in line
     # On the fixture's 5 mm mesh no second fold forms (docs/scenarios.md): no phase II.
-    assert "II not detected" in line
+    assert "phases: II not detected" in line
 
 
 def test_bad_settings_are_named() -> None:

@@ -610,10 +610,11 @@ pub fn run(
             }
             StepKind::Modal(_) => unreachable!("modal steps are handled above"),
         };
-        // The initial record of a run that starts moving: its reactions with the inertia of the
-        // consistent accelerations (assembled statically they missed it: a pendulum released
-        // swinging showed its weight where its pin felt the centripetal pull).
-        if let (0, Some(p)) = (k, start_probes) {
+        // The initial record of a run that starts moving (no step before this one recorded a
+        // state: none, or modal ones): its reactions with the inertia of the consistent
+        // accelerations (assembled statically they missed it: a pendulum released swinging
+        // showed its weight where its pin felt the centripetal pull).
+        if let (1, Some(p)) = (history.len(), start_probes) {
             let n = history.reaction_dofs.len();
             if p.len() == n && history.reactions.len() >= n {
                 history.reactions[..n].copy_from_slice(&p);
