@@ -89,8 +89,10 @@ def test_per_record_costs_add_up_to_the_step_stats():
     # consistent accelerations) and after the last record.
     assert r.wall_s[free].sum() <= stats["wall_s"]
     assert r.wall_s[free].sum() > 0.5 * stats["wall_s"]
-    # Assembly and solver times are disjoint parts of the step's wall time (an assembly done to
-    # build a fresh iteration matrix was once counted in both).
+    # Assembly and solver times are disjoint parts of the step's wall time. (An assembly done to
+    # build a fresh iteration matrix was once counted in both: the 10 s deployment reported 53 s
+    # and 58.5 s in 102 s. On this small strip other costs leave room, so this is a statement
+    # of the definition more than a test of that fix.)
     assert stats["assembly_s"] + stats["solve_s"] <= stats["wall_s"]
 
 
