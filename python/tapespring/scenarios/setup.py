@@ -1577,8 +1577,9 @@ def dynamic_options(rho_inf: float, sample_rate: float, tolerance: float) -> dic
     slowly and costs more factorisations (measured with the earlier mass split: the first second
     of the opposite-sense deployment on 5 mm 15.9 s instead of 17.9 s, 3422 factorisations instead
     of 4059; 0.3 s of the vibration decay on the paper's meshes 5.0 s instead of 6.7 s; the
-    single tape released with a tip body, `tapespring release`, uses it too). Long fixed steps
-    (the numerical damping study's 5 ms) are the other way round, and keep the default.
+    single tape released with a tip body, `tapespring release`, uses it too when damped). Long
+    fixed steps (the numerical damping study's 5 ms) and the undamped release are the other way
+    round, and keep the default.
     """
     options: dict[str, Any] = {
         "rho_inf": rho_inf,
