@@ -284,6 +284,8 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
     };
     let mut pending: Vec<Vec<f64>> = (0..b).map(|_| rng.vector(n)).collect();
     let tol = params.tolerance;
+    // The eigenvalue of a Ritz value of the shift-inverted operator.
+    let lambda = |theta: f64| sigma + 1.0 / theta;
     // The worst residual of the wanted pairs at each iteration since the last (re)start.
     let mut worst_so_far: Vec<f64> = Vec::new();
     loop {
@@ -353,12 +355,12 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
                     && worst > 0.5 * worst_so_far[k - 1 - STALL_ITERATIONS]
                 {
                     let first = residuals.iter().position(|&r| r > tol).unwrap_or(0);
-                    let value = sigma + 1.0 / pairs[first].0;
+                    let value = lambda(pairs[first].0);
                     let usable = pairs
                         .iter()
                         .zip(&residuals)
                         .take_while(|((theta, _), &r)| {
-                            r <= tol && ((sigma + 1.0 / theta) - value).abs() > CLUSTER_GAP * value.abs()
+                            r <= tol && (lambda(*theta) - value).abs() > CLUSTER_GAP * value.abs()
                         })
                         .count();
                     out.stalled = Some(Stalled {
@@ -387,7 +389,6 @@ pub fn eigenpairs_near(pencil: &mut dyn Pencil, params: &EigenParams) -> Result<
             continue;
         }
         // Sturm check: the eigenvalues within the distance of the farthest wanted one.
-        let lambda = |theta: f64| sigma + 1.0 / theta;
         let reach = pairs
             .iter()
             .take(target)

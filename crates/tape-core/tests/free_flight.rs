@@ -15,7 +15,8 @@
 //!   flight). Issue 8 asks that the energy never increase: generalised-alpha dissipates in its
 //!   own energy norm, for linear systems, not in `K + U` from step to step, whose O(h^2)
 //!   fluctuation the rho_inf = 1 run shows; the largest rise measured at rho_inf = 0.7 is
-//!   2.9e-6 of the energy, below that fluctuation's scale (1e-5 is asserted).
+//!   2.9e-6 of the energy (5e-6 is asserted). That bound holds an undamped run too; what tells the
+//!   schemes apart is the dissipation, asserted above 1e-5 of the energy.
 //! * Angular momentum: generalised-alpha is not a variational integrator and does not keep it
 //!   exactly (issue 8 asks 1e-10, which no generalised-alpha variant offers); its drift is the
 //!   scheme's error, second order in the step: halving h divides it by about 4.
@@ -79,11 +80,10 @@ fn momenta(system: &System, state: &State) -> (Vector3<f64>, Vector3<f64>, f64) 
             .node_rotation(state, i)
             .to_rotation_matrix()
             .into_inner();
-        let s = r * body.moment;
-        let (v, w) = (state.v[i], state.w[i]);
-        let pi = body.mass * v + w.cross(&s);
+        let v = state.v[i];
+        let (pi, hi) = body.momentum(&r, &v, &state.w[i]);
         p += pi;
-        l += state.x[i].cross(&pi) + s.cross(&v) + r * body.inertia * r.transpose() * w;
+        l += state.x[i].cross(&pi) + hi;
         scale += body.mass * v.norm();
     }
     (p, l, scale)
@@ -172,7 +172,7 @@ fn numerical_damping_never_adds_energy_in_free_flight() -> Result<()> {
         growth / e0,
         f.dp
     );
-    assert!(growth <= 1e-5 * e0, "the energy grew by {growth:e} J in a record");
+    assert!(growth <= 5e-6 * e0, "the energy grew by {growth:e} J in a record");
     // The dissipation is the scheme's, well above the undamped run's fluctuation.
     assert!(lost > 1e-5, "only {lost:e} of the energy dissipated");
     assert!(f.dp < 1e-10, "linear momentum changed by {:e}", f.dp);

@@ -130,12 +130,6 @@ fn deflections(h: &History, z0: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The time at which `w` first exceeds `level`, interpolated linearly between the records `t`.
-fn first_crossing(t: &[f64], w: &[f64], level: f64) -> Option<f64> {
-    let i = w.iter().position(|&v| v > level)?;
-    (i > 0).then(|| t[i - 1] + (t[i] - t[i - 1]) * (level - w[i - 1]) / (w[i] - w[i - 1]))
-}
-
 fn modal(name: &str) -> Step {
     Step::new_modal(
         name,
@@ -247,8 +241,9 @@ fn hinged_roof_snaps_dynamically_at_the_limit_load_and_settles_on_the_far_branch
     }
 
     // The snap.
-    let jump =
-        |fraction: f64| first_crossing(&h.t, &w, w_limit + fraction * (w_far - w_limit)).expect("the roof snaps");
+    let jump = |fraction: f64| {
+        common::value_at_load(&w, &h.t, w_limit + fraction * (w_far - w_limit), true).expect("the roof snaps")
+    };
     let t_snap = jump(0.5);
     let lambda_snap = load(t_snap);
     let (t10, t90) = (jump(0.1), jump(0.9));
