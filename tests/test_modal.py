@@ -26,11 +26,10 @@ from tapespring.signals import fit_damping
 E, RHO, L, B, T = 2e11, 7850.0, 0.2, 0.02, 2e-3
 
 
-def strip(poisson: float = 0.3) -> tuple[Model, dict[str, np.ndarray]]:
+def strip(poisson: float = 0.3, eta: float = 0.0) -> tuple[Model, dict[str, np.ndarray]]:
     nodes, quads, sets = flat_plate_mesh(L, B, 16, 2)
-    model = Model(
-        nodes, quads, node_sets=sets, thickness=T, youngs_modulus=E, poisson=poisson, density=RHO
-    )
+    section = {"thickness": T, "youngs_modulus": E, "poisson": poisson, "density": RHO}
+    model = Model(nodes, quads, node_sets=sets, eta=eta, **section)
     model.fix("x0", "all")
     return model, sets
 
@@ -178,10 +177,7 @@ def test_free_decay_fitted_period_is_the_modal_period():
     ratio eta omega / 2 of 1 % (the higher modes, damped in proportion to their frequency, soon
     leave the peaks alone), pushed at its tip by 0.15 N (0.15 mm) and released: six periods at
     fixed steps of a hundredth of the modal period, rho_inf = 0.7."""
-    nodes, quads, sets = flat_plate_mesh(L, B, 16, 2)
-    section = {"thickness": T, "youngs_modulus": E, "poisson": 0.0, "density": RHO}
-    model = Model(nodes, quads, node_sets=sets, eta=7.8e-5, **section)
-    model.fix("x0", "all")
+    model, sets = strip(poisson=0.0, eta=7.8e-5)
     for n in sets["x1"]:
         model.add_load(int(n), "uz", -0.05, id="push", active=False)
     model.add_marker("tip", model.nearest_node([L, B / 2, 0.0]))

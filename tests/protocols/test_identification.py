@@ -117,7 +117,7 @@ def test_a_moved_support_is_warned_and_reported():
         r = analyze_identification(identification_trial(displacements=moved, noise=False))
     assert r.control_moved and r.summary()["control_moved"] is True
     assert r.control_m is not None and r.control_m[0] == pytest.approx(1.5e-3)
-    assert CONTROL_TOLERANCE == 1e-3
+    assert 1.5e-3 > CONTROL_TOLERANCE  # the premise: a move beyond the threshold
     # Not corrected for it: markers 1-3 as recorded.
     np.testing.assert_allclose(r.marker3_m, [41.8e-3, 0.6e-3, 110.9e-3], rtol=1e-12)
 
@@ -130,7 +130,6 @@ def test_too_short_a_record_is_refused():
     slow = identification_trial(rate=10.0, noise=False)
     with pytest.raises(TrialError, match=f"6 sample\\(s\\) .* needs {MIN_REST_SAMPLES} at least"):
         analyze_identification(slow)
-    assert issubclass(TrialError, ValueError)
 
 
 def test_a_record_still_swinging_at_its_end_is_not_at_rest():
@@ -178,7 +177,7 @@ def test_a_record_without_a_fold_is_refused():
     small = {k: tuple(0.1 * np.asarray(v)) for k, v in TABLE3.items()}  # tip 11.8 mm
     with pytest.raises(TrialError, match=r"not a static identification test: marker 3 \('M3'\)"):
         analyze_identification(identification_trial(displacements=small))
-    assert MIN_TIP_DISPLACEMENT == 20e-3
+    assert 11.8e-3 < MIN_TIP_DISPLACEMENT  # the premise: a tip move below the threshold
     # A free decay (its tip starts 8 mm down, and swings): refused either way.
     decay = make_vibration_trial(duration=3.0)
     with pytest.raises(TrialError):

@@ -28,18 +28,24 @@ def early():
     return release(ReleaseSetup(tape=TAPE, duration=0.02))
 
 
-def test_fold_follows_the_static_bending_curve(early):
+@pytest.fixture(scope="module")
+def static_curve():
+    """The bending scenario's curve of the same tape to 60 deg (jumping at the snap)."""
+    return bend(replace(TAPE, theta_max_deg=60.0, jump=True))
+
+
+def test_fold_follows_the_static_bending_curve(early, static_curve):
     # The fold is the bending scenario's loading step on a model that also has mass and a tip
     # body; at rest neither may change the statics: the same peak moment to 1 % (the issue's
     # tolerance; measured equal to round-off, the static solver never sees the mass).
-    curve = bend(replace(TAPE, theta_max_deg=60.0, jump=True))
+    curve = static_curve
     _, clamped, _ = release_model(early.setup)
     fold = early.results.in_step(0)
     m_fold = np.max(np.abs(early.results.reaction(clamped, "ry")[fold]))
     assert m_fold == pytest.approx(np.max(np.abs(curve.moment)), rel=0.01)
 
 
-def test_slow_dynamic_fold_follows_the_static_bending_curve():
+def test_slow_dynamic_fold_follows_the_static_bending_curve(static_curve):
     # Issue 8, 6.g: folded slowly by rotating the end, the moment follows the static curve. A
     # dynamic step turns the end by t * 60 deg over 1 s (the fold's "fold" constraint, its
     # function linear in time), with the paper's eta to damp the snap's ringing. Measured: the
@@ -53,7 +59,7 @@ def test_slow_dynamic_fold_follows_the_static_bending_curve():
     fold = Step.dynamic("fold", duration=1.0, initial_step=1e-4, max_step=5e-3)
     r = run(model, [fold], outputs=Outputs(reactions=((clamped, "ry"),)))
     assert r.error is None
-    curve = bend(replace(TAPE, theta_max_deg=60.0, jump=True))
+    curve = static_curve
     m_static = np.max(np.abs(curve.moment))
     m = np.abs(r.reaction(clamped, "ry"))
     assert np.max(m) == pytest.approx(m_static, rel=0.01)
