@@ -23,7 +23,6 @@ from .scenario_options import (
     finish,
     spec_from_args,
     with_comparison,
-    with_spec_assignments,
 )
 
 if TYPE_CHECKING:
@@ -136,7 +135,6 @@ def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
     input)."""
     import sys
-    from dataclasses import replace
 
     import numpy as np
 
@@ -152,8 +150,7 @@ def run(args: argparse.Namespace) -> int:
             FLEXIBLE_SAMPLE_RATE if args.support == "flexible" else DeploymentSettings.sample_rate
         )
     settings = DeploymentSettings(
-        # --support, then --spec's assignments (which override the options, support included).
-        spec=with_spec_assignments(replace(spec_from_args(args), support=args.support), args.spec),
+        spec=spec_from_args(args, support=args.support),
         sense=args.sense,
         sample_rate=rate,
         duration=args.duration,

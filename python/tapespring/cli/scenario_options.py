@@ -220,8 +220,9 @@ def add_tolerance_option(
     )
 
 
-def spec_from_args(args: argparse.Namespace) -> Any:
-    """The :class:`SetupSpec` of the parsed options."""
+def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
+    """The :class:`SetupSpec` of the parsed options: the dedicated ones and `fields` (a
+    command's own options, such as deploy's ``support``), then ``--spec``'s assignments."""
     from dataclasses import replace
 
     from tapespring.scenarios.setup import PAPER_SETUP
@@ -233,6 +234,7 @@ def spec_from_args(args: argparse.Namespace) -> Any:
         eta=getattr(args, "eta", PAPER_SETUP.eta),
         mesh_tape=args.mesh_tape,
         mesh_plates=args.mesh_plates,
+        **fields,
     )
     return with_spec_assignments(spec, getattr(args, "spec", []))
 

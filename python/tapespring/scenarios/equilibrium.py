@@ -277,15 +277,15 @@ class EquilibriumResult:
             analyze_identification,
         )
 
-        if isinstance(trial, IdentificationResult):
-            measured = trial
-        else:
-            measured = analyze_identification(trial, markers=markers, control=control, rest=rest)
         if not self.found:
             raise ValueError(
                 "the simulation found no folded equilibrium on the push path (push further): "
                 "nothing to compare with"
             )
+        if isinstance(trial, IdentificationResult):
+            measured = trial
+        else:
+            measured = analyze_identification(trial, markers=markers, control=control, rest=rest)
         return EquilibriumComparison(
             simulation_markers12_m=np.array(self.markers12_m, dtype=float),
             simulation_marker3_m=np.array(self.marker3_m, dtype=float),
