@@ -97,7 +97,8 @@ def test_noise_free_displacements_are_exact():
     r = analyze_identification(identification_trial(noise=False))
     np.testing.assert_allclose(r.markers12_m, [24.7e-3, 0.1e-3, 77.9e-3], rtol=1e-12)
     np.testing.assert_allclose(r.marker3_m, [41.8e-3, 0.6e-3, 110.9e-3], rtol=1e-12)
-    assert r.rest_motion_m < 1e-15
+    # Round-off only: `smooth`'s running sums leave ~5e-15 m on positions of ~0.1 m.
+    assert r.rest_motion_m < 1e-13
 
 
 def test_a_shorter_rest_window_and_without_control_marker():

@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 
 from tapespring.report import save_figure, summary_json, summary_row, write_table
-from tapespring.signals.smoothing import noise_std, span_samples
+from tapespring.signals.smoothing import complete_windows, noise_std, smooth, span_samples
 from tapespring.signals.stats import Summary, summarize
 from tapespring.trials.trial import Trial, TrialError, TrialWarning
 
@@ -90,9 +90,10 @@ CONTROL_MARKER = "M0"
 #: Largest displacement of marker 0 along an axis [m] without a warning.
 CONTROL_TOLERANCE = 1e-3
 
-# Averaging of the positions for the rest check [s] (21 samples at 800 Hz), and the noise
-# allowance in sigmas of the raw samples: the average of white noise over 21 samples has a
-# standard deviation of sigma / 4.5, its largest excursion over 400 samples stays under sigma.
+# Averaging of the positions for the rest check [s] (21 samples at 800 Hz: `smooth`'s full
+# windows; a window with fewer samples averages the odd number of them it has, as `smooth` does),
+# and the noise allowance in sigmas of the raw samples: the average of white noise over 21 samples
+# has a standard deviation of sigma / 4.5, its largest excursion over 400 samples stays under sigma.
 _REST_SMOOTHING = 0.025
 _REST_NOISE_SIGMA = 3.0
 
@@ -120,11 +121,14 @@ class IdentificationResult:
     displacements_m : mapping of str -> ndarray, shape (3,)
         Absolute displacement (x, y, z) [m] of each marker between the rest states.
     markers12_m, marker3_m : ndarray, shape (3,)
-        Absolute displacements (x, y, z) [m] of markers 1-2 (their mean) and of marker 3.
+        Absolute displacements (x, y, z) [m] of markers 1-2 (their mean) and of marker 3
+        (properties, from ``displacements_m``).
     control_m : ndarray, shape (3,), or None
-        Absolute displacement (x, y, z) [m] of marker 0 (None without ``control``).
+        Absolute displacement (x, y, z) [m] of marker 0 (None without ``control``; a property,
+        from ``displacements_m``).
     control_moved : bool
-        Whether marker 0 moved by more than `CONTROL_TOLERANCE` along an axis (warned).
+        Whether marker 0 moved by more than `CONTROL_TOLERANCE` along an axis (warned; a
+        property, from ``control_m``).
     rest_motion_m : float
         Largest excursion [m] of a marker, averaged over 25 ms, from its median in either rest
         window (what the rest check measured).
@@ -145,13 +149,31 @@ class IdentificationResult:
     unfolded_m: Mapping[str, np.ndarray]
     folded_m: Mapping[str, np.ndarray]
     displacements_m: Mapping[str, np.ndarray]
-    markers12_m: np.ndarray
-    marker3_m: np.ndarray
-    control_m: np.ndarray | None
-    control_moved: bool
     rest_motion_m: float
     time: np.ndarray
     tracks_m: Mapping[str, np.ndarray]
+
+    @property
+    def markers12_m(self) -> np.ndarray:
+        """Absolute displacement (x, y, z) [m] of markers 1-2: the mean of theirs."""
+        m1, m2, _ = self.markers
+        return 0.5 * (self.displacements_m[m1] + self.displacements_m[m2])
+
+    @property
+    def marker3_m(self) -> np.ndarray:
+        """Absolute displacement (x, y, z) [m] of marker 3, the tip of the additional weight."""
+        return self.displacements_m[self.markers[2]]
+
+    @property
+    def control_m(self) -> np.ndarray | None:
+        """Absolute displacement (x, y, z) [m] of marker 0 (None without ``control``)."""
+        return None if self.control is None else self.displacements_m[self.control]
+
+    @property
+    def control_moved(self) -> bool:
+        """Whether marker 0 moved by more than `CONTROL_TOLERANCE` [m] along an axis."""
+        control_m = self.control_m
+        return bool(control_m is not None and np.max(control_m) > CONTROL_TOLERANCE)
 
     def figures(self) -> dict[str, float | None]:
         """Table 3's figures [m]: ``marker0_dx_m`` .. ``marker0_dz_m`` (None without a control
@@ -275,10 +297,9 @@ def analyze_identification(
                     f"{rest:g} s window)",
                 )
             median = np.median(p, axis=0)
-            k = min(span, p.shape[0])
-            kernel = np.full(k, 1.0 / k)
+            full = complete_windows(p.shape[0], span)
             for i, axis in enumerate(_AXES):
-                averaged = np.convolve(p[:, i], kernel, mode="valid")
+                averaged = smooth(p[:, i], span)[full]
                 excursion = float(np.max(np.abs(averaged - median[i])))
                 allowed = REST_TOLERANCE + _REST_NOISE_SIGMA * noise_std(p[:, i])
                 if excursion > allowed:
@@ -303,23 +324,10 @@ def analyze_identification(
             f"(Table 3), {MIN_TIP_DISPLACEMENT * 1e3:g} mm at least here: no fold (the tapes "
             "did not buckle), or a vibration record?",
         )
-    control_m = None if control is None else displacements[control]
-    moved = bool(control_m is not None and np.max(control_m) > CONTROL_TOLERANCE)
-    if moved:
-        assert control_m is not None
-        shown = ", ".join(f"{v * 1e3:.3g}" for v in control_m)
-        warnings.warn(
-            f"{label}: the control marker {control!r} on the fixation support moved by "
-            f"({shown}) mm along (x, y, z) between the rest states, more than "
-            f"{CONTROL_TOLERANCE * 1e3:g} mm (Table 3: 0.2 mm at most): the support moved, or "
-            "the marker is not on it? The displacements are not corrected for it",
-            TrialWarning,
-            stacklevel=2,
-        )
     tracks = {n: trial.marker(n) - rest_pos["unfolded"][n] for n in names}
     meta = trial.metadata
     first, last = t[windows["unfolded"]], t[windows["folded"]]
-    return IdentificationResult(
+    result = IdentificationResult(
         name=trial.name,
         tape_pair=meta.tape_pair,
         session=meta.session,
@@ -331,14 +339,22 @@ def analyze_identification(
         unfolded_m=rest_pos["unfolded"],
         folded_m=rest_pos["folded"],
         displacements_m=displacements,
-        markers12_m=0.5 * (displacements[m1] + displacements[m2]),
-        marker3_m=displacements[m3],
-        control_m=control_m,
-        control_moved=moved,
         rest_motion_m=rest_motion,
         time=t,
         tracks_m=tracks,
     )
+    if result.control_moved:
+        assert result.control_m is not None
+        shown = ", ".join(f"{v * 1e3:.3g}" for v in result.control_m)
+        warnings.warn(
+            f"{label}: the control marker {control!r} on the fixation support moved by "
+            f"({shown}) mm along (x, y, z) between the rest states, more than "
+            f"{CONTROL_TOLERANCE * 1e3:g} mm (Table 3: 0.2 mm at most): the support moved, or "
+            "the marker is not on it? The displacements are not corrected for it",
+            TrialWarning,
+            stacklevel=2,
+        )
+    return result
 
 
 def analyze_identification_group(
