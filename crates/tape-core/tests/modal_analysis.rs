@@ -300,9 +300,9 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
 /// a reason; now it stops as stalled and says how many modes it can give.
 #[test]
 fn modes_beyond_the_drilling_cluster_are_refused_with_the_count_that_converges() -> Result<()> {
-    let mut section = common::section(12.7, 3102.75, 0.3);
-    section.density = 1.19e-9;
-    let (model, _) = common::hinged_roof_quarter(2540.0, 254.0, 0.1, 8, section, 0.0)?;
+    let mut section = common::hinged_roof::section(12.7);
+    section.density = common::hinged_roof::PMMA_DENSITY;
+    let (model, _) = common::hinged_roof::quarter(8, section, 0.0)?;
     let five = modes_of(&model, &[modal(5)])?;
     let f = &five.modes[0].frequencies_hz;
     assert!((f[0] - 98.6).abs() < 0.1 && (f[4] - 502.18).abs() < 0.1, "{f:?}");

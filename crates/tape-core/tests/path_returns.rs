@@ -23,9 +23,8 @@ use tape_core::solver::{solve_static, Control, StaticParams, StaticPath};
 use tape_core::{Error, Result, System};
 
 fn roof(lambda_end: f64, initial_increment: f64) -> Result<(StaticPath, usize)> {
-    let (r, half_length) = (2540.0, 254.0);
-    let section = common::section(6.35, 3102.75, 0.3);
-    let (model, c) = common::hinged_roof_quarter(r, half_length, 0.1, 4, section, 600.0)?;
+    let section = common::hinged_roof::section(6.35);
+    let (model, c) = common::hinged_roof::quarter(4, section, 600.0)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
     let params = StaticParams {

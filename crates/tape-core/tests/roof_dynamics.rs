@@ -6,7 +6,7 @@
 //! branch within 1 %.
 //!
 //! ```text
-//!            P(t) (down) at the crown C          quarter model, 8 x 8 (common::hinged_roof_quarter)
+//!            P(t) (down) at the crown C          quarter model, 8 x 8 (common::hinged_roof)
 //!   hinged ====v==== hinged                      R = 2540, half-length 254, theta = 0.1 rad
 //!          /         \                           E = 3102.75 N/mm^2, nu = 0.3; units N, mm, s
 //!
@@ -79,8 +79,6 @@ use tape_core::model::Marker;
 use tape_core::solver::{Control, DynamicParams, ModalParams, StaticParams};
 use tape_core::{run, History, Model, Outputs, Result, Step, TimeFunction};
 
-/// Density of the roof \[t/mm^3\] (PMMA, 1190 kg/m^3).
-const DENSITY: f64 = 1.19e-9;
 /// Duration of the load ramp, in lowest periods of the unloaded roof.
 const RAMP_PERIODS: f64 = 3000.0;
 /// Load at the end of the ramp, held after it \[Pmax\].
@@ -90,28 +88,15 @@ const HOLD_PERIODS: f64 = 50.0;
 /// Kelvin-Voigt damping ratio `eta omega_1 / 2` of the lowest mode of the unloaded roof.
 const ZETA: f64 = 0.1;
 
-/// The roof's quarter model (`common::hinged_roof_quarter`, 8 x 8, the load Pmax on the full
-/// roof at load factor 1) with density and Kelvin-Voigt `eta` \[s\], and a marker `"crown"` on the
-/// loaded node; also that node's initial height.
+/// The roof's quarter model (`common::hinged_roof::quarter`, 8 x 8, h = 12.7, the load Pmax on
+/// the full roof at load factor 1) with PMMA's density and Kelvin-Voigt `eta` \[s\], and a marker
+/// `"crown"` on the loaded node; also that node's initial height.
 fn roof(eta: f64) -> Result<(Model, f64)> {
-    let data = common::reference("sze2004.json");
-    let p = &data["problems"]["hinged_cylindrical_roof"];
-    let g = &p["geometry"];
-    let mut section = common::section(
-        common::num(&p["thickness"]["case_12_7"]),
-        common::num(&p["material"]["E"]),
-        common::num(&p["material"]["nu"]),
-    );
-    section.density = DENSITY;
+    let p = common::hinged_roof::data();
+    let mut section = common::hinged_roof::section(common::num(&p["thickness"]["case_12_7"]));
+    section.density = common::hinged_roof::PMMA_DENSITY;
     section.eta = eta;
-    let (mut model, c) = common::hinged_roof_quarter(
-        common::num(&g["R"]),
-        common::num(&g["L_kratos"]),
-        common::num(&g["theta_rad"]),
-        8,
-        section,
-        common::num(&p["load"]["Pmax_h12_7"]),
-    )?;
+    let (mut model, c) = common::hinged_roof::quarter(8, section, common::num(&p["load"]["Pmax_h12_7"]))?;
     model.add_marker(Marker {
         name: "crown".into(),
         node: c,
@@ -143,8 +128,7 @@ fn modal(name: &str) -> Step {
 #[test]
 fn hinged_roof_snaps_dynamically_at_the_limit_load_and_settles_on_the_far_branch() -> Result<()> {
     let start = std::time::Instant::now();
-    let data = common::reference("sze2004.json");
-    let table = common::nums(&data["problems"]["hinged_cylindrical_roof"]["tabulated"]["h_12_7"]["P"]);
+    let table = common::nums(&common::hinged_roof::data()["tabulated"]["h_12_7"]["P"]);
     let sze_limit = table
         .windows(2)
         .find(|p| p[1] < p[0])

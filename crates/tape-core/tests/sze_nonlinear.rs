@@ -361,24 +361,13 @@ fn open_cylinder_pull_out_follows_sze_within_2_percent_away_from_the_snap() -> R
 /// in deflection).
 #[test]
 fn hinged_roof_snaps_through_along_sze_curve() -> Result<()> {
-    let data = common::reference("sze2004.json");
-    let p = &data["problems"]["hinged_cylindrical_roof"];
-    let g = &p["geometry"];
-    let (r, theta, half_length) = (
-        common::num(&g["R"]),
-        common::num(&g["theta_rad"]),
-        common::num(&g["L_kratos"]),
-    );
-    let section = common::section(
-        common::num(&p["thickness"]["case_12_7"]),
-        common::num(&p["material"]["E"]),
-        common::num(&p["material"]["nu"]),
-    );
+    let p = common::hinged_roof::data();
+    let section = common::hinged_roof::section(common::num(&p["thickness"]["case_12_7"]));
     let p_max = common::num(&p["load"]["Pmax_h12_7"]);
     let table = &p["tabulated"]["h_12_7"];
     let (p_ref, w_ref) = (common::nums(&table["P"]), common::nums(&table["minus_w_C"]));
 
-    let (model, c) = common::hinged_roof_quarter(r, half_length, theta, 8, section, p_max)?;
+    let (model, c) = common::hinged_roof::quarter(8, section, p_max)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();
     let params = StaticParams {

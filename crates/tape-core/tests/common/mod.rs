@@ -10,7 +10,7 @@ use tape_core::assembly::Assembled;
 use tape_core::linalg::LinearSolver;
 use tape_core::material::ShellSection;
 use tape_core::mesh::Mesh;
-use tape_core::{Dof, Model, Result, State, System};
+use tape_core::{Model, Result, State, System};
 
 /// Homogeneous isotropic section; the other fields (drilling factor, shear factor) keep their defaults.
 pub fn section(thickness: f64, youngs_modulus: f64, poisson: f64) -> ShellSection {
@@ -295,32 +295,73 @@ pub fn value_at_load(lambdas: &[f64], values: &[f64], level: f64, first: bool) -
     }
 }
 
-/// Quarter model of the hinged cylindrical roof (Sze et al. 2004): a panel of radius `r` and
-/// half-length `half_length`, opening `theta` \[rad\] from the crown, `n x n` elements, symmetric at
-/// the middle (`x1`) and the crown (`phi0`), hinged along the straight edge (`phi1`), with a
-/// quarter of the load `p` \[N\] pushing the crown's centre down. Returns the model and that node.
-pub fn hinged_roof_quarter(
-    r: f64,
-    half_length: f64,
-    theta: f64,
-    n: usize,
-    section: ShellSection,
-    p: f64,
-) -> Result<(Model, usize)> {
-    let mesh = tape_core::mesh::generate::cylindrical_panel(r, half_length, 0.0, theta, n, n)?;
-    let mut model = Model::try_new(mesh, section)?;
-    let middle = model.mesh.node_set("x1")?.to_vec();
-    let crown = model.mesh.node_set("phi0")?.to_vec();
-    let hinged = model.mesh.node_set("phi1")?.to_vec();
-    model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
-    model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
-    model.fix(&hinged, &Dof::TRANSLATIONS)?;
-    let c = model
-        .mesh
-        .nearest_node(&Vector3::new(half_length, 0.0, r))
-        .expect("the mesh has nodes");
-    model.add_load(c, Dof::Uz, -p / 4.0)?;
-    Ok((model, c))
+/// The hinged cylindrical roof of Sze, Liu & Lo (2004, sec. 3.8; K.Y. Sze, X.H. Liu, S.H. Lo,
+/// "Popular benchmark problems for geometric nonlinear analysis of shells", FEAD 40 (2004)
+/// 1551-1569), isotropic, in units N, mm, s (density t/mm^3). Geometry and material from
+/// `reference_values/sze2004.json` (`problems.hinged_cylindrical_roof`, after the Kratos
+/// documentation): R = 2540, half-length 254 (straight edges 508 long, the file's reading of the
+/// Kratos figure), curved edges subtending +-theta = 0.1 rad about the crown, E = 3102.75 N/mm^2,
+/// nu = 0.3; the paper's thicknesses are 12.7 (Pmax = 3000 N) and 6.35 (Pmax not found in the
+/// sources read).
+///
+/// ```text
+///            P (down) at the centre C
+///   hinged ====v==== hinged      straight edges (phi = +-theta) hinged, curved edges free
+///          /         \
+/// ```
+pub mod hinged_roof {
+    use nalgebra::Vector3;
+    use serde_json::Value;
+    use tape_core::material::ShellSection;
+    use tape_core::mesh::generate::cylindrical_panel;
+    use tape_core::{Dof, Model, Result};
+
+    use super::num;
+
+    /// PMMA's density \[t/mm^3\] (1190 kg/m^3; E = 3.1 GPa is in PMMA's range), the roof's mass for
+    /// its modes and dynamics (the paper's problem is static and has none).
+    pub const PMMA_DENSITY: f64 = 1.19e-9;
+
+    /// `problems.hinged_cylindrical_roof` of `reference_values/sze2004.json`: geometry, material,
+    /// thickness cases, Pmax and the tabulated paths.
+    pub fn data() -> Value {
+        super::reference("sze2004.json")["problems"]["hinged_cylindrical_roof"].take()
+    }
+
+    /// Homogeneous isotropic section of thickness `thickness` \[mm\] with the roof's E and nu.
+    pub fn section(thickness: f64) -> ShellSection {
+        let data = data();
+        super::section(thickness, num(&data["material"]["E"]), num(&data["material"]["nu"]))
+    }
+
+    /// Quarter model of the roof, `n x n` elements (`mesh::generate::cylindrical_panel`, axis along
+    /// x): x in [0, 254] (x = 0 the free curved edge, node set `x1` the symmetry plane x = 254:
+    /// u_x = theta_y = theta_z = 0), phi in [0, theta] (`phi0` the symmetry plane y = 0 through
+    /// the crown: u_y = theta_x = theta_z = 0; `phi1` the straight edge, hinged: u = 0, rotations
+    /// free). A quarter of the load `p` \[N\] on the full roof pushes the crown's centre C down
+    /// (dead, linear in the load factor). Returns the model and C.
+    ///
+    /// # Errors
+    /// `n = 0` or an invalid section.
+    pub fn quarter(n: usize, section: ShellSection, p: f64) -> Result<(Model, usize)> {
+        let data = data();
+        let g = &data["geometry"];
+        let (r, half_length, theta) = (num(&g["R"]), num(&g["L_kratos"]), num(&g["theta_rad"]));
+        let mesh = cylindrical_panel(r, half_length, 0.0, theta, n, n)?;
+        let mut model = Model::try_new(mesh, section)?;
+        let middle = model.mesh.node_set("x1")?.to_vec();
+        let crown = model.mesh.node_set("phi0")?.to_vec();
+        let hinged = model.mesh.node_set("phi1")?.to_vec();
+        model.fix(&middle, &[Dof::Ux, Dof::Ry, Dof::Rz])?;
+        model.fix(&crown, &[Dof::Uy, Dof::Rx, Dof::Rz])?;
+        model.fix(&hinged, &Dof::TRANSLATIONS)?;
+        let c = model
+            .mesh
+            .nearest_node(&Vector3::new(half_length, 0.0, r))
+            .expect("the mesh has nodes");
+        model.add_load(c, Dof::Uz, -p / 4.0)?;
+        Ok((model, c))
+    }
 }
 
 /// The steel strip of the dynamics tests: E = 2e11 Pa, rho = 7850 kg/m^3, width 0.02 m, 2 mm
