@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from _heavy_top import GRAVITY, MASS, body_on_a_pin, heavy_top
 from tapespring.analysis import Model, Outputs, Step, dynamic_step_options, run
 from tapespring.results import Results
 from tapespring.shell import flat_plate_mesh
@@ -176,22 +177,6 @@ def test_free_flight_of_a_curved_strip_keeps_its_energy():
     assert np.linalg.norm(rotations, axis=1).min() > 0.5
 
 
-def body_on_a_pin(mass, centre, inertia):
-    """A rigid body on a reference node at the origin pinned in ux, uy, uz (its rotations free),
-    with a marker at its centre of mass; the model's shell is a clamped, massless plate 10 m away
-    that takes no part (the heavy top's model of crates/tape-core/tests/rigid_dynamics.rs)."""
-    nodes, quads, _ = flat_plate_mesh(0.1, 0.1, 1, 1)
-    model = Model(
-        np.asarray(nodes) + [0.0, 0.0, 10.0], quads, thickness=1e-3, youngs_modulus=E, poisson=0.3
-    )
-    model.fix([0, 1, 2, 3], "all")
-    pin = model.add_node([0.0, 0.0, 0.0])
-    model.fix(pin, ["ux", "uy", "uz"])
-    model.add_rigid_body(pin, mass, centre_of_mass=centre, inertia=inertia)
-    model.add_marker("com", pin, offset=centre)
-    return model, pin
-
-
 def test_the_pin_of_a_swinging_body_feels_its_inertia():
     # Issue 8, sec. 3: "reactions including inertia (the force the clamp feels)". A compound
     # pendulum: 2 kg whose centre of mass is 0.5 m from a pin, J = 0.01 kg m^2 about it
@@ -258,12 +243,8 @@ def test_the_pin_of_the_heavy_top_feels_the_centre_of_mass_acceleration():
     # difference's own error, h^2 / 12 times the track's fourth derivative: measured 3.6e-4 of the
     # peak, second order (5.8e-3, 1.4e-3, 3.6e-4 at h = 0.4, 0.2, 0.1 ms). Bound 1e-3. A pin force
     # without the inertia would be the weight, 610 N off at the peak.
-    mass, h = 15.0, 1e-4
-    centre = np.array([0.0, 1.0, 0.0])
-    model, pin = body_on_a_pin(mass, centre, np.diag([0.234375, 0.46875, 0.234375]))
-    model.set_initial_velocity(pin, angular_velocity=[0.0, 150.0, -4.61538])
-    gravity = np.array([0.0, 0.0, -9.81])
-    model.set_gravity(gravity, function="constant")
+    h = 1e-4
+    model, pin = heavy_top()
     outputs = Outputs(reactions=[(pin, d) for d in ("ux", "uy", "uz")])
     step = Step.dynamic("spin", duration=0.4, adaptive=False, initial_step=h, max_step=h)
     res = run(model, [step], outputs=outputs)
@@ -272,9 +253,9 @@ def test_the_pin_of_the_heavy_top_feels_the_centre_of_mass_acceleration():
     reaction = np.stack([res.reaction(pin, d) for d in ("ux", "uy", "uz")], axis=1)
     x = res.marker("com")
     a_com = (x[2:] - 2.0 * x[1:-1] + x[:-2]) / h**2
-    expected = mass * a_com - mass * gravity
+    expected = MASS * a_com - MASS * GRAVITY
     peak = np.abs(reaction).max()
-    assert peak > 4.0 * mass * 9.81
+    assert peak > 4.0 * MASS * 9.81
     assert np.abs(reaction[1:-1] - expected).max() < 1e-3 * peak
 
 

@@ -16,16 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _heavy_top import COM, GRAVITY, J_COM, MASS, OMEGA0, heavy_top
 from scipy.optimize import fsolve
 from scipy.spatial.transform import Rotation
-from tapespring.analysis import Model, Step, run
-from tapespring.shell import flat_plate_mesh
+from tapespring.analysis import Step, run
 
-MASS = 15.0  # kg
-COM = np.array([0.0, 1.0, 0.0])  # m, from the fixed point, in the body frame
-J_COM = np.diag([0.234375, 0.46875, 0.234375])  # kg m^2 about the centre of mass
-OMEGA0 = np.array([0.0, 150.0, -4.61538])  # rad/s, body frame (= spatial at t = 0)
-GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s^2
 # Published displacements of the centre of mass (the Rust test's reference).
 REFERENCE = {
     1.0: np.array([0.1733440436, -0.3599112987, -0.7484906793]),
@@ -83,17 +78,7 @@ def independent_top(h: float, duration: float, rho_inf: float) -> dict[float, np
 
 def core_top(h: float, duration: float, rho_inf: float) -> dict[float, np.ndarray]:
     """The same top in the core: a rigid body on a pinned node (the Rust test's model)."""
-    nodes, quads, _ = flat_plate_mesh(0.1, 0.1, 1, 1)
-    nodes = np.asarray(nodes) + [0.0, 0.0, 10.0]
-    # A clamped, massless plate far away that takes no part in the motion.
-    model = Model(nodes, quads, thickness=1e-3, youngs_modulus=2e11, poisson=0.3)
-    model.fix([0, 1, 2, 3], "all")
-    top = model.add_node([0.0, 0.0, 0.0])
-    model.fix(top, ["ux", "uy", "uz"])
-    model.add_rigid_body(top, MASS, centre_of_mass=COM, inertia=J_COM)
-    model.set_initial_velocity(top, angular_velocity=OMEGA0)
-    model.set_gravity(GRAVITY, function="constant")
-    model.add_marker("com", top, offset=COM)
+    model, _ = heavy_top()
     step = Step.dynamic(
         "motion",
         duration=duration,
