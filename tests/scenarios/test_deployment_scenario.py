@@ -279,6 +279,26 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert "no such file" in refused([*args, f"--experiment={tmp_path / 'missing.csv'}"], capsys)
 
 
+def test_deploy_prints_the_recordings_warnings_as_lines(tmp_path, capsys) -> None:
+    # The analysis of a recording that stops while the tape still swings warns (TrialWarning);
+    # the command prints it as 'tapespring trials analyze' does, one 'warning: ...' line on
+    # stderr (not Python's warning with its source line), here before the sense's refusal,
+    # which stops the command before the run.
+    from tapespring.cli import main
+    from tapespring.trials.csv import write_csv
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial("equal", duration=1.5)
+    path = write_csv(trial, tmp_path / "swinging.csv")
+    argv = ["deploy", "--sense=opposite", f"--experiment={path}", "--no-progress"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    warning, error = err.splitlines()
+    assert warning.startswith(f"warning: {path}: the bending angle still moves near the record")
+    assert error.startswith("error: the recording 'swinging' is a deployment in equal sense")
+
+
 @pytest.mark.parametrize("sense", ["opposite", "equal"])
 def test_trial_force_plate_reads_the_clamp_force_in_both_senses(
     sense: str, opposite: DeploymentSimulation

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 import functools
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from .bend import _checked
 from .scenario_options import (
@@ -60,22 +60,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _analyze_recording(trial: Any) -> Any:
-    """`analyze_identification` of `trial`, its warnings (marker 0 moved) printed as
-    ``warning: ...`` on stderr."""
-    import warnings
-
-    from tapespring.protocols.identification import analyze_identification
-
-    from .bend import print_warnings
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = analyze_identification(trial)
-    print_warnings(caught)
-    return result
-
-
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring equilibrium``; returns the exit code (0; 1 stopped early, no
     folded equilibrium on the push path, or no comparison; 2 bad input or experiment file)."""
@@ -85,7 +69,10 @@ def run(args: argparse.Namespace) -> int:
 
     measured = None
     if args.experiment:
-        measured = analyze_experiment(args.experiment, _analyze_recording)
+        from tapespring.protocols.identification import analyze_identification
+
+        # Its warnings (marker 0 moved) printed as ``warning: ...`` on stderr.
+        measured = analyze_experiment(args.experiment, analyze_identification)
         if measured is None:
             return 2
     problems: list[str] = []

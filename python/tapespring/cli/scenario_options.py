@@ -337,21 +337,36 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
 def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
     """Read a recorded trial (C3D or CSV) and analyse it with `analyze` (a protocol function).
 
+    The reader's and the analysis' warnings (`TrialWarning`: a record that stops before the
+    tape settles, a support that moved, ...) are printed as ``warning: ...`` lines on stderr,
+    as ``tapespring trials analyze`` prints them (`print_warnings`).
+
     Returns the analysis, or None after printing ``error: FILE: problem`` on stderr if the file
     is missing, unreadable or corrupt, or the analysis refuses it (the caller exits with 2).
     """
+    import warnings
+
     from tapespring.trials.load import read_trial
 
-    try:
-        return analyze(read_trial(path))
-    except (OSError, ValueError) as exc:
-        message = str(exc)
-        if isinstance(exc, OSError) and exc.strerror:
-            message = exc.strerror
-        if str(path) not in message and str(Path(path)) not in message:
-            message = f"{path}: {message}"
-        print(f"error: {message}", file=sys.stderr)
-        return None
+    from .bend import print_warnings
+
+    failure: OSError | ValueError | None = None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            measured = analyze(read_trial(path))
+        except (OSError, ValueError) as exc:
+            failure = exc
+    print_warnings(caught)
+    if failure is None:
+        return measured
+    message = str(failure)
+    if isinstance(failure, OSError) and failure.strerror:
+        message = failure.strerror
+    if str(path) not in message and str(Path(path)) not in message:
+        message = f"{path}: {message}"
+    print(f"error: {message}", file=sys.stderr)
+    return None
 
 
 def with_comparison(
