@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from _cli import refused
+from _identification import identification_trial
 from tapespring.cli import main
 from tapespring.protocols.identification import analyze_identification
 from tapespring.scenarios.equilibrium import (
@@ -26,7 +27,6 @@ from tapespring.scenarios.equilibrium import (
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.trials import Trial
 from tapespring.trials.csv import write_csv
-from tapespring.trials.trial import Metadata
 
 COARSE = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=5e-3)
 ARGS = ["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--no-progress"]
@@ -51,19 +51,17 @@ TABLE6_DELTA = {k: TABLE6[k] / TABLE3[k] - 1.0 for k in TABLE3}
 
 
 def table3_trial(*, control: tuple[float, float, float] = (0.2e-3, -0.1e-3, 0.1e-3)) -> Trial:
-    """A noise-free recording of Table 3 at 800 Hz: 1 s at rest, a 1.5 s fold (downwards and
-    towards the support), 1.5 s at rest. Markers 1 and 2 move 0.6 mm apart along x and z, so
-    that their mean is Table 3's row; marker 0 moves by `control` [m]."""
-    t = np.arange(3201) / 800.0
-    ramp = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - 1.0) / 1.5, 0.0, 1.0))
+    """A noise-free recording of Table 3 at 800 Hz (`_identification.identification_trial`): 1 s
+    at rest, a 1.5 s fold (downwards and towards the support), 1.5 s at rest. Markers 1 and 2
+    move 0.6 mm apart along x and z, so that their mean is Table 3's row; marker 0 moves by
+    `control` [m]."""
     moves = {
-        "M0": (np.array([-0.02, 0.0, 0.0]), np.array(control)),
-        "M1": (np.array([0.15, 0.02, 0.01]), np.array([-24.4e-3, 0.1e-3, -77.6e-3])),
-        "M2": (np.array([0.19, 0.0, 0.01]), np.array([-25.0e-3, 0.1e-3, -78.2e-3])),
-        "M3": (np.array([0.24, 0.0, -0.03]), np.array([-41.8e-3, 0.6e-3, -110.9e-3])),
+        "M0": control,
+        "M1": (-24.4e-3, 0.1e-3, -77.6e-3),
+        "M2": (-25.0e-3, 0.1e-3, -78.2e-3),
+        "M3": (-41.8e-3, 0.6e-3, -110.9e-3),
     }
-    markers = {k: start + np.outer(ramp, d) for k, (start, d) in moves.items()}
-    return Trial(t, markers, metadata=Metadata(name="table3", sense="opposite"))
+    return identification_trial(displacements=moves, fold=(1.0, 2.5), noise=False, name="table3")
 
 
 @pytest.fixture(scope="module")
