@@ -97,6 +97,16 @@ class EquilibriumSettings:
         check_count("field_interval", self.field_interval, minimum=0)
 
 
+def _figures(markers12_m: np.ndarray, marker3_m: np.ndarray) -> dict[str, float]:
+    """Displacements [m] keyed as the summaries: ``markers12_dx_m`` .. ``marker3_dz_m`` (x, y,
+    z), from those (x, y, z) [m] of markers 1-2 and 3."""
+    out = {}
+    for prefix, values in (("markers12", markers12_m), ("marker3", marker3_m)):
+        for i, axis in enumerate("xyz"):
+            out[f"{prefix}_d{axis}_m"] = float(values[i])
+    return out
+
+
 def _relative(value: float, reference: float) -> float:
     """``value / reference - 1`` [-] (NaN for a zero reference)."""
     return value / reference - 1.0 if reference != 0.0 else float("nan")
@@ -125,14 +135,7 @@ class EquilibriumComparison:
     def simulation_figures(self) -> dict[str, float]:
         """The simulation's displacements [m]: ``markers12_dx_m`` .. ``marker3_dz_m`` (x, y,
         z)."""
-        out = {}
-        for prefix, values in (
-            ("markers12", self.simulation_markers12_m),
-            ("marker3", self.simulation_marker3_m),
-        ):
-            for i, axis in enumerate("xyz"):
-                out[f"{prefix}_d{axis}_m"] = float(values[i])
-        return out
+        return _figures(self.simulation_markers12_m, self.simulation_marker3_m)
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures [m]: ``trial``; ``simulation`` (markers 1-2 and 3, x, y, z);
@@ -297,12 +300,8 @@ class EquilibriumResult:
         comparison with a recording (``comparison``: :meth:`EquilibriumComparison.summary`, or
         None)."""
         paper = _paper_table6()
-        ours = {
-            "markers12_dx_m": float(self.markers12_m[0]),
-            "markers12_dz_m": float(self.markers12_m[2]),
-            "marker3_dx_m": float(self.marker3_m[0]),
-            "marker3_dz_m": float(self.marker3_m[2]),
-        }
+        figures = _figures(self.markers12_m, self.marker3_m)
+        ours = {key: figures[key] for key, _, _ in TABLE6_ROWS}  # x and z, as Table 6
         r = self.results
         return {
             "found": self.found,
