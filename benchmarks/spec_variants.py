@@ -69,6 +69,13 @@ EXTRA_PEAK_WINDOW_S = (
 )
 
 
+def large_minima(peaks: dict[str, list[float]]) -> list[tuple[float, float]]:
+    """The large minima ``(time [s], angle [deg])`` of a deployment summary's ``peaks``: those
+    below `LARGE_DEG`, in time order."""
+    minima = zip(peaks["min_time_s"], peaks["min_deg"], strict=True)
+    return [(t, v) for t, v in minima if v < LARGE_DEG]
+
+
 def check_equal(eta: float, large: list[tuple[float, float]]) -> bool | None:
     """Issue 9 sec. 4, equal sense: print a PASS or FAIL line for the large minima ``(time [s],
     angle [deg])`` of a run with `eta` and return whether it passed (None: no check for it).
@@ -117,10 +124,7 @@ def run_tests(name: str, spec: SetupSpec, tests: list[str], etas: list[float]) -
         for eta in etas:
             start = time.perf_counter()
             settings = DeploymentSettings(spec=replace(spec, eta=eta), sense="equal", duration=2.6)
-            p = deploy(settings).summary()["peaks"]
-            large = [
-                (t, v) for t, v in zip(p["min_time_s"], p["min_deg"], strict=True) if v < LARGE_DEG
-            ]
+            large = large_minima(deploy(settings).summary()["peaks"])
             listed = ", ".join(f"{v:+.1f} deg at {t:.2f} s" for t, v in large)
             print(
                 f"  equal    eta {eta:.3g} s: large minima {listed or 'none'} "
