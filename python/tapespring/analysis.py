@@ -114,6 +114,9 @@ def dynamic_step_options() -> dict[str, Any]:
     Kelvin-Voigt tangent: quadratic Newton when eta > 0, but a non-symmetric iteration matrix;
     off by default, see docs/dynamics.md); ``reuse_factorisation`` (modified Newton: a factorised
     iteration matrix kept while the residual contracts fast, on by default, see docs/dynamics.md);
+    ``start_stress`` (the iteration matrix's geometric part from the step start's stresses,
+    replacing ``mixed_stress``: fewer Newton failures where a thin shell rings undamped, off by
+    default, see docs/dynamics.md);
     and the Newton options (``line_search`` excepted; ``tol_force`` 1e-4 of the reference force,
     inertia included, where static steps use 1e-8).
     """
