@@ -134,8 +134,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
     input)."""
-    import sys
-
     import numpy as np
 
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
@@ -193,8 +191,6 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def fields(result: DeploymentSimulation) -> None:
-        for problem in problems:
-            print(f"error: {problem}", file=sys.stderr)
         if args.vtu:
             from tapespring.io.vtu import write_pvd
 
@@ -227,5 +223,4 @@ def run(args: argparse.Namespace) -> int:
             "clamp_force_N": result.clamp_force_N[rows],
         }
 
-    code = finish(args, simulate, columns, plot, extra=fields)
-    return 1 if problems and code == 0 else code
+    return finish(args, simulate, columns, plot, extra=fields, problems=problems)

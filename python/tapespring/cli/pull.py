@@ -61,8 +61,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring pull``; returns the exit code (0, 1 stopped early or no
     comparison, 2 bad input or experiment file)."""
-    import sys
-
     from tapespring.scenarios.pull import PullSettings, pull
 
     measured = None
@@ -97,8 +95,5 @@ def run(args: argparse.Namespace) -> int:
 
     def extra(result: PullResult) -> None:
         write_vtu(args, result.results, result.setup.model)
-        for problem in problems:
-            print(f"error: {problem}", file=sys.stderr)
 
-    code = finish(args, simulate, columns, plot, extra=extra)
-    return 1 if problems and code == 0 else code
+    return finish(args, simulate, columns, plot, extra=extra, problems=problems)

@@ -269,11 +269,15 @@ def finish(
     columns: Callable[[R], dict[str, Sequence[float]]],
     plot: Callable[[R, str], None],
     extra: Callable[[R], None] | None = None,
+    problems: Sequence[str] = (),
 ) -> int:
     """Run a scenario and write its outputs; returns the exit code.
 
-    0 on success; 1 if the run stopped early (what was computed is still written); 2 on bad
-    input (the message on stderr). `extra` writes further outputs after the summary.
+    0 on success; 1 if the run stopped early (what was computed is still written) or a
+    comparison asked for could not be made; 2 on bad input (the message on stderr). `extra`
+    writes further outputs after the summary. `problems` are the comparisons `run` could not
+    make (filled by `with_comparison` while it runs), printed as ``error: ...`` lines on stderr
+    after the outputs.
     """
     from tapespring.analysis import ConvergenceError
     from tapespring.report import jsonable_tree, write_table
@@ -310,10 +314,12 @@ def finish(
                 print(f"  wrote {getattr(args, name)}")
     if extra is not None:
         extra(result)
+    for problem in problems:
+        print(f"error: {problem}", file=sys.stderr)
     if failure is not None:
         print(f"error: {failure}", file=sys.stderr)
         return 1
-    return 0
+    return 1 if problems else 0
 
 
 def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: str) -> None:
@@ -373,7 +379,7 @@ def with_comparison(
     result: D, compare: Callable[[], object], experiment: str, problems: list[str]
 ) -> D:
     """`result` with ``comparison=compare()``; if the comparison cannot be made (ValueError), the
-    result unchanged and the reason appended to `problems` (the command prints it after its
+    result unchanged and the reason appended to `problems` (`finish` prints it after the
     outputs and exits with 1)."""
     from dataclasses import replace
 

@@ -147,8 +147,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring vibrate``; returns the exit code (0, 1 stopped early or no
     comparison, 2 bad input or experiment file)."""
-    import sys
-
     from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
     _check(args)
@@ -200,11 +198,8 @@ def run(args: argparse.Namespace) -> int:
 
     def extra(result: VibrationSimulation) -> None:
         write_vtu(args, result.results, None)
-        for problem in problems:
-            print(f"error: {problem}", file=sys.stderr)
 
-    code = finish(args, simulate, columns, plot, extra=extra)
-    return 1 if problems and code == 0 else code
+    return finish(args, simulate, columns, plot, extra=extra, problems=problems)
 
 
 def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
