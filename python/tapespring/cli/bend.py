@@ -237,6 +237,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_theta_max_deg,
     )
 
+    # scenario_options imports this module: imported here, as in add_tape_options.
+    from .scenario_options import add_json_and_progress_options
+
     d = BendingSetup()
     p = sub.add_parser(
         "bend",
@@ -290,8 +293,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="write theta_deg, moment_Nm, stable, branch, jump, event to this CSV file",
     )
     p.add_argument("--plot", type=_image_file, help="write the curve as a PNG (paper Fig. 4)")
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
 
@@ -306,6 +308,8 @@ def run(args: argparse.Namespace) -> int:
         2 on bad input (the message is printed on stderr).
     """
     from tapespring.scenarios.bending import BendingSetup, bend, summarize, write_csv
+
+    from .scenario_options import shows_progress
 
     # A zero or non-finite --theta-max was refused by the parser (BendingSetup's own check).
     imperfection = args.imperfection
@@ -327,7 +331,7 @@ def run(args: argparse.Namespace) -> int:
         switch_branches=jump if args.switch_branches is None else args.switch_branches,
     )
     try:
-        result = bend(setup, progress=not (args.no_progress or args.json))
+        result = bend(setup, progress=shows_progress(args))
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

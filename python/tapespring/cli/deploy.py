@@ -21,6 +21,7 @@ from .scenario_options import (
     add_tolerance_option,
     analyze_experiment,
     finish,
+    shows_progress,
     spec_from_args,
     with_comparison,
 )
@@ -169,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         settings.check_recording(measured)
 
     def simulate() -> DeploymentSimulation:
-        result = deploy(settings, progress=not (args.no_progress or args.json))
+        result = deploy(settings, progress=shows_progress(args))
         if measured is not None:
 
             def compare() -> object:

@@ -14,6 +14,7 @@ from .scenario_options import (
     add_spec_options,
     analyze_experiment,
     finish,
+    shows_progress,
     spec_from_args,
     with_comparison,
     write_vtu,
@@ -79,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
         settings = EquilibriumSettings(
             spec=spec_from_args(args), push=args.push, field_interval=1 if args.vtu else 0
         )
-        result = equilibrium(settings, progress=not (args.no_progress or args.json))
+        result = equilibrium(settings, progress=shows_progress(args))
         if measured is not None:
             compare = functools.partial(result.compare, measured)
             result = with_comparison(result, compare, args.experiment, problems)

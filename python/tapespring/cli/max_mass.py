@@ -18,6 +18,7 @@ import sys
 from functools import partial
 
 from .bend import _checked, _count, _field, _image_file, _output_file, refuse, warn
+from .scenario_options import add_json_and_progress_options, shows_progress
 
 __all__ = ["register", "run"]
 
@@ -153,8 +154,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_image_file,
         help="write a contour plot of m_max [g] like the paper's Fig. 7 (PNG)",
     )
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
 
@@ -226,7 +226,7 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    result = max_mass(settings, progress=not (args.no_progress or args.json))
+    result = max_mass(settings, progress=shows_progress(args))
     if args.csv:
         write_csv(result, args.csv)
     if args.plot:

@@ -13,6 +13,7 @@ from .scenario_options import (
     add_spec_options,
     analyze_experiment,
     finish,
+    shows_progress,
     spec_from_args,
     with_comparison,
     write_vtu,
@@ -78,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
             max_displacement=args.max_displacement,
             field_interval=1 if args.vtu else 0,
         )
-        result = pull(settings, progress=not (args.no_progress or args.json))
+        result = pull(settings, progress=shows_progress(args))
         if measured is not None:
             compare = functools.partial(result.compare, measured)
             result = with_comparison(result, compare, args.experiment, problems)

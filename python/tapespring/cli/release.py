@@ -15,7 +15,13 @@ import sys
 from typing import Any
 
 from .bend import _checked, _image_file, _output_file, add_tape_options, tape_fields
-from .scenario_options import add_eta_option, add_rho_inf_option, add_tolerance_option
+from .scenario_options import (
+    add_eta_option,
+    add_json_and_progress_options,
+    add_rho_inf_option,
+    add_tolerance_option,
+    shows_progress,
+)
 
 __all__ = ["register", "run"]
 
@@ -105,8 +111,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="write time_s, theta_deg, moment_Nm and the energies to this CSV",
     )
     p.add_argument("--plot", type=_image_file, help="write the angle and energy histories as a PNG")
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
 
@@ -153,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
             planar=args.planar,
             tolerance=args.tolerance,
         )
-        result = release(setup, progress=not (args.no_progress or args.json))
+        result = release(setup, progress=shows_progress(args))
         failure = None
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
 __all__ = [
     "add_comparison_options",
     "add_eta_option",
+    "add_json_and_progress_options",
     "add_output_options",
     "add_rho_inf_option",
     "add_sample_rate_option",
@@ -29,6 +30,7 @@ __all__ = [
     "add_youngs_modulus_option",
     "analyze_experiment",
     "finish",
+    "shows_progress",
     "spec_assignment",
     "spec_from_args",
     "with_comparison",
@@ -259,8 +261,20 @@ def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
     """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
     p.add_argument("--csv", type=_output_file, help=f"write {csv_what} to this CSV file")
     p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
+    add_json_and_progress_options(p)
+
+
+def add_json_and_progress_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--json`` and ``--no-progress``, which every scenario command takes (the commands
+    with their own ``--csv`` and ``--plot`` add these two alone); read by `shows_progress`."""
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def shows_progress(args: argparse.Namespace) -> bool:
+    """Whether the run shows its progress bar: not with ``--no-progress``, nor with ``--json``
+    (the output is then one JSON object)."""
+    return not (args.no_progress or args.json)
 
 
 def finish(

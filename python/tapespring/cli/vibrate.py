@@ -18,6 +18,7 @@ from .scenario_options import (
     add_tolerance_option,
     analyze_experiment,
     finish,
+    shows_progress,
     spec_from_args,
     with_comparison,
     write_vtu,
@@ -177,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
             # About VTU_RATE whatever the records' rate.
             interval = max(1, round(settings.record_rate / VTU_RATE))
             settings = dataclasses.replace(settings, field_interval=interval)
-        result = vibrate(settings, progress=not (args.no_progress or args.json))
+        result = vibrate(settings, progress=shows_progress(args))
         if measured is not None:
             compare = functools.partial(result.compare, measured)
             result = with_comparison(result, compare, args.experiment, problems)
@@ -221,9 +222,7 @@ def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
         # every step): a "warning: ..." line on stderr, as the other commands' notes.
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            study = numerical_damping_study(
-                settings, rho, progress=not (args.no_progress or args.json)
-            )
+            study = numerical_damping_study(settings, rho, progress=shows_progress(args))
         print_warnings(caught)
         return study
 
