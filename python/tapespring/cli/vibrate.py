@@ -26,7 +26,7 @@ from .scenario_options import (
 
 if TYPE_CHECKING:
     from tapespring.scenarios.numerical_damping import NumericalDampingStudy
-    from tapespring.scenarios.vibration import VibrationSimulation
+    from tapespring.scenarios.vibration import VibrationSettings, VibrationSimulation
 
 __all__ = ["register", "run"]
 
@@ -34,6 +34,23 @@ __all__ = ["register", "run"]
 def _given(args: argparse.Namespace, *names: str) -> dict[str, Any]:
     """The options of `names` that were given (the settings' defaults for the others)."""
     return {n: getattr(args, n) for n in names if getattr(args, n) is not None}
+
+
+def _settings(
+    args: argparse.Namespace, window: tuple[float, float], *optional: str
+) -> VibrationSettings:
+    """The decay's settings from the options, the fitted `window` [m] and, of the `optional`
+    options (None when not given), those given (`_given`)."""
+    from tapespring.scenarios.vibration import VibrationSettings
+
+    return VibrationSettings(
+        spec=spec_from_args(args),
+        duration=args.duration,
+        initial_displacement=args.initial_displacement,
+        window=window,
+        time_step=args.time_step,
+        **_given(args, *optional),
+    )
 
 
 def _check(args: argparse.Namespace) -> None:
@@ -148,7 +165,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring vibrate``; returns the exit code (0, 1 stopped early or no
     comparison, 2 bad input or experiment file)."""
-    from tapespring.scenarios.vibration import VibrationSettings, vibrate
+    from tapespring.scenarios.vibration import vibrate
 
     _check(args)
     window = (args.window_mm[0] * 1e-3, args.window_mm[1] * 1e-3)
@@ -166,14 +183,7 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def simulate() -> VibrationSimulation:
-        settings = VibrationSettings(
-            spec=spec_from_args(args),
-            duration=args.duration,
-            initial_displacement=args.initial_displacement,
-            window=window,
-            time_step=args.time_step,
-            **_given(args, "rho_inf", "tolerance", "sample_rate"),
-        )
+        settings = _settings(args, window, "rho_inf", "tolerance", "sample_rate")
         if args.vtu:
             # About VTU_RATE whatever the records' rate.
             interval = max(1, round(settings.record_rate / VTU_RATE))
@@ -206,17 +216,10 @@ def run(args: argparse.Namespace) -> int:
 def _run_study(args: argparse.Namespace, window: tuple[float, float]) -> int:
     """``tapespring vibrate --rho-inf-study ...``: the numerical damping study (Fig. 26)."""
     from tapespring.scenarios.numerical_damping import numerical_damping_study
-    from tapespring.scenarios.vibration import VibrationSettings
 
     def simulate() -> NumericalDampingStudy:
-        settings = VibrationSettings(
-            spec=spec_from_args(args),
-            duration=args.duration,
-            initial_displacement=args.initial_displacement,
-            window=window,
-            time_step=args.time_step,
-            **_given(args, "tolerance", "sample_rate"),
-        )
+        # No rho_inf: the study gives the radii (--rho-inf is refused beside it, _check).
+        settings = _settings(args, window, "tolerance", "sample_rate")
         rho = tuple(args.rho_inf_study)
         # The study warns when fixed steps were cut back (its prediction then does not apply to
         # every step): a "warning: ..." line on stderr, as the other commands' notes.
