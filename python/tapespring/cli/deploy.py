@@ -133,8 +133,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early, 2 bad
-    input)."""
+    """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early or no
+    comparison, 2 bad input or experiment file)."""
     import numpy as np
 
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
