@@ -16,6 +16,7 @@
 
 mod common;
 
+use tape_core::solver::{DynamicParams, Stats};
 use tape_core::{run, History, Model, Outputs, Result, StepKind};
 
 use common::strip::{beam_frequency, bend_then_release as steps, crossings_and_peaks, push_tip, E};
@@ -192,39 +193,46 @@ fn consistent_viscous_tangent_converges_as_fast_as_undamped() -> Result<()> {
     Ok(())
 }
 
+/// The released strip's tip track over two periods of 50 fixed steps, Newton to 1e-10 of the
+/// reference force, with the dynamic step's settings changed by `set`; and that step's counts.
+fn released_track(model: &Model, set: impl Fn(&mut DynamicParams)) -> Result<(Vec<[f64; 3]>, Stats)> {
+    let f1 = first_frequency();
+    let mut steps = steps(0.7, 1.0 / f1 / 50.0, 2.0 / f1);
+    for step in &mut steps {
+        if let StepKind::Dynamic(p) = &mut step.kind {
+            set(p);
+        }
+    }
+    let result = run(model, &steps, &Outputs::default(), &mut |_| true)?;
+    assert!(result.error.is_none(), "{:?}", result.error);
+    Ok((result.history.marker_positions.clone(), result.step_stats[1]))
+}
+
+/// Largest difference of two tip tracks over any axis and record \[m\], and the first one's
+/// vertical amplitude \[m\].
+fn track_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len());
+    let amplitude = a.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    (worst, amplitude)
+}
+
 /// The default modified Newton iteration ([`tape_core::solver::DynamicParams::reuse_factorisation`])
-/// lands on the states of full Newton: the released strip with Kelvin-Voigt damping over two
-/// periods of 50 fixed steps, Newton to 1e-10 of the reference force. The tip's track agrees to
-/// 1e-7 of its amplitude (a residual of 1e-10 of the forces moves it by about that much; measured
-/// 2.7e-8), and the iteration factorises at most half as many matrices as full Newton (measured:
-/// 84 instead of 209 for 100 steps).
+/// lands on the states of full Newton: the released strip with Kelvin-Voigt damping
+/// ([`released_track`]). The tip's track agrees to 1e-7 of its amplitude (a residual of 1e-10 of
+/// the forces moves it by about that much; measured 2.7e-8), and the iteration factorises at most
+/// half as many matrices as full Newton (measured: 84 instead of 209 for 100 steps).
 #[test]
 fn reused_iteration_matrix_lands_on_the_full_newton_states() -> Result<()> {
-    use tape_core::StepKind;
-    let f1 = first_frequency();
     let model = strip(5e-5)?;
-    let go = |reuse: bool| -> Result<(Vec<[f64; 3]>, usize)> {
-        let mut steps = steps(0.7, 1.0 / f1 / 50.0, 2.0 / f1);
-        for step in &mut steps {
-            if let StepKind::Dynamic(p) = &mut step.kind {
-                p.reuse_factorisation = reuse;
-            }
-        }
-        let result = run(&model, &steps, &Outputs::default(), &mut |_| true)?;
-        assert!(result.error.is_none(), "{:?}", result.error);
-        Ok((
-            result.history.marker_positions.clone(),
-            result.step_stats[1].factorisations,
-        ))
-    };
-    let ((full, n_full), (reused, n_reused)) = (go(false)?, go(true)?);
-    assert_eq!(full.len(), reused.len());
-    let amplitude = full.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
-    let worst = full
-        .iter()
-        .zip(&reused)
-        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max))
-        .fold(0.0, f64::max);
+    let (full, n_full) = released_track(&model, |p| p.reuse_factorisation = false)?;
+    let (reused, n_reused) = released_track(&model, |p| p.reuse_factorisation = true)?;
+    let (worst, amplitude) = track_difference(&full, &reused);
+    let (n_full, n_reused) = (n_full.factorisations, n_reused.factorisations);
     eprintln!(
         "factorisations: full Newton {n_full}, reused {n_reused}; worst difference {worst:e} m of {amplitude:e} m"
     );
@@ -238,34 +246,17 @@ fn reused_iteration_matrix_lands_on_the_full_newton_states() -> Result<()> {
 
 /// The iteration matrix with the step start's stresses in its geometric part
 /// ([`tape_core::solver::DynamicParams::start_stress`]) lands on the states of the default one:
-/// it changes Newton's path, not the residual. The released strip without damping over two
-/// periods of 50 fixed steps, Newton to 1e-10 of the reference force: the tip's track agrees to
-/// 1e-7 of its amplitude as for the reused matrix above (measured 5e-8), along another path (228
-/// iterations against 250: a different count, or the option would not act).
+/// it changes Newton's path, not the residual. The released strip without damping
+/// ([`released_track`]): the tip's track agrees to 1e-7 of its amplitude as for the reused matrix
+/// above (measured 5e-8), along another path (228 iterations against 250: a different count, or
+/// the option would not act).
 #[test]
 fn start_stress_iteration_matrix_lands_on_the_same_states() -> Result<()> {
-    use tape_core::StepKind;
-    let f1 = first_frequency();
     let model = strip(0.0)?;
-    let go = |start_stress: bool| -> Result<(Vec<[f64; 3]>, usize)> {
-        let mut steps = steps(0.7, 1.0 / f1 / 50.0, 2.0 / f1);
-        for step in &mut steps {
-            if let StepKind::Dynamic(p) = &mut step.kind {
-                p.start_stress = start_stress;
-            }
-        }
-        let result = run(&model, &steps, &Outputs::default(), &mut |_| true)?;
-        assert!(result.error.is_none(), "{:?}", result.error);
-        Ok((result.history.marker_positions.clone(), result.step_stats[1].iterations))
-    };
-    let ((mixed, n_mixed), (start, n_start)) = (go(false)?, go(true)?);
-    assert_eq!(mixed.len(), start.len());
-    let amplitude = mixed.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
-    let worst = mixed
-        .iter()
-        .zip(&start)
-        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max))
-        .fold(0.0, f64::max);
+    let (mixed, n_mixed) = released_track(&model, |p| p.start_stress = false)?;
+    let (start, n_start) = released_track(&model, |p| p.start_stress = true)?;
+    let (worst, amplitude) = track_difference(&mixed, &start);
+    let (n_mixed, n_start) = (n_mixed.iterations, n_start.iterations);
     eprintln!("iterations: mixed {n_mixed}, start stresses {n_start}; worst difference {worst:e} m of {amplitude:e} m");
     assert!(
         worst <= 1e-7 * amplitude,
