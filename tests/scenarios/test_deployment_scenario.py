@@ -312,3 +312,15 @@ def test_trial_force_plate_reads_the_clamp_force_in_both_senses(
     expected = np.interp(plate.time - plate.time[0], run.time_s, run.clamp_force_N)
     np.testing.assert_allclose(plate.force[:, 2], expected, atol=1e-9 * np.abs(expected).max())
     assert plate.force[0, 2] < 0.0
+
+
+def test_deploy_names_the_series_it_wrote(tmp_path, capsys) -> None:
+    # As the other commands do: the ParaView series is written as a .pvd file (the suffix is
+    # added if missing) and that file's path is printed, not the option's value.
+    from tapespring.cli import main
+
+    stem = tmp_path / "run"
+    assert main(["deploy", "--duration=0.02", f"--vtu={stem}", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert f"  wrote {stem}.pvd" in out.splitlines()
+    assert (tmp_path / "run.pvd").is_file()

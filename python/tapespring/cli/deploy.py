@@ -24,6 +24,7 @@ from .scenario_options import (
     shows_progress,
     spec_from_args,
     with_comparison,
+    write_vtu,
 )
 
 if TYPE_CHECKING:
@@ -192,12 +193,7 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def fields(result: DeploymentSimulation) -> None:
-        if args.vtu:
-            from tapespring.io.vtu import write_pvd
-
-            write_pvd(result.results, result.setup.model, args.vtu)
-            if not args.json:
-                print(f"  wrote {args.vtu}")
+        write_vtu(args, result.results, result.setup.model)
         if args.snapshots:
             import matplotlib
 
