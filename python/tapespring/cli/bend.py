@@ -69,9 +69,17 @@ def warn(message: str) -> None:
 
 
 def print_warnings(caught: list[warnings.WarningMessage]) -> None:
-    """:func:`warn` each warning recorded by :func:`warnings.catch_warnings`."""
+    """:func:`warn` each note recorded by :func:`warnings.catch_warnings` that is meant for the
+    user (a ``UserWarning``, as the package's ``TrialWarning``); re-issue any other warning (a
+    numpy ``RuntimeWarning``, a ``DeprecationWarning``) as it came, so that the warning filters
+    in force still see it rather than a ``warning:`` line hiding it."""
     for note in caught:
-        warn(str(note.message))
+        if issubclass(note.category, UserWarning):
+            warn(str(note.message))
+        else:
+            warnings.warn_explicit(
+                note.message, note.category, note.filename, note.lineno, source=note.source
+            )
 
 
 def _count(name: str, what: str = "an integer >= 1"):

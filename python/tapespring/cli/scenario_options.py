@@ -359,7 +359,8 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
 
     The reader's and the analysis' warnings (`TrialWarning`: a record that stops before the
     tape settles, a support that moved, ...) are printed as ``warning: ...`` lines on stderr,
-    as ``tapespring trials analyze`` prints them (`print_warnings`).
+    as ``tapespring trials analyze`` prints them (`print_warnings`, which re-issues any other
+    category as it came).
 
     Returns the analysis, or None after printing ``error: FILE: problem`` on stderr if the file
     is missing, unreadable or corrupt, or the analysis refuses it (the caller exits with 2).
