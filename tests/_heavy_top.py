@@ -1,10 +1,8 @@
 """The heavy top on its pin, shared by the dynamics tests: ``from _heavy_top import heavy_top``.
 
 The heavy top of issue 8, 6.b (Brüls, Cardona & Arnold 2012; the model of
-`crates/tape-core/tests/rigid_dynamics.rs`): a rigid body of 15 kg whose centre of mass lies at
-X = (0, 1, 0) m from a fixed point at the origin, J = diag(0.234375, 0.46875, 0.234375) kg m^2
-about the centre of mass, spun at (0, 150, -4.61538) rad/s (body frame, the spatial one at
-t = 0) under g = 9.81 m/s^2 along -z. Units SI.
+`crates/tape-core/tests/rigid_dynamics.rs`): a rigid body spinning about a fixed point at the
+origin under gravity, its data below. Units SI.
 """
 
 from __future__ import annotations

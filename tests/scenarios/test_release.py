@@ -160,13 +160,13 @@ def test_damped_history_through_the_snap_is_stable_when_the_tolerance_is_halved(
     # Issue 8, 6.g: results stable when the error tolerance is halved. With the paper's eta the
     # snap's short waves are damped and the history through the snap and the equal-sense fold
     # (200 ms) moves by 0.13 deg at most (measured; 0.06 deg over the first 50 ms), on a swing
-    # from +60 to -61 deg: 0.5 deg is the bound of the undamped pre-snap test above. It is tight
-    # for other pairs, whose differences sit where the angle crosses zero at 2000 deg/s and more:
-    # halving once more (5e-5 against 2.5e-5 m) moves the history by 0.79 deg at 0.16 s, a shift
-    # of 0.3 ms; a run at 1e-5 m with Newton at 1e-6 differs from the default by 2.2 deg at
-    # 0.18 s, a shift of 1.2 ms (rms 0.6 deg). Undamped, the history past the snap is not
-    # converged at the default tolerance (docs/dynamics.md). The steps do not depend on the
-    # duration, so the 1 s fixture's first 200 ms are this run's.
+    # from +60 to -61 deg: 0.5 deg is the bound of the undamped pre-snap test above. It would
+    # fail for other pairs, whose differences sit where the angle crosses zero at 1900 deg/s and
+    # more: halving once more (5e-5 against 2.5e-5 m) moves the history by 0.79 deg at 0.16 s,
+    # a shift of 0.3 ms; a run at 1e-5 m with Newton at 1e-6 differs from the default by
+    # 2.2 deg at 0.18 s, a shift of 1.2 ms (rms 0.6 deg). Undamped, the history past the snap
+    # is not converged at the default tolerance (docs/dynamics.md). The steps do not depend on
+    # the duration, so the 1 s fixture's first 200 ms are this run's.
     fine = release(ReleaseSetup(tape=TAPE, duration=0.2, eta=1.73e-4, tolerance=0.5e-4))
     t = np.linspace(0.0, 0.2, 2001)
     coarse_theta = np.interp(t, settled.time_s, settled.theta_deg)

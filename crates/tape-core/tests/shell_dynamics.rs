@@ -248,8 +248,7 @@ fn reused_iteration_matrix_lands_on_the_full_newton_states() -> Result<()> {
 /// ([`tape_core::solver::DynamicParams::start_stress`]) lands on the states of the default one:
 /// it changes Newton's path, not the residual. The released strip without damping
 /// ([`released_track`]): the tip's track agrees to 1e-7 of its amplitude as for the reused matrix
-/// above (measured 5e-8), along another path (228 iterations against 250: a different count, or
-/// the option would not act).
+/// above (measured 5e-8), along another path, shorter here (228 iterations against 250).
 #[test]
 fn start_stress_iteration_matrix_lands_on_the_same_states() -> Result<()> {
     let model = strip(0.0)?;
@@ -262,7 +261,7 @@ fn start_stress_iteration_matrix_lands_on_the_same_states() -> Result<()> {
         worst <= 1e-7 * amplitude,
         "tracks differ by {worst:e} m (amplitude {amplitude:e} m)"
     );
-    assert_ne!(n_mixed, n_start, "the option changed nothing");
+    assert!(n_start < n_mixed, "{n_start} iterations against {n_mixed}");
     Ok(())
 }
 

@@ -109,13 +109,11 @@ pub struct DynamicParams {
     /// converged state) at every iteration of the step, instead of the iterate's or, with
     /// `newton.mixed_stress`, their linearisation from the predictor (which this replaces). The
     /// converged states are the same (the residual is untouched); only the path to them changes.
-    /// Where a thin shell rings undamped, a predictor's or correction's membrane stresses of the
-    /// wrong sign make the consistent and the mixed iteration matrices indefinite, and Newton
-    /// fails at steps where this one converges; the error estimate then sets the steps, not
-    /// Newton's failures, so they are longer and the history as accurate as the tolerance asks,
-    /// no more (measured in docs/dynamics.md: the 2 mm release without Kelvin-Voigt damping, 1 s,
-    /// 121 s instead of 217 s with the mixed matrix, and at half the tolerance, for the mixed
-    /// matrix's accuracy, about 150 s; with damping it is slower than the plain one).
+    /// Where a thin shell rings undamped, a predictor's or correction's membrane stresses make the
+    /// other two iteration matrices indefinite and Newton fails; with this one it converges, and
+    /// the error estimate, not Newton's failures, sets the steps: fewer and longer ones, and a
+    /// history only as accurate as the tolerance asks. False (the default): the iterate's
+    /// stresses or the mixed ones. Measurements in docs/dynamics.md (`start_stress`).
     #[serde(default)]
     pub start_stress: bool,
     /// Record nodal fields (set by the analysis runner).
