@@ -150,8 +150,10 @@ def test_summary_text_says_which_phases_were_found(opposite: DeploymentSimulatio
         label = name.upper()
         expected = f"{label} not detected" if start is None else f"{label} from {start:.2f} s"
         assert expected in line
-    # On the fixture's 5 mm mesh no second fold forms (docs/scenarios.md): no phase II.
+    # On the fixture's 5 mm mesh no second fold forms (docs/scenarios.md): no phase II, and the
+    # line says that the phases depend on the mesh.
     assert "phases: II not detected" in line
+    assert "tapes meshed at 5 mm, coarser than the paper's 2 mm" in line
 
 
 def test_bad_settings_are_named() -> None:
