@@ -72,6 +72,7 @@ __all__ = [
     "analyze_identification",
     "analyze_identification_group",
     "check_rest",
+    "displacement_figures",
 ]
 
 KIND = "identification"
@@ -98,6 +99,16 @@ _REST_SMOOTHING = 0.025
 _REST_NOISE_SIGMA = 3.0
 
 _AXES = "xyz"
+
+
+def displacement_figures(markers: Iterable[tuple[str, np.ndarray]]) -> dict[str, float]:
+    """Displacements [m] keyed as Tables 3 and 6: ``{name}_dx_m``, ``{name}_dy_m``,
+    ``{name}_dz_m`` for each ``(name, (x, y, z) [m])`` of `markers`, in order."""
+    return {
+        f"{name}_d{axis}_m": float(values[i])
+        for name, values in markers
+        for i, axis in enumerate(_AXES)
+    }
 
 
 @dataclass(frozen=True)
@@ -178,14 +189,12 @@ class IdentificationResult:
     def figures(self) -> dict[str, float | None]:
         """Table 3's figures [m]: ``marker0_dx_m`` .. ``marker0_dz_m`` (None without a control
         marker), ``markers12_dx_m`` .. ``markers12_dz_m``, ``marker3_dx_m`` .. ``marker3_dz_m``."""
-        out: dict[str, float | None] = {}
-        for prefix, values in (
-            ("marker0", self.control_m),
-            ("markers12", self.markers12_m),
-            ("marker3", self.marker3_m),
-        ):
-            for i, axis in enumerate(_AXES):
-                out[f"{prefix}_d{axis}_m"] = None if values is None else float(values[i])
+        out: dict[str, float | None] = {f"marker0_d{axis}_m": None for axis in _AXES}
+        if self.control_m is not None:
+            out.update(displacement_figures([("marker0", self.control_m)]))
+        out.update(
+            displacement_figures([("markers12", self.markers12_m), ("marker3", self.marker3_m)])
+        )
         return out
 
     def summary(self) -> dict[str, Any]:

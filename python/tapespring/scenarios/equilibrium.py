@@ -100,11 +100,9 @@ class EquilibriumSettings:
 def _figures(markers12_m: np.ndarray, marker3_m: np.ndarray) -> dict[str, float]:
     """Displacements [m] keyed as the summaries: ``markers12_dx_m`` .. ``marker3_dz_m`` (x, y,
     z), from those (x, y, z) [m] of markers 1-2 and 3."""
-    out = {}
-    for prefix, values in (("markers12", markers12_m), ("marker3", marker3_m)):
-        for i, axis in enumerate("xyz"):
-            out[f"{prefix}_d{axis}_m"] = float(values[i])
-    return out
+    from tapespring.protocols.identification import displacement_figures
+
+    return displacement_figures([("markers12", markers12_m), ("marker3", marker3_m)])
 
 
 def _relative(value: float, reference: float) -> float:
