@@ -101,16 +101,14 @@ def spec_assignment(text: str) -> tuple[str, Any]:
     name, sep, value = (part.strip() for part in text.partition("="))
     if not sep or not name:
         raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
-    owner, field = (TapeSpring, name[5:]) if name.startswith("tape.") else (SetupSpec, name)
-    types = {f.name: str(f.type) for f in fields(owner)}
-    if field not in types or types[field] == "TapeSpring":
-        known = [f"tape.{n}" for n in (f.name for f in fields(TapeSpring))] + [
-            n for n, t in ((f.name, str(f.type)) for f in fields(SetupSpec)) if t != "TapeSpring"
-        ]
+    # The assignable names and their types' names: the tape's fields, then the spec's own.
+    types = {f"tape.{f.name}": str(f.type) for f in fields(TapeSpring)}
+    types.update((f.name, str(f.type)) for f in fields(SetupSpec) if str(f.type) != "TapeSpring")
+    kind = types.get(name)
+    if kind is None:
         raise argparse.ArgumentTypeError(
-            f"unknown set-up field {name!r}; the fields are {', '.join(known)}"
+            f"unknown set-up field {name!r}; the fields are {', '.join(types)}"
         )
-    kind = types[field]
     try:
         if kind == "str":
             return name, value
