@@ -60,6 +60,7 @@ from tapespring.scenarios.setup import (
     drive,
     dynamic_options,
     gravity_step,
+    last_ndof,
     raise_if_stopped,
     sample_rows,
 )
@@ -371,7 +372,7 @@ class DeploymentSimulation:
             "rejected_steps": int(stats.get("cutbacks", 0)),
             "newton_iterations": int(r.stats.get("iterations", 0)),
             "factorisations": int(r.stats.get("factorisations", 0)),
-            "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
+            "ndof": last_ndof(r),
             "wall_s": self.wall_s,
             "completed": r.completed,
             "error": r.error,

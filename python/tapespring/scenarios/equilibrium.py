@@ -40,6 +40,7 @@ from tapespring.scenarios.setup import (
     check_displacement,
     drive,
     gravity_step,
+    last_ndof,
     raise_if_stopped,
 )
 
@@ -309,7 +310,7 @@ class EquilibriumResult:
             "unstable_modes": self.unstable_modes,
             "push_m": self.push_m.tolist(),
             "force_N": self.force_N.tolist(),
-            "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
+            "ndof": last_ndof(r),
             "newton_iterations": int(r.stats.get("iterations", 0)),
             "wall_s": self.wall_s,
             "settings": asdict(self.settings),

@@ -38,6 +38,7 @@ from tapespring.scenarios.setup import (
     check_displacement,
     drive,
     gravity_step,
+    last_ndof,
     raise_if_stopped,
 )
 
@@ -380,7 +381,7 @@ class PullResult:
             "displacement_difference": self.max_force_displacement_m / paper_d - 1.0,
             "displacement_m": self.displacement_m.tolist(),
             "force_N": self.force_N.tolist(),
-            "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
+            "ndof": last_ndof(r),
             "newton_iterations": int(r.stats.get("iterations", 0)),
             "wall_s": self.wall_s,
             "completed": r.completed,

@@ -33,6 +33,7 @@ from tapespring.scenarios.setup import (
     check_number,
     check_rho_inf,
     check_tolerance,
+    last_ndof,
 )
 
 __all__ = [
@@ -310,7 +311,7 @@ class ReleaseResult:
             "steps": int(stats.get("steps", 0)),
             "rejected_steps": int(stats.get("cutbacks", 0)),
             "newton_iterations": int(stats.get("iterations", 0)),
-            "ndof": int(r.ndof[-1]) if len(r.ndof) else 0,
+            "ndof": last_ndof(r),
             "wall_s": self.wall_s,
             "completed": r.completed,
             "error": r.error,

@@ -1604,3 +1604,9 @@ def raise_if_stopped(results: Any, result: Any, what: str) -> None:
         err = ConvergenceError(f"{results.error} (the {what} so far is in the 'result' attribute)")
         err.result = result
         raise err
+
+
+def last_ndof(results: Any) -> int:
+    """Free DOFs of the last step's numbering of `results` (0 if no step ran): the model's size
+    that the scenarios' summaries report as ``ndof``."""
+    return int(results.ndof[-1]) if len(results.ndof) else 0
