@@ -333,7 +333,12 @@ class DeploymentSimulation:
         )
 
     def summary(self) -> dict[str, Any]:
-        """The figures as JSON-ready values, with the settings."""
+        """The figures as JSON-ready values, with the settings.
+
+        ``steps`` and ``rejected_steps`` count the motion after the release (the last step's);
+        ``newton_iterations`` and ``factorisations`` the whole analysis (gravity, fold and settle
+        included).
+        """
         r = self.results
         stats = r.step_stats[-1] if len(r.step_stats) else {}
         peaks: dict[str, Any] = {"max_time_s": [], "max_deg": [], "min_time_s": [], "min_deg": []}

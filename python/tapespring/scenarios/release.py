@@ -279,9 +279,9 @@ class ReleaseResult:
         lines = [
             f"tape spring released from {self.setup.fold_deg:+.1f} deg ({sense} sense) with a "
             f"{self.setup.tip_mass * 1e3:.1f} g tip body, {s['ndof']} DOFs",
-            f"  free motion {reached:.4g} s in {s['steps']} steps "
-            f"({s['rejected_steps']} rejected, {s['newton_iterations']} Newton iterations), "
-            f"wall time {self.wall_s:.1f} s",
+            f"  free motion {reached:.4g} s: {s['steps']} steps ({s['rejected_steps']} rejected), "
+            f"{s['newton_iterations']} Newton iterations (the fold's not counted); wall time "
+            f"{self.wall_s:.1f} s with the fold",
         ]
         if self.theta_deg.size:
             lines.append(
@@ -299,8 +299,16 @@ class ReleaseResult:
         return "\n".join(lines)
 
     def summary(self) -> dict[str, Any]:
-        """The figures of a run as plain JSON-ready values."""
+        """The figures of a run as plain JSON-ready values.
+
+        ``steps``, ``rejected_steps`` and ``newton_iterations`` count the free motion alone (the
+        release step's accepted and rejected steps and its Newton iterations; 0 if the fold did
+        not finish), not the static fold before it, unlike the set-up's scenarios, whose
+        ``newton_iterations`` count the whole analysis. ``wall_s`` is the whole run's, fold
+        included; ``ndof`` the free DOFs of the last step run.
+        """
         r = self.results
+        # The free motion's counters: the release step's, not the whole analysis's (r.stats).
         stats = r.step_stats[-1] if len(r.step_stats) > 1 else {}
         return {
             "fold_deg": self.setup.fold_deg,

@@ -320,7 +320,12 @@ class VibrationSimulation:
         return self.rejected_steps if self.settings.time_step > 0.0 else None
 
     def summary(self) -> dict[str, Any]:
-        """The figures as JSON-ready values, with the settings and the paper's values."""
+        """The figures as JSON-ready values, with the settings and the paper's values.
+
+        ``steps`` and ``rejected_steps`` count the free decay (the last step's);
+        ``newton_iterations`` the whole analysis: the Newton iterations of gravity, push and decay
+        and the modal step's eigensolver iterations.
+        """
         r = self.results
         fit = self.fit
         stats = r.step_stats[-1] if len(r.step_stats) else {}
@@ -358,7 +363,8 @@ class VibrationSimulation:
         lines = [
             f"small vibrations of the set-up with the additional weight: {s['ndof']} DOFs, "
             f"{self.time_s[-1] if self.time_s.size else 0.0:.3g} s of free decay in {s['steps']} "
-            f"steps ({s['newton_iterations']} Newton iterations), wall time {self.wall_s:.1f} s",
+            f"steps ({s['newton_iterations']} iterations in all steps, the modal solver's "
+            f"included), wall time {self.wall_s:.1f} s",
             f"  modal period about the loaded equilibrium {s['modal_period_s']:.4f} s; "
             f"Kelvin-Voigt eta omega/2 = {s['kelvin_voigt_damping_ratio']:.3%}",
         ]
