@@ -300,7 +300,8 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
 /// a reason; now it stops as stalled and says how many modes it can give.
 #[test]
 fn modes_beyond_the_drilling_cluster_are_refused_with_the_count_that_converges() -> Result<()> {
-    let mut section = common::hinged_roof::section(12.7);
+    let h = common::num(&common::hinged_roof::data()["thickness"]["case_12_7"]);
+    let mut section = common::hinged_roof::section(h);
     section.density = common::hinged_roof::PMMA_DENSITY;
     let (model, _) = common::hinged_roof::quarter(8, section, 0.0)?;
     let five = modes_of(&model, &[modal(5)])?;

@@ -23,7 +23,8 @@ use tape_core::solver::{solve_static, Control, StaticParams, StaticPath};
 use tape_core::{Error, Result, System};
 
 fn roof(lambda_end: f64, initial_increment: f64) -> Result<(StaticPath, usize)> {
-    let section = common::hinged_roof::section(6.35);
+    let h = common::num(&common::hinged_roof::data()["thickness"]["case_6_35"]);
+    let section = common::hinged_roof::section(h);
     let (model, c) = common::hinged_roof::quarter(4, section, 600.0)?;
     let mut system = System::try_new(&model)?;
     let mut state = system.initial_state();

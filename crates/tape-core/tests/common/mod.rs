@@ -310,6 +310,8 @@ pub fn value_at_load(lambdas: &[f64], values: &[f64], level: f64, first: bool) -
 ///          /         \
 /// ```
 pub mod hinged_roof {
+    use std::sync::OnceLock;
+
     use nalgebra::Vector3;
     use serde_json::Value;
     use tape_core::material::ShellSection;
@@ -323,15 +325,17 @@ pub mod hinged_roof {
     pub const PMMA_DENSITY: f64 = 1.19e-9;
 
     /// `problems.hinged_cylindrical_roof` of `reference_values/sze2004.json`: geometry, material,
-    /// thickness cases, Pmax and the tabulated paths.
-    pub fn data() -> Value {
-        super::reference("sze2004.json")["problems"]["hinged_cylindrical_roof"].take()
+    /// thickness cases, Pmax and the tabulated paths. Read once per test binary; `section` and
+    /// `quarter` read it too.
+    pub fn data() -> &'static Value {
+        static DATA: OnceLock<Value> = OnceLock::new();
+        DATA.get_or_init(|| super::reference("sze2004.json")["problems"]["hinged_cylindrical_roof"].take())
     }
 
     /// Homogeneous isotropic section of thickness `thickness` \[mm\] with the roof's E and nu.
     pub fn section(thickness: f64) -> ShellSection {
-        let data = data();
-        super::section(thickness, num(&data["material"]["E"]), num(&data["material"]["nu"]))
+        let material = &data()["material"];
+        super::section(thickness, num(&material["E"]), num(&material["nu"]))
     }
 
     /// Quarter model of the roof, `n x n` elements (`mesh::generate::cylindrical_panel`, axis along
@@ -344,8 +348,7 @@ pub mod hinged_roof {
     /// # Errors
     /// `n = 0` or an invalid section.
     pub fn quarter(n: usize, section: ShellSection, p: f64) -> Result<(Model, usize)> {
-        let data = data();
-        let g = &data["geometry"];
+        let g = &data()["geometry"];
         let (r, half_length, theta) = (num(&g["R"]), num(&g["L_kratos"]), num(&g["theta_rad"]));
         let mesh = cylindrical_panel(r, half_length, 0.0, theta, n, n)?;
         let mut model = Model::try_new(mesh, section)?;
