@@ -326,3 +326,23 @@ def test_deploy_names_the_series_it_wrote(tmp_path, capsys) -> None:
     out = capsys.readouterr().out
     assert f"  wrote {stem}.pvd" in out.splitlines()
     assert (tmp_path / "run.pvd").is_file()
+
+
+def test_a_deployment_stopped_in_its_fold_reports_no_motion(monkeypatch) -> None:
+    # The fold limited to one arc-length increment: the run stops before the release. The
+    # motion's counters are zero, not the fold's (the summary read the last step run), and its
+    # trial holds no motion, not the fold's records.
+    import tapespring.scenarios.deployment as scenario
+    from tapespring.analysis import ConvergenceError
+
+    full = scenario.buckling_step
+    monkeypatch.setattr(scenario, "buckling_step", lambda name, **kw: full(name, max_steps=1, **kw))
+    with pytest.raises(ConvergenceError) as caught:
+        deploy(DeploymentSettings(spec=COARSE, sense="opposite", duration=0.05))
+    partial = caught.value.result
+    assert len(partial.results.step_stats) == 2 and partial.results.step_stats[-1]["steps"] >= 1
+    summary = partial.summary()
+    assert (summary["steps"], summary["rejected_steps"]) == (0, 0)
+    assert partial.time_s.size == 0
+    with pytest.raises(ValueError, match=r"no record belongs to steps \[2\]"):
+        partial.to_trial()

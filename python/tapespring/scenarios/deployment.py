@@ -63,6 +63,7 @@ from tapespring.scenarios.setup import (
     last_ndof,
     raise_if_stopped,
     sample_rows,
+    step_counts,
 )
 
 __all__ = ["TRIAL_MARKERS", "DeploymentSettings", "DeploymentSimulation", "deploy"]
@@ -168,6 +169,11 @@ class DeploymentSettings:
             )
 
 
+def _release_step(settings: DeploymentSettings) -> int:
+    """Index of the release among the analysis steps: gravity, fold, settle (if any), release."""
+    return 3 if settings.settle > 0.0 else 2
+
+
 @dataclass(frozen=True)
 class DeploymentSimulation:
     """A simulated deployment.
@@ -238,7 +244,7 @@ class DeploymentSimulation:
         from tapespring.trials.trial import Metadata
 
         rate = self.settings.sample_rate if rate_hz is None else rate_hz
-        steps = [len(self.results.step_stats) - 1]
+        steps = [self.release_step]
         meta = Metadata(
             name=f"simulated deployment ({self.settings.sense} sense)", sense=self.settings.sense
         )
@@ -332,15 +338,21 @@ class DeploymentSimulation:
             self.time_s, self.angle_deg, self.clamp_force_N, start=0.0, end=end
         )
 
+    @property
+    def release_step(self) -> int:
+        """Index of the release (the motion) among the analysis steps of :attr:`results`."""
+        return _release_step(self.settings)
+
     def summary(self) -> dict[str, Any]:
         """The figures as JSON-ready values, with the settings.
 
-        ``steps`` and ``rejected_steps`` count the motion after the release (the last step's);
+        ``steps`` and ``rejected_steps`` count the motion after the release (0 if the run stopped
+        before it);
         ``newton_iterations`` and ``factorisations`` the whole analysis (gravity, fold and settle
         included).
         """
         r = self.results
-        stats = r.step_stats[-1] if len(r.step_stats) else {}
+        stats = step_counts(r, self.release_step)
         peaks: dict[str, Any] = {"max_time_s": [], "max_deg": [], "min_time_s": [], "min_deg": []}
         if self.peaks is not None:
             for kind, ext in (("max", self.peaks.maxima), ("min", self.peaks.minima)):
@@ -482,6 +494,7 @@ def deploy(
     steps.append(
         Step.dynamic("release", duration=settings.duration, deactivate=["fold"], **dynamic)
     )
+    assert len(steps) - 1 == _release_step(settings)
     outputs = Outputs(
         reactions=tuple((built.clamp, d) for d in ("ux", "uy", "uz", "rx", "ry", "rz")),
         field_interval=settings.field_interval,
@@ -495,7 +508,7 @@ def deploy(
     angle0 = bending_angle(
         results.marker_positions[[ref], m1], results.marker_positions[[ref], m2]
     )[0]
-    free = results.in_step(len(steps) - 1)
+    free = results.in_step(_release_step(settings))
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free.astype(np.int64)
     t = results.t[idx] - results.t[idx[0]] if idx.size else np.zeros(0)
     angle = (

@@ -34,6 +34,7 @@ from tapespring.scenarios.setup import (
     check_rho_inf,
     check_tolerance,
     last_ndof,
+    step_counts,
 )
 
 __all__ = [
@@ -59,6 +60,9 @@ __all__ = [
 #: default body (10 g, 1e-6 kg m^2), and far beyond what a tape spring lifts.
 MAX_TIP_MASS = 1e3
 MAX_TIP_INERTIA = 1.0
+
+#: Index of the free motion among the analysis steps of `release_steps`: fold, release.
+FREE_STEP = 1
 
 
 def check_tip_mass(value: object) -> None:
@@ -309,7 +313,7 @@ class ReleaseResult:
         """
         r = self.results
         # The free motion's counters: the release step's, not the whole analysis's (r.stats).
-        stats = r.step_stats[-1] if len(r.step_stats) > 1 else {}
+        stats = step_counts(r, FREE_STEP)
         return {
             "fold_deg": self.setup.fold_deg,
             "time_s": self.time_s.tolist(),
@@ -347,7 +351,7 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
     results = run(
         model, release_steps(setup, tip), outputs=outputs, progress=progress, raise_on_error=False
     )
-    free = results.in_step(1)
+    free = results.in_step(FREE_STEP)
     t0 = results.t[free[0] - 1] if free.size else 0.0
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free
     rot = results.marker_rotations[idx, 0, 1]

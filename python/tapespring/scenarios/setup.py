@@ -1606,6 +1606,13 @@ def raise_if_stopped(results: Any, result: Any, what: str) -> None:
         raise err
 
 
+def step_counts(results: Any, step: int) -> dict[str, Any]:
+    """The counters of analysis step `step` of `results` (``steps``, ``cutbacks``, ...), empty if
+    the run stopped before that step: a scenario's motion or decay counts are never another
+    step's."""
+    return dict(results.step_stats[step]) if len(results.step_stats) > step else {}
+
+
 def last_ndof(results: Any) -> int:
     """Free DOFs of the last step's numbering of `results` (0 if no step ran): the model's size
     that the scenarios' summaries report as ``ndof``."""

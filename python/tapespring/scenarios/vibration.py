@@ -53,6 +53,7 @@ from tapespring.scenarios.setup import (
     raise_if_stopped,
     sample_rows,
     shown,
+    step_counts,
 )
 
 __all__ = [
@@ -98,6 +99,9 @@ def check_modes(value: object) -> None:
 
 #: Trial marker names of the set-up's markers (marker 3 on the additional weight is analysed).
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2", "marker3": "M3"}
+
+#: Index of the free decay among the analysis steps: gravity, modes, push, free.
+DECAY_STEP = 3
 
 
 def check_time_step(value: object) -> None:
@@ -265,7 +269,7 @@ class VibrationSimulation:
         trial = self.results.to_trial(
             markers=TRIAL_MARKERS,
             rate_hz=rate,
-            steps=[3],  # the free decay (vibrate)
+            steps=[DECAY_STEP],
             metadata=Metadata(name="simulated free decay", units={"markers": "m"}),
         )
         return rest_before(trial, hold)
@@ -310,8 +314,7 @@ class VibrationSimulation:
     @property
     def rejected_steps(self) -> int:
         """Steps of the decay rejected and cut back."""
-        stats = self.results.step_stats[-1] if len(self.results.step_stats) else {}
-        return int(stats.get("cutbacks", 0))
+        return int(step_counts(self.results, DECAY_STEP).get("cutbacks", 0))
 
     @property
     def fixed_step_cutbacks(self) -> int | None:
@@ -322,13 +325,13 @@ class VibrationSimulation:
     def summary(self) -> dict[str, Any]:
         """The figures as JSON-ready values, with the settings and the paper's values.
 
-        ``steps`` and ``rejected_steps`` count the free decay (the last step's);
+        ``steps`` and ``rejected_steps`` count the free decay (0 if the run stopped before it);
         ``newton_iterations`` the whole analysis: the Newton iterations of gravity, push and decay
         and the modal step's eigensolver iterations.
         """
         r = self.results
         fit = self.fit
-        stats = r.step_stats[-1] if len(r.step_stats) else {}
+        stats = step_counts(r, DECAY_STEP)
         out: dict[str, Any] = {
             "damping_ratio": None if fit is None else fit.damping_ratio,
             "damping_ratio_std": None if fit is None else fit.damping_ratio_std,
@@ -543,11 +546,12 @@ def vibrate(
         Step.static("push", activate=["push"], increments=4, lambda_end=2.0),
         Step.dynamic("free", duration=settings.duration, deactivate=["push"], **options),
     ]
+    assert len(steps) - 1 == DECAY_STEP
     outputs = Outputs(reactions=((built.clamp, "uz"),), field_interval=settings.field_interval)
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
     marker = results.marker_names.index("marker3")
     loaded = results.in_step(0)
-    free = results.in_step(3)
+    free = results.in_step(DECAY_STEP)
     z0 = results.marker_positions[loaded[-1], marker, 2] if loaded.size else 0.0
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free
     t = results.t[idx] - (results.t[idx[0]] if idx.size else 0.0)
