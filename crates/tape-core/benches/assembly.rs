@@ -184,6 +184,12 @@ fn small_factorisation(c: &mut Criterion) {
             &format!("numeric factorisation {mesh_mm} mm tape, {n} DOFs (default)"),
             |b| b.iter(|| solver.factorize(&out.k_ff).expect("factor")),
         );
+        let mut solver = LinearSolver::with_dissection(&system.pattern_ff, &[]).expect("symbolic");
+        let split = if solver.is_bordered() { "dissected" } else { "not split" };
+        c.bench_function(
+            &format!("numeric factorisation {mesh_mm} mm tape, {n} DOFs ({split})"),
+            |b| b.iter(|| solver.factorize(&out.k_ff).expect("factor")),
+        );
         let mut solver = LinearSolver::with_simplicial(&system.pattern_ff).expect("symbolic");
         c.bench_function(
             &format!("numeric factorisation {mesh_mm} mm tape, {n} DOFs (simplicial)"),
@@ -213,6 +219,11 @@ fn assembly_and_solve(c: &mut Criterion) {
         b.iter(|| solver.factorize(&out.k_ff).expect("factor"))
     });
     solver.factorize(&out.k_ff).expect("factor");
+    let mut dissected = LinearSolver::with_dissection(&system.pattern_ff, &[]).expect("symbolic");
+    assert!(dissected.is_bordered(), "no separator found");
+    c.bench_function("numeric factorisation 2 mm tape (dissected)", |b| {
+        b.iter(|| dissected.factorize(&out.k_ff).expect("factor"))
+    });
     small_factorisation(c);
     let rhs = out.residual();
     // This out-of-equilibrium state has a strongly indefinite symmetric part: GMRES does not

@@ -187,7 +187,8 @@ struct Numbering {
 
 /// The free DOFs of the reference nodes of rigid ties: the only links between the parts they
 /// join (the set-up's tapes, rod and appendix), hence the separator of the bordered
-/// factorisation that factorises those parts in parallel ([`LinearSolver::with_separator`]).
+/// factorisation that factorises those parts in parallel ([`LinearSolver::with_dissection`],
+/// which finds a separator from the graph where these do not split the model).
 fn separator(dofs: &DofMap) -> Vec<usize> {
     let mut is_reference = vec![false; dofs.master.len()];
     for &r in dofs.master.iter().flatten() {
@@ -359,7 +360,7 @@ impl System {
             inertia[b.node].add(b.mass, &b.centre_of_mass, &b.inertia);
         }
         let num = numbering(&elements, &dofs);
-        let linear = LinearSolver::with_separator(&num.pattern_ff, &separator(&dofs))?;
+        let linear = LinearSolver::with_dissection(&num.pattern_ff, &separator(&dofs))?;
         let reference = State::at_rest(model.mesh.nodes.clone(), triads);
         let (loads, gravity) = active_loads(model, activity);
         let n_el = elements.len();
@@ -407,7 +408,7 @@ impl System {
         let renumber = !dofs.same_numbering(&self.dofs);
         if renumber {
             let num = numbering(&self.elements, &dofs);
-            self.linear = LinearSolver::with_separator(&num.pattern_ff, &separator(&dofs))?;
+            self.linear = LinearSolver::with_dissection(&num.pattern_ff, &separator(&dofs))?;
             self.pattern_ff = num.pattern_ff;
             self.pattern_fc = num.pattern_fc;
             self.slots = num.slots;

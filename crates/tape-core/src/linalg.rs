@@ -38,7 +38,11 @@
 //! (paper's meshes, 10578 DOFs, 18 separator DOFs, bins of 55 and 45 % of the flops): a
 //! factorisation in 3.8 ms on 2 cores instead of 7.0 ms, a solve in 0.52 ms instead of 0.63 ms
 //! (the vibration's 7206 DOFs: 1.7 and 0.23 ms instead of 3.2 and 0.33 ms); on one core 6.4 ms
-//! instead of 6.2 ms.
+//! instead of 6.2 ms. A single tape spring has no such tie: [`LinearSolver::with_dissection`]
+//! then takes a cross-section found from the matrix graph (private module `dissection`), 66
+//! DOFs on the 2 mm tape, whose halves fill more than the whole (354k factor entries against
+//! 291k) but factorise in parallel: 1.2 ms instead of 1.4 to 1.6 ms (criterion, 2 cores), and
+//! the damped release (`bench_release.py --eta 1.73e-4`) in 10 s instead of 13.7 s.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -56,6 +60,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 
 mod bordered;
+mod dissection;
 use bordered::Bordered;
 
 /// Compressed-column pattern.
@@ -446,15 +451,26 @@ impl LinearSolver {
     /// # Errors
     /// As [`Self::try_new`].
     pub fn with_separator(pattern: &Pattern, separator: &[usize]) -> Result<Self> {
-        Self::build(pattern, SupernodalThreshold::FORCE_SUPERNODAL, separator)
+        Self::build(pattern, SupernodalThreshold::FORCE_SUPERNODAL, separator, false)
+    }
+
+    /// [`Self::with_separator`], and where `separator` does not split the unknowns usefully (a
+    /// single tape spring, whose only tie holds its end), the bordered LDL^T with a separator
+    /// found from the pattern's graph: the thinnest level of a breadth-first level structure
+    /// near its middle, a cross-section of a strip-like mesh (private module `dissection`).
+    ///
+    /// # Errors
+    /// As [`Self::try_new`].
+    pub fn with_dissection(pattern: &Pattern, separator: &[usize]) -> Result<Self> {
+        Self::build(pattern, SupernodalThreshold::FORCE_SUPERNODAL, separator, true)
     }
 
     /// [`Self::try_new`] with faer's simplicial/supernodal selection threshold.
     fn with_threshold(pattern: &Pattern, threshold: SupernodalThreshold) -> Result<Self> {
-        Self::build(pattern, threshold, &[])
+        Self::build(pattern, threshold, &[], false)
     }
 
-    fn build(pattern: &Pattern, threshold: SupernodalThreshold, separator: &[usize]) -> Result<Self> {
+    fn build(pattern: &Pattern, threshold: SupernodalThreshold, separator: &[usize], dissect: bool) -> Result<Self> {
         let n = pattern.nrows;
         if n == 0 {
             return Err(Error::InvalidModel("the model has no free degree of freedom".into()));
@@ -464,10 +480,19 @@ impl LinearSolver {
         let transpose_of = transpose_positions(pattern)?;
         // The bordered factorisation is an optimisation: where it cannot be set up (or the memory
         // check refuses its factors), the whole one is tried.
-        let bordered = Bordered::try_new(pattern, &transpose_of, separator)
-            .ok()
-            .flatten()
-            .filter(|b| crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes()).is_ok());
+        let bordered_with = |sep: &[usize]| {
+            Bordered::try_new(pattern, &transpose_of, sep)
+                .ok()
+                .flatten()
+                .filter(|b| crate::memory::check_factor(n, nnz, b.len_val(), b.workspace_bytes()).is_ok())
+        };
+        let bordered = bordered_with(separator).or_else(|| {
+            if dissect {
+                bordered_with(&dissection::level_separator(pattern))
+            } else {
+                None
+            }
+        });
         let factor = match bordered {
             Some(b) => SymFactor::Bordered(Box::new(b)),
             None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &transpose_of, threshold)?)),
@@ -1270,6 +1295,70 @@ mod tests {
             assert_eq!(z, x.as_slice());
         }
         assert!(straddling > 0, "no supernode straddles the interior and the separator");
+    }
+
+    /// A strip's matrix (40 x 3 nodes of 4 unknowns, the nodes of each cell coupled, unknowns
+    /// numbered across the strip in a shuffled order) with no separator given:
+    /// `with_dissection` finds one and factorises in two bins, with the whole factorisation's
+    /// solution and inertia, for positive definite and indefinite matrices; `with_separator`
+    /// alone leaves it whole.
+    #[test]
+    fn dissection_splits_a_strip_and_solves_as_the_whole() {
+        let (nx, ny, d) = (40, 3, 4);
+        let n = nx * ny * d;
+        for (shift, seed) in [(14.0, 61), (0.0, 62), (-2.0, 63)] {
+            let mut rng = Lcg(seed);
+            let mut label: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
+                label.swap(i, j);
+            }
+            let mut dense = DMatrix::<f64>::zeros(n, n);
+            let mut filled = vec![vec![false; n]; n];
+            let node = |i: usize, j: usize| i * ny + j;
+            for i in 0..nx - 1 {
+                for j in 0..ny - 1 {
+                    let cell = [node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)];
+                    for &a in &cell {
+                        for &b in &cell {
+                            for (da, db) in (0..d).flat_map(|x| (0..d).map(move |y| (x, y))) {
+                                let (p, q) = (label[a * d + da], label[b * d + db]);
+                                if p < q && !filled[p][q] {
+                                    let v = 0.3 * rng.next();
+                                    dense[(p, q)] = v;
+                                    dense[(q, p)] = v;
+                                    filled[p][q] = true;
+                                    filled[q][p] = true;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            for i in 0..n {
+                dense[(i, i)] = 3.0 * rng.next() + shift;
+                filled[i][i] = true;
+            }
+            let (pattern, values) = compressed(&dense, &filled);
+            assert!(!LinearSolver::with_separator(&pattern, &[])
+                .expect("symbolic")
+                .is_bordered());
+            let mut solver = LinearSolver::with_dissection(&pattern, &[]).expect("symbolic");
+            assert!(solver.is_bordered());
+            solver.factorize(&values).expect("factorisation");
+            assert!(!solver.use_fallback, "the bordered factorisation failed");
+            let negative = negative_eigenvalues_dense(&dense);
+            assert_eq!(negative == 0, shift > 10.0, "{negative} negative eigenvalues");
+            assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
+            let b = DVector::from_fn(n, |i, _| (0.3 * i as f64).cos());
+            let x = check_symmetric_solve(&mut solver, &dense, &b);
+            let mut whole = LinearSolver::try_new(&pattern).expect("symbolic");
+            whole.factorize(&values).expect("factorisation");
+            let mut y = b.as_slice().to_vec();
+            whole.solve_sym(&mut y);
+            let diff = (DVector::from_vec(y) - &x).norm() / x.norm();
+            assert!(diff < 1e-11, "bordered and whole solutions differ by {diff:e}");
+        }
     }
 
     /// A bordered matrix whose symmetric part is singular (two unknowns of a group coupled by a

@@ -1,6 +1,7 @@
 //! The bordered factorisation on a miniature of the paper's set-up: the parts joined only by
 //! rigid ties are factorised in parallel, with the same solutions and inertia as the whole
-//! matrix's LDL^T, and the same history bit for bit on one thread or two.
+//! matrix's LDL^T, and the same history bit for bit on one thread or two; and on a single tape
+//! spring, split at a cross-section.
 //!
 //! ```text
 //!   clamp |~~~~ tape0 ~~~~| interface0 |            |
@@ -137,11 +138,28 @@ fn backward_error(pattern: &tape_core::linalg::Pattern, k: &[f64], x: &[f64], b:
 /// beside 3 mm plates).
 #[test]
 fn bordered_and_whole_factorisations_agree_on_the_setup() -> Result<()> {
-    let model = setup()?;
-    let mut system = System::try_new(&model)?;
+    agree(&setup()?, 0)
+}
+
+/// The same on a single tape spring (the release scenario's, 4 mm elements, 1010 DOFs), which
+/// no tie splits: the separator is a cross-section found from the matrix graph. Its deformed
+/// tangent is skew enough that GMRES gives up, for both, and LU solves it.
+#[test]
+fn bordered_and_whole_factorisations_agree_on_a_single_tape() -> Result<()> {
+    let tape = tape_core::samples::TapeBending {
+        mesh_size: 4e-3,
+        ..Default::default()
+    }
+    .build()?;
+    agree(&tape.model, 1)
+}
+
+/// `lu_fallbacks`: the LU solves expected of each factorisation (one per GMRES that gives up).
+fn agree(model: &Model, lu_fallbacks: usize) -> Result<()> {
+    let mut system = System::try_new(model)?;
     assert!(
         system.linear.is_bordered(),
-        "the set-up's parts are not factorised in parallel"
+        "the model's parts are not factorised in parallel"
     );
     let n = system.pattern_ff.nrows;
     let mut whole = LinearSolver::try_new(&system.pattern_ff)?;
@@ -163,7 +181,8 @@ fn bordered_and_whole_factorisations_agree_on_the_setup() -> Result<()> {
         let (mut x_b, mut x_w) = (b.clone(), b.clone());
         system.linear.solve_in_place(&mut x_b)?;
         whole.solve_in_place(&mut x_w)?;
-        assert_eq!((system.linear.lu_fallbacks, whole.lu_fallbacks), (0, 0));
+        let expected = if negative_expected.is_some() { 0 } else { lu_fallbacks };
+        assert_eq!((system.linear.lu_fallbacks, whole.lu_fallbacks), (expected, expected));
         let (e_b, e_w) = (
             backward_error(&system.pattern_ff, &asm.k_ff, &x_b, &b),
             backward_error(&system.pattern_ff, &asm.k_ff, &x_w, &b),

@@ -2,7 +2,8 @@
 //! factorised in parallel.
 //!
 //! When removing a small set of unknowns (the separator: in a shell model, the free DOFs of the
-//! reference nodes of rigid ties) splits the others into groups that no entry couples, `S`
+//! reference nodes of rigid ties, or a cross-section of a single part found from the graph) splits
+//! the others into groups that no entry couples, `S`
 //! ordered group by group with the separator last is
 //!
 //! ```text
@@ -204,6 +205,10 @@ struct Bin {
     tmp: Vec<f64>,
     /// The trailing block `T_i` (dense, lower triangle filled).
     trailing: Mat<f64>,
+    /// A supernode's separator rows (`l`), scaled by the pivots (`ld`), and their product.
+    l: Mat<f64>,
+    ld: Mat<f64>,
+    update: Mat<f64>,
     /// Negative pivots of the interior columns.
     negative: usize,
 }
@@ -286,6 +291,10 @@ impl Bin {
             .map(|k| s.supernode(k).pattern().len() + s.supernode_end()[k] - s.supernode_begin()[k])
             .max()
             .unwrap_or(0);
+        let max_cols = (0..s.n_supernodes())
+            .map(|k| s.supernode_end()[k] - s.supernode_begin()[k])
+            .max()
+            .unwrap_or(0);
         let work = MemBuffer::new(ldlt.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()));
         Ok(Self {
             n_int,
@@ -300,6 +309,9 @@ impl Bin {
             x: vec![0.0; m],
             tmp: vec![0.0; max_pattern],
             trailing: Mat::zeros(sep.len(), sep.len()),
+            l: Mat::zeros(sep.len(), max_cols),
+            ld: Mat::zeros(sep.len(), max_cols),
+            update: Mat::zeros(sep.len(), sep.len()),
             negative: 0,
             dofs,
         })
@@ -381,14 +393,39 @@ impl Bin {
                     rows.push((i - n_int, r));
                 }
             }
+            if rows.is_empty() {
+                continue;
+            }
+            // The supernode's separator rows times `D`, and times their transposes: one dense
+            // product per supernode. A scalar rank-one update per column took 2 ms of the 2 mm
+            // tape's 3.4 ms (66 separator DOFs, 40 % of the columns reaching them); on the
+            // set-up's vibration (18) the factorisations' share went from 1.30 to 1.18 s.
+            let nr = rows.len();
+            let mut ld = self.ld.as_mut().submatrix_mut(0, 0, nr, ki);
+            let mut l = self.l.as_mut().submatrix_mut(0, 0, nr, ki);
             for c in 0..ki {
                 let d = v[(c, c)];
-                for (a, &(sa, ra)) in rows.iter().enumerate() {
-                    let la = d * v[(ra, c)];
-                    for &(sb, rb) in &rows[..=a] {
-                        // Rows in increasing order: sa >= sb, the lower triangle.
-                        self.trailing[(sa, sb)] -= la * v[(rb, c)];
-                    }
+                for (a, &(_, ra)) in rows.iter().enumerate() {
+                    l[(a, c)] = v[(ra, c)];
+                    ld[(a, c)] = d * v[(ra, c)];
+                }
+            }
+            let mut update = self.update.as_mut().submatrix_mut(0, 0, nr, nr);
+            faer::linalg::matmul::triangular::matmul(
+                update.rb_mut(),
+                faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
+                Accum::Replace,
+                ld.rb(),
+                faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+                l.rb().transpose(),
+                faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+            for (a, &(sa, _)) in rows.iter().enumerate() {
+                for (b, &(sb, _)) in rows[..=a].iter().enumerate() {
+                    // Rows in increasing order: sa >= sb, the lower triangle.
+                    self.trailing[(sa, sb)] -= update[(a, b)];
                 }
             }
         }
@@ -630,7 +667,8 @@ impl Bordered {
             .enumerate()
             .map(|(b, bin)| {
                 let (m, s) = bin.fill(values, shifts, if b == 0 { 1.0 } else { -1.0 });
-                (m, s, bin.factorize())
+                let ok = bin.factorize();
+                (m, s, ok)
             })
             .collect();
         let max_bits = results.iter().map(|r| r.0).max().unwrap_or(0);
