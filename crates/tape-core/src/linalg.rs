@@ -1361,6 +1361,97 @@ mod tests {
         }
     }
 
+    /// Property test of `with_dissection` beyond one strip: strips and tubes (closed
+    /// cross-sections, the cells of the last row of nodes coupled to the first) of 2 to 6 unknowns
+    /// per node, numbered in a shuffled order, some with a second unconnected part (a group of
+    /// its own), definite and indefinite, some with a skew part: each is factorised in two bins
+    /// with the whole factorisation's inertia and symmetric solution, and `K` is solved (GMRES
+    /// on the bordered LDL^T where skew).
+    #[test]
+    fn dissection_solves_as_the_whole_on_shuffled_strips_and_tubes() {
+        // (nodes along, across, unknowns per node, closed, second part, shift, skew)
+        let cases = [
+            (40, 3, 4, false, false, 14.0, 0.0),
+            (30, 4, 6, true, false, 0.0, 0.0),
+            (60, 2, 6, false, false, -2.0, 0.0),
+            (25, 5, 3, true, true, 14.0, 1e-2),
+            (50, 3, 3, false, true, 0.0, 1e-2),
+            (70, 2, 3, false, true, -1.0, 0.0),
+            (24, 6, 3, true, false, -3.0, 0.0),
+            (60, 4, 2, false, false, 0.0, 0.0),
+        ];
+        for (case, &(nx, ny, d, closed, second, shift, skew)) in cases.iter().enumerate() {
+            let seed = 300 + case as u64;
+            let mut rng = Lcg(seed);
+            // Nodes of the strip or tube, then of the second part (6 x 2), each with `d` unknowns.
+            let mut cells: Vec<[usize; 4]> = Vec::new();
+            let rows = if closed { ny } else { ny - 1 };
+            for i in 0..nx - 1 {
+                for j in 0..rows {
+                    let node = |i: usize, j: usize| i * ny + j % ny;
+                    cells.push([node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)]);
+                }
+            }
+            let mut nodes = nx * ny;
+            if second {
+                for i in 0..5 {
+                    let node = |i: usize, j: usize| nx * ny + i * 2 + j;
+                    cells.push([node(i, 0), node(i + 1, 0), node(i, 1), node(i + 1, 1)]);
+                }
+                nodes += 12;
+            }
+            let n = nodes * d;
+            let mut label: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
+                label.swap(i, j);
+            }
+            let mut dense = DMatrix::<f64>::zeros(n, n);
+            let mut filled = vec![vec![false; n]; n];
+            for cell in &cells {
+                for &a in cell {
+                    for &b in cell {
+                        for (da, db) in (0..d).flat_map(|x| (0..d).map(move |y| (x, y))) {
+                            let (p, q) = (label[a * d + da], label[b * d + db]);
+                            if p < q && !filled[p][q] {
+                                let (v, w) = (0.3 * rng.next(), skew * rng.next());
+                                dense[(p, q)] = v + w;
+                                dense[(q, p)] = v - w;
+                                filled[p][q] = true;
+                                filled[q][p] = true;
+                            }
+                        }
+                    }
+                }
+            }
+            for i in 0..n {
+                dense[(i, i)] = 3.0 * rng.next() + shift;
+                filled[i][i] = true;
+            }
+            let (pattern, values) = compressed(&dense, &filled);
+            let mut solver = LinearSolver::with_dissection(&pattern, &[]).expect("symbolic");
+            assert!(solver.is_bordered(), "case {case}: not split");
+            solver.factorize(&values).expect("factorisation");
+            assert!(!solver.use_fallback, "case {case}: the bordered factorisation failed");
+            let mut whole = LinearSolver::try_new(&pattern).expect("symbolic");
+            whole.factorize(&values).expect("factorisation");
+            let negative = whole.negative_eigenvalues().expect("inertia");
+            assert_eq!(negative == 0, shift > 10.0, "case {case}: {negative} negative pivots");
+            assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative, "case {case}");
+            let b = DVector::from_fn(n, |i, _| (0.3 * i as f64).cos());
+            let x = check_symmetric_solve(&mut solver, &dense, &b);
+            let mut y = b.as_slice().to_vec();
+            whole.solve_sym(&mut y);
+            let diff = (DVector::from_vec(y) - &x).norm() / x.norm();
+            assert!(
+                diff < 1e-11,
+                "case {case}: bordered and whole solutions differ by {diff:e}"
+            );
+            check_solve(&mut solver, &dense, seed + 100);
+            assert_eq!(solver.lu_fallbacks, 0, "case {case}");
+        }
+    }
+
     /// A bordered matrix whose symmetric part is singular (two unknowns of a group coupled by a
     /// skew pair only): the bordered factorisation fails, so does the whole one, and the solves
     /// use LU; the symmetric solve is refused, not answered from the failed factors. Non-finite

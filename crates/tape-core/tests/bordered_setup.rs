@@ -141,6 +141,30 @@ fn bordered_and_whole_factorisations_agree_on_the_setup() -> Result<()> {
     agree(&setup()?, 0)
 }
 
+/// The set-up is split at its ties (the three reference nodes' 18 DOFs), not at a level of the
+/// graph: `System` passes the ties to `LinearSolver::with_dissection`, which falls back to a
+/// level separator only where they do not split the model, and a level separator alone splits
+/// the set-up too (159k factor entries against the ties' 148k), so `is_bordered` alone cannot
+/// tell the two apart. The factor sizes do.
+#[test]
+fn the_setup_is_split_at_its_ties() -> Result<()> {
+    let system = System::try_new(&setup()?)?;
+    let mut is_reference = vec![false; system.dofs.master.len()];
+    for &r in system.dofs.master.iter().flatten() {
+        is_reference[r] = true;
+    }
+    let ties: Vec<usize> = (0..system.dofs.n_free)
+        .filter(|&k| is_reference[system.dofs.free_dofs[k].0])
+        .collect();
+    assert_eq!(ties.len(), 18);
+    let by_ties = LinearSolver::with_separator(&system.pattern_ff, &ties)?;
+    let by_levels = LinearSolver::with_dissection(&system.pattern_ff, &[])?;
+    assert!(by_ties.is_bordered() && by_levels.is_bordered());
+    assert_ne!(by_ties.factor_entries(), by_levels.factor_entries());
+    assert_eq!(system.linear.factor_entries(), by_ties.factor_entries());
+    Ok(())
+}
+
 /// The same on a single tape spring (the release scenario's, 4 mm elements, 1010 DOFs), which
 /// no tie splits: the separator is a cross-section found from the matrix graph. Its deformed
 /// tangent is skew enough that GMRES gives up, for both, and LU solves it.

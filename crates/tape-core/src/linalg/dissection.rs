@@ -223,4 +223,244 @@ mod tests {
         assert!(sep.iter().all(|&s| s < na));
         assert_eq!(sides(&pattern, &sep).len(), 3);
     }
+
+    /// Deterministic pseudo-random integers below `m` (xorshift).
+    struct Rng(u64);
+    impl Rng {
+        fn below(&mut self, m: usize) -> usize {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            usize::try_from(self.0 % m as u64).expect("below m")
+        }
+    }
+
+    /// A grid as [`grid`], closed into a tube when `closed` (the cells of the last row of nodes
+    /// couple it to the first: a cylinder's mesh).
+    fn tube(nx: usize, ny: usize, dofs: usize, closed: bool) -> Pattern {
+        let node = |i: usize, j: usize| i * ny + j % ny;
+        let mut cols = vec![Vec::new(); nx * ny * dofs];
+        let rows = if closed { ny } else { ny - 1 };
+        for i in 0..nx - 1 {
+            for j in 0..rows {
+                let cell = [node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)];
+                for &a in &cell {
+                    for &b in &cell {
+                        for da in 0..dofs {
+                            for db in 0..dofs {
+                                cols[a * dofs + da].push(b * dofs + db);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Pattern::from_columns(nx * ny * dofs, cols)
+    }
+
+    /// The graphs of `parts` side by side (unconnected), then `isolated` unknowns with their
+    /// diagonal only, all renumbered by a random permutation; and the new label of each old one.
+    fn shuffled_union(parts: &[Pattern], isolated: usize, rng: &mut Rng) -> (Pattern, Vec<usize>) {
+        let n = parts.iter().map(|p| p.nrows).sum::<usize>() + isolated;
+        let mut label: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            label.swap(i, rng.below(i + 1));
+        }
+        let mut cols = vec![Vec::new(); n];
+        let mut offset = 0;
+        for p in parts {
+            for j in 0..p.nrows {
+                cols[label[offset + j]] = p.row_idx[p.col_ptr[j]..p.col_ptr[j + 1]]
+                    .iter()
+                    .map(|&i| label[offset + i])
+                    .collect();
+            }
+            offset += p.nrows;
+        }
+        for j in offset..n {
+            cols[label[j]] = vec![label[j]];
+        }
+        (Pattern::from_columns(n, cols), label)
+    }
+
+    /// The component of each unknown once the unknowns `removed` are taken out (`usize::MAX`
+    /// for those), by a depth-first search independent of `levels`; and the components' sizes.
+    fn component_labels(pattern: &Pattern, removed: &[usize]) -> (Vec<usize>, Vec<usize>) {
+        let mut label = vec![usize::MAX; pattern.nrows];
+        let mut out = vec![false; pattern.nrows];
+        for &s in removed {
+            out[s] = true;
+        }
+        let mut sizes = Vec::new();
+        for seed in 0..pattern.nrows {
+            if out[seed] || label[seed] != usize::MAX {
+                continue;
+            }
+            let c = sizes.len();
+            let (mut stack, mut size) = (vec![seed], 0);
+            label[seed] = c;
+            while let Some(j) = stack.pop() {
+                size += 1;
+                for &i in &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]] {
+                    if !out[i] && label[i] == usize::MAX {
+                        label[i] = c;
+                        stack.push(i);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        (label, sizes)
+    }
+
+    /// Checks what `level_separator` promises of a non-empty separator: sorted and distinct, all
+    /// in one largest component, which it cuts into pieces with at least `MIN_SIDE` of the
+    /// component on each side (so no piece above `1 - MIN_SIDE` less the separator, and the
+    /// pieces other than the largest at least `MIN_SIDE`), every separator unknown touching two
+    /// pieces (none is superfluous). Returns the size of the component cut.
+    #[allow(clippy::cast_precision_loss)]
+    fn check_split(pattern: &Pattern, sep: &[usize]) -> usize {
+        assert!(sep.windows(2).all(|w| w[0] < w[1]), "separator not sorted: {sep:?}");
+        assert!(sep.iter().all(|&s| s < pattern.nrows));
+        let (whole, whole_sizes) = component_labels(pattern, &[]);
+        let largest = whole_sizes.iter().copied().max().expect("a component");
+        let c = whole[sep[0]];
+        assert!(sep.iter().all(|&s| whole[s] == c), "the separator spans components");
+        assert_eq!(whole_sizes[c], largest, "the separator is not in a largest component");
+        let (cut, cut_sizes) = component_labels(pattern, sep);
+        let mut pieces: Vec<usize> = (0..pattern.nrows)
+            .filter(|&j| whole[j] == c && cut[j] != usize::MAX)
+            .map(|j| cut[j])
+            .collect();
+        pieces.sort_unstable();
+        pieces.dedup();
+        assert!(pieces.len() >= 2, "the separator does not split its component");
+        let sizes: Vec<usize> = pieces.iter().map(|&p| cut_sizes[p]).collect();
+        let biggest = *sizes.iter().max().expect("pieces");
+        let rest = largest - sep.len() - biggest;
+        let min_side = MIN_SIDE * largest as f64;
+        assert!(
+            rest as f64 >= min_side && biggest as f64 <= (largest - sep.len()) as f64 - min_side,
+            "pieces {sizes:?} of a component of {largest} less {} separator unknowns",
+            sep.len()
+        );
+        for &s in sep {
+            let mut touched: Vec<usize> = pattern.row_idx[pattern.col_ptr[s]..pattern.col_ptr[s + 1]]
+                .iter()
+                .map(|&i| cut[i])
+                .filter(|&p| p != usize::MAX)
+                .collect();
+            touched.sort_unstable();
+            touched.dedup();
+            assert!(touched.len() >= 2, "separator unknown {s} touches pieces {touched:?}");
+        }
+        largest
+    }
+
+    /// Property test over random strips, grids and tubes (closed cross-sections), with 1 to 6
+    /// unknowns per node, shuffled numberings, sometimes a second unconnected part and isolated
+    /// unknowns (diagonal only): every separator found splits a largest component as promised
+    /// (`check_split`); on a strip at least three times as long as wide and 12 nodes long, the
+    /// largest component and 400 unknowns or more, it is found and is one cross-section of nodes.
+    #[test]
+    fn level_separator_splits_shuffled_strips_grids_and_tubes() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let (mut cut, mut cross_sections) = (0, 0);
+        for trial in 0..400 {
+            let closed = trial % 4 == 3;
+            let ny = if closed { 3 + rng.below(10) } else { 2 + rng.below(11) };
+            let nx = 2 + rng.below(70);
+            let dofs = [1, 2, 3, 6][rng.below(4)];
+            let mut parts = vec![tube(nx, ny, dofs, closed)];
+            if trial % 5 == 0 {
+                parts.push(grid(2 + rng.below(30), 2 + rng.below(4), dofs));
+            }
+            let isolated = if trial % 3 == 0 { rng.below(300) } else { 0 };
+            let (pattern, label) = shuffled_union(&parts, isolated, &mut rng);
+            let sep = level_separator(&pattern);
+            let strip = parts[0].nrows;
+            let strip_is_largest = parts.iter().skip(1).all(|p| p.nrows < strip) && strip > 1;
+            let long = nx >= 12 && nx >= 3 * ny;
+            if sep.is_empty() {
+                assert!(
+                    !(long && strip_is_largest && pattern.nrows >= MIN_UNKNOWNS),
+                    "no separator for a {nx} x {ny} strip of {dofs} unknowns per node (closed: {closed})"
+                );
+                continue;
+            }
+            cut += 1;
+            let size = check_split(&pattern, &sep);
+            if long && strip_is_largest {
+                assert_eq!(size, strip);
+                // The separator is whole nodes of the strip (its first part's labels).
+                let mut old = vec![usize::MAX; pattern.nrows];
+                for (o, &j) in label.iter().enumerate() {
+                    old[j] = o;
+                }
+                for &s in &sep {
+                    let node = old[s] / dofs;
+                    assert!(old[s] < strip, "separator unknown {s} outside the strip");
+                    assert!((0..dofs).all(|d| sep.binary_search(&label[node * dofs + d]).is_ok()));
+                }
+                assert_eq!(sep.len(), ny * dofs, "{nx} x {ny} x {dofs} (closed: {closed})");
+                cross_sections += 1;
+            }
+        }
+        assert!(
+            cut > 100 && cross_sections > 50,
+            "{cut} graphs cut, {cross_sections} strips"
+        );
+    }
+
+    /// Graphs with nothing to cut: isolated unknowns only, columns with no entry at all (not even
+    /// the diagonal), a clique larger than the strip beside it; none panics and none is cut. A
+    /// path (a tridiagonal matrix) and a ring are cut at one and two unknowns, near the middle. A
+    /// comb (a path with one pendant unknown on each of its unknowns) from a pendant: each level
+    /// is a path unknown and the previous one's pendant, which has no neighbour in the next level
+    /// and is dropped (the refinement), leaving one unknown that still splits the comb.
+    #[test]
+    fn degenerate_graphs_are_cut_only_where_they_split() {
+        let diagonal = Pattern::from_columns(500, (0..500).map(|j| vec![j]).collect());
+        assert!(level_separator(&diagonal).is_empty());
+        let empty = Pattern::from_columns(500, vec![Vec::new(); 500]);
+        assert!(level_separator(&empty).is_empty());
+        let mut rng = Rng(7);
+        let (clique_and_strip, _) = shuffled_union(&[grid(2, 2, 120), grid(20, 2, 6)], 10, &mut rng);
+        assert!(level_separator(&clique_and_strip).is_empty());
+        for n in [400, 1001, 5000] {
+            let path = Pattern::from_columns(
+                n,
+                (0..n)
+                    .map(|j| (j.saturating_sub(1)..(j + 2).min(n)).collect())
+                    .collect(),
+            );
+            let sep = level_separator(&path);
+            assert_eq!(sep.len(), 1, "path of {n}: {sep:?}");
+            check_split(&path, &sep);
+            let ring = Pattern::from_columns(
+                n,
+                (0..n)
+                    .map(|j| vec![(j + n - 1) % n, j, (j + 1) % n])
+                    .collect(),
+            );
+            let sep = level_separator(&ring);
+            assert_eq!(sep.len(), 2, "ring of {n}: {sep:?}");
+            check_split(&ring, &sep);
+            let comb = Pattern::from_columns(
+                2 * n,
+                (0..2 * n)
+                    .map(|j| match j.checked_sub(n) {
+                        None => (j.saturating_sub(1)..(j + 2).min(n))
+                            .chain([n + j])
+                            .collect(),
+                        Some(i) => vec![i, j],
+                    })
+                    .collect(),
+            );
+            let sep = level_separator(&comb);
+            assert_eq!(sep.len(), 1, "comb of {n}: {sep:?}");
+            assert!(sep[0] < n, "comb of {n}: a pendant in the separator");
+            check_split(&comb, &sep);
+        }
+    }
 }
