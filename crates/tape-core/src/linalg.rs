@@ -493,6 +493,13 @@ impl LinearSolver {
                 None
             }
         });
+        log::debug!(
+            "factorisation of {n} unknowns: {}",
+            match &bordered {
+                Some(b) => format!("split in two, {} separator unknowns", b.separator_len()),
+                None => "whole (no useful split)".to_string(),
+            }
+        );
         let factor = match bordered {
             Some(b) => SymFactor::Bordered(Box::new(b)),
             None => SymFactor::Whole(Box::new(Whole::try_new(pattern, &transpose_of, threshold)?)),
@@ -1450,6 +1457,55 @@ mod tests {
             check_solve(&mut solver, &dense, seed + 100);
             assert_eq!(solver.lu_fallbacks, 0, "case {case}");
         }
+    }
+
+    /// A group of one unknown has a factor with no flops, which faer analyses as simplicial even
+    /// when forced supernodal (`factorize_symbolic_cholesky`: supernodal only where flops / nnz
+    /// exceeds the threshold, 0 / 1 here): the split must be set up or refused, not panic. A
+    /// tridiagonal 3 x 3 matrix split at its middle unknown.
+    #[test]
+    fn a_group_of_one_unknown_does_not_panic() {
+        let path = Pattern::from_columns(3, vec![vec![0, 1], vec![0, 1, 2], vec![1, 2]]);
+        let values = [4.0, 1.0, 1.0, 4.0, 1.0, 1.0, 4.0];
+        let mut solver = LinearSolver::with_separator(&path, &[1]).expect("symbolic");
+        solver.factorize(&values).expect("factorisation");
+        let mut x = vec![6.0, 10.0, 6.0];
+        solver.solve_in_place(&mut x).expect("solve");
+        assert!(
+            (x[0] - 1.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14 && (x[2] - 1.0).abs() < 1e-14,
+            "{x:?}"
+        );
+    }
+
+    /// The same through `with_dissection`: every component other than the one cut is a group,
+    /// so one isolated unknown (a diagonal-only column) beside a strip is a group of one. (Not
+    /// reachable through `System`, which refuses a node without element or tie, but through the
+    /// public `LinearSolver` constructors, and for a piece of one unknown left by a separator.)
+    #[test]
+    fn an_isolated_unknown_beside_a_strip_does_not_panic() {
+        // A 40 x 3 strip of 4 unknowns per node, then 10 isolated unknowns.
+        let (nx, ny, d) = (40, 3, 4);
+        let mut cols = vec![Vec::new(); nx * ny * d + 10];
+        for i in 0..nx - 1 {
+            for j in 0..ny - 1 {
+                let cell = [i * ny + j, (i + 1) * ny + j, i * ny + j + 1, (i + 1) * ny + j + 1];
+                for &a in &cell {
+                    for &b in &cell {
+                        for (da, db) in (0..d).flat_map(|x| (0..d).map(move |y| (x, y))) {
+                            cols[a * d + da].push(b * d + db);
+                        }
+                    }
+                }
+            }
+        }
+        for (j, c) in cols.iter_mut().enumerate().skip(nx * ny * d) {
+            c.push(j);
+        }
+        let pattern = Pattern::from_columns(nx * ny * d + 10, cols);
+        // The isolated unknowns cost nothing: the strip is still split.
+        assert!(LinearSolver::with_dissection(&pattern, &[])
+            .expect("symbolic")
+            .is_bordered());
     }
 
     /// A bordered matrix whose symmetric part is singular (two unknowns of a group coupled by a

@@ -65,7 +65,9 @@ const NONE: usize = usize::MAX;
 const MAX_BIN_SHARE: f64 = 0.85;
 
 /// Largest separator: its dense Schur complement is factorised serially at every factorisation.
-const MAX_SEPARATOR: usize = 240;
+/// A tape-like grid's cross-section of 384 DOFs (334 x 64 nodes) still paid: 158 ms split against
+/// 208 ms whole (measured beside other work, 2026-11-27).
+const MAX_SEPARATOR: usize = 400;
 
 /// Largest ratio of the separator's dense work (`n_s^3`) to the groups' factorisations.
 const MAX_DENSE_SHARE: f64 = 0.05;
@@ -137,7 +139,13 @@ fn amd_order(pattern: &Pattern, dofs: &[usize], local: &mut [usize]) -> Result<(
         Some(perm) => perm.arrays().0.iter().map(|&i| dofs[i]).collect(),
         None => dofs.to_vec(),
     };
-    Ok((order, flops(supernodal(&ldlt))))
+    // A group without off-diagonal entries (one unknown) has no flops, and faer then analyses it
+    // as simplicial whatever the threshold.
+    let cost = match ldlt.raw() {
+        SymbolicCholeskyRaw::Supernodal(s) => flops(s),
+        SymbolicCholeskyRaw::Simplicial(_) => 0.0,
+    };
+    Ok((order, cost))
 }
 
 /// The row of the factor held in row `r` of a supernode's values: the supernode's own columns
@@ -286,7 +294,9 @@ impl Bin {
             symbolic_params(),
         )
         .map_err(symbolic_error)?;
-        let s = supernodal(&ldlt);
+        let SymbolicCholeskyRaw::Supernodal(s) = ldlt.raw() else {
+            return Err(Error::Factorisation("a bin's factor has no off-diagonal entry".into()));
+        };
         let max_pattern = (0..s.n_supernodes())
             .map(|k| s.supernode(k).pattern().len() + s.supernode_end()[k] - s.supernode_begin()[k])
             .max()
@@ -401,13 +411,13 @@ impl Bin {
             // tape's 3.4 ms (66 separator DOFs, 40 % of the columns reaching them); on the
             // set-up's vibration (18) the factorisations' share went from 1.30 to 1.18 s.
             let nr = rows.len();
-            let mut ld = self.ld.as_mut().submatrix_mut(0, 0, nr, ki);
-            let mut l = self.l.as_mut().submatrix_mut(0, 0, nr, ki);
+            let mut sep_ld = self.ld.as_mut().submatrix_mut(0, 0, nr, ki);
+            let mut sep_l = self.l.as_mut().submatrix_mut(0, 0, nr, ki);
             for c in 0..ki {
                 let d = v[(c, c)];
                 for (a, &(_, ra)) in rows.iter().enumerate() {
-                    l[(a, c)] = v[(ra, c)];
-                    ld[(a, c)] = d * v[(ra, c)];
+                    sep_l[(a, c)] = v[(ra, c)];
+                    sep_ld[(a, c)] = d * v[(ra, c)];
                 }
             }
             let mut update = self.update.as_mut().submatrix_mut(0, 0, nr, nr);
@@ -415,9 +425,9 @@ impl Bin {
                 update.rb_mut(),
                 faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
                 Accum::Replace,
-                ld.rb(),
+                sep_ld.rb(),
                 faer::linalg::matmul::triangular::BlockStructure::Rectangular,
-                l.rb().transpose(),
+                sep_l.rb().transpose(),
                 faer::linalg::matmul::triangular::BlockStructure::Rectangular,
                 1.0,
                 Par::Seq,
@@ -532,7 +542,7 @@ impl Bordered {
     /// symmetric; `transpose_of[p]` the position of entry `p`'s transpose), split by the unknowns
     /// `separator`; `None` when it does not split them into groups whose factorisation can share
     /// the work (a single group, a bin with more than 85 % of the flops, or a separator of more
-    /// than 240 unknowns).
+    /// than `MAX_SEPARATOR` unknowns).
     ///
     /// # Errors
     /// [`Error::Factorisation`] if faer rejects a group's pattern.
@@ -622,6 +632,11 @@ impl Bordered {
                     .count()
             })
             .sum()
+    }
+
+    /// Number of separator unknowns.
+    pub(super) fn separator_len(&self) -> usize {
+        self.sep.len()
     }
 
     /// Entries of the factors (sparse and dense).
