@@ -652,6 +652,9 @@ impl Bordered {
                 b.ldlt
                     .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
                     .unaligned_bytes_required()
+                    + 8 * (b.l.nrows() * b.l.ncols()
+                        + b.ld.nrows() * b.ld.ncols()
+                        + b.update.nrows() * b.update.ncols())
             })
             .sum::<usize>()
             + 8 * 3 * self.sep.len() * self.sep.len()
