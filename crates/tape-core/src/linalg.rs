@@ -1304,71 +1304,7 @@ mod tests {
         assert!(straddling > 0, "no supernode straddles the interior and the separator");
     }
 
-    /// A strip's matrix (40 x 3 nodes of 4 unknowns, the nodes of each cell coupled, unknowns
-    /// numbered across the strip in a shuffled order) with no separator given:
-    /// `with_dissection` finds one and factorises in two bins, with the whole factorisation's
-    /// solution and inertia, for positive definite and indefinite matrices; `with_separator`
-    /// alone leaves it whole.
-    #[test]
-    fn dissection_splits_a_strip_and_solves_as_the_whole() {
-        let (nx, ny, d) = (40, 3, 4);
-        let n = nx * ny * d;
-        for (shift, seed) in [(14.0, 61), (0.0, 62), (-2.0, 63)] {
-            let mut rng = Lcg(seed);
-            let mut label: Vec<usize> = (0..n).collect();
-            for i in (1..n).rev() {
-                let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
-                label.swap(i, j);
-            }
-            let mut dense = DMatrix::<f64>::zeros(n, n);
-            let mut filled = vec![vec![false; n]; n];
-            let node = |i: usize, j: usize| i * ny + j;
-            for i in 0..nx - 1 {
-                for j in 0..ny - 1 {
-                    let cell = [node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)];
-                    for &a in &cell {
-                        for &b in &cell {
-                            for (da, db) in (0..d).flat_map(|x| (0..d).map(move |y| (x, y))) {
-                                let (p, q) = (label[a * d + da], label[b * d + db]);
-                                if p < q && !filled[p][q] {
-                                    let v = 0.3 * rng.next();
-                                    dense[(p, q)] = v;
-                                    dense[(q, p)] = v;
-                                    filled[p][q] = true;
-                                    filled[q][p] = true;
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            for i in 0..n {
-                dense[(i, i)] = 3.0 * rng.next() + shift;
-                filled[i][i] = true;
-            }
-            let (pattern, values) = compressed(&dense, &filled);
-            assert!(!LinearSolver::with_separator(&pattern, &[])
-                .expect("symbolic")
-                .is_bordered());
-            let mut solver = LinearSolver::with_dissection(&pattern, &[]).expect("symbolic");
-            assert!(solver.is_bordered());
-            solver.factorize(&values).expect("factorisation");
-            assert!(!solver.use_fallback, "the bordered factorisation failed");
-            let negative = negative_eigenvalues_dense(&dense);
-            assert_eq!(negative == 0, shift > 10.0, "{negative} negative eigenvalues");
-            assert_eq!(solver.negative_eigenvalues().expect("inertia"), negative);
-            let b = DVector::from_fn(n, |i, _| (0.3 * i as f64).cos());
-            let x = check_symmetric_solve(&mut solver, &dense, &b);
-            let mut whole = LinearSolver::try_new(&pattern).expect("symbolic");
-            whole.factorize(&values).expect("factorisation");
-            let mut y = b.as_slice().to_vec();
-            whole.solve_sym(&mut y);
-            let diff = (DVector::from_vec(y) - &x).norm() / x.norm();
-            assert!(diff < 1e-11, "bordered and whole solutions differ by {diff:e}");
-        }
-    }
-
-    /// Property test of `with_dissection` beyond one strip: strips and tubes (closed
+    /// Property test of `with_dissection`: strips and tubes (closed
     /// cross-sections, the cells of the last row of nodes coupled to the first) of 2 to 6 unknowns
     /// per node, numbered in a shuffled order, some with a second unconnected part (a group of
     /// its own), definite and indefinite, some with a skew part: each is factorised in two bins

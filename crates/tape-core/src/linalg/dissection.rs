@@ -132,26 +132,9 @@ pub(super) fn level_separator(pattern: &Pattern) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    /// The graph of a grid of `nx` x `ny` nodes with `dofs` unknowns each, the nodes of each
-    /// cell coupled (a quadrilateral shell mesh's pattern).
+    /// An open [`tube`]: a quadrilateral shell mesh's pattern.
     fn grid(nx: usize, ny: usize, dofs: usize) -> Pattern {
-        let node = |i: usize, j: usize| i * ny + j;
-        let mut cols = vec![Vec::new(); nx * ny * dofs];
-        for i in 0..nx - 1 {
-            for j in 0..ny - 1 {
-                let cell = [node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)];
-                for &a in &cell {
-                    for &b in &cell {
-                        for da in 0..dofs {
-                            for db in 0..dofs {
-                                cols[a * dofs + da].push(b * dofs + db);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        Pattern::from_columns(nx * ny * dofs, cols)
+        tube(nx, ny, dofs, false)
     }
 
     /// Unknowns not in `sep`, grouped by the components left once `sep` is removed.
@@ -235,8 +218,9 @@ mod tests {
         }
     }
 
-    /// A grid as [`grid`], closed into a tube when `closed` (the cells of the last row of nodes
-    /// couple it to the first: a cylinder's mesh).
+    /// The graph of a grid of `nx` x `ny` nodes with `dofs` unknowns each, the nodes of each
+    /// cell coupled, closed into a tube when `closed` (the cells of the last row of nodes couple
+    /// it to the first: a cylinder's mesh).
     fn tube(nx: usize, ny: usize, dofs: usize, closed: bool) -> Pattern {
         let node = |i: usize, j: usize| i * ny + j % ny;
         let mut cols = vec![Vec::new(); nx * ny * dofs];
