@@ -1160,6 +1160,16 @@ mod tests {
         solver.factorize(&values).expect("finite values");
     }
 
+    /// A random permutation of `0..n` (Fisher-Yates).
+    fn shuffled(n: usize, rng: &mut Lcg) -> Vec<usize> {
+        let mut label: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
+            label.swap(i, j);
+        }
+        label
+    }
+
     /// A structurally symmetric matrix whose unknowns form groups of `sizes` coupled only through
     /// `ns` separator unknowns, numbered in a shuffled order. Within a group: a band of half-width
     /// 3 plus random couplings; each separator unknown couples to three unknowns of every group
@@ -1179,11 +1189,7 @@ mod tests {
         let mut rng = Lcg(seed);
         let n = sizes.iter().sum::<usize>() + ns;
         // Shuffled numbering: label[k] is the unknown of the k-th (group-ordered) one.
-        let mut label: Vec<usize> = (0..n).collect();
-        for i in (1..n).rev() {
-            let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
-            label.swap(i, j);
-        }
+        let label = shuffled(n, &mut rng);
         let mut dense = DMatrix::<f64>::zeros(n, n);
         let mut filled = vec![vec![false; n]; n];
         let mut couple = |a: usize, b: usize, rng: &mut Lcg| {
@@ -1345,11 +1351,7 @@ mod tests {
                 nodes += 12;
             }
             let n = nodes * d;
-            let mut label: Vec<usize> = (0..n).collect();
-            for i in (1..n).rev() {
-                let j = ((rng.next() + 1.0) * 0.5 * (i + 1) as f64) as usize % (i + 1);
-                label.swap(i, j);
-            }
+            let label = shuffled(n, &mut rng);
             let mut dense = DMatrix::<f64>::zeros(n, n);
             let mut filled = vec![vec![false; n]; n];
             for cell in &cells {
