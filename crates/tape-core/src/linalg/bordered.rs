@@ -639,6 +639,18 @@ impl Bordered {
         self.sep.len()
     }
 
+    /// Each bin's share of the two bins' factorisation flops (`sum ncols nrows^2` over their
+    /// supernodes, separator rows included).
+    pub(super) fn work_shares(&self) -> Vec<f64> {
+        let work: Vec<f64> = self
+            .bins
+            .iter()
+            .map(|b| flops(supernodal(&b.ldlt)))
+            .collect();
+        let total: f64 = work.iter().sum();
+        work.iter().map(|w| w / total).collect()
+    }
+
     /// Entries of the factors (sparse and dense).
     pub(super) fn len_val(&self) -> usize {
         self.bins.iter().map(|b| b.ldlt.len_val()).sum::<usize>() + self.sep.len() * self.sep.len()
