@@ -497,12 +497,15 @@ impl LinearSolver {
         log::debug!(
             "factorisation of {n} unknowns: {}",
             match &bordered {
-                Some(b) => format!(
-                    "split in two, {} separator unknowns, bins of {:.0} and {:.0} % of the work",
-                    b.separator_len(),
-                    100.0 * b.work_shares()[0],
-                    100.0 * b.work_shares()[1]
-                ),
+                Some(b) => {
+                    let shares = b.work_shares();
+                    format!(
+                        "split in two, {} separator unknowns, bins of {:.0} and {:.0} % of the work",
+                        b.separator_len(),
+                        100.0 * shares[0],
+                        100.0 * shares[1]
+                    )
+                }
                 None => "whole (no useful split)".to_string(),
             }
         );

@@ -38,7 +38,6 @@ fn levels(pattern: &Pattern, root: usize, seen: &mut [bool]) -> (Vec<usize>, Vec
             }
         }
     }
-    starts.dedup();
     (order, starts)
 }
 
