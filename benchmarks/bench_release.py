@@ -18,6 +18,7 @@ import argparse
 import numpy as np
 from tapespring.scenarios.bending import BendingSetup
 from tapespring.scenarios.release import ReleaseSetup, release
+from tapespring.scenarios.setup import last_ndof
 
 
 def main() -> None:
@@ -39,7 +40,7 @@ def main() -> None:
     )
     result = release(setup, progress=True)
     r = result.results
-    print(f"mesh {mesh * 1e3:g} mm, {int(r.ndof[-1])} DOFs, free motion {duration:g} s")
+    print(f"mesh {mesh * 1e3:g} mm, {last_ndof(r)} DOFs, free motion {duration:g} s")
     header = (
         f"{'step':8} {'steps':>7} {'rejected':>8} {'iter':>7} {'factor':>7} "
         f"{'assembly s':>10} {'solve s':>8} {'wall s':>8}"

@@ -39,7 +39,7 @@ import spec_variants  # benchmarks/spec_variants.py: run as a script, its folder
 from spec_variants import LARGE_DEG, large_minima
 from tapespring.scenarios.deployment import DeploymentSettings, deploy
 from tapespring.scenarios.pull import PullSettings, pull
-from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
+from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP, last_ndof
 from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
 #: Window of the first maximum of the opposite-sense deployment [s]: the paper's "around 0.5 s"
@@ -63,7 +63,7 @@ def line(name: str, result, simulated: float) -> None:
     stats = r.stats
     dyn = r.step_stats[-1] if r.step_stats else {}
     print(
-        f"{name:28s} ndof {int(r.ndof[-1]):6d}  simulated {simulated:6.3g} s  "
+        f"{name:28s} ndof {last_ndof(r):6d}  simulated {simulated:6.3g} s  "
         f"steps {int(dyn.get('steps', 0)):6d} (rejected {int(dyn.get('cutbacks', 0)):5d})  "
         f"iterations {int(stats.get('iterations', 0)):7d}  "
         f"factorisations {int(stats.get('factorisations', 0)):7d}  wall {result.wall_s:8.1f} s",
