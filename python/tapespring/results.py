@@ -7,6 +7,7 @@ state (time 0, before the first step). Units are SI (m, N, N m, J, rad).
 from __future__ import annotations
 
 import json
+import math
 import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -408,12 +409,20 @@ class Results:
         with path.open("rb") as handle, _npz(np.load(handle, allow_pickle=False), path) as f:
             if "meta" not in f:
                 raise _NotResults(f"{path} is not a saved tapespring Results")
-            meta = json.loads(str(f["meta"]))
+            _check_member_sizes(f)
+            try:
+                meta = json.loads(str(f["meta"]))
+            except RecursionError:
+                # json gives up on deep nesting with a RecursionError, not a ValueError.
+                raise ValueError("meta is nested too deeply to be a saved meta") from None
             if not isinstance(meta, dict):
                 raise ValueError(f"meta is a JSON {type(meta).__name__}, not an object")
             if meta.get("format") != _FORMAT:
                 raise _NotResults(f"{path} is not a saved tapespring Results")
-            if meta.get("version", 0) > _VERSION:
+            version = meta.get("version", 0)
+            if isinstance(version, bool) or not isinstance(version, int):
+                raise ValueError(f"meta field version must be an integer (got {version!r})")
+            if version > _VERSION:
                 raise _NotResults(
                     f"{path} was written by a newer tapespring (format {meta['version']})"
                 )
@@ -447,6 +456,30 @@ def _npz(loaded: Any, path: Path) -> Any:
     if not isinstance(loaded, np.lib.npyio.NpzFile):
         raise _NotResults(f"{path} is not a saved tapespring Results (not a .npz archive)")
     return loaded
+
+
+def _check_member_sizes(f: Any) -> None:
+    """Raise ValueError naming the first array of the archive whose header declares more data
+    than the archive member holds: a corrupted header would otherwise make `np.load` allocate
+    what it declares (a MemoryError for terabytes) before finding the data missing."""
+    for name in f.zip.namelist():
+        if not name.endswith(".npy"):
+            continue  # np.load reads other members as raw bytes, allocating what they hold
+        size = f.zip.getinfo(name).file_size
+        with f.zip.open(name) as member:
+            version = np.lib.format.read_magic(member)
+            read_header = (
+                np.lib.format.read_array_header_1_0
+                if version == (1, 0)
+                else np.lib.format.read_array_header_2_0
+            )
+            shape, _, dtype = read_header(member)
+            declared = math.prod(int(e) for e in shape) * dtype.itemsize
+            if declared > size - member.tell():
+                raise ValueError(
+                    f"{name} declares {declared} bytes of data ({dtype}, shape {shape}) but "
+                    f"holds {max(size - member.tell(), 0)} (truncated or corrupted)"
+                )
 
 
 def _check_array(name: str, a: Any, dtype: Any, shape: tuple[int | None, ...]) -> None:

@@ -16,14 +16,38 @@ with a `TrialError` that lists the gaps; fill short gaps first with
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from tapespring.trials.trial import Trial, TrialError
 
-__all__ = ["DEFAULT_MARKERS", "finite_marker"]
+__all__ = ["DEFAULT_MARKERS", "check_markers", "finite_marker"]
 
 #: Default marker names: support, middle of the rod, tip.
 DEFAULT_MARKERS = ("M1", "M2", "M3")
+
+
+def check_markers(markers: object, roles: Sequence[int] = (0, 1, 2)) -> None:
+    """Raise ValueError unless `markers` is three marker names (markers 1, 2 and 3) naming
+    distinct markers in the `roles` an analysis uses (indices into `markers`).
+
+    An option error, not a `TrialError`: a string would be read as its letters (``"M1M2M3"`` as
+    markers ``"M"``, ``"1"``, ...) and one marker given for two roles (``("M1", "M1", "M3")``)
+    would measure an angle between a marker and itself, in every trial alike.
+    """
+    if isinstance(markers, str | bytes) or not isinstance(markers, Sequence) or len(markers) != 3:
+        raise ValueError(f"markers must be 3 names (markers 1, 2 and 3), got {markers!r}")
+    for name in markers:
+        if not isinstance(name, str):
+            raise ValueError(f"markers must be names (strings), got {name!r} in {markers!r}")
+    used = [markers[i] for i in roles]
+    repeated = sorted({m for m in used if used.count(m) > 1})
+    if repeated:
+        raise ValueError(
+            f"markers {tuple(markers)!r} give {', '.join(map(repr, repeated))} for more than one "
+            "of the markers the analysis uses: each must be a distinct marker"
+        )
 
 
 def finite_marker(trial: Trial, name: str) -> np.ndarray:

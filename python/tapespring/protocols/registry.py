@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, Literal, TypeVar, overload
 
-from .markers import DEFAULT_MARKERS
+from .markers import DEFAULT_MARKERS, check_markers
 
 if TYPE_CHECKING:
     import numpy as np
@@ -357,6 +357,7 @@ def analyze_trials(
         If a trial cannot be analysed (unless ``skip_bad``).
     """
     protocol = protocol_for(kind)
+    check_markers(markers, protocol.marker_roles)
     _check_options(n_peaks=n_peaks, window=window, span=span, span_time=span_time)
     if not trials and not skipped:
         raise ValueError("no trial to analyse")
@@ -390,7 +391,11 @@ def analyze_trials(
 def check_span_time(value: object) -> None:
     """Raise ValueError unless `value` is a quasi-static force smoothing span ``span_time``: a
     finite duration > 0 [s] (the command line's ``--span-time`` is refused by this check)."""
-    if not (isinstance(value, numbers.Real) and math.isfinite(value) and float(value) > 0):
+    try:
+        valid = isinstance(value, numbers.Real) and math.isfinite(value) and float(value) > 0
+    except OverflowError:
+        valid = False  # an int beyond the floats' range (10**400)
+    if not valid:
         raise ValueError(f"span_time must be a finite duration > 0 [s], got {value!r}")
 
 

@@ -56,6 +56,7 @@ from tapespring.scenarios.setup import (
     check_rho_inf,
     check_sampling,
     check_sense,
+    check_spec,
     check_tolerance,
     drive,
     dynamic_options,
@@ -122,6 +123,7 @@ class DeploymentSettings:
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
+        check_spec(self.spec)
         self.spec.validate()
         check_sense(self.sense)
         for name in ("duration", "sample_rate"):

@@ -38,6 +38,7 @@ from tapespring.scenarios.setup import (
     build_setup,
     check_count,
     check_displacement,
+    check_spec,
     drive,
     gravity_step,
     last_ndof,
@@ -93,6 +94,7 @@ class EquilibriumSettings:
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
+        check_spec(self.spec)
         self.spec.validate()
         check_push(self.push)
         check_count("field_interval", self.field_interval, minimum=0)

@@ -36,6 +36,7 @@ from tapespring.scenarios.setup import (
     build_setup,
     check_count,
     check_displacement,
+    check_spec,
     drive,
     gravity_step,
     last_ndof,
@@ -87,6 +88,7 @@ class PullSettings:
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
+        check_spec(self.spec)
         self.spec.validate()
         check_max_displacement(self.max_displacement)
         check_count("field_interval", self.field_interval, minimum=0)

@@ -69,6 +69,7 @@ __all__ = [
     "check_sample_rate",
     "check_sampling",
     "check_sense",
+    "check_spec",
     "check_thickness",
     "check_thin",
     "check_tolerance",
@@ -765,7 +766,14 @@ def check_number(name: str, value: object, *, positive: bool, zero: bool = False
     """
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{name} must be a number (got {value!r})")
-    if not math.isfinite(value):
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:
+        # An int beyond the floats' range (10**400): no setting, and no float to compare.
+        bits = value.bit_length()  # type: ignore[union-attr]
+        message = f"{name} must be finite (got an integer beyond the floats: {bits} bits)"
+        raise ValueError(message) from None
+    if not finite:
         raise ValueError(f"{name} must be finite (got {value})")
     if positive and zero and value < 0.0:
         raise ValueError(f"{name} must be >= 0 (got {value})")
@@ -1006,6 +1014,13 @@ def check_poisson(value: object, name: str = "poisson") -> None:
 def check_rho_inf(value: float) -> None:
     """Raise ValueError unless `value` is a spectral radius at infinity, a number in [0, 1]."""
     check_bounded("rho_inf", value, low=0.0, high=1.0)
+
+
+def check_spec(value: object) -> None:
+    """Raise ValueError unless `value` is a scenario's ``spec``: a `SetupSpec` (a mistyped one
+    would otherwise fail as an AttributeError on its missing ``validate``)."""
+    if not isinstance(value, SetupSpec):
+        raise ValueError(f"spec must be a SetupSpec (got {value!r})")
 
 
 def check_count(name: str, value: object, *, minimum: int) -> None:

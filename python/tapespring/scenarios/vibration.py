@@ -45,6 +45,7 @@ from tapespring.scenarios.setup import (
     check_number,
     check_rho_inf,
     check_sampling,
+    check_spec,
     check_tolerance,
     drive,
     dynamic_options,
@@ -179,6 +180,7 @@ class VibrationSettings:
 
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
+        check_spec(self.spec)
         self.spec.validate()
         check_initial_displacement(self.initial_displacement)
         for name in ("duration", "sample_rate"):

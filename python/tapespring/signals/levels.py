@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from scipy.signal import find_peaks
 
@@ -32,6 +34,11 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
     y = np.asarray(y, dtype=float)
     if not tail > 0:
         raise ValueError(f"tail must satisfy tail > 0, got {tail}")
+    if time.ndim != 1 or time.shape != y.shape or time.size == 0:
+        raise ValueError(
+            f"time and y must be 1-D arrays of one length >= 1, got shapes {time.shape} and "
+            f"{y.shape}"
+        )
     last = y[time >= time[-1] - tail]
     last = last[np.isfinite(last)]
     if last.size == 0:
@@ -70,6 +77,8 @@ def swing_midline(y: np.ndarray, prominence: float, *, tail: float = 0.25) -> fl
         raise ValueError(f"tail must satisfy 0 < tail <= 1, got {tail}")
     if not prominence > 0:
         raise ValueError(f"prominence must be > 0, got {prominence}")
+    if y.ndim != 1 or y.size == 0:
+        raise ValueError(f"y must be a 1-D array of at least one sample, got shape {y.shape}")
     last = y[-max(1, round(tail * y.size)) :]
     if not np.isfinite(last).all():
         raise ValueError("the record's tail has non-finite samples")
@@ -102,10 +111,26 @@ def release_index(y: np.ndarray, threshold: float, *, n_initial: int = 10) -> in
     -------
     int
         The first index ``i`` with ``|y[i] - y0| > threshold``; 0 if never.
+
+    Raises
+    ------
+    ValueError
+        If `y` is not a 1-D array of at least one sample, `threshold` is not > 0, `n_initial` is
+        not an integer >= 1, or the first `n_initial` samples hold no finite value (no initial
+        value to leave: every sample would read as "never left").
     """
     y = np.asarray(y, dtype=float)
     if not threshold > 0:
         raise ValueError(f"threshold must satisfy threshold > 0, got {threshold}")
-    y0 = np.nanmedian(y[:n_initial])
+    if isinstance(n_initial, bool) or not isinstance(n_initial, numbers.Integral) or n_initial < 1:
+        raise ValueError(f"n_initial must be an integer >= 1, got {n_initial!r}")
+    if y.ndim != 1 or y.size == 0:
+        raise ValueError(f"y must be a 1-D array of at least one sample, got shape {y.shape}")
+    initial = y[:n_initial]
+    if not np.isfinite(initial).any():
+        raise ValueError(
+            f"the first {initial.size} sample(s) of y hold no finite value: no initial value"
+        )
+    y0 = np.nanmedian(initial[np.isfinite(initial)])
     moved = np.flatnonzero(np.abs(y - y0) > threshold)
     return int(moved[0]) if moved.size else 0

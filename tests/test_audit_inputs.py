@@ -1,0 +1,192 @@
+"""Regression tests of an input-robustness audit: inputs that escaped as the wrong exception
+(RecursionError, MemoryError, OverflowError, AttributeError, IndexError, a TrialError for an
+option), were silently accepted, or hung, and are now refused with a ValueError naming them."""
+
+from __future__ import annotations
+
+import io
+import json
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tapespring import Model, Outputs, Results, Step, run, shell
+from tapespring.protocols import analyze_trials
+from tapespring.scenarios.bending import BendingSetup
+from tapespring.scenarios.deployment import DeploymentSettings
+from tapespring.scenarios.equilibrium import EquilibriumSettings
+from tapespring.scenarios.max_mass import MaxMassSettings
+from tapespring.scenarios.pull import PullSettings
+from tapespring.scenarios.vibration import VibrationSettings
+from tapespring.signals import equilibrium_value, release_index, swing_midline
+from tapespring.trials import TrialError
+from tapespring.trials.samples import make_deployment_trial
+
+# --- Results.load: corrupted files --------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
+    model = Model(*mesh[:2], node_sets=mesh[2], thickness=2e-3, youngs_modulus=2e11, poisson=0.0)
+    model.fix("x0")
+    tip = model.add_node([0.2, 0.01, 0.0])
+    model.tie("x1", tip)
+    model.add_load(tip, "uz", 10.0)
+    results = run(model, [Step.static(increments=2)], outputs=Outputs(field_interval=1))
+    return results.save(tmp_path_factory.mktemp("saved") / "r.npz")
+
+
+def _rewrite(saved: Path, out: Path, *, meta: str | None = None, t_member: bytes | None = None):
+    """A copy of `saved` with its meta text or its ``t.npy`` member replaced."""
+    with zipfile.ZipFile(saved) as src, zipfile.ZipFile(out, "w") as dst:
+        for name in src.namelist():
+            data = src.read(name)
+            if name == "meta.npy" and meta is not None:
+                buffer = io.BytesIO()
+                np.save(buffer, np.array(meta))
+                data = buffer.getvalue()
+            if name == "t.npy" and t_member is not None:
+                data = t_member
+            dst.writestr(name, data)
+    return out
+
+
+def _meta(saved: Path) -> dict:
+    with np.load(saved, allow_pickle=False) as f:
+        return json.loads(str(f["meta"]))
+
+
+def test_a_deeply_nested_meta_is_a_value_error_not_a_recursion_error(saved, tmp_path):
+    deep = '{"a": ' + "[" * 200_000 + "]" * 200_000 + "}"
+    path = _rewrite(saved, tmp_path / "deep.npz", meta=deep)
+    with pytest.raises(ValueError, match="nested too deeply"):
+        Results.load(path)
+
+
+@pytest.mark.parametrize("version", ["9", None, float("nan"), True, 2.5])
+def test_a_format_version_that_is_not_an_integer_is_named(saved, tmp_path, version):
+    meta = {**_meta(saved), "version": version}
+    path = _rewrite(saved, tmp_path / "version.npz", meta=json.dumps(meta))
+    with pytest.raises(ValueError, match="version must be an integer"):
+        Results.load(path)
+
+
+def test_a_header_declaring_terabytes_is_refused_before_any_allocation(saved, tmp_path):
+    header = "{'descr': '<f8', 'fortran_order': False, 'shape': (100000000000,), }"
+    header = header.ljust(117) + "\n"
+    member = b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode()
+    path = _rewrite(saved, tmp_path / "huge.npz", t_member=member + b"\0" * 64)
+    with pytest.raises(ValueError, match=r"t\.npy declares 800000000000 bytes"):
+        Results.load(path)
+
+
+def test_an_unchanged_and_a_compressed_file_still_load(saved, tmp_path):
+    with np.load(saved, allow_pickle=False) as f:
+        np.savez_compressed(tmp_path / "c.npz", **{k: f[k] for k in f.files})
+    a, b = Results.load(saved), Results.load(tmp_path / "c.npz")
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.displacements, b.displacements)
+
+
+# --- Settings: integers beyond the floats, a spec of the wrong type --------------------------
+
+
+def test_an_integer_beyond_the_floats_is_a_value_error_not_an_overflow_error():
+    with pytest.raises(ValueError, match="length must be finite"):
+        BendingSetup(length=10**400).validate()
+    with pytest.raises(ValueError, match="thicknesses must be finite"):
+        MaxMassSettings(thicknesses=(10**400,)).validate()
+    with pytest.raises(ValueError, match="span_time must be a finite duration"):
+        analyze_trials([make_deployment_trial(duration=2.0)[0]], "quasi-static", span_time=10**400)
+
+
+@pytest.mark.parametrize(
+    "settings", [DeploymentSettings, VibrationSettings, PullSettings, EquilibriumSettings]
+)
+@pytest.mark.parametrize("spec", [None, 1.0, "paper", {}])
+def test_a_spec_that_is_not_a_setup_spec_is_named(settings, spec):
+    with pytest.raises(ValueError, match="spec must be a SetupSpec"):
+        settings(spec=spec).validate()
+
+
+# --- analyze_trials: the markers option -----------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def trial():
+    return make_deployment_trial(duration=2.0)[0]
+
+
+@pytest.mark.parametrize(
+    ("markers", "message"),
+    [
+        ("M1M2M3", "markers must be 3 names"),
+        (("M1", "M2"), "markers must be 3 names"),
+        ((1, 2, 3), "must be names"),
+        (("M1", "M1", "M3"), "'M1' for more than one"),
+        (("M1", "M2", "M2"), "'M2' for more than one"),
+    ],
+)
+def test_bad_markers_are_an_option_error_not_a_trial_error(trial, markers, message):
+    with pytest.raises(ValueError, match=message) as info:
+        analyze_trials([trial], "deployment", markers=markers)
+    # A TrialError would be skipped with skip_bad=True, trial after trial.
+    assert not isinstance(info.value, TrialError)
+
+
+def test_markers_a_kind_does_not_use_may_repeat():
+    from tapespring.protocols.markers import check_markers
+
+    check_markers(("X", "X", "M3"), (2,))  # a vibration test uses the tip only
+
+
+# --- signals: degenerate signals --------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("y", "kwargs", "message"),
+    [
+        (np.array([]), {}, "at least one sample"),
+        (np.full(100, np.nan), {}, "no finite value"),
+        (np.zeros((2, 50)), {}, "1-D"),
+        (np.zeros(50), {"n_initial": 0}, "n_initial must be an integer"),
+        (np.zeros(50), {"n_initial": 2.5}, "n_initial must be an integer"),
+    ],
+)
+def test_release_index_refuses_a_signal_without_an_initial_value(y, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        release_index(y, 0.1, **kwargs)
+
+
+def test_release_index_still_finds_the_release():
+    y = np.r_[np.zeros(20), np.linspace(0.0, 1.0, 30)]
+    assert release_index(y, 0.1) == 23
+    assert release_index(np.r_[np.nan, np.zeros(20), np.ones(5)], 0.5) == 21
+
+
+@pytest.mark.parametrize(
+    ("time", "y"), [(np.array([]), np.array([])), (np.arange(5.0), np.zeros((2, 5)))]
+)
+def test_equilibrium_value_refuses_empty_or_mismatched_arrays(time, y):
+    with pytest.raises(ValueError, match="1-D arrays of one length"):
+        equilibrium_value(time, y)
+
+
+def test_swing_midline_refuses_an_empty_signal():
+    with pytest.raises(ValueError, match="at least one sample"):
+        swing_midline(np.array([]), 0.1)
+
+
+# --- max-mass: a grid too large to run is refused at once ------------------------------------
+
+
+def test_a_grid_of_more_runs_than_the_bound_is_refused_before_it_is_built():
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match="MAX_GRID_RUNS"):
+        MaxMassSettings.grid(10**6, 1)
+    grid = MaxMassSettings.grid(101, 100)  # 10 100 runs: more than MAX_GRID_RUNS = 10 000
+    with pytest.raises(ValueError, match="bending runs"):
+        grid.validate()
+    assert time.perf_counter() - start < 5.0
