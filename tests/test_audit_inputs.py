@@ -190,3 +190,50 @@ def test_a_grid_of_more_runs_than_the_bound_is_refused_before_it_is_built():
     with pytest.raises(ValueError, match="bending runs"):
         grid.validate()
     assert time.perf_counter() - start < 5.0
+
+
+# --- run and solve_static: arguments of the wrong type -------------------------------------
+
+
+def _loaded_plate() -> Model:
+    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
+    model = Model(*mesh[:2], node_sets=mesh[2], thickness=2e-3, youngs_modulus=2e11, poisson=0.0)
+    model.fix("x0")
+    model.add_load(mesh[2]["x1"][0], "uz", 1.0)
+    return model
+
+
+@pytest.mark.parametrize(
+    ("steps", "message"),
+    [("static", "steps must be a sequence"), (["static"], r"steps\[0\] must be a Step")],
+)
+def test_steps_that_are_not_steps_are_named(steps, message):
+    with pytest.raises(TypeError, match=message):
+        run(_loaded_plate(), steps)
+
+
+def test_raise_on_error_must_be_a_bool():
+    with pytest.raises(TypeError, match="raise_on_error must be True or False"):
+        run(_loaded_plate(), [Step.static(increments=2)], raise_on_error="no")
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"progress": "yes"}, "progress must be True, False, None or a callable"),
+        ({"progress": 1}, "progress must be True, False, None or a callable"),
+        ({"record_fields": "no"}, "record_fields must be True or False"),
+        ({"raise_on_error": "no"}, "raise_on_error must be True or False"),
+    ],
+)
+def test_solve_static_does_not_ignore_or_misread_its_switches(kwargs, message):
+    with pytest.raises(TypeError, match=message):
+        shell.solve_static(_loaded_plate(), increments=2, **kwargs)
+
+
+def test_a_reaction_dof_in_upper_case_is_the_model_s_dof():
+    results = run(
+        _loaded_plate(), [Step.static(increments=2)], outputs=Outputs(reactions=[(0, "UZ")])
+    )
+    assert results.reaction_dofs == ((0, "uz"),)
+    assert results.reaction(0, "UZ").shape == (3,)

@@ -355,8 +355,15 @@ def _reaction_dofs(reactions: Any) -> tuple[tuple[int, str], ...]:
         node, dof = pair
         if not isinstance(dof, str):
             raise TypeError(f"{what}[{k}]: the dof must be a DOF name such as 'uz' (got {dof!r})")
-        pairs.append((_index(node, what, (node, dof)), dof))
+        # Lower case, as the Model methods and Results.reaction take DOF names ("UZ" is "uz").
+        pairs.append((_index(node, what, (node, dof)), dof.lower()))
     return tuple(pairs)
+
+
+def _check_bool(name: str, value: object) -> None:
+    """Raise TypeError unless `value` is a bool: ``"no"`` would be taken as true."""
+    if not isinstance(value, bool | np.bool_):
+        raise TypeError(f"{name} must be True or False, not {type(value).__name__}: {value!r}")
 
 
 ProgressCallback = Callable[[int, str, float], "bool | None"]
@@ -402,14 +409,26 @@ def run(
     Raises
     ------
     TypeError
-        If `outputs` is not an `Outputs`, or `progress` is neither a bool, None nor callable.
+        If `steps` is not a sequence of `Step` or dicts, `outputs` is not an `Outputs`,
+        `progress` is neither a bool, None nor callable, or `raise_on_error` is not a bool.
     ValueError
         For an invalid model, step or output request (unknown or inapplicable options, unknown
         ids, ...), before anything runs.
     ConvergenceError
         If the analysis stopped early and `raise_on_error` is True.
     """
-    raw_steps = [s.to_dict() if isinstance(s, Step) else dict(s) for s in steps]
+    if isinstance(steps, str | bytes | Mapping) or not isinstance(steps, Iterable):
+        raise TypeError(
+            f"steps must be a sequence of Step (or dicts), e.g. [Step.static()], not "
+            f"{type(steps).__name__}"
+        )
+    raw_steps = []
+    for k, s in enumerate(steps):
+        if not isinstance(s, Step | Mapping):
+            # dict() of a string or a list would fail on its letters, naming neither.
+            raise TypeError(f"steps[{k}] must be a Step or a dict, not {type(s).__name__}: {s!r}")
+        raw_steps.append(s.to_dict() if isinstance(s, Step) else dict(s))
+    _check_bool("raise_on_error", raise_on_error)
     if outputs is None:
         outputs = Outputs()
     elif not isinstance(outputs, Outputs):

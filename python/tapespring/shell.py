@@ -202,11 +202,22 @@ def solve_static(
 
     Raises
     ------
+    TypeError
+        If `record_fields` or `raise_on_error` is not a bool, or `progress` is neither a bool,
+        None nor callable.
     ValueError
         For an invalid set-up (no load, no constraint, bad option), at once.
     ConvergenceError
         If the path stopped early and `raise_on_error` is True.
     """
+    if not isinstance(record_fields, bool | np.bool_):
+        raise TypeError(f"record_fields must be True or False, not {record_fields!r}")
+    # Checked here: anything neither True nor callable was passed on as no callback at all.
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(
+            "progress must be True, False, None or a callable (index, t), not "
+            f"{type(progress).__name__}"
+        )
     step = Step.static("static", **options)
     outputs = Outputs(field_interval=1 if record_fields else 0)
     if progress is True:
