@@ -237,3 +237,64 @@ def test_a_reaction_dof_in_upper_case_is_the_model_s_dof():
     )
     assert results.reaction_dofs == ((0, "uz"),)
     assert results.reaction(0, "UZ").shape == (3,)
+
+
+# --- Results accessors and results_to_trial -----------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def dynamic_results():
+    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
+    model = Model(
+        *mesh[:2],
+        node_sets=mesh[2],
+        thickness=2e-3,
+        youngs_modulus=2e11,
+        poisson=0.0,
+        density=7800.0,
+    )
+    model.fix("x0")
+    model.add_marker("tip", int(mesh[2]["x1"][0]))
+    model.set_gravity([0.0, 0.0, -9.81])
+    results = run(
+        model, [Step.dynamic(duration=2e-2, max_step=1e-3)], outputs=Outputs(field_interval=1)
+    )
+    return results, [int(n) for n in mesh[2]["x0"]]
+
+
+def test_a_fractional_record_is_refused_not_truncated(dynamic_results):
+    results, _ = dynamic_results
+    with pytest.raises(TypeError, match="record must be an integer"):
+        results.field(1.5)
+
+
+def test_a_dof_that_is_not_a_name_is_a_type_error(dynamic_results):
+    results, nodes = dynamic_results
+    with pytest.raises(TypeError, match="dof must be a DOF name"):
+        results.reaction(nodes[0], 5)
+    with pytest.raises(TypeError, match="dof must be a DOF name"):
+        results.total_reaction(5)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"origin": [np.nan, 0.0, 0.0]}, "origin must be a finite point"),
+        ({"origin": [0.0, 0.0]}, "origin must be a finite point"),
+        ({"force_nodes": [1.5]}, "integer node indices"),
+        ({"force_nodes": "0"}, "sequence of node indices"),
+        ({"force_nodes": None, "origin": [0.0, 0.0, 0.0]}, "give force_nodes too"),
+    ],
+)
+def test_results_to_trial_refuses_a_bad_plate_rather_than_misreading_it(
+    dynamic_results, kwargs, message
+):
+    results, nodes = dynamic_results
+    with pytest.raises(ValueError, match=message):
+        results.to_trial(markers={"tip": "M1"}, **{"force_nodes": nodes, **kwargs})
+
+
+def test_results_to_trial_still_gives_a_plate(dynamic_results):
+    results, nodes = dynamic_results
+    trial = results.to_trial(markers={"tip": "M1"}, force_nodes=nodes, origin=[0.0, 0.0, 0.0])
+    assert np.all(np.isfinite(trial.force_plates[0].moment))

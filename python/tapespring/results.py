@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -242,7 +243,7 @@ class Results:
         KeyError
             If that (node, dof) was not recorded.
         """
-        key = (int(node), dof.lower())
+        key = (int(node), _dof_name(dof))
         try:
             column = self.reaction_dofs.index(key)
         except ValueError:
@@ -257,7 +258,8 @@ class Results:
         KeyError
             If no force at that DOF was recorded (or the name is not a DOF).
         """
-        columns = [i for i, (_, d) in enumerate(self.reaction_dofs) if d == dof.lower()]
+        name = _dof_name(dof)
+        columns = [i for i, (_, d) in enumerate(self.reaction_dofs) if d == name]
         if not columns:
             raise KeyError(f"no reaction at {dof!r} was recorded (recorded: {self.reaction_dofs})")
         return self.reactions[:, columns].sum(axis=1)
@@ -281,12 +283,17 @@ class Results:
 
         Raises
         ------
+        TypeError
+            If `record` is not an integer (``1.5`` is refused, not truncated).
         IndexError
             If there is no record `record`.
         KeyError
             If the fields of that record were not kept.
         """
         n = self.n_records
+        if isinstance(record, bool | np.bool_) or not isinstance(record, numbers.Integral):
+            # int(1.5) would give the fields of record 1.
+            raise TypeError(f"record must be an integer index (got {record!r})")
         if not -n <= int(record) < n:
             raise IndexError(f"record {record} out of range: the results hold {n} records")
         r = int(record) % n
@@ -445,6 +452,13 @@ class Results:
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
         d["modes"] = modes
         return cls.from_dict(d)
+
+
+def _dof_name(dof: object) -> str:
+    """`dof` in lower case, as the records name it; TypeError if it is not a string."""
+    if not isinstance(dof, str):
+        raise TypeError(f"dof must be a DOF name such as 'uz' (got {dof!r})")
+    return dof.lower()
 
 
 class _NotResults(ValueError):

@@ -30,6 +30,8 @@ from its clamp gives ``F_z = -m g``: the convention of the laboratory's plates a
 
 from __future__ import annotations
 
+import math
+import numbers
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -95,14 +97,18 @@ def results_to_trial(
     Raises
     ------
     ValueError
-        If a marker or a force node is unknown or incomplete, a rate is not positive, no record
-        is selected, the selected times do not increase strictly, or they span less than one
-        sampling interval.
+        If a marker or a force node is unknown or incomplete, a force node is not an integer
+        index, `origin` is not a finite point or is given without `force_nodes`, a rate is not
+        positive, no record is selected, the selected times do not increase strictly, or they
+        span less than one sampling interval.
     """
     if not rate_hz > 0 or not np.isfinite(rate_hz):
         raise ValueError(f"rate_hz must satisfy rate_hz > 0, got {rate_hz}")
     if not force_rate_hz > 0 or not np.isfinite(force_rate_hz):
         raise ValueError(f"force_rate_hz must satisfy force_rate_hz > 0, got {force_rate_hz}")
+    if origin is not None and force_nodes is None:
+        # The origin is the force plate's: without one it would be ignored.
+        raise ValueError("origin is the force plate's moment origin: give force_nodes too")
     columns = _marker_columns(results, markers)
     records = _selected_records(results, steps)
     t = results.t[records]
@@ -223,7 +229,9 @@ def _plate_history(
     results: Results, force_nodes: Sequence[int], origin: ArrayLike | None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Force [N] and moment [N m] on the plate at every record, shapes (n, 3)."""
-    nodes = [int(node) for node in force_nodes]
+    if isinstance(force_nodes, str | bytes):
+        raise ValueError(f"force_nodes must be a sequence of node indices (got {force_nodes!r})")
+    nodes = [_node_index(node) for node in force_nodes]
     if not nodes:
         raise ValueError("force_nodes is empty (pass None for a trial without force plate)")
     if len(set(nodes)) != len(nodes):
@@ -244,9 +252,27 @@ def _plate_history(
     moment = moments.sum(axis=1)
     if len(nodes) > 1 or origin is not None:
         x = _reference_positions(results, nodes)
-        o = x[0] if origin is None else np.asarray(origin, dtype=float).reshape(3)
+        o = x[0] if origin is None else _origin(origin)
         moment = moment + np.cross(x - o, forces).sum(axis=1)
     return -forces.sum(axis=1), -moment
+
+
+def _node_index(node: object) -> int:
+    """`node` as a node index: an integer >= 0, or an integral float (``1.5`` is refused, not
+    truncated to node 1)."""
+    if isinstance(node, bool | np.bool_) or not isinstance(node, numbers.Real):
+        raise ValueError(f"force_nodes must hold node indices (got {node!r})")
+    if not (math.isfinite(node) and float(node).is_integer() and node >= 0):
+        raise ValueError(f"force_nodes must hold integer node indices >= 0 (got {node!r})")
+    return int(node)
+
+
+def _origin(origin: ArrayLike) -> NDArray[np.float64]:
+    """`origin` as a finite point, shape (3,): a NaN would make every moment a missing sample."""
+    o = np.asarray(origin, dtype=float)
+    if o.shape != (3,) or not np.all(np.isfinite(o)):
+        raise ValueError(f"origin must be a finite point [x, y, z] in m (got {origin!r})")
+    return o
 
 
 def _reference_positions(results: Results, nodes: list[int]) -> NDArray[np.float64]:
