@@ -298,3 +298,42 @@ def test_results_to_trial_still_gives_a_plate(dynamic_results):
     results, nodes = dynamic_results
     trial = results.to_trial(markers={"tip": "M1"}, force_nodes=nodes, origin=[0.0, 0.0, 0.0])
     assert np.all(np.isfinite(trial.force_plates[0].moment))
+
+
+# --- modal_scipy: its options ----------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def matrices():
+    from tapespring.analysis import system_matrices
+
+    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
+    model = Model(
+        *mesh[:2],
+        node_sets=mesh[2],
+        thickness=2e-3,
+        youngs_modulus=2e11,
+        poisson=0.0,
+        density=7800.0,
+    )
+    model.fix("x0")
+    return system_matrices(model)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        ({"modes": 2.5}, TypeError, "modes must be an integer"),
+        ({"modes": True}, TypeError, "modes must be an integer"),
+        ({"modes": 0}, ValueError, "modes must be from 1 to 47"),
+        ({"modes": 48}, ValueError, "modes must be from 1 to 47"),
+        ({"modes": 3, "shift_hz": float("nan")}, ValueError, "shift_hz must be finite"),
+        ({"modes": 3, "shift_hz": 1e300}, ValueError, "shift_hz must be finite"),
+    ],
+)
+def test_modal_scipy_names_its_bad_options(matrices, kwargs, error, message):
+    from tapespring.modes import modal_scipy
+
+    assert matrices.n == 48
+    with pytest.raises(error, match=message):
+        modal_scipy(matrices, **kwargs)

@@ -12,6 +12,8 @@ This module uses numpy and scipy only (it never imports the compiled core).
 
 from __future__ import annotations
 
+import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -245,9 +247,37 @@ def modal_scipy(
     Returns
     -------
     ScipyModes
+
+    Raises
+    ------
+    TypeError
+        If `modes` is not an integer or `shift_hz` not a number.
+    ValueError
+        If `modes` is not from 1 to ``n - 1`` (eigsh's bound), or `shift_hz` or its squared
+        pulsation is not finite.
     """
     from scipy.sparse.linalg import eigsh
 
+    n = matrices.n
+    # eigsh truncates 2.5 to 2 and fails on 0 or n with messages that name neither the option
+    # nor the bound.
+    if isinstance(modes, bool | np.bool_) or not isinstance(modes, numbers.Integral):
+        raise TypeError(f"modes must be an integer (got {modes!r})")
+    if not 1 <= modes < n:
+        raise ValueError(
+            f"modes must be from 1 to {n - 1}, fewer than the {n} free equations (got {modes})"
+        )
+    if shift_hz is not None:
+        if isinstance(shift_hz, bool) or not isinstance(shift_hz, numbers.Real):
+            raise TypeError(f"shift_hz must be a number or None (got {shift_hz!r})")
+        # A NaN or infinite shift was a "singular factor" from SciPy, one beyond 1e153 Hz an
+        # OverflowError.
+        try:
+            finite = math.isfinite(shift_from_hz(shift_hz))
+        except OverflowError:
+            finite = False
+        if not finite:
+            raise ValueError(f"shift_hz must be finite, its (2 pi f)^2 too (got {shift_hz!r})")
     k = matrices.stiffness
     k_sym = ((k + k.T) * 0.5).tocsc()
     m = matrices.mass.tocsc()
