@@ -41,7 +41,7 @@ use super::newton::{Convergence, NewtonParams, Stall};
 use super::{StaticStep, Stats};
 use crate::assembly::{Assembled, System};
 use crate::constraint::Slot;
-use crate::element::shell::ElementStress;
+use crate::element::shell::{ElementStress, ViscousWork};
 use crate::error::{check_positive, shown, Clock, Error, Result};
 use crate::inertia::Motion;
 use crate::options::Options;
@@ -68,6 +68,15 @@ pub struct DynamicParams {
     /// Local error tolerance of the displacements per step \[m\] (0: `1e-5` times the model's
     /// characteristic length, half its bounding-box diagonal).
     pub tolerance: f64,
+    /// Largest numerical energy error of a step, relative to the step's energy scale (the largest
+    /// kinetic plus strain energy so far, from the step's start): with it, a step whose energy
+    /// balance leaves a remainder (the scheme's dissipation, or energy it created) above
+    /// `energy_tolerance` times that scale is rejected, and the next step's size follows from
+    /// both this and the local error estimate (0: off, the default). The local error estimate
+    /// measures the displacements only; at a snap it lets steps grow where the scheme loses
+    /// energy in the short waves of the fold, which this catches. Only with `adaptive`.
+    #[serde(default)]
+    pub energy_tolerance: f64,
     /// Steps land exactly on every multiple of this interval from the step's start \[s\] (0: none).
     pub output_interval: f64,
     /// Largest number of accepted steps.
@@ -131,6 +140,7 @@ impl Default for DynamicParams {
             min_step: 0.0,
             adaptive: true,
             tolerance: 0.0,
+            energy_tolerance: 0.0,
             output_interval: 0.0,
             max_steps: 100_000,
             max_cutbacks: 12,
@@ -233,6 +243,17 @@ impl DynamicParams {
                 )));
             }
         }
+        if !(self.energy_tolerance.is_finite() && (0.0..1.0).contains(&self.energy_tolerance)) {
+            return Err(Error::InvalidParameter(format!(
+                "energy_tolerance must lie in [0, 1) (0: off) (got {})",
+                shown(self.energy_tolerance)
+            )));
+        }
+        if self.energy_tolerance > 0.0 && !self.adaptive {
+            return Err(Error::InvalidParameter(
+                "energy_tolerance needs adaptive time steps (adaptive = true)".into(),
+            ));
+        }
         if self.max_steps == 0 {
             return Err(Error::InvalidParameter("max_steps must be >= 1".into()));
         }
@@ -324,6 +345,7 @@ impl DynamicParams {
             min_step: o.take_or("min_step", d.min_step)?,
             adaptive: o.take_or("adaptive", d.adaptive)?,
             tolerance: o.take_or("tolerance", d.tolerance)?,
+            energy_tolerance: o.take_or("energy_tolerance", d.energy_tolerance)?,
             output_interval: o.take_or("output_interval", d.output_interval)?,
             max_steps: o.take_or("max_steps", d.max_steps)?,
             max_cutbacks: o.take_or("max_cutbacks", d.max_cutbacks)?,
@@ -350,6 +372,7 @@ impl DynamicParams {
         m.insert("min_step".into(), self.min_step.into());
         m.insert("adaptive".into(), self.adaptive.into());
         m.insert("tolerance".into(), self.tolerance.into());
+        m.insert("energy_tolerance".into(), self.energy_tolerance.into());
         m.insert("output_interval".into(), self.output_interval.into());
         m.insert("max_steps".into(), self.max_steps.into());
         m.insert("max_cutbacks".into(), self.max_cutbacks.into());
@@ -361,6 +384,9 @@ impl DynamicParams {
         m
     }
 }
+
+/// Order in `h` of a step's energy remainder assumed by the step controller.
+const ENERGY_ERROR_ORDER: f64 = 4.0;
 
 /// Energy terms of a dynamic record, cumulated from the start of its step \[J\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -1064,6 +1090,8 @@ pub fn solve_dynamic(
     let mut last = Energies::of(&integ, state);
     let mut last_work = integ.system.viscous_work().to_vec();
     let mech0 = last.kinetic + last.strain + last.gravity;
+    // The energy in motion that `energy_tolerance` is relative to.
+    let mut energy_scale = last.kinetic + last.strain;
 
     let eps_t = TIME_RESOLUTION * params.duration.max(t_end.abs());
     let mut cutbacks = 0;
@@ -1128,10 +1156,23 @@ pub fn solve_dynamic(
                 error,
                 a_gen,
             } => {
+                let step = StepEnergy::of(&integ, state, &scratch, &last, &last_work, step_h);
+                // The step's remainder of the energy balance, against the energy in motion.
+                let scale = energy_scale.max(step.now.kinetic + step.now.strain);
+                let energy_error = if params.energy_tolerance > 0.0 && scale > 0.0 {
+                    step.remainder(&last).abs() / (params.energy_tolerance * scale)
+                } else {
+                    0.0
+                };
+                let (error, what, order) = if energy_error > error {
+                    (energy_error, "the energy balance", ENERGY_ERROR_ORDER)
+                } else {
+                    (error, "the error estimate", 3.0)
+                };
                 let ok = !params.adaptive || error <= 1.0;
                 // Next size from the error estimate (third-order local error in h).
                 let factor = if params.adaptive {
-                    (0.9 * error.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 2.0)
+                    (0.9 * error.max(1e-10).powf(-1.0 / order)).clamp(0.2, 2.0)
                 } else {
                     2.0
                 };
@@ -1145,15 +1186,15 @@ pub fn solve_dynamic(
                     if !params.adaptive {
                         h = h.min(default_or(params.initial_step, params.duration / 1000.0));
                     }
-                    (iterations, true)
+                    (iterations, Some(step))
                 } else {
                     log::debug!(
-                        "t = {:.6e} s: step {step_h:.3e} s rejected by the error estimate ({error:.3} times the tolerance)",
+                        "t = {:.6e} s: step {step_h:.3e} s rejected by {what} ({error:.3} times the tolerance)",
                         state.t
                     );
                     integ.stats.cutbacks += 1;
                     h = step_h * factor.min(0.9);
-                    (iterations, false)
+                    (iterations, None)
                 }
             }
             Attempt::Failed {
@@ -1184,11 +1225,11 @@ pub fn solve_dynamic(
                     });
                     break;
                 }
-                (iterations, false)
+                (iterations, None)
             }
         };
-        retry = !accepted;
-        if !accepted {
+        retry = accepted.is_none();
+        let Some(step) = accepted else {
             if h < min_step {
                 path.error = Some(Error::NotConverged {
                     step: None,
@@ -1204,45 +1245,19 @@ pub fn solve_dynamic(
                 break;
             }
             continue;
-        }
+        };
         cutbacks = 0;
-        // Energy terms: trapezoidal work of loads and supports, viscous dissipation as the
-        // viscous stresses' work on the strain increments (see `ViscousWork::work_to`).
-        let asm = &integ.asm;
-        let now = Energies::of(&integ, &scratch);
-        let mut w_loads = 0.0;
-        for i in 0..n_nodes {
-            if integ.system.dofs.master[i].is_some() {
-                continue;
-            }
-            let inc = integ.increment(state, &scratch, i);
-            for k in 0..6 {
-                w_loads += 0.5 * (last.loads[i][k] + now.loads[i][k]) * inc[k / 3][k % 3];
-            }
-        }
-        let dc = integ.system.constrained_increments(state.t, step_h);
-        let w_presc: f64 = dc
-            .iter()
-            .zip(last.reactions.iter().zip(&now.reactions))
-            .map(|(d, (r0, r1))| 0.5 * (r0 + r1) * d)
-            .sum();
-        // Gravity's power on the motion is `-d/dt(-g . P) - dg/dt . P`: the potential's change
-        // counts the first part, this the second (trapezoidal in `P`, exact in `g`).
-        let dg = integ.system.gravity_at(scratch.t) - integ.system.gravity_at(state.t);
-        w_loads -= dg.dot(&(0.5 * (last.mass_moment + now.mass_moment)));
-        balance.work_loads += w_loads;
-        balance.work_prescribed += w_presc + integ.velocity_jump_work(state, &scratch);
-        let now_work = integ.system.viscous_work();
-        balance.viscous += last_work
-            .iter()
-            .zip(now_work)
-            .map(|(w0, w1)| w0.work_to(w1))
-            .sum::<f64>();
-        last_work.copy_from_slice(now_work);
+        balance.work_loads += step.work_loads;
+        balance.work_prescribed += step.work_prescribed;
+        balance.viscous += step.viscous;
+        last_work.copy_from_slice(integ.system.viscous_work());
+        let now = step.now;
         balance.kinetic = now.kinetic;
         balance.numerical = balance.work_loads + balance.work_prescribed
             - balance.viscous
             - (now.kinetic + now.strain + now.gravity - mech0);
+        energy_scale = energy_scale.max(now.kinetic + now.strain);
+        let asm = &integ.asm;
         std::mem::swap(state, &mut scratch);
         integ.stats.steps += 1;
         let mut record = record(&integ, state, asm, iterations, balance, params.record_fields);
@@ -1262,6 +1277,68 @@ pub fn solve_dynamic(
     integ.stats.lu_fallbacks = integ.system.linear.lu_fallbacks - linear_counts.1;
     path.stats = integ.stats;
     Ok(path)
+}
+
+/// The energy balance's terms over one converged step, before it is accepted.
+struct StepEnergy {
+    /// Trapezoidal work of the nodal loads (and of gravity's change in time) \[J\].
+    work_loads: f64,
+    /// Work of the prescribed motions, and of velocity jumps at released constraints \[J\].
+    work_prescribed: f64,
+    /// Viscous stresses' work on the strain increments \[J\].
+    viscous: f64,
+    /// The step's end.
+    now: Energies,
+}
+
+impl StepEnergy {
+    /// The terms from `start` (whose energies are `last` and element viscous work `last_work`) to
+    /// the converged `end`, whose assembly is the integrator's last.
+    fn of(integ: &Integrator, start: &State, end: &State, last: &Energies, last_work: &[ViscousWork], h: f64) -> Self {
+        // Trapezoidal work of loads and supports, viscous dissipation as the viscous stresses'
+        // work on the strain increments (see `ViscousWork::work_to`).
+        let now = Energies::of(integ, end);
+        let mut work_loads = 0.0;
+        for i in 0..start.x.len() {
+            if integ.system.dofs.master[i].is_some() {
+                continue;
+            }
+            let inc = integ.increment(start, end, i);
+            for k in 0..6 {
+                work_loads += 0.5 * (last.loads[i][k] + now.loads[i][k]) * inc[k / 3][k % 3];
+            }
+        }
+        let dc = integ.system.constrained_increments(start.t, h);
+        let w_presc: f64 = dc
+            .iter()
+            .zip(last.reactions.iter().zip(&now.reactions))
+            .map(|(d, (r0, r1))| 0.5 * (r0 + r1) * d)
+            .sum();
+        // Gravity's power on the motion is `-d/dt(-g . P) - dg/dt . P`: the potential's change
+        // counts the first part, this the second (trapezoidal in `P`, exact in `g`).
+        let dg = integ.system.gravity_at(end.t) - integ.system.gravity_at(start.t);
+        work_loads -= dg.dot(&(0.5 * (last.mass_moment + now.mass_moment)));
+        let viscous = last_work
+            .iter()
+            .zip(integ.system.viscous_work())
+            .map(|(w0, w1)| w0.work_to(w1))
+            .sum::<f64>();
+        Self {
+            work_loads,
+            work_prescribed: w_presc + integ.velocity_jump_work(start, end),
+            viscous,
+            now,
+        }
+    }
+
+    /// The step's remainder of the balance: work in, minus the viscous dissipation and the change
+    /// of kinetic, strain and gravity energy from `last` \[J\].
+    fn remainder(&self, last: &Energies) -> f64 {
+        let now = &self.now;
+        self.work_loads + self.work_prescribed
+            - self.viscous
+            - (now.kinetic + now.strain + now.gravity - (last.kinetic + last.strain + last.gravity))
+    }
 }
 
 /// What the energy balance needs of a state.
