@@ -156,6 +156,25 @@ def test_damped_release_settles_straight(settled):
     assert 0.0 < r.energy["numerical"][-1] < 0.1 * stored
 
 
+def test_an_energy_tolerance_closes_the_damped_releases_energy_balance(settled):
+    # Issue 8, 6.g: "the energy balance closes within 0.5 % of the stored strain energy". At
+    # the default settings the remainder (the scheme's dissipation, rho_inf = 0.7) is 4.5 % of
+    # it (the fixture): the displacement error estimate lets the steps grow where the snap's
+    # short waves carry energy that the scheme, not the material, then dissipates. With the
+    # dynamic step's energy_tolerance each step's remainder is bounded by 3e-5 of the energy in
+    # motion. Measured: 0.27 % at 1 s (950 steps, 160 rejected, 4645 Newton iterations against
+    # 4092: 4 s of wall time), never below -2e-7; the tape settles straight as without it.
+    r = release(ReleaseSetup(tape=TAPE, duration=1.0, eta=1.73e-4, energy_tolerance=3e-5))
+    assert r.results.error is None
+    assert r.summary()["settings"]["energy_tolerance"] == 3e-5
+    stored = r.energy["strain"][0]
+    assert settled.energy["numerical"][-1] > 0.02 * stored
+    assert 0.0 < r.energy["numerical"][-1] < 0.005 * stored
+    assert np.all(r.energy["numerical"] > -1e-4 * stored)
+    assert abs(r.theta_deg[-1]) < 0.1
+    assert r.energy["kinetic"][-1] + r.energy["strain"][-1] < 1e-4 * stored
+
+
 def test_damped_history_through_the_snap_is_stable_when_the_tolerance_is_halved(settled):
     # Issue 8, 6.g: results stable when the error tolerance is halved. With the paper's eta the
     # snap's short waves are damped and the history through the snap and the equal-sense fold
@@ -208,6 +227,12 @@ def test_release_command_json(capsys):
 
 def test_release_command_refuses_bad_input(capsys):
     assert "rho_inf must lie in [0, 1]" in refused(["release", "--rho-inf", "2"], capsys)
+    assert "energy_tolerance must lie in [0, 0.01]" in refused(
+        ["release", "--energy-tolerance", "0.5"], capsys
+    )
+    assert "duration must lie in [1e-05, 500] s" in refused(
+        ["release", "--duration", "1e-300"], capsys
+    )
 
 
 @pytest.mark.parametrize(

@@ -49,7 +49,12 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_tip_inertia,
         check_tip_mass,
     )
-    from tapespring.scenarios.setup import MAX_DURATION, MAX_GRAVITY
+    from tapespring.scenarios.setup import (
+        MAX_DURATION,
+        MAX_ENERGY_TOLERANCE,
+        MAX_GRAVITY,
+        check_energy_tolerance,
+    )
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -104,6 +109,14 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="after the release, keep the free end in the x-z plane (held in y, about x and z)",
     )
     add_tolerance_option(p, d.tolerance)
+    p.add_argument(
+        "--energy-tolerance",
+        type=_checked("energy_tolerance", check_energy_tolerance),
+        default=d.energy_tolerance,
+        help=f"largest remainder of the energy balance per time step, relative to the largest "
+        f"kinetic plus strain energy so far, in [0, {MAX_ENERGY_TOLERANCE:g}] (default 0: off; "
+        "with --eta, 3e-5 closes the balance to about 0.3 %%)",
+    )
     add_tape_options(p, d.tape)
     p.add_argument(
         "--csv",
@@ -157,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
             gravity=args.gravity,
             planar=args.planar,
             tolerance=args.tolerance,
+            energy_tolerance=args.energy_tolerance,
         )
         result = release(setup, progress=shows_progress(args))
         failure = None
