@@ -90,6 +90,58 @@ def test_an_unchanged_and_a_compressed_file_still_load(saved, tmp_path):
     assert np.array_equal(a.t, b.t) and np.array_equal(a.displacements, b.displacements)
 
 
+def _with_array(saved: Path, out: Path, name: str, value: np.ndarray) -> Path:
+    """A copy of `saved` with its array `name` replaced by `value`."""
+    buffer = io.BytesIO()
+    np.save(buffer, value)
+    with zipfile.ZipFile(saved) as src, zipfile.ZipFile(out, "w") as dst:
+        for member in src.namelist():
+            data = buffer.getvalue() if member == f"{name}.npy" else src.read(member)
+            dst.writestr(member, data)
+    return out
+
+
+def _edited(saved: Path, name: str, edit) -> np.ndarray:
+    with np.load(saved, allow_pickle=False) as f:
+        return edit(f[name].copy())
+
+
+def _set_last(a: np.ndarray, value) -> np.ndarray:
+    a.reshape(-1)[-1] = value
+    return a
+
+
+@pytest.mark.parametrize(
+    ("name", "edit", "message"),
+    [
+        ("step", lambda a: _set_last(a.astype(np.uint64), 2**63), "step holds values beyond int64"),
+        ("iterations", lambda a: np.full(a.shape, 2**64 - 1, np.uint64), "beyond int64"),
+        ("step", lambda a: a - 1, "step holds negative step indices"),
+        ("step", lambda a: a + 1, "step holds indices beyond the 1 steps"),
+        ("residual", lambda a: _set_last(a, np.nan), "residual holds non-finite"),
+        ("reactions", lambda a: _set_last(a, np.inf), "reactions holds non-finite"),
+        ("displacements", lambda a: _set_last(a, np.nan), "displacements holds non-finite"),
+        ("rotations", lambda a: _set_last(a, np.nan), "rotations holds non-finite"),
+    ],
+)
+def test_an_edited_array_a_run_cannot_produce_is_refused(saved, tmp_path, name, edit, message):
+    path = _with_array(saved, tmp_path / "edited.npz", name, _edited(saved, name, edit))
+    with pytest.raises(ValueError, match=message):
+        Results.load(path)
+
+
+def test_the_nan_of_static_records_still_loads(saved):
+    results = Results.load(saved)
+    # Static records have no cumulated energy balance nor per-record cost: NaN.
+    assert np.isnan(results.work_loads[1:]).all() and np.isnan(results.wall_s).all()
+
+
+@pytest.mark.parametrize("path", [5, None, b"r.npz"])
+def test_a_path_that_is_not_a_path_is_a_type_error(path):
+    with pytest.raises(TypeError, match="path must be a str or an os.PathLike"):
+        Results.load(path)
+
+
 # --- Settings: integers beyond the floats, a spec of the wrong type --------------------------
 
 

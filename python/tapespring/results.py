@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import numbers
+import os
 import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -386,15 +387,21 @@ class Results:
 
         Raises
         ------
+        TypeError
+            If `path` is not a path (a str or an os.PathLike).
         FileNotFoundError
             If there is no such file.
         ValueError
             If the file is not a saved `Results` (another file, or one truncated, corrupted or
             whose parts disagree: per-record arrays of other lengths than ``t``, sparse matrix
-            indices out of range, a ``meta`` that is not a JSON object; the message names the
-            file and what failed), or is of a newer format. Everything is checked before any
-            array is used.
+            indices out of range, integers beyond their type, step indices outside the saved
+            steps, a non-finite value where a run records finite ones, a ``meta`` that is not a
+            JSON object; the message names the file and what failed), or is of a newer format.
+            Everything is checked before any array is used.
         """
+        # Here, not in the try below, which reports a TypeError as a corrupted file.
+        if not isinstance(path, str | os.PathLike):
+            raise TypeError(f"path must be a str or an os.PathLike (got {path!r})")
         try:
             return cls._read(Path(path))
         except (FileNotFoundError, IsADirectoryError, PermissionError, _NotResults):
@@ -503,6 +510,11 @@ def _check_array(name: str, a: Any, dtype: Any, shape: tuple[int | None, ...]) -
     if not np.can_cast(a.dtype, dtype, casting="same_kind"):
         # A cast across kinds would truncate (1.5 -> 1) or drop (complex -> real) silently.
         raise ValueError(f"{name} holds {a.dtype} values, not {np.dtype(dtype)}")
+    if np.issubdtype(dtype, np.integer) and a.size:
+        # A same-kind cast wraps what the type cannot hold (uint64 2**63 -> -2**63).
+        info = np.iinfo(dtype)
+        if a.min() < info.min or a.max() > info.max:
+            raise ValueError(f"{name} holds values beyond {np.dtype(dtype)}")
     if a.ndim != len(shape) or any(
         e is not None and e != s for e, s in zip(shape, a.shape, strict=True)
     ):
@@ -584,10 +596,21 @@ def _check_records(d: Mapping[str, Any]) -> None:
     }
     for key, dtype in _ARRAYS.items():
         _check_array(key, d[key], dtype, shapes.get(key, (n,)))
-    # A run records converged states only: their times and markers are finite.
-    for key in ("t", "marker_positions", "marker_rotations"):
+    # A run records converged states only: their times, residuals, energies, markers, reactions
+    # and fields are finite (NaN marks what was not recorded: the cumulated energy terms and
+    # costs of static records, the arrays older formats lack).
+    finite = ("t", "residual", "strain_energy", "gravity_energy", "marker_positions")
+    finite += ("marker_rotations", "reactions", "displacements", "rotations")
+    for key in finite:
         if not np.all(np.isfinite(np.asarray(d[key], dtype=float))):
             raise ValueError(f"{key} holds non-finite values (a run records finite states only)")
+    # Each record belongs to a step of the settings (the initial state to step 0).
+    steps = d["settings"].get("steps") if isinstance(d.get("settings"), dict) else None
+    step = np.asarray(d["step"])
+    if step.size and step.min() < 0:
+        raise ValueError("step holds negative step indices")
+    if step.size and isinstance(steps, list) and step.max() >= max(len(steps), 1):
+        raise ValueError(f"step holds indices beyond the {len(steps)} steps of the settings")
     records = np.asarray(d["field_records"])
     if records.size and not (records.min() >= 0 and records.max() < n):
         raise ValueError(f"field_records holds records outside [0, {n})")
