@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import time
 import zipfile
 from pathlib import Path
@@ -192,6 +193,35 @@ def test_markers_a_kind_does_not_use_may_repeat():
     from tapespring.protocols.markers import check_markers
 
     check_markers(("X", "X", "M3"), (2,))  # a vibration test uses the tip only
+
+
+# --- trial readers: a path that is not a regular file -----------------------------------------
+
+
+@pytest.mark.parametrize("reader", ["read_trial", "read_csv", "read_c3d", "check_c3d"])
+def test_a_folder_named_like_a_trial_is_not_a_missing_file(tmp_path, reader):
+    from tapespring import trials
+    from tapespring.trials.c3d_check import check_c3d
+
+    read = check_c3d if reader == "check_c3d" else getattr(trials, reader)
+    suffix = ".csv" if reader == "read_csv" else ".c3d"
+    (tmp_path / f"x{suffix}").mkdir()
+    with pytest.raises(IsADirectoryError, match="a folder, not a regular file"):
+        read(tmp_path / f"x{suffix}")
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        read(tmp_path / f"missing{suffix}")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+@pytest.mark.parametrize("name", ["x.csv", "x.c3d"])
+def test_a_fifo_named_like_a_trial_is_not_a_regular_file(tmp_path, name):
+    from tapespring.trials import find_trial_files, read_trial
+
+    os.mkfifo(tmp_path / name)
+    with pytest.raises(TrialError, match="not a regular file"):
+        read_trial(tmp_path / name)
+    with pytest.raises(TrialError, match="not a regular file"):
+        find_trial_files([tmp_path / name])
 
 
 # --- signals: degenerate signals --------------------------------------------------------------

@@ -108,8 +108,11 @@ def read_c3d(
     ------
     FileNotFoundError
         If the file does not exist.
+    IsADirectoryError
+        If the path is a folder.
     TrialError
-        If the file is not a C3D file, is truncated or corrupt (the message says
+        If the path is not a regular file (a FIFO, a socket, a device), the file is
+        not a C3D file, is truncated or corrupt (the message says
         where: an infinite marker coordinate or one beyond 1 km names the marker and
         the frame), makes ezc3d fail, crash or exceed ``timeout``, has an ``ANALOG:RATE``
         that disagrees with the header, or has missing, unknown or mixed units; a force-plate

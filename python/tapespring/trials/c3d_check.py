@@ -37,6 +37,7 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .common import check_regular_file
 from .trial import TrialError
 
 __all__ = ["C3DLayout", "check_c3d"]
@@ -138,14 +139,16 @@ def check_c3d(path: str | Path) -> C3DLayout:
     ------
     FileNotFoundError
         If the file does not exist.
+    IsADirectoryError
+        If the path is a folder.
     TrialError
-        If the file is not a C3D file, is truncated in its header or parameter
+        If the path is not a regular file (a FIFO, a socket, a device), the file is
+        not a C3D file, is truncated in its header or parameter
         section, or has a record whose sizes do not fit (the message gives the
         byte offset and the record).
     """
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+    check_regular_file(path)
     size = path.stat().st_size
     with path.open("rb") as fh:
         head = fh.read(_BLOCK + 64)

@@ -23,6 +23,7 @@ __all__ = [
     "MOMENT",
     "TIME",
     "check_durations",
+    "check_regular_file",
     "first_absurd_coordinate",
     "first_absurd_sample",
     "unit_scale",
@@ -59,6 +60,19 @@ MAX_COORDINATE = 1e3
 MAX_FORCE = 1e6
 #: Largest force-plate moment a reader accepts [N m]: `MAX_FORCE` at 1 m, the size of a plate.
 MAX_MOMENT = 1e6
+
+
+def check_regular_file(path: Path) -> None:
+    """Raise FileNotFoundError if `path` does not exist, IsADirectoryError if it is a folder and
+    TrialError if it is no regular file either (a FIFO, a socket, a device: a reader would block
+    on it or read without end)."""
+    if path.is_file():
+        return
+    if path.is_dir():
+        raise IsADirectoryError(f"{path}: a folder, not a regular file")
+    if path.exists():
+        raise TrialError(path, "not a regular file (a FIFO, a socket or a device)")
+    raise FileNotFoundError(f"{path}: no such file")
 
 
 def unit_scale(unit: str, table: dict[str, float], source: Path, what: str) -> float:

@@ -48,6 +48,7 @@ from .common import (
     MOMENT,
     TIME,
     check_durations,
+    check_regular_file,
     first_absurd_coordinate,
     first_absurd_sample,
     unit_scale,
@@ -338,14 +339,16 @@ def read_csv(
     ------
     FileNotFoundError
         If the file does not exist.
+    IsADirectoryError
+        If the path is a folder.
     TrialError
-        If the layout, the units or the data are invalid, or ``path`` is a force
-        side file (``*.forces.csv``: the message names its marker file); the
-        message names the file and the problem.
+        If the path is not a regular file (a FIFO, a socket, a device), the layout,
+        the units or the data are invalid, or ``path`` is a force side file
+        (``*.forces.csv``: the message names its marker file); the message names
+        the file and the problem.
     """
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+    check_regular_file(path)
     marker = marker_file_of(path)  # None unless path is a force side file
     if marker is not None:
         # Read as markers, its first force column would be "not a marker coordinate".

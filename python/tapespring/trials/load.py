@@ -35,7 +35,7 @@ from typing import TypedDict, Unpack
 from tqdm import tqdm
 
 from .c3d import DEFAULT_TIMEOUT, read_c3d
-from .common import META_KEYS
+from .common import META_KEYS, check_regular_file
 from .csv import is_forces_file, marker_file_of, needs_length_unit, read_csv
 from .trial import SENSES, Trial, TrialError, TrialWarning
 
@@ -134,8 +134,11 @@ def read_trial(
     ------
     FileNotFoundError
         If the file does not exist.
+    IsADirectoryError
+        If the path is a folder.
     TrialError
-        If the suffix is unknown or the file is invalid.
+        If the path is not a regular file (a FIFO, a socket, a device), the suffix
+        is unknown or the file is invalid.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -181,7 +184,8 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
     FileNotFoundError
         If a path does not exist.
     TrialError
-        If a folder holds no trial file.
+        If a folder holds no trial file, or a path is neither a folder nor a regular file (a
+        FIFO, a socket, a device).
     """
     files: list[Path] = []
     given: set[Path] = set()
@@ -192,7 +196,8 @@ def find_trial_files(paths: Iterable[str | Path]) -> list[Path]:
             found = _folder_trials(path)
             if not found:
                 raise TrialError(path, "the folder holds no .c3d or .csv trial")
-        elif path.is_file():
+        elif path.exists():
+            check_regular_file(path)  # a FIFO, a socket: no "no such file"
             found = [path]
         else:
             raise FileNotFoundError(f"{path}: no such file or folder")
