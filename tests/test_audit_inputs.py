@@ -21,7 +21,15 @@ from tapespring.scenarios.equilibrium import EquilibriumSettings
 from tapespring.scenarios.max_mass import MaxMassSettings
 from tapespring.scenarios.pull import PullSettings
 from tapespring.scenarios.vibration import VibrationSettings
-from tapespring.signals import equilibrium_value, release_index, swing_midline
+from tapespring.signals import (
+    equilibrium_value,
+    extract_peaks,
+    fit_damping,
+    noise_std,
+    release_index,
+    summarize,
+    swing_midline,
+)
 from tapespring.trials import TrialError
 from tapespring.trials.samples import make_deployment_trial
 
@@ -259,6 +267,42 @@ def test_equilibrium_value_refuses_empty_or_mismatched_arrays(time, y):
 def test_swing_midline_refuses_an_empty_signal():
     with pytest.raises(ValueError, match="at least one sample"):
         swing_midline(np.array([]), 0.1)
+
+
+@pytest.mark.parametrize("y", [np.array([]), np.full(10, np.nan), np.array([1.0, 2.0])])
+def test_noise_std_refuses_a_signal_without_a_second_difference(y):
+    # 0.0 would read as a noise-free signal.
+    with pytest.raises(ValueError, match="noise_std needs 3 consecutive finite samples"):
+        noise_std(y)
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_times_not_in_seconds_are_named_not_an_svd_failure(scale):
+    t = np.linspace(0.0, 2.0, 801)
+    y = np.exp(-0.5 * t) * np.cos(10 * np.pi * t)
+    with pytest.raises(ValueError, match="t must be in seconds: its mean step"):
+        extract_peaks(t * scale, y)
+    with pytest.raises(ValueError, match="t must be in seconds: its mean step"):
+        fit_damping(t * scale, y, (0.01, 1.0))
+
+
+@pytest.mark.parametrize("values", [[1e300, -1e300, 1e300], [1e308, 1e308]])
+def test_summarize_refuses_values_whose_statistics_overflow(values):
+    with pytest.raises(ValueError, match="overflows to inf"):
+        summarize(values)
+
+
+def test_complex_signals_are_refused_not_cast():
+    t = np.linspace(0.0, 2.0, 801)
+    y = np.cos(10 * np.pi * t) * (1 + 1j)
+    with pytest.raises(TypeError, match="y must be real numbers"):
+        noise_std(y)
+    with pytest.raises(TypeError, match="y must be real numbers"):
+        extract_peaks(t, y)
+    with pytest.raises(TypeError, match="z must be real numbers"):
+        fit_damping(t, y, (0.01, 1.0))
+    with pytest.raises(TypeError, match="values must be real numbers"):
+        summarize(np.array([1.0, 2.0 + 0j]))
 
 
 # --- max-mass: a grid too large to run is refused at once ------------------------------------

@@ -45,7 +45,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .peaks import extract_peaks
-from .smoothing import noise_std
+from .smoothing import noise_std, real_array
 
 __all__ = ["DampingFit", "check_window", "fit_damping", "select_window_peaks"]
 
@@ -179,7 +179,7 @@ def _all_peaks(
         # (0.16 A for a noise-free sinusoid of amplitude A at 10 samples per period, 0.04 A at
         # 20), and a noise-free 10 mm decay sampled 10 times per period lost its 1.9 mm peak
         # (8 sigma = 4.2 mm).
-        z = np.asarray(z, dtype=float)
+        z = real_array(z, "z")
         if z.size >= 3 and np.all(np.isfinite(z)):  # else `extract_peaks` says what is wrong
             prominence = min(max(8.0 * noise_std(z), 1e-3 * float(np.ptp(z))), lo)
     time, value, kind = extract_peaks(t, z, None, prominence=prominence).sequence()

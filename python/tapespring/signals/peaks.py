@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
-from .smoothing import noise_std, smooth
+from .smoothing import noise_std, real_array, smooth
 from .stats import Summary, summarize
 
 __all__ = [
@@ -309,8 +309,8 @@ def extract_peaks(
         strictly increasing, ``y`` is not finite, or an option is invalid (the message names
         the argument).
     """
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
+    t = real_array(t, "t")
+    y = real_array(y, "y")
     if t.shape != y.shape or t.ndim != 1:
         raise ValueError(f"t and y must be 1-D arrays of the same length, got {t.shape}, {y.shape}")
     if y.size < 3:
@@ -350,8 +350,19 @@ def extract_peaks(
     )
 
 
+#: Range of the mean sampling step of the times `check_time` accepts [s]: the trials' sampling
+#: rates (1 Hz to 1 MHz, `tapespring.trials.trial.MIN_RATE`, `MAX_RATE`) widened a thousandfold
+#: either way. Beyond it the times are not in seconds, and the analyses fail or misfit: peaks
+#: in 2.5e297 s steps were NumPy's "SVD did not converge" (the parabola's squared times overflow,
+#: so in 2.5e-83 s steps), a decay in 2.5e5 s steps fitted a damping ratio of 0.013 for 0.016
+#: (1.0 in 2.5e6 s steps: the fit's initial decay rate is floored at 1e-6 /s).
+MIN_TIME_STEP = 1e-9
+MAX_TIME_STEP = 1e3
+
+
 def check_time(t: np.ndarray) -> None:
-    """Raise ValueError unless the sampling instants `t` [s] are finite and strictly increasing.
+    """Raise ValueError unless the sampling instants `t` [s] are finite and strictly increasing,
+    with a mean step from `MIN_TIME_STEP` to `MAX_TIME_STEP` (times in seconds).
 
     Uniform steps are assumed (the peak refinement uses the mean step) but not checked: a
     simulated series with slightly uneven steps is still analysed as before.
@@ -364,6 +375,12 @@ def check_time(t: np.ndarray) -> None:
         raise ValueError(
             f"t must be strictly increasing: t[{i + 1}] = {t[i + 1]:.6g} s follows "
             f"t[{i}] = {t[i]:.6g} s ({bad.size} such step(s))"
+        )
+    step = (t[-1] - t[0]) / (t.size - 1) if t.size > 1 else MIN_TIME_STEP
+    if not MIN_TIME_STEP <= step <= MAX_TIME_STEP:
+        raise ValueError(
+            f"t must be in seconds: its mean step of {step:.3g} s is outside "
+            f"[{MIN_TIME_STEP:g}, {MAX_TIME_STEP:g}] s (MIN_TIME_STEP, MAX_TIME_STEP)"
         )
 
 

@@ -11,8 +11,31 @@ white measurement noise on a smooth signal.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-__all__ = ["complete_windows", "effective_span", "noise_std", "smooth", "span_samples"]
+__all__ = [
+    "complete_windows",
+    "effective_span",
+    "noise_std",
+    "real_array",
+    "smooth",
+    "span_samples",
+]
+
+
+def real_array(values: ArrayLike, name: str) -> np.ndarray:
+    """`values` as an array of floats.
+
+    Raises
+    ------
+    TypeError
+        If `values` are complex (named `name`): a cast to float would drop their imaginary
+        parts with a mere ComplexWarning.
+    """
+    a = np.asarray(values)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real numbers, got complex values ({a.dtype})")
+    return np.asarray(a, dtype=float)
 
 
 def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
@@ -42,7 +65,7 @@ def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
     >>> smooth([1.0, 4.0, 9.0, 16.0, 25.0], span=5).tolist()
     [1.0, 4.666666666666667, 11.0, 16.666666666666668, 25.0]
     """
-    y = np.asarray(y, dtype=float)
+    y = real_array(y, "y")
     if y.ndim != 1:
         raise ValueError(f"smooth expects a 1-D array, got shape {y.shape}")
     if int(span) != span or span < 1:
@@ -146,10 +169,22 @@ def noise_std(y: np.ndarray) -> float:
     -------
     float
         Noise standard deviation, in the unit of ``y``.
+
+    Raises
+    ------
+    TypeError
+        If ``y`` is complex.
+    ValueError
+        If ``y`` has no 3 consecutive finite samples (no second difference: nothing to
+        estimate the noise from; 0 would read as a noise-free signal).
     """
-    d2 = np.diff(np.asarray(y, dtype=float), n=2)
+    y = real_array(y, "y")
+    d2 = np.diff(y, n=2)
     d2 = d2[np.isfinite(d2)]
     if d2.size == 0:
-        return 0.0
+        raise ValueError(
+            f"noise_std needs 3 consecutive finite samples of y, got {y.size} samples "
+            f"({np.count_nonzero(np.isfinite(y))} finite)"
+        )
     mad = np.median(np.abs(d2 - np.median(d2)))
     return float(1.4826 * mad / np.sqrt(6.0))

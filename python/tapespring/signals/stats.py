@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .smoothing import real_array
+
 __all__ = ["Summary", "summarize"]
 
 
@@ -59,11 +61,14 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
 
     Raises
     ------
+    TypeError
+        If ``values`` are complex.
     ValueError
-        If ``values`` is empty (along ``axis``) or holds an infinite value (a mean of inf, or
-        a count that leaves it out while the mean uses it, would be no statistic).
+        If ``values`` is empty (along ``axis``), holds an infinite value (a mean of inf, or
+        a count that leaves it out while the mean uses it, would be no statistic) or values so
+        large that a statistic overflows (beyond about 1e154: the squares of the deviations).
     """
-    x = np.asarray(values, dtype=float)
+    x = real_array(values, "values")
     if x.ndim == 1:
         axis = None
     if x.size == 0 or (axis is not None and x.shape[axis] == 0):
@@ -79,6 +84,11 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
         std = np.where(count >= 2, np.nanstd(x, axis=axis, ddof=1), np.nan)
         max_diff = np.nanmax(x, axis=axis) - np.nanmin(x, axis=axis)
         cv = std / np.abs(mean)
+    if np.isinf(mean).any() or np.isinf(std).any() or np.isinf(max_diff).any():
+        raise ValueError(
+            "values too large for their statistics: the mean, standard deviation or maximum "
+            "difference overflows to inf"
+        )
     if np.ndim(mean) == 0:
         return Summary(float(mean), float(std), float(max_diff), float(cv), int(count))
     return Summary(mean, std, max_diff, cv, count)
