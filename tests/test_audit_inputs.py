@@ -30,7 +30,7 @@ from tapespring.signals import (
     summarize,
     swing_midline,
 )
-from tapespring.trials import TrialError
+from tapespring.trials import Metadata, Trial, TrialError
 from tapespring.trials.samples import make_deployment_trial
 
 # --- Results.load: corrupted files --------------------------------------------------------
@@ -230,6 +230,34 @@ def test_a_fifo_named_like_a_trial_is_not_a_regular_file(tmp_path, name):
         read_trial(tmp_path / name)
     with pytest.raises(TrialError, match="not a regular file"):
         find_trial_files([tmp_path / name])
+
+
+# --- Trial and Metadata: arguments of the wrong type ----------------------------------------
+
+
+def _trial_arguments():
+    return np.arange(10) / 100.0, np.zeros((10, 3))
+
+
+@pytest.mark.parametrize(
+    ("make", "error", "message"),
+    [
+        (lambda t, m: Trial(t, {"M1": m}, metadata="x"), TypeError, "metadata must be a Metadata"),
+        (lambda t, m: Trial(t, {"M1": m}).crop("a", 1), TypeError, "start must be a time"),
+        (lambda t, m: Trial(t, {"M1": m}).crop(0.0, True), TypeError, "stop must be a time"),
+        (lambda t, m: Trial(t, {1: m}), TypeError, "marker names must be str, got 1"),
+        (lambda t, m: Trial(t, {"": m}), TrialError, "a marker has an empty name"),
+        (lambda t, m: Metadata(name=5), TypeError, "name must be a str, got 5"),
+    ],
+)
+def test_trial_arguments_of_the_wrong_type_are_named(make, error, message):
+    with pytest.raises(error, match=message):
+        make(*_trial_arguments())
+
+
+def test_a_trial_still_crops_at_numpy_times():
+    t, m = _trial_arguments()
+    assert Trial(t, {"M1": m}).crop(0.01, np.float64(0.05)).time.size == 5
 
 
 # --- signals: degenerate signals --------------------------------------------------------------

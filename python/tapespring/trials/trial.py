@@ -212,6 +212,13 @@ class Metadata:
         The arrays of a `Trial` are always in SI units.
     source : Path or None
         File the trial was read from.
+
+    Raises
+    ------
+    TypeError
+        If `name` is not a str.
+    TrialError
+        If `sense` is not one of `SENSES` or None.
     """
 
     name: str = ""
@@ -222,6 +229,8 @@ class Metadata:
     source: Path | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a str, got {self.name!r}")
         if self.sense is not None and self.sense not in SENSES:
             raise TrialError(
                 self.source, f"sense must be one of {SENSES} or None, got {self.sense!r}"
@@ -305,10 +314,12 @@ class Trial:
 
     Raises
     ------
+    TypeError
+        If `metadata` is not a `Metadata` or a marker name is not a str.
     TrialError
-        If the shapes or the time vector are inconsistent, or a marker coordinate is
-        infinite (the message names the marker and the sample); the message names the
-        source file.
+        If the shapes or the time vector are inconsistent, a marker name is empty, or a marker
+        coordinate is infinite (the message names the marker and the sample); the message
+        names the source file.
     """
 
     time: np.ndarray
@@ -317,6 +328,8 @@ class Trial:
     metadata: Metadata = field(default_factory=Metadata)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.metadata, Metadata):
+            raise TypeError(f"metadata must be a Metadata, got {self.metadata!r}")
         source = self.metadata.label
         time = _frozen_array(self.time)
         _check_time(time, source, "marker")
@@ -324,6 +337,11 @@ class Trial:
             raise TrialError(source, "the trial has no markers")
         markers = {}
         for name, values in self.markers.items():
+            if not isinstance(name, str):
+                # str(1) would make marker 1 answer to trial.marker("1") only.
+                raise TypeError(f"marker names must be str, got {name!r}")
+            if not name:
+                raise TrialError(source, "a marker has an empty name")
             arr = np.asarray(values, dtype=float)
             if arr.shape != (time.size, 3):
                 raise TrialError(
@@ -337,7 +355,7 @@ class Trial:
                     f"marker {name!r} has {'xyz'[axis]} = {arr[sample, axis]} at sample "
                     f"{sample + 1} (t = {time[sample]:.6g} s): only NaN marks a missing sample",
                 )
-            markers[str(name)] = _frozen_array(arr)
+            markers[name] = _frozen_array(arr)
         plates = tuple(self.force_plates)
         for plate in plates:
             if not isinstance(plate, ForcePlate):
@@ -472,9 +490,16 @@ class Trial:
 
         Raises
         ------
+        TypeError
+            If `start` or `stop` is neither a real number nor None.
         TrialError
             If fewer than 2 marker samples remain.
         """
+        for what, value in (("start", start), ("stop", stop)):
+            if value is not None and (
+                isinstance(value, bool) or not isinstance(value, numbers.Real)
+            ):
+                raise TypeError(f"{what} must be a time [s] or None, got {value!r}")
         lo = -np.inf if start is None else start
         hi = np.inf if stop is None else stop
         keep = (self.time >= lo) & (self.time <= hi)
