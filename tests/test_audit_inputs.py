@@ -151,6 +151,25 @@ def test_a_path_that_is_not_a_path_is_a_type_error(path):
         Results.load(path)
 
 
+@pytest.mark.parametrize("record", [1.5, True, np.float64(1.0)])
+def test_write_pvd_refuses_a_record_that_is_not_an_integer(saved, tmp_path, record):
+    pytest.importorskip("meshio")
+    from tapespring.io.vtu import write_pvd
+
+    with pytest.raises(TypeError, match="records must hold integer record indices"):
+        write_pvd(Results.load(saved), None, tmp_path / "run.pvd", records=[record])
+    assert not (tmp_path / "run").exists()
+
+
+def test_snapshots_refuse_a_bool_record(saved):
+    from tapespring.plot.snapshots import _field_records
+
+    results = Results.load(saved)
+    with pytest.raises(TypeError, match="records_or_times must hold records or times"):
+        _field_records(results, [True])
+    assert _field_records(results, [1, np.int64(-1), 0.5]) == [1, 2, 1]
+
+
 # --- Settings: integers beyond the floats, a spec of the wrong type --------------------------
 
 

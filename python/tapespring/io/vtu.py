@@ -21,6 +21,7 @@ with ``records=`` chosen within steps whose time increases.
 
 from __future__ import annotations
 
+import numbers
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
@@ -115,6 +116,8 @@ def write_pvd(
     ------
     ImportError
         If meshio is not installed.
+    TypeError
+        If a record is not an integer (``1.5`` is refused, not truncated; so is ``True``).
     ValueError
         If no field was recorded, a record's fields were not kept, or the model does not match.
     """
@@ -134,6 +137,10 @@ def write_pvd(
     if records is None:
         chosen = [int(r) for r in kept]
     else:
+        for r in records:
+            if isinstance(r, bool | np.bool_) or not isinstance(r, numbers.Integral):
+                # int(1.5) would write the fields of record 1.
+                raise TypeError(f"records must hold integer record indices (got {r!r})")
         n = results.n_records
         outside = [int(r) for r in records if not -n <= int(r) < n]
         if outside:

@@ -61,6 +61,8 @@ def plot_snapshots(
 
     Raises
     ------
+    TypeError
+        If an item of `records_or_times` is a bool.
     ValueError
         If `view` is not two distinct axes, no snapshot is asked for, or a record's fields were
         not kept.
@@ -131,6 +133,9 @@ def _field_records(results: Results, records_or_times: Sequence[int | float]) ->
         )
     out = []
     for item in records_or_times:
+        if isinstance(item, bool | np.bool_):
+            # An Integral: True would draw record 1.
+            raise TypeError(f"records_or_times must hold records or times, got {item!r}")
         if isinstance(item, Integral):
             n = results.n_records
             if not -n <= int(item) < n:
