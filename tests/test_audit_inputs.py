@@ -385,6 +385,12 @@ def test_steps_that_are_not_steps_are_named(steps, message):
         run(_loaded_plate(), steps)
 
 
+@pytest.mark.parametrize("name", [None, 5, b"static"])
+def test_a_step_name_that_is_not_a_str_is_a_type_error(name):
+    with pytest.raises(TypeError, match="name must be a str"):
+        Step(name)
+
+
 def test_raise_on_error_must_be_a_bool():
     with pytest.raises(TypeError, match="raise_on_error must be True or False"):
         run(_loaded_plate(), [Step.static(increments=2)], raise_on_error="no")

@@ -206,6 +206,9 @@ class Step:
     options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            # The core refuses other types, but takes None for a missing name ("").
+            raise TypeError(f"name must be a str, got {self.name!r}")
         # Also for a Step built directly: a string given as ids would be split into letters.
         object.__setattr__(self, "activate", _ids(self.activate))
         object.__setattr__(self, "deactivate", _ids(self.deactivate))
