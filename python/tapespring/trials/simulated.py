@@ -262,9 +262,13 @@ def _node_index(node: object) -> int:
     truncated to node 1)."""
     if isinstance(node, bool | np.bool_) or not isinstance(node, numbers.Real):
         raise ValueError(f"force_nodes must hold node indices (got {node!r})")
-    if not (math.isfinite(node) and float(node).is_integer() and node >= 0):
+    try:
+        value = float(node)
+    except OverflowError:  # an int beyond floats, e.g. 10**400
+        value = math.inf
+    if not (math.isfinite(value) and value.is_integer() and value >= 0):
         raise ValueError(f"force_nodes must hold integer node indices >= 0 (got {node!r})")
-    return int(node)
+    return int(value)
 
 
 def _origin(origin: ArrayLike) -> NDArray[np.float64]:
