@@ -109,8 +109,10 @@ def dynamic_step_options() -> dict[str, Any]:
     ``max_step``, ``min_step`` [s] (0: ``duration/1000``, ``duration/20`` or the fixed step,
     ``1e-12 duration``);
     ``adaptive`` (time steps from the local error estimate); ``tolerance`` [m] (local error per
-    step; 0: 1e-5 times the model's characteristic length); ``output_interval`` [s] (steps land on
-    its multiples; 0: none); ``max_steps``; ``max_cutbacks``; ``viscous_tangent`` (the exact
+    step; 0: 1e-5 times the model's characteristic length); ``energy_tolerance`` (the largest
+    remainder of the energy balance a step may leave, relative to the largest kinetic plus strain
+    energy so far; 0, the default: off; see docs/dynamics.md); ``output_interval`` [s] (steps
+    land on its multiples; 0: none); ``max_steps``; ``max_cutbacks``; ``viscous_tangent`` (the exact
     Kelvin-Voigt tangent: quadratic Newton when eta > 0, but a non-symmetric iteration matrix;
     off by default, see docs/dynamics.md); ``reuse_factorisation`` (modified Newton: a factorised
     iteration matrix kept while the residual contracts fast, on by default, see docs/dynamics.md);
