@@ -406,6 +406,31 @@ def test_equal_sense_path_does_not_step_over_an_instability():
     assert result.stable[result.jump].all()
 
 
+def test_a_thin_soft_tape_passes_the_nearly_singular_point_of_its_equal_sense_path():
+    # The max-mass grid's corner t = 0.12 mm, E = 100 GPa, equal sense on 2 mm (its
+    # bending_setup, here with the CLI's --no-switch-branches): beside a point of the path near
+    # -52.7 deg the tangent is nearly singular, the arc-length sphere has no real root from the
+    # corrections, and cutting the increment back only crept towards that point (963 rejections,
+    # increments of 1e-9 in the load factor, the 1000-step limit at -52.7 deg) after the single
+    # tape's factorisation was split in two; the whole one had passed it by the round-off's luck.
+    # Now the corrections fall back to the plane normal to the increment. Measured: -90 deg in
+    # 191 states, M* = -0.0132 N m, 2.5 % from (1 - nu) D alpha (the whole factorisation's
+    # figure); 12 s.
+    setup = BendingSetup(
+        thickness=0.12e-3,
+        youngs_modulus=1e11,
+        theta_max_deg=-90.0,
+        imperfection_deg=0.1,
+        jump=True,
+        switch_branches=False,
+    )
+    result = bend(setup)
+    assert result.error is None
+    assert result.theta_deg[-1] == pytest.approx(-90.0)
+    s = summarize(result)
+    assert s.m_star == pytest.approx(s.m_star_analytical, rel=0.05)
+
+
 def test_perfect_tape_bifurcates_in_equal_sense_and_follows_the_stable_branch():
     # The perfect tape's symmetric path loses its stability at a bifurcation (measured on 2 mm:
     # -3.33 deg, M = -0.152 N m) while the angle keeps growing, and goes on unstable (the peak of

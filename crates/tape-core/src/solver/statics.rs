@@ -393,10 +393,21 @@ impl Driver<'_> {
                     let disc = b * b - 4.0 * a * c;
                     if disc < 0.0 {
                         no_root += 1;
-                        if no_root > 2 {
-                            return Err(Rejection::NoArcRoot);
+                        if no_root <= 2 {
+                            -b / (2.0 * a)
+                        } else {
+                            // The sphere is out of reach from here (a nearly singular tangent,
+                            // whose corrections are long in its null direction, beside a
+                            // bifurcation the path passes): the plane normal to the increment so
+                            // far, at its own end, always cuts the correction's line unless it is
+                            // parallel to it. Cutting the increment back only crept towards the
+                            // singular point, the increments shrinking to nothing.
+                            let den = self.dot_w(&dq_b, &acc) + acc_lambda * self.c_lambda;
+                            if den.abs() < 1e-300 {
+                                return Err(Rejection::NoArcRoot);
+                            }
+                            -(self.dot_w(&dq_r, &acc)) / den
                         }
-                        -b / (2.0 * a)
                     } else {
                         let sq = disc.sqrt();
                         let roots = [(-b + sq) / (2.0 * a), (-b - sq) / (2.0 * a)];
