@@ -361,6 +361,9 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert code == 0
     out = json.loads(capsys.readouterr().out)
     assert out["marker_displacements_m"]["marker3_dz_m"] == pytest.approx(result.marker3_m[2])
+    # Relative figures carry no unit suffix (they were "differences" keyed "..._m").
+    rel = out["relative_to_paper_model"]["marker3_dz_relative"]
+    assert rel == pytest.approx(result.marker3_m[2] / p.marker3_dz - 1.0)
 
 
 def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:

@@ -297,7 +297,9 @@ class EquilibriumResult:
         )
 
     def summary(self) -> dict[str, Any]:
-        """The figures as JSON-ready values [m, N, s], with Table 6 beside them and the
+        """The figures as JSON-ready values [m, N, s], with Table 6 beside them
+        (``paper_model_marker_displacements_m``) and our figures relative to it
+        (``relative_to_paper_model``: ``markers12_dx_relative`` ... = ours / paper - 1), and the
         comparison with a recording (``comparison``: :meth:`EquilibriumComparison.summary`, or
         None)."""
         paper = _paper_table6()
@@ -308,7 +310,12 @@ class EquilibriumResult:
             "found": self.found,
             "marker_displacements_m": ours,
             "paper_model_marker_displacements_m": paper,
-            "differences": {k: ours[k] / paper[k] - 1.0 for k in ours} if self.found else None,
+            # Relative (ours / paper - 1): named without the figures' unit suffix.
+            "relative_to_paper_model": (
+                {k.removesuffix("_m") + "_relative": ours[k] / paper[k] - 1.0 for k in ours}
+                if self.found
+                else None
+            ),
             "unstable_modes": self.unstable_modes,
             "push_m": self.push_m.tolist(),
             "force_N": self.force_N.tolist(),
@@ -332,7 +339,7 @@ class EquilibriumResult:
         ours, paper, diff = (
             s["marker_displacements_m"],
             s["paper_model_marker_displacements_m"],
-            s["differences"],
+            s["relative_to_paper_model"],
         )
         for key, label in (
             ("markers12_dx_m", "markers 1-2 x"),
@@ -342,7 +349,7 @@ class EquilibriumResult:
         ):
             lines.append(
                 f"  {label}: {ours[key] * 1e3:6.1f} mm (Table 6: {paper[key] * 1e3:6.1f} mm, "
-                f"{diff[key]:+.1%})"
+                f"{diff[key.removesuffix('_m') + '_relative']:+.1%})"
             )
         stable = "stable" if self.unstable_modes == 0 else f"{self.unstable_modes} unstable mode(s)"
         lines.append(f"  the equilibrium under the weight: {stable}")
