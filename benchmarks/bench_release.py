@@ -2,7 +2,8 @@
 
 Usage::
 
-    python benchmarks/bench_release.py [--mesh 2e-3] [--duration 1.0] [--eta 0] [--quick]
+    python benchmarks/bench_release.py [--mesh 2e-3] [--duration 1.0] [--eta 0]
+        [--energy-tolerance 0] [--quick]
 
 Prints, for the fold (static) and the free motion (dynamic) steps: steps, rejected steps, Newton
 iterations, factorisations, assembly and solve times, wall time, and for the dynamic step the
@@ -28,6 +29,7 @@ def main() -> None:
     ap.add_argument("--eta", type=float, default=0.0, help="Kelvin-Voigt eta [s]")
     ap.add_argument("--rho-inf", type=float, default=0.7)
     ap.add_argument("--tolerance", type=float, default=ReleaseSetup().tolerance)
+    ap.add_argument("--energy-tolerance", type=float, default=ReleaseSetup().energy_tolerance)
     ap.add_argument("--quick", action="store_true", help="50 ms on the 4 mm mesh")
     args = ap.parse_args()
     mesh, duration = (4e-3, 0.05) if args.quick else (args.mesh, args.duration)
@@ -37,6 +39,7 @@ def main() -> None:
         eta=args.eta,
         rho_inf=args.rho_inf,
         tolerance=args.tolerance,
+        energy_tolerance=args.energy_tolerance,
     )
     result = release(setup, progress=True)
     r = result.results
@@ -73,6 +76,12 @@ def main() -> None:
         if values.size:
             q50, q90 = np.percentile(values, [50, 90])
             print(f"per step, {name}: median {q50:.3g}, 90 % {q90:.3g}, max {values.max():.3g}")
+    e = result.energy
+    stored = e["strain"][0]
+    print(
+        f"energy balance: the scheme's share {e['numerical'][-1] / stored:+.2%} of the "
+        f"{stored * 1e3:.1f} mJ stored, the material's {e['viscous'][-1] / stored:.2%}"
+    )
     print(result.describe())
 
 
