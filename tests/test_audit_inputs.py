@@ -421,8 +421,8 @@ def test_a_reaction_dof_in_upper_case_is_the_model_s_dof():
 # --- Results accessors and results_to_trial -----------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def dynamic_results():
+def _steel_strip() -> tuple[Model, tuple]:
+    """A 200 x 20 x 2 mm steel strip, 4 x 1 elements, clamped at x = 0; and its mesh."""
     mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
     model = Model(
         *mesh[:2],
@@ -433,6 +433,12 @@ def dynamic_results():
         density=7800.0,
     )
     model.fix("x0")
+    return model, mesh
+
+
+@pytest.fixture(scope="module")
+def dynamic_results():
+    model, mesh = _steel_strip()
     model.add_marker("tip", int(mesh[2]["x1"][0]))
     model.set_gravity([0.0, 0.0, -9.81])
     results = run(
@@ -486,17 +492,7 @@ def test_results_to_trial_still_gives_a_plate(dynamic_results):
 def matrices():
     from tapespring.analysis import system_matrices
 
-    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
-    model = Model(
-        *mesh[:2],
-        node_sets=mesh[2],
-        thickness=2e-3,
-        youngs_modulus=2e11,
-        poisson=0.0,
-        density=7800.0,
-    )
-    model.fix("x0")
-    return system_matrices(model)
+    return system_matrices(_steel_strip()[0])
 
 
 @pytest.mark.parametrize(
