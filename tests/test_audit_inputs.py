@@ -168,6 +168,10 @@ def test_snapshots_refuse_a_bool_record(saved):
     with pytest.raises(TypeError, match="records_or_times must hold records or times"):
         _field_records(results, [True])
     assert _field_records(results, [1, np.int64(-1), 0.5]) == [1, 2, 1]
+    # A NaN time drew the first field record (argmin of NaN distances).
+    for t in (float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="a time must be finite"):
+            _field_records(results, [t])
 
 
 # --- Settings: integers beyond the floats, a spec of the wrong type --------------------------

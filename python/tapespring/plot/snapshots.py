@@ -146,6 +146,10 @@ def _field_records(results: Results, records_or_times: Sequence[int | float]) ->
                     f"the fields of record {r} were not kept (field records: {kept.tolist()})"
                 )
         else:
-            r = int(kept[np.argmin(np.abs(results.t[kept] - float(item)))])
+            t = float(item)
+            if not np.isfinite(t):
+                # argmin over NaN distances would pick the first field record.
+                raise ValueError(f"records_or_times: a time must be finite (got {item!r})")
+            r = int(kept[np.argmin(np.abs(results.t[kept] - t))])
         out.append(r)
     return out
