@@ -7,7 +7,11 @@
 //! `K dq_b = b` (one factorisation, two solves) and sets `dq = dq_r + dlambda dq_b`, where `dlambda`
 //! comes from the control equation: zero (load control), the controlled DOF fixed (displacement
 //! control, Batoz & Dhatt 1979), or the arc-length constraint `|Dq|_W^2 + Dlambda^2 c = Ds^2`
-//! (Crisfield 1981), whose root is chosen at the smallest angle with the predictor. The first
+//! (Crisfield 1981), whose root is chosen at the smallest angle with the predictor; where it has
+//! no real root, the correction takes the quadratic's closest approach twice, then keeps to the
+//! plane normal to the increment so far (Ramm 1981), which a correction from a nearly singular
+//! tangent always cuts, where cutting the increment back only crept towards the singular point.
+//! The first
 //! predictor follows the tangent in the requested direction; later ones follow the tangent at the
 //! converged state (when its factorisation is at hand from the stability count) oriented like the
 //! previous increment (Feng et al. 1996), or else, and always after a cut-back, extrapolate the
