@@ -346,3 +346,18 @@ def test_a_deployment_stopped_in_its_fold_reports_no_motion(monkeypatch) -> None
     assert partial.time_s.size == 0
     with pytest.raises(ValueError, match=r"no record belongs to steps \[2\]"):
         partial.to_trial()
+
+
+def test_the_energy_tolerance_reaches_the_motion_step(capsys) -> None:
+    # DeploymentSettings.energy_tolerance (its effect: docs/scenarios.md; the solver's option:
+    # crates/tape-core/tests/free_flight.rs) is the motion's step option, saved with the run.
+    sim = deploy(DeploymentSettings(spec=COARSE, duration=0.05, energy_tolerance=1e-4))
+    steps = sim.results.settings["steps"]
+    assert steps[-1]["energy_tolerance"] == 1e-4
+    assert all(s.get("energy_tolerance", 0.0) == 0.0 for s in steps[:-1])
+    assert sim.summary()["settings"]["energy_tolerance"] == 1e-4
+    with pytest.raises(ValueError, match=r"energy_tolerance must lie in \[0, 0.01\]"):
+        DeploymentSettings(energy_tolerance=0.5).validate()
+    assert "energy_tolerance must lie in [0, 0.01]" in refused(
+        ["deploy", "--energy-tolerance", "0.5"], capsys
+    )

@@ -14,6 +14,7 @@ from .bend import (
     refuse,
 )
 from .scenario_options import (
+    add_energy_tolerance_option,
     add_output_options,
     add_rho_inf_option,
     add_sample_rate_option,
@@ -87,6 +88,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_rho_inf_option(p, d.rho_inf)
     add_tolerance_option(p, d.tolerance)
+    add_energy_tolerance_option(p, d.energy_tolerance)
     p.add_argument(
         "--experiment",
         type=_input_file,
@@ -156,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
         duration=args.duration,
         rho_inf=args.rho_inf,
         tolerance=args.tolerance,
+        energy_tolerance=args.energy_tolerance,
         field_interval=16 if (args.vtu or args.snapshots) else 0,
     )
     settings.validate()  # before a recording is read (main prints a ValueError, exit 2)

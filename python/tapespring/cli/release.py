@@ -16,6 +16,7 @@ from typing import Any
 
 from .bend import _checked, _image_file, _output_file, add_tape_options, tape_fields
 from .scenario_options import (
+    add_energy_tolerance_option,
     add_eta_option,
     add_json_and_progress_options,
     add_rho_inf_option,
@@ -49,12 +50,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         check_tip_inertia,
         check_tip_mass,
     )
-    from tapespring.scenarios.setup import (
-        MAX_DURATION,
-        MAX_ENERGY_TOLERANCE,
-        MAX_GRAVITY,
-        check_energy_tolerance,
-    )
+    from tapespring.scenarios.setup import MAX_DURATION, MAX_GRAVITY
 
     d = ReleaseSetup()
     p = sub.add_parser(
@@ -109,14 +105,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="after the release, keep the free end in the x-z plane (held in y, about x and z)",
     )
     add_tolerance_option(p, d.tolerance)
-    p.add_argument(
-        "--energy-tolerance",
-        type=_checked("energy_tolerance", check_energy_tolerance),
-        default=d.energy_tolerance,
-        help=f"largest remainder of the energy balance per time step, relative to the largest "
-        f"kinetic plus strain energy so far, in [0, {MAX_ENERGY_TOLERANCE:g}] (default 0: off; "
-        "with --eta, 3e-5 closes the balance to about 0.3 %%)",
-    )
+    add_energy_tolerance_option(p, d.energy_tolerance)
     add_tape_options(p, d.tape)
     p.add_argument(
         "--csv",

@@ -220,6 +220,21 @@ def add_tolerance_option(
     )
 
 
+def add_energy_tolerance_option(p: argparse._ActionsContainer, default: float) -> None:
+    """Add ``--energy-tolerance``, the largest remainder of the energy balance a time step may
+    leave, relative to the largest kinetic plus strain energy so far (0: off)."""
+    from tapespring.scenarios.setup import MAX_ENERGY_TOLERANCE, check_energy_tolerance
+
+    p.add_argument(
+        "--energy-tolerance",
+        type=_checked("energy_tolerance", check_energy_tolerance),
+        default=default,
+        help="largest remainder of the energy balance per time step (the scheme's dissipation), "
+        "relative to the largest kinetic plus strain energy so far, in "
+        f"[0, {MAX_ENERGY_TOLERANCE:g}] (default {default:g}; 0: off; see docs/dynamics.md)",
+    )
+
+
 def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
     """The :class:`SetupSpec` of the parsed options: the dedicated ones and `fields` (a
     command's own options, such as deploy's ``support``), then ``--spec``'s assignments."""

@@ -1598,9 +1598,12 @@ def check_sampling(duration: tuple[str, float], *, sample_rate: float, rate_name
         )
 
 
-def dynamic_options(rho_inf: float, sample_rate: float, tolerance: float) -> dict[str, Any]:
+def dynamic_options(
+    rho_inf: float, sample_rate: float, tolerance: float, energy_tolerance: float = 0.0
+) -> dict[str, Any]:
     """Options of a dynamic step of the set-up: steps landing on the samples at `sample_rate`
-    [Hz], the first and the largest one sample long; `tolerance` [m] (0: the solver's default).
+    [Hz], the first and the largest one sample long; `tolerance` [m] (0: the solver's default);
+    `energy_tolerance` (0: off).
 
     Newton's iteration matrix takes the geometric stresses of the iterate itself
     (``mixed_stress=False``), not the solver's default mixed-stress linearisation: on the set-up,
@@ -1624,6 +1627,8 @@ def dynamic_options(rho_inf: float, sample_rate: float, tolerance: float) -> dic
     }
     if tolerance > 0.0:
         options["tolerance"] = tolerance
+    if energy_tolerance > 0.0:
+        options["energy_tolerance"] = energy_tolerance
     return options
 
 
