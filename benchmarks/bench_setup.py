@@ -149,6 +149,12 @@ def main() -> None:
         help="free decay [s]",
     )
     p.add_argument("--only", choices=("deploy", "pull", "vibrate"), nargs="*")
+    p.add_argument(
+        "--energy-tolerance",
+        type=float,
+        default=DeploymentSettings.energy_tolerance,
+        help="the deployments' energy tolerance (0: off, the default)",
+    )
     args = p.parse_args()
     only = set(args.only or ("deploy", "pull", "vibrate"))
     if args.quick:
@@ -166,7 +172,12 @@ def main() -> None:
     if "deploy" in only:
         runs = {}
         for sense in ("opposite", "equal"):
-            settings = DeploymentSettings(spec=deploy_spec, sense=sense, duration=args.duration)
+            settings = DeploymentSettings(
+                spec=deploy_spec,
+                sense=sense,
+                duration=args.duration,
+                energy_tolerance=args.energy_tolerance,
+            )
             runs[sense] = deploy(settings)
             line(f"deploy {sense}", runs[sense], args.duration)
         if args.quick:
