@@ -94,7 +94,7 @@ def test_static_scenarios_take_no_viscosity(command, capsys):
         (["deploy", "--sample-rate", "1e7"], "sample_rate must be at most 1e+06 Hz"),
         (["vibrate", "--time-step", "1e-7"], "0 (adaptive steps) or at least 1e-06 s (got 1e-07 s"),
         (["max-mass", "--modulus-range", "1e11", "1e300"], "youngs_modulus must be at most 1e+13"),
-        (["max-mass", "--angle", "200"], "angle_deg must lie in (0, 180) degrees"),
+        (["max-mass", "--angle", "200"], "angle_deg must lie in [1e-06, 180) degrees"),
     ],
 )
 def test_absurd_values_are_refused_by_the_parser_in_short_numbers(argv, message, capsys):

@@ -335,8 +335,11 @@ def test_contour_plot_draws_both_fields(opposite, equal):
         ({"senses": ()}, "senses must name at least one"),
         ({"mesh_size": 0.0}, "mesh_size"),
         ({"mesh_size": 0.01}, "too coarse"),
-        ({"angle_deg": 0.0}, r"angle_deg must lie in \(0, 180\)"),
-        ({"angle_deg": 200.0}, r"angle_deg must lie in \(0, 180\)"),
+        ({"angle_deg": 0.0}, r"angle_deg must lie in \[1e-06, 180\)"),
+        ({"angle_deg": 200.0}, r"angle_deg must lie in \[1e-06, 180\)"),
+        # Below the bending run's smallest rotation: refused as angle_deg, not as the run's
+        # theta_max_deg (found by the settings' property test).
+        ({"angle_deg": 1e-291}, r"angle_deg must lie in \[1e-06, 180\)"),
         ({"gravity": -9.81}, r"gravity must lie in \[0.1, 100\] m/s\^2 \(got -9.81"),
         ({"gravity": float("nan")}, "gravity must be finite"),
         # Physical ranges (GRAVITY_RANGE, LEVER_ARM_RANGE): outside them m_max was printed in
@@ -445,8 +448,8 @@ def test_cli_refuses_a_range_beside_a_single_value(values, capsys):
         ("--gravity", "g", "gravity must be a number (got 'g')"),
         ("--lever-arm", "1e-300", "lever_arm must lie in [0.001, 10] m (got 1e-300"),
         ("--lever-arm", "nan", "lever_arm must be finite (got nan)"),
-        ("--angle", "200", "angle_deg must lie in (0, 180) degrees"),
-        ("--angle", "0", "angle_deg must lie in (0, 180) degrees"),
+        ("--angle", "200", "angle_deg must lie in [1e-06, 180) degrees"),
+        ("--angle", "0", "angle_deg must lie in [1e-06, 180) degrees"),
         ("--modulus-range", "1e300", "youngs_modulus must be at most 1e+13 Pa"),
     ],
 )

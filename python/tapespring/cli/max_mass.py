@@ -120,7 +120,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--angle",
         type=_checked("angle", check_angle_deg),
         default=90.0,
-        help="fold angle at which M* is taken [deg], in (0, 180) (default 90)",
+        help="fold angle at which M* is taken [deg], in [1e-6, 180) (default 90)",
     )
     (l_lo, l_hi), (g_lo, g_hi) = LEVER_ARM_RANGE, GRAVITY_RANGE
     p.add_argument(

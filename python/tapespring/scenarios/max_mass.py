@@ -46,6 +46,7 @@ from tapespring.report import jsonable, jsonable_tree
 from tapespring.scenarios.bending import BendingSetup, analytical_residual_moment
 from tapespring.scenarios.setup import (
     MAX_GRAVITY,
+    MIN_ROTATION_DEG,
     PAPER_BOUNDS,
     PAPER_SETUP,
     PAPER_TAPE,
@@ -100,10 +101,11 @@ LEVER_ARM_RANGE = (1e-3, 10.0)
 
 def check_angle_deg(value: object) -> None:
     """Raise ValueError unless `value` is the fold angle at which M* is taken [deg]: a number in
-    (0, 180), the magnitude of the angle in either sense."""
+    [:data:`~tapespring.scenarios.setup.MIN_ROTATION_DEG`, 180), the magnitude of the angle in
+    either sense (below that bound the bending run refused it, naming its theta_max_deg)."""
     check_bounded(
-        "angle_deg", value, low=0.0, high=180.0, low_open=True, high_open=True, unit="degrees",
-        why="the magnitude of the fold angle", note="the paper's is 90",
+        "angle_deg", value, low=MIN_ROTATION_DEG, high=180.0, high_open=True, unit="degrees",
+        why="the magnitude of the fold angle", note="the paper's is 90; see setup.MIN_ROTATION_DEG",
     )  # fmt: skip
 
 
