@@ -340,6 +340,9 @@ def test_contour_plot_draws_both_fields(opposite, equal):
         # Below the bending run's smallest rotation: refused as angle_deg, not as the run's
         # theta_max_deg (found by the settings' property test).
         ({"angle_deg": 1e-291}, r"angle_deg must lie in \[1e-06, 180\)"),
+        # A grid value that only a point's bending run refuses: named as the grid's point.
+        ({"youngs_moduli": (1.0, 2.0)}, r"grid point thicknesses = .*youngs_moduli = 1 Pa"),
+        ({"thicknesses": (1.0, 2.0)}, r"grid point thicknesses = 1 m.*not thin"),
         ({"gravity": -9.81}, r"gravity must lie in \[0.1, 100\] m/s\^2 \(got -9.81"),
         ({"gravity": float("nan")}, "gravity must be finite"),
         # Physical ranges (GRAVITY_RANGE, LEVER_ARM_RANGE): outside them m_max was printed in

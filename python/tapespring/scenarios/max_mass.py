@@ -320,10 +320,18 @@ class MaxMassSettings:
         # density, as the set-up's (0: massless tapes).
         check_density(self.tape.density, "tape.density", zero=True)
         # Geometry, material and mesh of every run, checked before the first one starts.
+        # Named as the grid's point: the run's own message names its single thickness and
+        # modulus, which are no field of these settings.
         for s in self.senses:
             for t in self.thicknesses:
                 for e in self.youngs_moduli:
-                    self.bending_setup(s, t, e).validate()
+                    try:
+                        self.bending_setup(s, t, e).validate()
+                    except ValueError as exc:
+                        raise ValueError(
+                            f"the grid point thicknesses = {t:g} m, youngs_moduli = {e:g} Pa "
+                            f"({s} sense): {exc}"
+                        ) from None
 
 
 def analytical_max_mass(
