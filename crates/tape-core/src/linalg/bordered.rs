@@ -697,8 +697,7 @@ impl Bordered {
             .enumerate()
             .map(|(b, bin)| {
                 let (m, s) = bin.fill(values, shifts, if b == 0 { 1.0 } else { -1.0 });
-                let ok = bin.factorize();
-                (m, s, ok)
+                (m, s, bin.factorize())
             })
             .collect();
         let max_bits = results.iter().map(|r| r.0).max().unwrap_or(0);

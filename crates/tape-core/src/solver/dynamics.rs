@@ -1096,7 +1096,7 @@ pub fn solve_dynamic(
     path.start_probes = integ.system.probe(&integ.asm);
     let mut last = Energies::of(&integ, state);
     let mut last_work = integ.system.viscous_work().to_vec();
-    let mech0 = last.kinetic + last.strain + last.gravity;
+    let mech0 = last.mechanical();
     // The energy in motion that `energy_tolerance` is relative to.
     let mut energy_scale = last.kinetic + last.strain;
 
@@ -1199,17 +1199,11 @@ pub fn solve_dynamic(
                 // Next size from both estimates: the local error is third order in h, the energy
                 // remainder taken as `ENERGY_ERROR_ORDER`.
                 let grow = |e: f64, order: f64| 0.9 * e.max(1e-10).powf(-1.0 / order);
-                let factor = if params.adaptive {
-                    grow(error, 3.0)
-                        .min(if params.energy_tolerance > 0.0 {
-                            grow(energy_error, ENERGY_ERROR_ORDER).min(ENERGY_GROWTH)
-                        } else {
-                            f64::INFINITY
-                        })
-                        .clamp(0.2, 2.0)
-                } else {
-                    2.0
-                };
+                let mut factor = grow(error, 3.0);
+                if params.energy_tolerance > 0.0 {
+                    factor = factor.min(grow(energy_error, ENERGY_ERROR_ORDER).min(ENERGY_GROWTH));
+                }
+                let factor = if params.adaptive { factor.clamp(0.2, 2.0) } else { 2.0 };
                 let by_energy = energy_error > error;
                 let error = error.max(energy_error);
                 let ok = !params.adaptive || error <= 1.0;
@@ -1296,9 +1290,7 @@ pub fn solve_dynamic(
         last_work.copy_from_slice(integ.system.viscous_work());
         let now = step.now;
         balance.kinetic = now.kinetic;
-        balance.numerical = balance.work_loads + balance.work_prescribed
-            - balance.viscous
-            - (now.kinetic + now.strain + now.gravity - mech0);
+        balance.numerical = balance.work_loads + balance.work_prescribed - balance.viscous - (now.mechanical() - mech0);
         energy_scale = energy_scale.max(now.kinetic + now.strain);
         let asm = &integ.asm;
         std::mem::swap(state, &mut scratch);
@@ -1377,10 +1369,7 @@ impl StepEnergy {
     /// The step's remainder of the balance: work in, minus the viscous dissipation and the change
     /// of kinetic, strain and gravity energy from `last` \[J\].
     fn remainder(&self, last: &Energies) -> f64 {
-        let now = &self.now;
-        self.work_loads + self.work_prescribed
-            - self.viscous
-            - (now.kinetic + now.strain + now.gravity - (last.kinetic + last.strain + last.gravity))
+        self.work_loads + self.work_prescribed - self.viscous - (self.now.mechanical() - last.mechanical())
     }
 }
 
@@ -1398,6 +1387,11 @@ struct Energies {
 }
 
 impl Energies {
+    /// Kinetic, strain and gravity energy \[J\].
+    fn mechanical(&self) -> f64 {
+        self.kinetic + self.strain + self.gravity
+    }
+
     fn of(integ: &Integrator, state: &State) -> Self {
         let asm = &integ.asm;
         Self {

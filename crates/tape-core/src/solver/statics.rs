@@ -290,6 +290,25 @@ impl Driver<'_> {
         self.dot_w(a.0, b.0) + a.1 * b.1 * self.c_lambda
     }
 
+    /// The load factor's correction `dl` that keeps the increment `acc` plus the correction
+    /// `dq_r + dl dq_b` on the plane orthogonal to `chord` through `fraction` of it:
+    /// `(acc - fraction c + dq_r + dl dq_b) . c = 0` (arc-length norm, load factor included).
+    fn plane_correction(
+        &self,
+        acc: (&[f64], f64),
+        dq_r: &[f64],
+        dq_b: &[f64],
+        chord: (&[f64], f64),
+        fraction: f64,
+    ) -> std::result::Result<f64, Rejection> {
+        let num = fraction * self.arc_dot(chord, chord) - self.arc_dot(acc, chord) - self.dot_w(dq_r, chord.0);
+        let den = self.arc_dot((dq_b, 1.0), chord);
+        if den.abs() < 1e-300 {
+            return Err(Rejection::NoArcRoot);
+        }
+        Ok(num / den)
+    }
+
     /// One increment from the converged `state`; on rejection the state is left modified.
     #[allow(clippy::too_many_lines)]
     pub fn increment(&mut self, state: &mut State, inc: &Increment) -> std::result::Result<Outcome, Rejection> {
@@ -406,11 +425,7 @@ impl Driver<'_> {
                             // far, at its own end, always cuts the correction's line unless it is
                             // parallel to it. Cutting the increment back only crept towards the
                             // singular point, the increments shrinking to nothing.
-                            let den = self.dot_w(&dq_b, &acc) + acc_lambda * self.c_lambda;
-                            if den.abs() < 1e-300 {
-                                return Err(Rejection::NoArcRoot);
-                            }
-                            -(self.dot_w(&dq_r, &acc)) / den
+                            self.plane_correction((&acc, acc_lambda), &dq_r, &dq_b, (&acc, acc_lambda), 1.0)?
                         }
                     } else {
                         let sq = disc.sqrt();
@@ -430,19 +445,7 @@ impl Driver<'_> {
                     chord,
                     chord_lambda,
                     fraction,
-                } => {
-                    // The corrections stay orthogonal to the chord:
-                    // (acc - fraction c + dq_r + dl dq_b) . c = 0.
-                    let c2 = self.arc_dot((chord, *chord_lambda), (chord, *chord_lambda));
-                    let num = fraction * c2
-                        - self.arc_dot((&acc, acc_lambda), (chord, *chord_lambda))
-                        - self.dot_w(&dq_r, chord);
-                    let den = self.dot_w(&dq_b, chord) + chord_lambda * self.c_lambda;
-                    if den.abs() < 1e-300 {
-                        return Err(Rejection::NoArcRoot);
-                    }
-                    num / den
-                }
+                } => self.plane_correction((&acc, acc_lambda), &dq_r, &dq_b, (chord, *chord_lambda), *fraction)?,
             };
             let step: Vec<f64> = dq_r.iter().zip(&dq_b).map(|(r, b)| r + dl * b).collect();
             let e = self
