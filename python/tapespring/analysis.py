@@ -371,6 +371,16 @@ def _check_bool(name: str, value: object) -> None:
         raise TypeError(f"{name} must be True or False, not {type(value).__name__}: {value!r}")
 
 
+def _check_progress(progress: object, arguments: str) -> None:
+    """Raise TypeError unless `progress` is True, False, None or a callable taking
+    `arguments` (named in the message)."""
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(
+            f"progress must be True, False, None or a callable {arguments}, not "
+            f"{type(progress).__name__}"
+        )
+
+
 ProgressCallback = Callable[[int, str, float], "bool | None"]
 
 
@@ -444,11 +454,7 @@ def run(
     out = outputs.to_dict()
     # Checked here although the core checks its callback too: its message would name only
     # callables and None, not the True and False that this function takes.
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise TypeError(
-            "progress must be True, False, None or a callable (step, name, t), not "
-            f"{type(progress).__name__}"
-        )
+    _check_progress(progress, "(step, name, t)")
     try:
         if progress is True:
             from tqdm import tqdm

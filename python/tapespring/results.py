@@ -599,9 +599,17 @@ def _check_records(d: Mapping[str, Any]) -> None:
     # A run records converged states only: their times, residuals, energies, markers, reactions
     # and fields are finite (NaN marks what was not recorded: the cumulated energy terms and
     # costs of static records, the arrays older formats lack).
-    finite = ["t", "residual", "strain_energy", "gravity_energy", "marker_positions"]
-    finite += ["marker_rotations", "reactions", "displacements", "rotations"]
-    for key in finite:
+    for key in (
+        "t",
+        "residual",
+        "strain_energy",
+        "gravity_energy",
+        "marker_positions",
+        "marker_rotations",
+        "reactions",
+        "displacements",
+        "rotations",
+    ):
         if not np.all(np.isfinite(np.asarray(d[key], dtype=float))):
             raise ValueError(f"{key} holds non-finite values (a run records finite states only)")
     # Each record belongs to a step of the settings (the initial state to step 0).

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from tapespring import _core
 from tapespring._core import ConvergenceError, Model, TapeError
-from tapespring.analysis import DOFS, Outputs, Step, run
+from tapespring.analysis import DOFS, Outputs, Step, _check_bool, _check_progress, run
 from tapespring.results import Results
 
 __all__ = [
@@ -210,14 +210,9 @@ def solve_static(
     ConvergenceError
         If the path stopped early and `raise_on_error` is True.
     """
-    if not isinstance(record_fields, bool | np.bool_):
-        raise TypeError(f"record_fields must be True or False, not {record_fields!r}")
+    _check_bool("record_fields", record_fields)
     # Checked here: anything neither True nor callable was passed on as no callback at all.
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise TypeError(
-            "progress must be True, False, None or a callable (index, t), not "
-            f"{type(progress).__name__}"
-        )
+    _check_progress(progress, "(index, t)")
     step = Step.static("static", **options)
     outputs = Outputs(field_interval=1 if record_fields else 0)
     if progress is True:

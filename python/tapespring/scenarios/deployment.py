@@ -108,10 +108,8 @@ class DeploymentSettings:
         Largest remainder of the energy balance a time step may leave, relative to the largest
         kinetic plus strain energy so far (the dynamic step's ``energy_tolerance``), in [0,
         :data:`~tapespring.scenarios.setup.MAX_ENERGY_TOLERANCE`]; 0 (the default, the paper's
-        model with rho_inf's numerical damping): off. At 1e-4 the scheme's share of the
-        dissipation over the first second (paper's meshes) falls from 5.4e-3 J to 1.9e-4 J (the
-        material's 9.6e-2 J) in the same Newton iterations, and the first maximum moves from
-        62.1 to 61.7 deg (docs/dynamics.md).
+        model with rho_inf's numerical damping): off. It converges the peaks at the default's
+        cost (figures in docs/scenarios.md, after the tolerance's).
     n_peaks : int
         Maxima and minima of the bending angle reported (paper: 10), from 1 to the trial
         analysis's :data:`~tapespring.protocols.registry.MAX_N_PEAKS` (1000).

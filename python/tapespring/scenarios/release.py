@@ -161,10 +161,8 @@ class ReleaseSetup:
         Largest remainder of the energy balance a time step may leave, relative to the largest
         kinetic plus strain energy so far (the dynamic step's ``energy_tolerance``), in [0,
         :data:`~tapespring.scenarios.setup.MAX_ENERGY_TOLERANCE`]; 0 (the default): off. With
-        Kelvin-Voigt damping 3e-5 closes the energy balance to 0.3 % of the stored energy over
-        the first second (4.5 % without, 4 mm mesh; 6.7 % on 2 mm) for 18 % more Newton
-        iterations. Without damping it cannot: the snap's short waves are lost to the scheme
-        whatever the step (docs/dynamics.md).
+        Kelvin-Voigt damping it closes the energy balance within issue 8's 0.5 %; without, it
+        cannot (figures in docs/dynamics.md, "energy_tolerance").
     """
 
     tape: BendingSetup = BendingSetup()
