@@ -153,7 +153,7 @@ def main() -> None:
         "--energy-tolerance",
         type=float,
         default=DeploymentSettings.energy_tolerance,
-        help="the deployments' energy tolerance (0: off, the default)",
+        help="the deployments' energy tolerance (0: off; default: DeploymentSettings')",
     )
     args = p.parse_args()
     only = set(args.only or ("deploy", "pull", "vibrate"))

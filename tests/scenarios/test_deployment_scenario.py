@@ -15,7 +15,12 @@ import numpy as np
 import pytest
 from _cli import refused
 from tapespring.protocols import analyze_deployment
-from tapespring.scenarios.deployment import DeploymentSettings, DeploymentSimulation, deploy
+from tapespring.scenarios.deployment import (
+    DEFAULT_ENERGY_TOLERANCE,
+    DeploymentSettings,
+    DeploymentSimulation,
+    deploy,
+)
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.trials import TrialWarning
 
@@ -25,7 +30,7 @@ COARSE = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3)
 @pytest.fixture(scope="module")
 def opposite() -> DeploymentSimulation:
     # 0.9 s: two maxima (0.52 and 0.80 s) and three minima (0.27, 0.72 and 0.87 s) for the trial
-    # analysis to find (0.6 s had one of each); 5.3 s of wall time, as 0.6 s took.
+    # analysis to find (0.6 s had one of each); 5.8 s of wall time.
     return deploy(DeploymentSettings(spec=COARSE, sense="opposite", duration=0.9))
 
 
@@ -53,7 +58,7 @@ def test_swings_through_straight_and_peaks_near_half_a_second(
     first_max_t, first_max = peaks.maxima.time[0], np.degrees(peaks.maxima.value[0])
     assert first_min < -20.0 and first_max > 20.0
     assert first_min_t < first_max_t
-    # The paper's first maximum peak: near 0.5 s (Sec. 6.1); 0.52 s measured here.
+    # The paper's first maximum peak: near 0.5 s (Sec. 6.1); 0.51 s measured here.
     assert first_max_t == pytest.approx(PAPER_MODEL.first_max_peak_time_opposite, abs=0.1)
 
 
@@ -61,8 +66,8 @@ def test_clamp_force_peaks_when_the_angle_crosses_zero(opposite: DeploymentSimul
     # Sec. 6.1: a large peak of the clamp force each time the angle crosses zero in phases I and
     # II (the folds vanish and form again). At each crossing the force's largest deviation
     # within a quarter of a half-cycle is at least twice the largest in the rest of the flanking
-    # half-cycles (measured here: 2.7, 4.5 and 3.9, the third crossing's before phase III at
-    # 0.72 s; on the paper's meshes 3.5 to 7.3 in phases I-II).
+    # half-cycles (measured here: 2.6, 5.2 and 2.6, the third crossing's before phase III at
+    # 0.72 s; on the paper's meshes 3.5 to 7.0 in phases I-II).
     x = opposite.clamp_force_at_crossings()
     assert x.time.size >= 2
     assert np.all(x.ratio >= 2.0), x.ratio
@@ -361,3 +366,29 @@ def test_the_energy_tolerance_reaches_the_motion_step(capsys) -> None:
     assert "energy_tolerance must lie in [0, 0.01]" in refused(
         ["deploy", "--energy-tolerance", "0.5"], capsys
     )
+
+
+def test_the_default_energy_tolerance_converges_the_first_maximum(
+    opposite: DeploymentSimulation,
+) -> None:
+    # The displacement error estimate alone lets the steps grow through the snaps, where the
+    # scheme then dissipates energy the first swing lacks (docs/scenarios.md, "How far the
+    # default ..."); the default energy tolerance holds those steps. Reference: the displacement
+    # control converged, 1e-6 m without the energy control (+49.81 deg; 2.5e-7 m gives +49.72).
+    # Asked: the default within 1 % of that amplitude. Measured: +50.18 deg, 0.37 deg off;
+    # without the energy control +52.49 deg, 2.7 deg off.
+    assert opposite.settings.energy_tolerance == DEFAULT_ENERGY_TOLERANCE > 0.0
+
+    def first_max_deg(sim: DeploymentSimulation) -> float:
+        assert sim.peaks is not None
+        return float(np.degrees(sim.peaks.maxima.value[0]))
+
+    # 0.6 s holds the first maximum (0.51 s); a shorter run is the start of a longer one.
+    tight = deploy(
+        DeploymentSettings(spec=COARSE, duration=0.6, tolerance=1e-6, energy_tolerance=0.0)
+    )
+    off = deploy(DeploymentSettings(spec=COARSE, duration=0.6, energy_tolerance=0.0))
+    reference = first_max_deg(tight)
+    error = abs(first_max_deg(opposite) - reference)
+    assert error < 0.01 * reference
+    assert abs(first_max_deg(off) - reference) > 2.0 * error
