@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tapespring import Model, Outputs, Results, Step, run, shell
+from tapespring import Model, Outputs, Results, Step, run, shell, signals
 from tapespring.protocols import analyze_trials
 from tapespring.scenarios.bending import BendingSetup
 from tapespring.scenarios.deployment import DeploymentSettings
@@ -355,6 +355,35 @@ def test_complex_signals_are_refused_not_cast():
         summarize(np.array([1.0, 2.0 + 0j]))
 
 
+
+_T = np.linspace(0.0, 2.0, 801)
+_Y = np.cos(10 * np.pi * _T)
+_P = np.column_stack([np.cos(_T), np.sin(_T), 0.0 * _T])
+_Z = 1j * _P
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: signals.bending_angle(_P, _Z), "marker_2"),
+        (lambda: signals.fit_circle(_Z), "points"),
+        (lambda: signals.max_lateral_displacement(_Y * 1j), "lateral"),
+        (lambda: signals.force_at_crossings(_T, _Y, _Y * 1j), "force"),
+        (lambda: signals.to_frame(np.eye(3), _Z), "points"),
+        (lambda: signals.motion_plane(_Z, _P), "origin"),
+        (lambda: signals.fit_motion_frame(_P, _P, _Z), r"moving\[1\]"),
+        (lambda: signals.equilibrium_value(_T, _Y * 1j), "y"),
+        (lambda: signals.swing_midline(_Y * 1j, 0.1), "y"),
+        (lambda: signals.release_index(_Y * 1j, 0.1), "y"),
+        (lambda: signals.analyze_pull_test(_T * 1j, _Y), "displacement"),
+    ],
+)
+def test_every_signal_refuses_complex_input_by_name(call, name):
+    # np.asarray(..., dtype=float) drops the imaginary parts with a mere ComplexWarning.
+    with pytest.raises(TypeError, match=f"{name} must be real numbers"):
+        call()
+
+
 # --- max-mass: a grid too large to run is refused at once ------------------------------------
 
 
@@ -392,6 +421,13 @@ def test_steps_that_are_not_steps_are_named(steps, message):
 def test_a_step_name_that_is_not_a_str_is_a_type_error(name):
     with pytest.raises(TypeError, match="name must be a str"):
         Step(name)
+
+
+@pytest.mark.parametrize("name", [None, 5])
+def test_a_dict_steps_name_that_is_not_a_str_is_a_type_error(name):
+    # Step refuses it itself; a dict went to the core, which ran a None name unnamed.
+    with pytest.raises(TypeError, match=r"steps\[0\]\['name'\] must be a str"):
+        run(_loaded_plate(), [{"name": name, "kind": "static"}])
 
 
 def test_raise_on_error_must_be_a_bool():

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .smoothing import real_array
+
 __all__ = ["bending_angle"]
 
 
@@ -33,8 +35,8 @@ def bending_angle(marker_1: np.ndarray, marker_2: np.ndarray) -> np.ndarray:
         marker is missing). Subtract the deployed-equilibrium value
         (`equilibrium_value`) to get the paper's bending angle.
     """
-    p1 = np.asarray(marker_1, dtype=float)
-    p2 = np.asarray(marker_2, dtype=float)
+    p1 = real_array(marker_1, "marker_1")
+    p2 = real_array(marker_2, "marker_2")
     if p1.shape != p2.shape or p1.ndim != 2 or p1.shape[1] != 3:
         raise ValueError(f"markers must both have shape (n, 3), got {p1.shape} and {p2.shape}")
     d = p2 - p1

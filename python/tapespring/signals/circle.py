@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .smoothing import real_array
+
 __all__ = ["CircleFit", "fit_circle", "max_lateral_displacement"]
 
 
@@ -68,7 +70,7 @@ def fit_circle(points: np.ndarray) -> CircleFit:
     ValueError
         If fewer than 3 finite points are given or they are collinear.
     """
-    p = np.asarray(points, dtype=float)
+    p = real_array(points, "points")
     if p.ndim != 2 or p.shape[1] != 2:
         raise ValueError(f"points must have shape (k, 2), got {p.shape}")
     p = p[np.isfinite(p).all(axis=1)]
@@ -132,7 +134,7 @@ def max_lateral_displacement(lateral: np.ndarray, reference: float | None = None
     float
         ``max |lateral - reference|`` [m].
     """
-    y = np.asarray(lateral, dtype=float)
+    y = real_array(lateral, "lateral")
     finite = y[np.isfinite(y)]
     if finite.size == 0:
         raise ValueError("no finite lateral sample")

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .smoothing import real_array
+
 __all__ = ["CrossingPeaks", "force_at_crossings"]
 
 
@@ -120,7 +122,7 @@ def force_at_crossings(
         Arrays of different lengths or fewer than two samples, non-finite values, times not
         strictly increasing, `fraction` outside (0, 0.5], or `start` after `end`.
     """
-    t, a, f = (np.asarray(v, dtype=float) for v in (time, angle, force))
+    t, a, f = (real_array(v, n) for v, n in ((time, "time"), (angle, "angle"), (force, "force")))
     if t.ndim != 1 or t.shape != a.shape or t.shape != f.shape:
         raise ValueError(
             "time, angle and force must be 1-D arrays of one length, "

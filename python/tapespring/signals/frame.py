@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .smoothing import real_array
+
 __all__ = ["MotionPlane", "fit_motion_frame", "motion_plane", "parse_frame", "to_frame"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
@@ -93,7 +95,7 @@ def to_frame(frame: np.ndarray, points: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (n, 3)
     """
-    return np.asarray(points, dtype=float) @ np.asarray(frame, dtype=float).T
+    return real_array(points, "points") @ real_array(frame, "frame").T
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,8 @@ def motion_plane(origin: np.ndarray, *moving: np.ndarray) -> MotionPlane:
     """
     if not moving:
         raise ValueError("the plane of motion needs at least one moving marker")
-    p0 = np.asarray(origin, dtype=float)
-    clouds = [np.asarray(m, dtype=float) - p0 for m in moving]
+    p0 = real_array(origin, "origin")
+    clouds = [real_array(m, f"moving[{k}]") - p0 for k, m in enumerate(moving)]
     clouds = [c[np.isfinite(c).all(axis=1)] for c in clouds]
     clouds = [c - c.mean(axis=0) for c in clouds if c.shape[0] >= 3]
     if not clouds:
@@ -196,7 +198,7 @@ def fit_motion_frame(
             f"(spread ratio {ratio:.2g}, needs > {MIN_SPREAD_RATIO})"
         )
     y = plane.normal
-    rod = np.asarray(moving[0], dtype=float) - np.asarray(origin, dtype=float)
+    rod = real_array(moving[0], "moving[0]") - real_array(origin, "origin")
     n = rod.shape[0]
     mask = np.zeros(n, bool) if deployed is None else np.asarray(deployed, bool)
     if deployed is None:

@@ -7,6 +7,8 @@ import numbers
 import numpy as np
 from scipy.signal import find_peaks
 
+from .smoothing import real_array
+
 __all__ = ["equilibrium_value", "release_index", "swing_midline"]
 
 #: Extrema of the swings used by `swing_midline`: the last this many midline estimates.
@@ -30,8 +32,8 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
     float
         Median of the finite samples with ``time >= time[-1] - tail``.
     """
-    time = np.asarray(time, dtype=float)
-    y = np.asarray(y, dtype=float)
+    time = real_array(time, "time")
+    y = real_array(y, "y")
     if not tail > 0:
         raise ValueError(f"tail must satisfy tail > 0, got {tail}")
     if time.ndim != 1 or time.shape != y.shape or time.size == 0:
@@ -72,7 +74,7 @@ def swing_midline(y: np.ndarray, prominence: float, *, tail: float = 0.25) -> fl
     -------
     float
     """
-    y = np.asarray(y, dtype=float)
+    y = real_array(y, "y")
     if not 0 < tail <= 1:
         raise ValueError(f"tail must satisfy 0 < tail <= 1, got {tail}")
     if not prominence > 0:
@@ -119,7 +121,7 @@ def release_index(y: np.ndarray, threshold: float, *, n_initial: int = 10) -> in
         not an integer >= 1, or the first `n_initial` samples hold no finite value (no initial
         value to leave: every sample would read as "never left").
     """
-    y = np.asarray(y, dtype=float)
+    y = real_array(y, "y")
     if not threshold > 0:
         raise ValueError(f"threshold must satisfy threshold > 0, got {threshold}")
     if isinstance(n_initial, bool) or not isinstance(n_initial, numbers.Integral) or n_initial < 1:

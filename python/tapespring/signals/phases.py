@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .peaks import Peaks
+from .smoothing import real_array
 
 __all__ = ["Phases", "detect_phases"]
 
@@ -71,7 +72,7 @@ class Phases:
 
     def phase_at(self, t: np.ndarray) -> np.ndarray:
         """Phase number (1, 2 or 3) at each instant of ``t`` [s]."""
-        t = np.asarray(t, dtype=float)
+        t = real_array(t, "t")
         phase = np.ones(t.shape, dtype=int)
         if self.phase_ii_start is not None:
             phase[t >= self.phase_ii_start] = 2

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .smoothing import effective_span, smooth
+from .smoothing import effective_span, real_array, smooth
 
 __all__ = ["PullTest", "analyze_pull_test", "check_span"]
 
@@ -101,8 +101,8 @@ def analyze_pull_test(
         record: its maximum would be a mean over the record, not the smoothed
         peak).
     """
-    d = np.asarray(displacement, dtype=float)
-    f = np.asarray(force, dtype=float)
+    d = real_array(displacement, "displacement")
+    f = real_array(force, "force")
     if d.shape != f.shape or d.ndim != 1:
         raise ValueError(
             f"displacement and force must be 1-D of equal length, got {d.shape}, {f.shape}"
