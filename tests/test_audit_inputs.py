@@ -355,7 +355,6 @@ def test_complex_signals_are_refused_not_cast():
         summarize(np.array([1.0, 2.0 + 0j]))
 
 
-
 _T = np.linspace(0.0, 2.0, 801)
 _Y = np.cos(10 * np.pi * _T)
 _P = np.column_stack([np.cos(_T), np.sin(_T), 0.0 * _T])

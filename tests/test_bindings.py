@@ -452,9 +452,10 @@ def test_gil_is_released_during_a_solve():
         thread.join()
     assert r["error"] is None
     inside = [t for t in ticks if start < t < end]
-    # Expect about (end - start) / 2 ms ticks; without the release there would be at most one.
-    assert end - start > 0.05, "the solve was too quick to test the GIL release"
-    assert len(inside) >= 5, (len(inside), end - start)
+    # Expect about (end - start) / 2 ms ticks (the solve takes about 0.8 s: some 400); without
+    # the release there would be at most one. No bound on the solve's wall time: its duration is
+    # only reported, should the count fall short.
+    assert len(inside) >= 5, f"{len(inside)} ticks during a solve of {end - start:.3f} s"
 
 
 def test_model_is_usable_from_another_thread_during_a_solve():
