@@ -57,7 +57,8 @@ def with_velocity(node, velocity):
 
 def test_an_initial_velocity_waits_for_the_first_dynamic_step():
     # 1 m/s of node 5: the same kinetic energy at the dynamic step's start whether it comes first
-    # or after a static preload (whose 1 N barely moves the node's mass: 5 % allowed).
+    # or after a static preload (whose 1 N barely moves the node's mass: measured -0.1 %, 1 %
+    # allowed; a velocity lost or applied twice would be -100 % or +300 %).
     first = run(with_velocity(5, [0, 0, 1.0]), [Step.dynamic("d", duration=1e-4)])
     after = run(
         with_velocity(5, [0, 0, 1.0]),
@@ -69,7 +70,7 @@ def test_an_initial_velocity_waits_for_the_first_dynamic_step():
     static_records = np.flatnonzero(after.step == 0)
     assert np.all(after.kinetic_energy[static_records] == 0.0)
     dynamic = np.flatnonzero(after.step == 1)
-    assert after.kinetic_energy[dynamic[0]] == pytest.approx(start, rel=0.05)
+    assert after.kinetic_energy[dynamic[0]] == pytest.approx(start, rel=0.01)
 
 
 def test_an_initial_velocity_on_a_constrained_dof_is_refused():

@@ -97,9 +97,9 @@ def test_per_record_costs_add_up_to_the_step_stats():
     assert int(r.factorisations[free].sum()) == stats["factorisations"]
     assert np.all(r.factorisations[free] >= 0) and np.all(r.wall_s[free] > 0.0)
     # The records' wall times are the step's, less what comes before the first step (the
-    # consistent accelerations) and after the last record.
+    # consistent accelerations) and after the last record. (How much less depends on the
+    # machine's load: not asserted.)
     assert r.wall_s[free].sum() <= stats["wall_s"]
-    assert r.wall_s[free].sum() > 0.5 * stats["wall_s"]
     # Assembly and solver times are disjoint parts of the step's wall time. (An assembly done to
     # build a fresh iteration matrix was once counted in both: the 10 s deployment reported 53 s
     # and 58.5 s in 102 s. On this small strip other costs leave room, so this is a statement
@@ -227,7 +227,9 @@ def test_energy_tolerance_never_stalls_a_step(tol, rho_inf, released, eta):
     # Whatever the tolerance and the scheme, from an equilibrium released or from rest under a
     # load applied at once (undamped or not): the step ends, its steps not cut back down to
     # min_step (the round-off floor and the guard against a remainder the step does not change,
-    # docs/dynamics.md), with finite energies. Measured: 60 random cases in 8 s.
+    # docs/dynamics.md), with finite energies. Measured: 60 random cases in 8 s, at most 2125
+    # steps over the 5 ms (tolerance 1e-7) and 0.24 rejected per accepted step; a stall (steps
+    # shrinking towards min_step, 5e-15 s) would go far past the bounds below before failing.
     model, _ = strip_model(eta)
     steps = [Step.static("bend", control="load", increments=1)] if released else []
     steps.append(
@@ -244,6 +246,9 @@ def test_energy_tolerance_never_stalls_a_step(tol, rho_inf, released, eta):
     free = r.in_step(len(steps) - 1)
     energy = (r.kinetic_energy + r.strain_energy)[free]
     assert np.all(np.isfinite(energy)) and np.all(np.isfinite(r.numerical_dissipation[free]))
+    stats = r.step_stats[-1]
+    assert stats["steps"] <= 10_000
+    assert stats["cutbacks"] <= 0.5 * stats["steps"]
 
 
 def test_the_pin_of_a_swinging_body_feels_its_inertia():

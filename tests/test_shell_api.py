@@ -40,14 +40,14 @@ def test_linear_tip_deflection_matches_beam_theory():
     # P chosen so that delta / L = 1e-3: geometric nonlinearity changes the deflection by
     # O((delta / L)^2) ~ 1e-6. Shear deformation adds 3 E I / (k G A L^2) = 0.6 (t / L)^2 = 6e-5
     # (G = E / 2 for nu = 0, k = 5/6). What is left is the discretisation error of 16 MITC4
-    # elements over a linearly varying bending moment, O(h^2), measured at -0.1 %; 2 % leaves room
-    # for a change of element formulation while still catching a wrong stiffness (a factor
-    # 1 - nu^2, a lost shear correction, a mis-scaled load).
+    # elements over a linearly varying bending moment, O(h^2), measured at -0.09 %. Bound 0.5 %:
+    # five times that, room for a change of element formulation, while a mis-scaled stiffness or
+    # load is caught. (With nu = 0 a factor 1 - nu^2 cannot show here; the tape's tests see it.)
     delta = 1e-3 * L
     model, tip = cantilever(STIFFNESS * delta)
     r = shell.solve_static(model, increments=1, **LOOSE)
     w = r.displacements[-1, tip, 2]
-    np.testing.assert_allclose(w, delta, rtol=0.02)
+    np.testing.assert_allclose(w, delta, rtol=0.005)
     # Plate theory with nu = 0: the three edge nodes move together (no anticlastic curvature).
     assert np.ptp(w) < 1e-3 * delta
 
