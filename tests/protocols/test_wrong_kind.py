@@ -129,7 +129,9 @@ def test_generated_free_decays_pass_the_decay_check(
     # (it refused 1 decay in 40 here, "the selected peaks do not alternate": about the
     # equilibrium taken from the record's end the window kept one kind of peak only).
     result = analyze_vibration(trial)
-    assert result.fit.damping_ratio == pytest.approx(damping_ratio, rel=0.3)
+    # And fits it: the marker noise (0.05 mm on decays of 5 to 10 mm, 40 to 160 samples a period)
+    # moves the damping ratio by up to 1.1 %, measured over 600 random decays; 3 % asked.
+    assert result.fit.damping_ratio == pytest.approx(damping_ratio, rel=0.03)
 
 
 @examples(ci=12, long=300)
