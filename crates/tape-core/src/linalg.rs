@@ -1332,7 +1332,7 @@ mod tests {
             (40, 3, 4, false, false, 14.0, 0.0),
             (30, 4, 6, true, false, 0.0, 0.0),
             (60, 2, 6, false, false, -2.0, 0.0),
-            (25, 5, 3, true, true, 14.0, 1e-2),
+            (28, 5, 3, true, true, 14.0, 1e-2),
             (50, 3, 3, false, true, 0.0, 1e-2),
             (70, 2, 3, false, true, -1.0, 0.0),
             (24, 6, 3, true, false, -3.0, 0.0),

@@ -81,8 +81,8 @@ fn rooted_levels(pattern: &Pattern) -> Option<(Vec<usize>, Vec<usize>)> {
 /// A separator of the graph of `pattern` (structurally symmetric): the thinnest level of the
 /// rooted level structure with at least 35 % of the largest component's unknowns on each side,
 /// less the unknowns with no neighbour in the next level (they can join the first side). Empty
-/// when no level qualifies (a component too shallow to cut) or the graph is too small for the
-/// split to pay (`MIN_UNKNOWNS`).
+/// when no level qualifies (a component too shallow to cut) or the largest component is too
+/// small for the split to pay (`MIN_UNKNOWNS`; the rest of the graph is not split either way).
 pub(super) fn level_separator(pattern: &Pattern) -> Vec<usize> {
     if pattern.nrows < MIN_UNKNOWNS {
         return Vec::new();
@@ -90,6 +90,9 @@ pub(super) fn level_separator(pattern: &Pattern) -> Vec<usize> {
     let Some((order, starts)) = rooted_levels(pattern) else {
         return Vec::new();
     };
+    if order.len() < MIN_UNKNOWNS {
+        return Vec::new();
+    }
     let size = order.len() as f64;
     let n_levels = starts.len() - 1;
     let chosen = (1..n_levels.saturating_sub(1))
@@ -170,7 +173,8 @@ mod tests {
     /// L-shaped rings of equal Chebyshev distance (the cells couple their diagonals), the
     /// thinnest one with 35 % of the 400 nodes inside is the ring at distance 12 (25 nodes).
     /// No separator for a graph too shallow to cut (one cell of 200 unknowns per node, all
-    /// coupled), one below `MIN_UNKNOWNS` (a strip of 360) or an empty one.
+    /// coupled), one whose largest component is below `MIN_UNKNOWNS` (a strip of 360, alone or
+    /// beside isolated unknowns) or an empty one.
     #[test]
     fn squares_are_cut_and_small_or_shallow_graphs_are_not() {
         let pattern = grid(20, 20, 1);
@@ -181,6 +185,11 @@ mod tests {
         assert!(level_separator(&grid(2, 2, 200)).is_empty());
         assert!(level_separator(&grid(30, 2, 6)).is_empty());
         assert!(!level_separator(&grid(34, 2, 6)).is_empty());
+        // The bound is on the component cut, not on the whole graph: the strip of 360 with 100
+        // isolated unknowns beside it stays whole.
+        let (with_isolated, _) = shuffled_union(&[grid(30, 2, 6)], 100, &mut Rng(7));
+        assert!(with_isolated.nrows >= MIN_UNKNOWNS);
+        assert!(level_separator(&with_isolated).is_empty());
         assert!(level_separator(&Pattern::default()).is_empty());
     }
 
@@ -366,13 +375,14 @@ mod tests {
             let long = nx >= 12 && nx >= 3 * ny;
             if sep.is_empty() {
                 assert!(
-                    !(long && strip_is_largest && pattern.nrows >= MIN_UNKNOWNS),
+                    !(long && strip_is_largest && strip >= MIN_UNKNOWNS),
                     "no separator for a {nx} x {ny} strip of {dofs} unknowns per node (closed: {closed})"
                 );
                 continue;
             }
             cut += 1;
             let size = check_split(&pattern, &sep);
+            assert!(size >= MIN_UNKNOWNS, "a component of {size} unknowns was split");
             if long && strip_is_largest {
                 assert_eq!(size, strip);
                 // The separator is whole nodes of the strip (its first part's labels).
