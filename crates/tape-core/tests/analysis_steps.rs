@@ -230,5 +230,28 @@ fn bad_steps_are_refused_with_their_name() -> Result<()> {
     );
     let err = run(&model, &[], &Outputs::default(), &mut |_| true).unwrap_err();
     assert!(err.to_string().contains("at least one step"), "{err}");
+    // A release over an empty load-factor range (the second step starts and ends at 1).
+    let (mut model, tip) = cantilever(4)?;
+    model.add_constraint(Constraint {
+        id: Some("push".into()),
+        node: tip,
+        dof: Dof::Uz,
+        value: 5e-4,
+        function: TimeFunction::Linear,
+        active: true,
+    })?;
+    let mut release = load_step("release", 1.0, 1);
+    release.deactivate.push("push".into());
+    let err = run(
+        &model,
+        &[load_step("push", 1.0, 1), release],
+        &Outputs::default(),
+        &mut |_| true,
+    )
+    .unwrap_err();
+    assert!(
+        err.to_string().contains("step 1 'release'") && err.to_string().contains("does not move the load factor"),
+        "{err}"
+    );
     Ok(())
 }
