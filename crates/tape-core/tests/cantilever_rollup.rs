@@ -1,6 +1,6 @@
 //! Cantilever rolled up into a full circle by an end moment.
 //!
-//! Source: closed form of the elastica under pure bending; benchmark 3.1 of Sze, Liu & Lo (2004),
+//! Source: closed form of the elastica under pure bending; benchmark 3.2 of Sze, Liu & Lo (2004),
 //! "Popular benchmark problems for geometric nonlinear analysis of shells", FEAD 40, 1551-1569.
 //!
 //! ```text
@@ -80,7 +80,8 @@ fn cantilever_rolls_into_full_circle_with_second_order_mesh_convergence() -> Res
         rate > 1.8,
         "convergence rate {rate} (errors {e16}, {e32}; closure {c16}, {c32})"
     );
-    // Sze et al. ask for 2 %: met from 32 elements along the strip.
+    // Sze et al. set no acceptance bound: 1 % on 32 elements, where the element's over-rotation
+    // predicts 0.64 % (above).
     assert!(e32 < 0.01, "32 elements: path error {e32}");
     Ok(())
 }

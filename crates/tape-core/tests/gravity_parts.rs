@@ -187,7 +187,10 @@ fn strip_of_two_thicknesses_matches_beam_theory() -> Result<()> {
     let w = common::linear_displacements(&model)?[tip][2];
     let err = (w - w_beam) / w_beam;
     eprintln!("stepped cantilever: w = {w:.6e} m, beam {w_beam:.6e} m ({err:+.2e})");
-    assert!(err.abs() < 0.01, "w/w_beam - 1 = {err}");
+    // Measured -3.9e-5. Beam theory leaves out the shear deflection, P a (1/(k G b t1) +
+    // 1/(k G b t2)) = 1.1e-4 of w here, and the ties' local stiffening of the sections they
+    // hold rigid: 1e-3 is ten times the shear term.
+    assert!(err.abs() < 1e-3, "w/w_beam - 1 = {err}");
     Ok(())
 }
 

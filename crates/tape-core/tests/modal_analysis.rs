@@ -105,8 +105,8 @@ fn cantilever(poisson: f64, l: f64) -> Result<Model> {
 }
 
 /// The first mode of a clamped strip against Euler-Bernoulli. With nu = 0 the strip is a beam:
-/// the frequency is within 0.5 % (the dynamic test measured +0.35 % on this mesh: the lumped mass
-/// and 16 bilinear elements; shear and rotary inertia count `(t / L)^2 = 1e-4`). With nu = 0.3 a
+/// the frequency is within 0.5 % (measured -0.11 % on this mesh: the lumped mass and 16 bilinear
+/// elements; shear and rotary inertia count `(t / L)^2 = 1e-4`). With nu = 0.3 a
 /// narrow strip (b / L = 0.1) in linear bending curls anticlastically as a beam does, so the
 /// modulus is E, not the plate modulus E / (1 - nu^2), except in a boundary layer of length ~b at
 /// the clamp, which stops the anticlastic curvature where the modal curvature is largest: the
@@ -269,21 +269,15 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
             ..ModalParams::default()
         },
     );
-    // Zero is a rigid-body eigenvalue only to round-off, so K - 0 M usually factorises with tiny
-    // pivots, and shift-invert then finds the rigid-body modes (as it should); if a pivot is
-    // exactly zero the step stops with a message.
+    // Zero is a rigid-body eigenvalue only to round-off, so K - 0 M factorises with tiny pivots,
+    // and shift-invert then finds the rigid-body modes (as it should; on this model, which is
+    // deterministic). A pivot exactly zero would stop the step with a message asking to move the
+    // shift; no mesh here produces one, so that message is not tested (noted for the team).
     let result = run(&model, &[modal(7), on_zero], &Outputs::default(), &mut |_| true)?;
     let f7 = result.history.modes[0].frequencies_hz[6];
-    match result.error {
-        Some(err) => {
-            assert!(err.to_string().contains("move the shift"), "{err}");
-            assert_eq!((result.history.modes.len(), result.steps_completed), (1, 1));
-        }
-        None => {
-            let f = &result.history.modes[1].frequencies_hz;
-            assert!(f.iter().all(|f| f.abs() < 1e-3 * f7), "{f:?}");
-        }
-    }
+    assert!(result.error.is_none(), "{:?}", result.error);
+    let f = &result.history.modes[1].frequencies_hz;
+    assert!(f.iter().all(|f| f.abs() < 1e-3 * f7), "{f:?}");
     // No density: no mass, refused before any step runs (an invalid model, not a failed step).
     let massless = Model::try_new(flat_plate(1.0, 1.0, 2, 2)?, common::section(0.01, E, 0.3))?;
     let err = run(&massless, &[modal(3)], &Outputs::default(), &mut |_| true).expect_err("no mass");

@@ -9,9 +9,10 @@
 //! * with Kelvin-Voigt viscosity eta the logarithmic decrement gives the damping ratio
 //!   `eta omega / 2` within 3 % (the material parameter eta in seconds; the paper's eq. 7 is the
 //!   single-DOF dashpot relation);
-//! * the energy balance closes: without damping and with rho_inf = 1 the integrator dissipates
-//!   less than 1e-3 of the energy released, and with damping the viscous dissipation accounts for
-//!   the lost energy to 1e-3 of it;
+//! * the energy balance closes: without damping and with rho_inf = 1 (the trapezoidal rule, which
+//!   keeps a linear system's energy exactly) the integrator dissipates less than 1e-6 of the
+//!   energy released, the Newton tolerance's share, and with damping the viscous dissipation
+//!   accounts for the lost energy to 1e-3 of it;
 //! * runs on one and on two threads give the same history bit for bit.
 
 mod common;
@@ -58,11 +59,13 @@ fn released_strip_vibrates_at_its_first_frequency_and_keeps_its_energy() -> Resu
     let numerical = hist.numerical_dissipation.last().copied().unwrap();
     let total_now = hist.kinetic_energy.last().unwrap() + hist.strain_energy.last().unwrap();
     eprintln!("released {released:e} J, numerical dissipation {numerical:e} J, total now {total_now:e} J");
+    // Measured: -1.2e-14 J of 1.1e-5 J; what could be left is Newton's residual (1e-4 of the
+    // reference force) working through the small displacements' corrections.
     assert!(
-        numerical.abs() < 1e-3 * released,
+        numerical.abs() < 1e-6 * released,
         "numerical dissipation {numerical:e} of {released:e} J"
     );
-    assert!((total_now - released).abs() < 1e-3 * released);
+    assert!((total_now - released).abs() < 1e-6 * released);
     Ok(())
 }
 
