@@ -221,10 +221,13 @@ fn axial_prestress_shifts_the_frequency_as_the_beam_formula_says() -> Result<()>
 }
 
 /// The released cantilever of `shell_dynamics.rs` (nu = 0, tip load released at once) vibrates at
-/// the first modal period of the unloaded strip within 0.5 %: the time step is a hundredth of the
-/// period (the scheme's period error `(omega h)^2 / 12 = 3e-4`, rho_inf = 1) and the amplitude is
-/// 0.1 mm on 0.2 m (no measurable geometric nonlinearity); the period is fitted from the upward
-/// zero crossings of the tip deflection, which the higher modes, excited far less, barely shift.
+/// the first modal period of the unloaded strip: the time step is a hundredth of the period (the
+/// scheme's period error `(omega h)^2 / 12 = 3.3e-4`, rho_inf = 1) and the amplitude is 0.1 mm on
+/// 0.2 m (no measurable geometric nonlinearity). The period comes from the upward zero crossings
+/// of the tip deflection, which the undamped second mode shifts by up to a few tenths of a
+/// percent of a period each (its share of the tip's static deflection, over the first mode's
+/// slope at the crossing): over 4 periods that gave +0.24 %, over 20 it gives +0.063 %, the
+/// scheme's 0.033 % and what is left of the jitter. Bound: 0.2 %, three times the measurement.
 #[test]
 fn free_decay_period_of_a_released_cantilever_is_the_modal_period() -> Result<()> {
     let l = 0.2;
@@ -235,7 +238,7 @@ fn free_decay_period_of_a_released_cantilever_is_the_modal_period() -> Result<()
     unloaded.loads.clear();
     let period = modes_of(&unloaded, &[modal(1)])?.modes[0].periods_s[0];
     let h = period / 100.0;
-    let hist = modes_of(&model, &strip::bend_then_release(1.0, h, 4.2 * period))?;
+    let hist = modes_of(&model, &strip::bend_then_release(1.0, h, 20.2 * period))?;
     let (up, _) = strip::crossings_and_peaks(&hist);
     assert!(up.len() >= 3, "{} crossings", up.len());
     #[allow(clippy::cast_precision_loss)]
@@ -245,7 +248,7 @@ fn free_decay_period_of_a_released_cantilever_is_the_modal_period() -> Result<()
         "free-decay period {measured:.6e} s vs modal {period:.6e} s ({:+.3} %)",
         100.0 * err
     );
-    assert!(err.abs() < 0.005, "period error {err:e}");
+    assert!(err.abs() < 0.002, "period error {err:e}");
     Ok(())
 }
 
