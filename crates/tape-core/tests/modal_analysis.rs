@@ -12,8 +12,8 @@
 //!      |        |      no support at all: six rigid-body modes at 0 Hz, then
 //!      |  free  | 10 m 1.622, 2.360, 2.922, 4.190, 4.190, 7.356, 7.356, 7.668 Hz
 //!      |        |
-//!      +--------+--> x  16 x 16 MITC4 elements; within 2 % (the benchmark's target, and the
-//!                        spread of the thin-shell elements NAFEMS lists)
+//!      +--------+--> x  16 x 16 and 32 x 32 MITC4 elements: within 2 % and 0.6 %, converging
+//!                        to the published values at second order
 //!   ```
 //!
 //! * a cantilever strip (L = 0.2 m, b = 0.02 m, t = 2 mm, steel) against Euler-Bernoulli,
@@ -60,15 +60,15 @@ fn out_of_plane_share(modes: &Modes, k: usize, n_nodes: usize) -> f64 {
     uz / u
 }
 
-#[test]
-fn nafems_fv12_free_square_plate() -> Result<()> {
+/// FV12's elastic frequencies [Hz] on an `n` x `n` mesh, after its rigid-body checks.
+fn fv12_frequencies(n: usize) -> Result<Vec<f64>> {
     let mut section = common::section(0.05, 200e9, 0.3);
     section.density = 8000.0;
-    let model = Model::try_new(flat_plate(10.0, 10.0, 16, 16)?, section)?;
+    let model = Model::try_new(flat_plate(10.0, 10.0, n, n)?, section)?;
     let hist = modes_of(&model, &[modal(14)])?;
     let modes = &hist.modes[0];
     let f = &modes.frequencies_hz;
-    eprintln!("FV12 frequencies [Hz]: {f:.4?}");
+    eprintln!("FV12 frequencies on {n} x {n} [Hz]: {f:.4?}");
     eprintln!(
         "shift {:.3e} rad^2/s^2, residuals {:.1e}",
         modes.shift,
@@ -80,12 +80,6 @@ fn nafems_fv12_free_square_plate() -> Result<()> {
     for (k, fk) in f[..6].iter().enumerate() {
         assert!(fk.abs() < 1e-3 * f[6], "rigid-body mode {k} at {fk} Hz");
     }
-    let reference = [1.622, 2.360, 2.922, 4.190, 4.190, 7.356, 7.356, 7.668];
-    for (k, (fk, r)) in f[6..].iter().zip(reference).enumerate() {
-        let err = fk / r - 1.0;
-        eprintln!("mode {}: {fk:.4} Hz vs {r} Hz ({:+.2} %)", k + 7, 100.0 * err);
-        assert!(err.abs() < 0.02, "mode {}: {fk} Hz vs {r} Hz", k + 7);
-    }
     // The rigid-body modes carry the whole mass in translation: sum of effective masses.
     let mass = 10.0 * 10.0 * 0.05 * 8000.0;
     for d in 0..3 {
@@ -94,6 +88,34 @@ fn nafems_fv12_free_square_plate() -> Result<()> {
             (sum / mass - 1.0).abs() < 1e-8,
             "effective mass {d}: {sum} vs {mass} kg"
         );
+    }
+    Ok(f[6..].to_vec())
+}
+
+#[test]
+fn nafems_fv12_free_square_plate() -> Result<()> {
+    let reference = [1.622, 2.360, 2.922, 4.190, 4.190, 7.356, 7.356, 7.668];
+    let (coarse, fine) = (fv12_frequencies(16)?, fv12_frequencies(32)?);
+    for (k, ((fc, ff), r)) in coarse.iter().zip(&fine).zip(reference).enumerate() {
+        let (ec, ef) = (fc / r - 1.0, ff / r - 1.0);
+        let ratio = ec / ef;
+        eprintln!(
+            "mode {}: {fc:.4} / {ff:.4} Hz vs {r} Hz ({:+.2} / {:+.2} %, ratio {ratio:.2})",
+            k + 7,
+            100.0 * ec,
+            100.0 * ef
+        );
+        // From below (the lumped mass) and converging to the published value at second order:
+        // measured -0.58 to -1.90 % on 16 x 16, -0.19 to -0.53 % on 32 x 32, the error divided
+        // by 3.0 to 4.0. The reference's four digits (3e-4 of it) blur the smallest fine error,
+        // mode 7's 0.19 %, by a sixth: a ratio of 2.5 asked, 2 % on 16 x 16 and 0.6 % on 32 x 32.
+        assert!(ec < 0.0 && ef < 0.0, "mode {}: {fc} / {ff} Hz vs {r} Hz", k + 7);
+        assert!(
+            ec.abs() < 0.02 && ef.abs() < 0.006,
+            "mode {}: {fc} / {ff} Hz vs {r} Hz",
+            k + 7
+        );
+        assert!(ratio > 2.5, "mode {}: error ratio {ratio}", k + 7);
     }
     Ok(())
 }
