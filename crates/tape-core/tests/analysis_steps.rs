@@ -63,6 +63,19 @@ fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
 }
 
 /// A steel strip 200 x 20 x 2 mm, clamped at x = 0, its tip section tied to a reference node.
+/// Prescribes the tip's uz to 0.5 mm over the load factor (constraint id "push", active).
+fn push_tip(model: &mut Model, tip: usize) -> Result<()> {
+    model.add_constraint(Constraint {
+        id: Some("push".into()),
+        node: tip,
+        dof: Dof::Uz,
+        value: 5e-4,
+        function: TimeFunction::Linear,
+        active: true,
+    })?;
+    Ok(())
+}
+
 fn cantilever(nx: usize) -> Result<(Model, usize)> {
     let mesh = flat_plate(0.2, 0.02, nx, 2)?;
     let mut model = Model::try_new(mesh, common::section(2e-3, 2e11, 0.0))?;
@@ -168,14 +181,7 @@ fn steps_carry_the_state_and_unloading_retraces_the_path() -> Result<()> {
 #[test]
 fn released_prescribed_displacement_leaves_the_state_continuous() -> Result<()> {
     let (mut model, tip) = cantilever(16)?;
-    model.add_constraint(Constraint {
-        id: Some("push".into()),
-        node: tip,
-        dof: Dof::Uz,
-        value: 5e-4,
-        function: TimeFunction::Linear,
-        active: true,
-    })?;
+    push_tip(&mut model, tip)?;
     let mut release = load_step("release", 2.0, 10);
     release.deactivate.push("push".into());
     let outputs = Outputs {
@@ -232,14 +238,7 @@ fn bad_steps_are_refused_with_their_name() -> Result<()> {
     assert!(err.to_string().contains("at least one step"), "{err}");
     // A release over an empty load-factor range (the second step starts and ends at 1).
     let (mut model, tip) = cantilever(4)?;
-    model.add_constraint(Constraint {
-        id: Some("push".into()),
-        node: tip,
-        dof: Dof::Uz,
-        value: 5e-4,
-        function: TimeFunction::Linear,
-        active: true,
-    })?;
+    push_tip(&mut model, tip)?;
     let mut release = load_step("release", 1.0, 1);
     release.deactivate.push("push".into());
     let err = run(
