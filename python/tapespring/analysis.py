@@ -424,8 +424,9 @@ def run(
     Raises
     ------
     TypeError
-        If `steps` is not a sequence of `Step` or dicts, `outputs` is not an `Outputs`,
-        `progress` is neither a bool, None nor callable, or `raise_on_error` is not a bool.
+        If `steps` is not a sequence of `Step` or dicts (or a dict's ``name`` is not a str),
+        `outputs` is not an `Outputs`, `progress` is neither a bool, None nor callable, or
+        `raise_on_error` is not a bool.
     ValueError
         For an invalid model, step or output request (unknown or inapplicable options, unknown
         ids, ...), before anything runs.

@@ -62,7 +62,6 @@ fn bending_path_on_the_runner_equals_the_dedicated_driver() -> Result<()> {
     Ok(())
 }
 
-/// A steel strip 200 x 20 x 2 mm, clamped at x = 0, its tip section tied to a reference node.
 /// Prescribes the tip's uz to 0.5 mm over the load factor (constraint id "push", active).
 fn push_tip(model: &mut Model, tip: usize) -> Result<()> {
     model.add_constraint(Constraint {
@@ -76,6 +75,7 @@ fn push_tip(model: &mut Model, tip: usize) -> Result<()> {
     Ok(())
 }
 
+/// A steel strip 200 x 20 x 2 mm, clamped at x = 0, its tip section tied to a reference node.
 fn cantilever(nx: usize) -> Result<(Model, usize)> {
     let mesh = flat_plate(0.2, 0.02, nx, 2)?;
     let mut model = Model::try_new(mesh, common::section(2e-3, 2e11, 0.0))?;

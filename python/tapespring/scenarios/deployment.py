@@ -68,14 +68,22 @@ from tapespring.scenarios.setup import (
     step_counts,
 )
 
-__all__ = ["TRIAL_MARKERS", "DeploymentSettings", "DeploymentSimulation", "deploy"]
+__all__ = [
+    "DEFAULT_ENERGY_TOLERANCE",
+    "TRIAL_MARKERS",
+    "DeploymentSettings",
+    "DeploymentSimulation",
+    "deploy",
+]
 
 #: The deployment's default energy tolerance (the dynamic step's ``energy_tolerance``: each step's
 #: remainder of the energy balance at most this fraction of the largest kinetic plus strain energy
 #: so far). The displacement error estimate lets the steps grow through the snaps, where the
 #: scheme then dissipates energy the paper's peaks depend on; bounding it converges the first
-#: extrema nearly to their tight-tolerance values for about the cost of the displacement control
-#: alone (figures in docs/scenarios.md, "How far the default ...").
+#: extrema nearly to their tight-tolerance values, for the displacement control's cost over the
+#: first second and 2 % (opposite sense) to 9 % (equal sense) more over the paper's 10 s (the
+#: table under "How far the time steps converge these figures" in docs/scenarios.md). It bounds
+#: the `settle` step too, when there is one (the same dynamic options).
 DEFAULT_ENERGY_TOLERANCE = 3e-5
 
 #: Trial marker names of the set-up's markers: the bending angle of the trial analysis is that of
@@ -118,7 +126,8 @@ class DeploymentSettings:
         :data:`~tapespring.scenarios.setup.MAX_ENERGY_TOLERANCE`]; by default
         :data:`DEFAULT_ENERGY_TOLERANCE` (3e-5), which converges the first extrema nearly to
         their tight-tolerance values; 0: off, the displacement control alone (figures in
-        docs/scenarios.md, after the tolerance's).
+        docs/scenarios.md, "How far the time steps converge these figures"). It applies to the
+        `settle` step too.
     n_peaks : int
         Maxima and minima of the bending angle reported (paper: 10), from 1 to the trial
         analysis's :data:`~tapespring.protocols.registry.MAX_N_PEAKS` (1000).
@@ -240,7 +249,7 @@ class DeploymentSimulation:
         """Rows of the histories at the sample instants ``k / sample_rate`` from the release.
 
         The time steps land on every sample (``output_interval``); the error control adds steps
-        between them where the motion is fast (148 of the 629 rows of the first 0.6 s at 800 Hz,
+        between them where the motion is fast (189 of the 670 rows of the first 0.6 s at 800 Hz,
         opposite sense, 5 mm tapes). These rows are the samples only, the release first, as a
         recording at `sample_rate` has them; a last state off that grid (a `duration` that is no
         multiple of the interval, a run stopped early) is not one.

@@ -101,7 +101,9 @@ class DampingFit:
     r_squared : float
         Coefficient of determination of the peak-value fit.
     success : bool
-        Both least-squares fits converged.
+        Both least-squares fits converged: always True on a returned fit, since a peak-value fit
+        that does not converge raises ValueError (and the peak-time fit is linear); kept so that
+        saved fits keep their fields.
     """
 
     damping_ratio: float
@@ -324,8 +326,10 @@ def fit_damping(
         If ``t`` is not finite and strictly increasing or ``z`` is not finite (`extract_peaks`),
         ``window`` or ``t_start`` is invalid, fewer than 3 peaks fall in the window, their
         spacing is not that of a free decay (two peaks a number of half periods apart of the
-        wrong parity), or the fitted envelope grows (by more than 1 % over the peaks fitted
-        and twice the damping ratio's standard error: a negative damping ratio, not a decay).
+        wrong parity), the fitted envelope grows (by more than 1 % over the peaks fitted
+        and twice the damping ratio's standard error: a negative damping ratio, not a decay),
+        or the peak-value fit does not converge (the peaks do not determine offset, amplitude
+        and rate, e.g. peaks on one side only whose envelope's curvature the noise hides).
     """
     if t_start is not None and not math.isfinite(t_start):
         raise ValueError(f"t_start must be finite [s], got {t_start}")
