@@ -222,3 +222,20 @@ def test_free_decay_fitted_period_is_the_modal_period():
     # its default tolerance, +1.3 % (20 steps per period).
     assert fit.period == pytest.approx(period, rel=0.005)
     assert fit.period_std < 0.001 * period
+
+
+def test_a_shift_exactly_on_an_eigenvalue_stops_the_step_by_name():
+    # A rigid body on a node no element holds: its six DOFs have mass and no stiffness at all, so
+    # K - 0 M has exactly zero pivots (a plate's rigid-body modes are zero only to round-off and
+    # factorise, test_free_plate_has_six_rigid_modes_carrying_the_whole_mass). The step stops
+    # with the message, and the run keeps what came before.
+    nodes, quads, sets = flat_plate_mesh(1.0, 1.0, 2, 2)
+    nodes = np.vstack([nodes, [[2.0, 2.0, 0.0]]])
+    model = Model(
+        nodes, quads, node_sets=sets, thickness=0.01, youngs_modulus=E, poisson=0.3, density=RHO
+    )
+    model.add_rigid_body(len(nodes) - 1, 1.0, inertia=1e-3 * np.eye(3))
+    model.fix(sets["x0"], ["ux", "uy", "uz", "rx", "ry", "rz"])
+    r = run(model, [Step.modal("on zero", modes=3, shift=0.0)], raise_on_error=False)
+    assert r.error is not None and "move the shift" in r.error
+    assert "step 0 'on zero'" in r.error and r.steps_completed == 0 and not r.modes

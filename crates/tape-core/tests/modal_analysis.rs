@@ -296,8 +296,8 @@ fn modal_steps_from_json_and_their_failures() -> Result<()> {
     );
     // Zero is a rigid-body eigenvalue only to round-off, so K - 0 M factorises with tiny pivots,
     // and shift-invert then finds the rigid-body modes (as it should; on this model, which is
-    // deterministic). A pivot exactly zero would stop the step with a message asking to move the
-    // shift; no mesh here produces one, so that message is not tested (noted for the team).
+    // deterministic). A pivot exactly zero stops the step with a message asking to move the
+    // shift: tests/test_modal.py forces one with a rigid body that no element holds.
     let result = run(&model, &[modal(7), on_zero], &Outputs::default(), &mut |_| true)?;
     let f7 = result.history.modes[0].frequencies_hz[6];
     assert!(result.error.is_none(), "{:?}", result.error);
