@@ -443,7 +443,10 @@ def run(
         if not isinstance(s, Step | Mapping):
             # dict() of a string or a list would fail on its letters, naming neither.
             raise TypeError(f"steps[{k}] must be a Step or a dict, not {type(s).__name__}: {s!r}")
-        raw = s.to_dict() if isinstance(s, Step) else dict(s)
+        if isinstance(s, Step):
+            raw_steps.append(s.to_dict())  # its name checked when it was built
+            continue
+        raw = dict(s)
         # The core takes None for a missing name (""), so a dict's None would run unnamed.
         if "name" in raw and not isinstance(raw["name"], str):
             raise TypeError(f"steps[{k}]['name'] must be a str, got {raw['name']!r}")

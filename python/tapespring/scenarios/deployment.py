@@ -150,7 +150,6 @@ class DeploymentSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         check_spec(self.spec)
-        self.spec.validate()
         check_sense(self.sense)
         for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)

@@ -95,7 +95,6 @@ class EquilibriumSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         check_spec(self.spec)
-        self.spec.validate()
         check_push(self.push)
         check_count("field_interval", self.field_interval, minimum=0)
 

@@ -89,7 +89,6 @@ class PullSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         check_spec(self.spec)
-        self.spec.validate()
         check_max_displacement(self.max_displacement)
         check_count("field_interval", self.field_interval, minimum=0)
 

@@ -1034,10 +1034,11 @@ def check_rho_inf(value: float) -> None:
 
 
 def check_spec(value: object) -> None:
-    """Raise ValueError unless `value` is a scenario's ``spec``: a `SetupSpec` (a mistyped one
-    would otherwise fail as an AttributeError on its missing ``validate``)."""
+    """Raise ValueError unless `value` is a scenario's ``spec``: a valid `SetupSpec` (a mistyped
+    one would otherwise fail as an AttributeError on its missing ``validate``)."""
     if not isinstance(value, SetupSpec):
         raise ValueError(f"spec must be a SetupSpec (got {value!r})")
+    value.validate()
 
 
 def check_count(name: str, value: object, *, minimum: int) -> None:

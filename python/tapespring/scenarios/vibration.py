@@ -181,7 +181,6 @@ class VibrationSettings:
     def validate(self) -> None:
         """Raise ValueError naming a bad value."""
         check_spec(self.spec)
-        self.spec.validate()
         check_initial_displacement(self.initial_displacement)
         for name in ("duration", "sample_rate"):
             check_number(name, getattr(self, name), positive=True)

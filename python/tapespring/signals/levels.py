@@ -133,6 +133,6 @@ def release_index(y: np.ndarray, threshold: float, *, n_initial: int = 10) -> in
         raise ValueError(
             f"the first {initial.size} sample(s) of y hold no finite value: no initial value"
         )
-    y0 = np.nanmedian(initial[np.isfinite(initial)])
+    y0 = np.median(initial[np.isfinite(initial)])
     moved = np.flatnonzero(np.abs(y - y0) > threshold)
     return int(moved[0]) if moved.size else 0
