@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .smoothing import real_array
+from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["bending_angle"]
 
@@ -34,12 +34,22 @@ def bending_angle(marker_1: np.ndarray, marker_2: np.ndarray) -> np.ndarray:
         ``atan2(-(z2 - z1), x2 - x1)`` [rad], unwrapped in time (NaN where a
         marker is missing). Subtract the deployed-equilibrium value
         (`equilibrium_value`) to get the paper's bending angle.
+
+    Raises
+    ------
+    ValueError
+        If the markers are not both of shape (n, 3) or hold infinite coordinates.
     """
     p1 = real_array(marker_1, "marker_1")
     p2 = real_array(marker_2, "marker_2")
     if p1.shape != p2.shape or p1.ndim != 2 or p1.shape[1] != 3:
         raise ValueError(f"markers must both have shape (n, 3), got {p1.shape} and {p2.shape}")
-    d = p2 - p1
+    if np.isinf(p1).any() or np.isinf(p2).any():
+        raise ValueError("marker positions must be finite or NaN (missing), got infinite values")
+    # Divided by a power of two (exact; the angle does not change): the difference of
+    # coordinates near 1e308 overflowed.
+    unit = power_of_two_scale(np.concatenate((p1.ravel(), p2.ravel())))
+    d = p2 / unit - p1 / unit
     angle = np.arctan2(-d[:, 2], d[:, 0])
     valid = np.isfinite(angle)
     angle[valid] = np.unwrap(angle[valid])

@@ -11,12 +11,13 @@ refinement removes that bias.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from .smoothing import real_array
+from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["CircleFit", "fit_circle", "max_lateral_displacement"]
 
@@ -76,13 +77,16 @@ def fit_circle(points: np.ndarray) -> CircleFit:
     p = p[np.isfinite(p).all(axis=1)]
     if p.shape[0] < 3:
         raise ValueError(f"a circle fit needs at least 3 finite points, got {p.shape[0]}")
-    # Centre the data for conditioning.
-    mean = p.mean(axis=0)
-    q = p - mean
-    scale = np.sqrt(np.mean(np.sum(q**2, axis=1)))
+    # Centre the data for conditioning (on points divided by a power of two, exactly: the mean
+    # and the squares of coordinates near 1e308 overflowed).
+    unit = power_of_two_scale(p)
+    mean = (p / unit).mean(axis=0)
+    q = p / unit - mean
+    mean = mean * unit
+    scale = np.sqrt(np.mean(np.sum(q**2, axis=1))) * unit
+    q = q * (unit / scale) if scale > 0 else q
     if scale == 0:
         raise ValueError("the points are all identical")
-    q = q / scale
     a = np.column_stack((q, np.ones(q.shape[0])))
     b = -np.sum(q**2, axis=1)
     sol, _, rank, sv = np.linalg.lstsq(a, b, rcond=None)
@@ -133,11 +137,25 @@ def max_lateral_displacement(lateral: np.ndarray, reference: float | None = None
     -------
     float
         ``max |lateral - reference|`` [m].
+
+    Raises
+    ------
+    ValueError
+        If no sample is finite, `reference` is not finite, or the excursion is beyond the
+        floating-point range.
     """
     y = real_array(lateral, "lateral")
     finite = y[np.isfinite(y)]
     if finite.size == 0:
         raise ValueError("no finite lateral sample")
+    # On values divided by a power of two (exact): medians and differences near 1e308 overflowed.
     if reference is None:
-        reference = float(np.median(finite[-max(1, finite.size // 10) :]))
-    return float(np.max(np.abs(finite - reference)))
+        unit = power_of_two_scale(finite)
+        reference = float(np.median(finite[-max(1, finite.size // 10) :] / unit)) * unit
+    elif not np.isfinite(reference):
+        raise ValueError(f"reference must be a finite lateral coordinate [m], got {reference}")
+    unit = power_of_two_scale(np.append(finite, reference))
+    excursion = float(np.max(np.abs(finite / unit - reference / unit))) * unit
+    if not math.isfinite(excursion):
+        raise ValueError("the lateral excursion is beyond the floating-point range")
+    return excursion

@@ -19,12 +19,13 @@ crossings of phases I and II, 2.5 at the last one before phase III.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .smoothing import real_array
+from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["CrossingPeaks", "force_at_crossings"]
 
@@ -120,7 +121,8 @@ def force_at_crossings(
     ------
     ValueError
         Arrays of different lengths or fewer than two samples, non-finite values, times not
-        strictly increasing, `fraction` outside (0, 0.5], or `start` after `end`.
+        strictly increasing, `fraction` outside (0, 0.5], `start` after `end`, or a
+        non-finite `baseline`.
     """
     t, a, f = (real_array(v, n) for v, n in ((time, "time"), (angle, "angle"), (force, "force")))
     if t.ndim != 1 or t.shape != a.shape or t.shape != f.shape:
@@ -133,8 +135,12 @@ def force_at_crossings(
     for name, v in (("time", t), ("angle", a), ("force", f)):
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{name} has non-finite values")
-    if not np.all(np.diff(t) > 0):
+    if not np.all(t[1:] > t[:-1]):
         raise ValueError("time must be strictly increasing")
+    if not math.isfinite(float(t[-1]) - float(t[0])):  # Python floats: inf, not a warning
+        raise ValueError(
+            f"time runs from {t[0]:.6g} to {t[-1]:.6g} s: a span beyond the floating-point range"
+        )
     if not 0.0 < fraction <= 0.5:
         raise ValueError(f"fraction must lie in (0, 0.5], got {fraction}")
     lo = t[0] if start is None else float(start)
@@ -144,7 +150,13 @@ def force_at_crossings(
     if baseline is None:
         after = t >= lo
         baseline = float(np.median(f[after] if after.any() else f))
-    dev = np.abs(f - baseline)
+    elif not math.isfinite(baseline):
+        raise ValueError(f"baseline must be a finite force [N], got {baseline}")
+    # The deviations and the crossings' interpolation on values divided by powers of two
+    # (exact): the differences of values near 1e308 overflowed (a crossing then fell on a sample).
+    scale = power_of_two_scale(np.append(f, baseline))
+    dev = np.abs(f / scale - baseline / scale)
+    a = a / power_of_two_scale(a)
 
     positive = a >= 0.0
     i = np.flatnonzero(positive[:-1] != positive[1:])
@@ -165,8 +177,8 @@ def force_at_crossings(
             near = np.abs(t - c[k]) == np.min(np.abs(t - c[k]))
         rest = (t > bounds[k] + reach[k]) & (t < bounds[k + 2] - reach[k + 2]) & ~near
         j = np.flatnonzero(near)[np.argmax(dev[near])]
-        peak[k], peak_time[k] = dev[j], t[j]
-        elsewhere[k] = dev[rest].max() if rest.any() else np.nan
+        peak[k], peak_time[k] = dev[j] * scale, t[j]
+        elsewhere[k] = dev[rest].max() * scale if rest.any() else np.nan
     return CrossingPeaks(
         time=c,
         window=window,

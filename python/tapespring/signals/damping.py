@@ -46,7 +46,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .peaks import extract_peaks
-from .smoothing import noise_std, real_array
+from .smoothing import noise_std, power_of_two_scale, real_array
 
 __all__ = ["DampingFit", "check_window", "fit_damping", "select_window_peaks"]
 
@@ -184,7 +184,8 @@ def _all_peaks(
         # (8 sigma = 4.2 mm).
         z = real_array(z, "z")
         if z.size >= 3 and np.all(np.isfinite(z)):  # else `extract_peaks` says what is wrong
-            prominence = min(max(8.0 * noise_std(z), 1e-3 * float(np.ptp(z))), lo)
+            unit = power_of_two_scale(z)  # the range of values near 1e308 overflows
+            prominence = min(max(8.0 * noise_std(z), 1e-3 * float(np.ptp(z / unit)) * unit), lo)
     time, value, kind = extract_peaks(t, z, None, prominence=prominence).sequence()
     if t_start is not None:
         after = time >= t_start
@@ -351,7 +352,12 @@ def fit_damping(
     h = fit_t.x[1]
     omega_d = np.pi / h
 
-    # 2. Peak values: z_k = c + s_k A exp(-a (t_k - t_first)).
+    # 2. Peak values: z_k = c + s_k A exp(-a (t_k - t_first)), fitted on the values divided by a
+    # power of two that brings them to order one (exact; values near 1e200 overflowed the
+    # squares of the residuals, near 1e-200 underflowed them).
+    unit = power_of_two_scale(value)
+    value_m = value
+    value = value / unit
     tau = time - time[0]
     a0 = max(np.log(abs(value[0]) / abs(value[-1])) / max(tau[-1], h), 1e-6)
 
@@ -397,13 +403,13 @@ def fit_damping(
         damping_ratio=epsilon,
         omega0=omega0,
         period=period,
-        amplitude=float(amp),
-        offset=float(c),
+        amplitude=float(amp) * unit,
+        offset=float(c) * unit,
         damping_ratio_std=eps_std,
         period_std=per_std,
         peak_time=time,
-        peak_value=value,
-        rms_amplitude_residual=float(np.sqrt(np.mean(fit_z.fun**2))),
+        peak_value=value_m,
+        rms_amplitude_residual=float(np.sqrt(np.mean(fit_z.fun**2))) * unit,
         rms_time_residual=float(np.sqrt(np.mean(fit_t.fun**2))),
         r_squared=r2,
         success=bool(fit_t.success and fit_z.success),

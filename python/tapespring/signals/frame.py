@@ -95,7 +95,13 @@ def to_frame(frame: np.ndarray, points: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (n, 3)
     """
-    return real_array(points, "points") @ real_array(frame, "frame").T
+    p = real_array(points, "points")
+    r = real_array(frame, "frame")
+    if r.shape != (3, 3):
+        raise ValueError(f"frame must have shape (3, 3), got {r.shape}")
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"points must have shape (n, 3), got {p.shape}")
+    return p @ r.T
 
 
 @dataclass(frozen=True)
@@ -143,12 +149,13 @@ def motion_plane(origin: np.ndarray, *moving: np.ndarray) -> MotionPlane:
     Raises
     ------
     ValueError
-        If no moving marker is given, or no marker has 3 complete samples.
+        If no moving marker is given, a marker is not of shape (n, 3) with the origin's n, or no
+        marker has 3 complete samples.
     """
     if not moving:
         raise ValueError("the plane of motion needs at least one moving marker")
-    p0 = real_array(origin, "origin")
-    clouds = [real_array(m, f"moving[{k}]") - p0 for k, m in enumerate(moving)]
+    p0 = _positions(origin, "origin")
+    clouds = [_positions(m, f"moving[{k}]", p0.shape[0]) - p0 for k, m in enumerate(moving)]
     clouds = [c[np.isfinite(c).all(axis=1)] for c in clouds]
     clouds = [c - c.mean(axis=0) for c in clouds if c.shape[0] >= 3]
     if not clouds:
@@ -185,7 +192,9 @@ def fit_motion_frame(
     Raises
     ------
     ValueError
-        If no moving marker is given, or the markers barely turn (no plane).
+        If no moving marker is given, the markers are not of shape (n, 3), `deployed` is not
+        n booleans, the markers barely turn (no plane), or the deployed samples hold no
+        complete position (or the rod lies along the plane's normal there).
     """
     if not moving:
         raise ValueError("fit_motion_frame needs at least one moving marker")
@@ -198,12 +207,41 @@ def fit_motion_frame(
             f"(spread ratio {ratio:.2g}, needs > {MIN_SPREAD_RATIO})"
         )
     y = plane.normal
-    rod = real_array(moving[0], "moving[0]") - real_array(origin, "origin")
+    rod = _positions(moving[0], "moving[0]") - _positions(origin, "origin")
     n = rod.shape[0]
-    mask = np.zeros(n, bool) if deployed is None else np.asarray(deployed, bool)
     if deployed is None:
+        mask = np.zeros(n, bool)
         mask[-max(1, n // 10) :] = True
-    direction = np.nanmean(rod[mask], axis=0)
+    else:
+        mask = np.asarray(deployed)
+        if mask.dtype != bool or mask.shape != (n,):
+            raise ValueError(
+                f"deployed must be an array of {n} booleans (one per sample), got "
+                f"{mask.dtype} of shape {mask.shape}"
+            )
+    rows = rod[mask]
+    rows = rows[np.isfinite(rows).all(axis=1)]
+    if rows.size == 0:
+        which = "deployed samples" if deployed is not None else "last tenth of the record"
+        raise ValueError(
+            "cannot fit the rig's x axis: no complete sample of the origin and the first "
+            f"moving marker among the {which}"
+        )
+    direction = rows.mean(axis=0)
     x = direction - (direction @ y) * y
-    x /= np.linalg.norm(x)
+    length = float(np.linalg.norm(x))
+    if not length > 1e-6 * float(np.linalg.norm(direction)):
+        raise ValueError(
+            "cannot fit the rig's x axis: the deployed rod is normal to the plane of motion"
+        )
+    x /= length
     return np.array([x, y, np.cross(x, y)])
+
+
+def _positions(values: np.ndarray, name: str, n: int | None = None) -> np.ndarray:
+    """`values` as marker positions of shape (n, 3) [m]; ValueError naming `name` otherwise."""
+    p = real_array(values, name)
+    if p.ndim != 2 or p.shape[1] != 3 or (n is not None and p.shape[0] != n):
+        want = "(n, 3)" if n is None else f"({n}, 3), as the origin"
+        raise ValueError(f"{name} must have shape {want}, got {p.shape}")
+    return p

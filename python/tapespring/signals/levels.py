@@ -7,7 +7,7 @@ import numbers
 import numpy as np
 from scipy.signal import find_peaks
 
-from .smoothing import real_array
+from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["equilibrium_value", "release_index", "swing_midline"]
 
@@ -41,11 +41,12 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
             f"time and y must be 1-D arrays of one length >= 1, got shapes {time.shape} and "
             f"{y.shape}"
         )
-    last = y[time >= time[-1] - tail]
+    last = y[time >= float(time[-1]) - float(tail)]  # Python floats: no overflow warning
     last = last[np.isfinite(last)]
     if last.size == 0:
         raise ValueError(f"no finite sample in the last {tail} s of the record")
-    return float(np.median(last))
+    unit = power_of_two_scale(last)  # the median of two values near 1e308 overflowed
+    return float(np.median(last / unit)) * unit
 
 
 def swing_midline(y: np.ndarray, prominence: float, *, tail: float = 0.25) -> float:
@@ -84,17 +85,21 @@ def swing_midline(y: np.ndarray, prominence: float, *, tail: float = 0.25) -> fl
     last = y[-max(1, round(tail * y.size)) :]
     if not np.isfinite(last).all():
         raise ValueError("the record's tail has non-finite samples")
+    # On values divided by a power of two (exact): the range and the extrema's sums of values
+    # near 1e308 overflowed.
+    unit = power_of_two_scale(last)
+    last = last / unit
     # A tenth of the tail's range keeps the ripples of higher modes riding on the swing out.
-    prominence = max(prominence, 0.1 * float(np.ptp(last)))
+    prominence = max(prominence / unit, 0.1 * float(np.ptp(last)))
     highs, _ = find_peaks(last, prominence=prominence)
     lows, _ = find_peaks(-last, prominence=prominence)
     order = np.argsort(np.concatenate([highs, lows]), kind="stable")
     kinds = np.concatenate([np.ones(highs.size), -np.ones(lows.size)])[order]
     p = last[np.concatenate([highs, lows])[order]]
     if p.size < 3 or np.any(kinds[1:] == kinds[:-1]):
-        return float(np.median(last))
+        return float(np.median(last)) * unit
     mid = 0.25 * (p[:-2] + 2.0 * p[1:-1] + p[2:])
-    return float(np.median(mid[-MIDLINE_SWINGS:]))
+    return float(np.median(mid[-MIDLINE_SWINGS:])) * unit
 
 
 def release_index(y: np.ndarray, threshold: float, *, n_initial: int = 10) -> int:
@@ -133,6 +138,11 @@ def release_index(y: np.ndarray, threshold: float, *, n_initial: int = 10) -> in
         raise ValueError(
             f"the first {initial.size} sample(s) of y hold no finite value: no initial value"
         )
-    y0 = np.median(initial[np.isfinite(initial)])
-    moved = np.flatnonzero(np.abs(y - y0) > threshold)
+    # On values divided by a power of two (exact): the median and differences of values near
+    # 1e308 overflowed.
+    unit = power_of_two_scale(y)
+    finite = initial[np.isfinite(initial)] / unit
+    y0 = np.median(finite)
+    with np.errstate(invalid="ignore"):  # inf - inf: NaN, which never counts as moved
+        moved = np.flatnonzero(np.abs(y / unit - y0) > float(threshold) / unit)
     return int(moved[0]) if moved.size else 0

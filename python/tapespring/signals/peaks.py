@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
-from .smoothing import noise_std, real_array, smooth
+from .smoothing import noise_std, power_of_two_scale, real_array, smooth
 from .stats import Summary, summarize
 
 __all__ = [
@@ -329,11 +329,18 @@ def extract_peaks(
         raise ValueError(f"prominence must satisfy prominence > 0, got {prominence}")
     if min_distance is not None and not (math.isfinite(min_distance) and min_distance > 0):
         raise ValueError(f"min_distance must be a finite duration > 0 [s], got {min_distance}")
+    # The search runs on y divided by a power of two (exact) that brings it to order one: the
+    # range, the second differences and the parabolas' squares of values near 1e308 overflowed,
+    # and the results are those of the unscaled signal, scaled back bit for bit.
+    scale = power_of_two_scale(y)
+    y = y / scale
     sigma = noise_std(y)
     if prominence is None:
         # 0 only for a constant signal, which has no peak (find_peaks finds none at any
         # prominence): the result is then empty rather than an error about an option not given.
         prominence = max(8.0 * sigma, 1e-3 * float(np.ptp(y)))
+    else:
+        prominence = prominence / scale
     distance = None
     if min_distance is not None:
         dt = (t[-1] - t[0]) / (t.size - 1)
@@ -341,11 +348,15 @@ def extract_peaks(
     depth = max(4.0 * sigma, 1e-12 * float(np.ptp(y)))
     t_ref = float(t[0]) if t_ref is None else float(t_ref)
     args = (t, y, n, prominence, depth, distance, refine, t_ref)
+
+    def unscaled(e: Extrema) -> Extrema:
+        return Extrema(e.time, e.value * scale, e.separation, e.index)
+
     return Peaks(
-        maxima=_extrema(*args, sign=1.0),
-        minima=_extrema(*args, sign=-1.0),
-        prominence=float(prominence),
-        noise=sigma,
+        maxima=unscaled(_extrema(*args, sign=1.0)),
+        minima=unscaled(_extrema(*args, sign=-1.0)),
+        prominence=float(prominence * scale),
+        noise=sigma * scale,
         t_ref=t_ref,
     )
 
@@ -369,14 +380,15 @@ def check_time(t: np.ndarray) -> None:
     """
     if not np.all(np.isfinite(t)):
         raise ValueError(f"t must be finite: it has {np.count_nonzero(~np.isfinite(t))} NaN or inf")
-    bad = np.flatnonzero(np.diff(t) <= 0)
+    bad = np.flatnonzero(t[1:] <= t[:-1])  # not np.diff, which overflows near 1e308
     if bad.size:
         i = int(bad[0])
         raise ValueError(
             f"t must be strictly increasing: t[{i + 1}] = {t[i + 1]:.6g} s follows "
             f"t[{i}] = {t[i]:.6g} s ({bad.size} such step(s))"
         )
-    step = (t[-1] - t[0]) / (t.size - 1) if t.size > 1 else MIN_TIME_STEP
+    # Python floats: a span beyond the floats is inf (refused below), not a RuntimeWarning.
+    step = (float(t[-1]) - float(t[0])) / (t.size - 1) if t.size > 1 else MIN_TIME_STEP
     if not MIN_TIME_STEP <= step <= MAX_TIME_STEP:
         raise ValueError(
             f"t must be in seconds: its mean step of {step:.3g} s is outside "

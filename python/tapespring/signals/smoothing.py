@@ -10,6 +10,8 @@ white measurement noise on a smooth signal.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -17,6 +19,7 @@ __all__ = [
     "complete_windows",
     "effective_span",
     "noise_std",
+    "power_of_two_scale",
     "real_array",
     "smooth",
     "span_samples",
@@ -36,6 +39,22 @@ def real_array(values: ArrayLike, name: str) -> np.ndarray:
     if np.iscomplexobj(a):
         raise TypeError(f"{name} must be real numbers, got complex values ({a.dtype})")
     return np.asarray(a, dtype=float)
+
+
+def power_of_two_scale(values: np.ndarray) -> float:
+    """The power of two at or just below the largest finite ``|values|`` (1.0 if there is none, or
+    it is 0).
+
+    Dividing by it is exact and brings the values below 2 in magnitude, so that sums and squares
+    neither overflow (values near 1e308) nor underflow (near 1e-200), and a computation that is
+    homogeneous in the values gives, scaled back, the very bits it gives on values of order one.
+    """
+    a = np.abs(np.asarray(values, dtype=float))
+    a = a[np.isfinite(a)]
+    top = float(a.max()) if a.size else 0.0
+    if top == 0.0:
+        return 1.0
+    return float(np.ldexp(1.0, int(np.frexp(top)[1]) - 1))
 
 
 def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
@@ -74,17 +93,44 @@ def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:
     width = effective_span(span, n)
     if width <= 1:
         return y.copy()
-    half = np.minimum(np.arange(n), np.arange(n)[::-1])
-    half = np.minimum(half, width // 2)
-    lo = np.arange(n) - half
-    hi = np.arange(n) + half + 1
     finite = np.isfinite(y)
-    csum = np.concatenate(([0.0], np.cumsum(np.where(finite, y, 0.0))))
+    scale = power_of_two_scale(y)
+    total = _window_sums(np.where(finite, y / scale, 0.0), width)
     ccount = np.concatenate(([0], np.cumsum(finite)))
-    count = ccount[hi] - ccount[lo]
+    half = np.minimum(np.minimum(np.arange(n), np.arange(n)[::-1]), width // 2)
+    count = ccount[np.arange(n) + half + 1] - ccount[np.arange(n) - half]
     with np.errstate(invalid="ignore", divide="ignore"):
-        out = (csum[hi] - csum[lo]) / count
+        out = total / count * scale
     out[count == 0] = np.nan
+    return out
+
+
+def _window_sums(z: np.ndarray, width: int) -> np.ndarray:
+    """Sums of the windows `smooth` averages (odd `width` <= ``z.size``), each summing its own
+    samples only.
+
+    A difference of running sums (``csum[hi] - csum[lo]``) carries the rounding of every
+    earlier sample: after one glitch of 1e17 the windows of unit samples summed to 0. Here the
+    record is cut in blocks of `width` samples; a full window is the suffix of one block plus
+    the prefix of the next (or one whole block), and the shrinking windows at the ends are
+    prefixes and suffixes of the record (van Herk's scheme, O(n)).
+    """
+    n = z.size
+    h = width // 2
+    blocks = -(-n // width)
+    padded = np.zeros(blocks * width)
+    padded[:n] = z
+    grid = padded.reshape(blocks, width)
+    prefix = np.cumsum(grid, axis=1).ravel()
+    suffix = np.cumsum(grid[:, ::-1], axis=1)[:, ::-1].ravel()
+    out = np.empty(n)
+    lo = np.arange(n - 2 * h)  # the full windows [lo, lo + width)
+    out[h : n - h] = np.where(
+        lo % width == 0, prefix[lo + width - 1], suffix[lo] + prefix[lo + width - 1]
+    )
+    ends = 2 * np.arange(h)  # windows [0, 2i + 1) and [n - 2i - 1, n), i < h
+    out[:h] = np.cumsum(z[: 2 * h])[ends]
+    out[n - 1 : n - 1 - h : -1] = np.cumsum(z[::-1][: 2 * h])[ends]
     return out
 
 
@@ -130,7 +176,10 @@ def span_samples(duration: float, rate: float) -> int:
         raise ValueError(f"the span duration must be a finite number > 0 s, got {duration}")
     if not (np.isfinite(rate) and rate > 0):
         raise ValueError(f"the sampling rate must be a finite number > 0 Hz, got {rate}")
-    return max(1, 2 * round((duration * rate - 1.0) / 2.0) + 1)
+    samples = float(duration) * float(rate)  # Python floats: inf, not a RuntimeWarning
+    if not math.isfinite(samples):
+        raise ValueError(f"a span of {duration} s at {rate} Hz is beyond any number of samples")
+    return max(1, 2 * round((samples - 1.0) / 2.0) + 1)
 
 
 def complete_windows(n: int, span: int) -> slice:
@@ -179,7 +228,9 @@ def noise_std(y: np.ndarray) -> float:
         estimate the noise from; 0 would read as a noise-free signal).
     """
     y = real_array(y, "y")
-    d2 = np.diff(y, n=2)
+    scale = power_of_two_scale(y)  # second differences of values near 1e308 overflow
+    with np.errstate(invalid="ignore"):  # inf - inf: NaN, left out below as inf is
+        d2 = np.diff(y / scale, n=2)
     d2 = d2[np.isfinite(d2)]
     if d2.size == 0:
         raise ValueError(
@@ -187,4 +238,4 @@ def noise_std(y: np.ndarray) -> float:
             f"({np.count_nonzero(np.isfinite(y))} finite)"
         )
     mad = np.median(np.abs(d2 - np.median(d2)))
-    return float(1.4826 * mad / np.sqrt(6.0))
+    return float(1.4826 * mad / np.sqrt(6.0) * scale)

@@ -66,7 +66,7 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
     ValueError
         If ``values`` is empty (along ``axis``), holds an infinite value (a mean of inf, or
         a count that leaves it out while the mean uses it, would be no statistic) or values so
-        large that a statistic overflows (beyond about 1e154: the squares of the deviations).
+        large that the maximum difference overflows (two of opposite signs beyond about 9e307).
     """
     x = real_array(values, "values")
     if x.ndim == 1:
@@ -80,10 +80,20 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
     count = np.sum(np.isfinite(x), axis=axis)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns give NaN, on purpose
-        mean = np.nanmean(x, axis=axis)
-        std = np.where(count >= 2, np.nanstd(x, axis=axis, ddof=1), np.nan)
+        # Each quantity divided by the power of two of its largest value (exact): the squares of
+        # the deviations neither overflow (1e300) nor underflow (1e-200, whose spread read 0).
+        top = np.nanmax(np.abs(x), axis=axis, keepdims=axis is not None)
+        top = np.where(np.isfinite(top) & (top > 0), top, 1.0)
+        scale = np.ldexp(1.0, np.frexp(top)[1] - 1)
+        scaled = x / scale
+        if axis is not None:
+            scale = np.squeeze(scale, axis=axis)
+        mean_scaled = np.nanmean(scaled, axis=axis)
+        std_scaled = np.where(count >= 2, np.nanstd(scaled, axis=axis, ddof=1), np.nan)
+        mean = mean_scaled * scale
+        std = std_scaled * scale
         max_diff = np.nanmax(x, axis=axis) - np.nanmin(x, axis=axis)
-        cv = std / np.abs(mean)
+        cv = std_scaled / np.abs(mean_scaled)
     if np.isinf(mean).any() or np.isinf(std).any() or np.isinf(max_diff).any():
         raise ValueError(
             "values too large for their statistics: the mean, standard deviation or maximum "
