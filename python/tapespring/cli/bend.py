@@ -18,7 +18,15 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn
 
-__all__ = ["add_tape_options", "refuse", "register", "run", "tape_fields", "warn"]
+__all__ = [
+    "add_tape_options",
+    "refuse",
+    "refuse_shared_paths",
+    "register",
+    "run",
+    "tape_fields",
+    "warn",
+]
 
 
 def _checked(name: str, check: Callable[[float], object]):
@@ -128,9 +136,12 @@ def _writable(folder: Path) -> bool:
 
 def _output_file(text: str) -> str:
     """An argparse type: a file the command will write, in a folder that exists and is writable
-    (checked before anything runs, so that a mistyped path does not cost the run)."""
+    (checked before anything runs, so that a mistyped path does not cost the run).
+
+    A name ending in a separator (``out/``) names a folder: refused, as the writers would drop
+    the separator and write a file ``out`` while the command said it wrote ``out/``."""
     path = Path(text)
-    if text == "" or path.is_dir():
+    if text == "" or path.is_dir() or text.endswith(("/", os.sep)):
         raise argparse.ArgumentTypeError(f"{text!r} is not a file name")
     folder = path.parent
     if not folder.is_dir():
@@ -162,19 +173,95 @@ def _output_folder(text: str) -> Path:
 
 def _image_file(text: str) -> str:
     """An argparse type: an image file the command will write (as `_output_file`), in a format
-    matplotlib writes, given by its extension (none: PNG)."""
-    _output_file(text)
-    suffix = Path(text).suffix.lower().lstrip(".")
-    if suffix:
-        from matplotlib.backend_bases import FigureCanvasBase
+    matplotlib writes, given by its extension.
 
-        formats = FigureCanvasBase.get_supported_filetypes()
-        if suffix not in formats:
-            raise argparse.ArgumentTypeError(
-                f"cannot write {text}: '.{suffix}' is not an image format matplotlib writes "
-                f"({', '.join(sorted(formats))})"
-            )
+    Without an extension the figure is a PNG, and the name returned is the one matplotlib writes:
+    ``fig`` gives ``fig.png`` and ``fig.`` too (its rule: the text after the last dot of the name,
+    trailing dots dropped), so that the command names the file it wrote (it said ``wrote fig``
+    of a file ``fig.png``) and `refuse_shared_paths` compares the real names."""
+    _output_file(text)
+    suffix = os.path.splitext(text)[1].lower().lstrip(".")
+    if not suffix:
+        named = text.rstrip(".") + ".png"
+        _output_file(named)  # "fig" may be a file and "fig.png" a folder
+        return named
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if suffix not in formats:
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text}: '.{suffix}' is not an image format matplotlib writes "
+            f"({', '.join(sorted(formats))})"
+        )
     return text
+
+
+def _vtu_file(text: str) -> str:
+    """An argparse type: the ``.pvd`` file of a ParaView series the command will write (as
+    `_output_file`), ``.pvd`` added if missing, as `tapespring.io.vtu.write_pvd` adds it; the
+    series' VTU files go into the folder of the same name without suffix, which must not be an
+    existing file (``out.pvd`` beside a file ``out``: the writer failed after the whole run with
+    "[Errno 17] File exists: 'out'")."""
+    _output_file(text)
+    path = Path(text)
+    if path.suffix != ".pvd":
+        path = path.with_name(path.name + ".pvd")
+        _output_file(str(path))
+    folder = path.with_suffix("")
+    if folder.exists() and not folder.is_dir():
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text}: its VTU files go into the folder {str(folder)!r}, which is "
+            "an existing file"
+        )
+    return str(path)
+
+
+#: The options naming a file a command writes, as `refuse_shared_paths` reads them.
+_OUTPUT_OPTIONS = ("csv", "plot", "snapshots", "vtu")
+
+
+def refuse_shared_paths(args: argparse.Namespace) -> None:
+    """Refuse (as `refuse`) outputs that would overwrite each other or the recording the command
+    reads: ``--csv``, ``--plot``, ``--snapshots`` and ``--vtu`` (its ``.pvd`` file and the folder
+    of its VTU files) naming one file, or naming the ``--experiment`` recording or a CSV
+    recording's force side file (``<stem>.forces.csv``). Each writer replaced the file silently:
+    ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's table.
+    Paths are compared once resolved (``./rec.csv``, a symbolic link)."""
+    read: dict[Path, str] = {}
+    experiment = getattr(args, "experiment", None)
+    if experiment:
+        read[Path(experiment).resolve()] = f"the --experiment recording {experiment}"
+        if Path(experiment).suffix.lower() == ".csv":
+            from tapespring.trials.csv import forces_file_of
+
+            try:
+                side = forces_file_of(Path(experiment))
+            except ValueError:  # two side files differing in case: the reader says so
+                side = None
+            if side is not None:
+                read[side.resolve()] = (
+                    f"the force side file {str(side)!r} of the --experiment recording"
+                )
+    written: dict[Path, str] = {}
+    for name in _OUTPUT_OPTIONS:
+        text = getattr(args, name, None)
+        if not text:
+            continue
+        option = f"--{name} {text}"
+        paths = [Path(text)]
+        if name == "vtu":
+            paths.append(Path(text).with_suffix(""))  # the folder of the VTU files
+        for path in paths:
+            key = path.resolve()
+            if key in read:
+                refuse(args, f"{option} would overwrite {read[key]}: give another file name")
+            if key in written:
+                refuse(
+                    args,
+                    f"{written[key]} and {option} would both write {str(path)!r}: give each "
+                    "output its own name",
+                )
+            written[key] = option
 
 
 def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
@@ -319,6 +406,7 @@ def run(args: argparse.Namespace) -> int:
 
     from .scenario_options import shows_progress
 
+    refuse_shared_paths(args)
     # A zero or non-finite --theta-max was refused by the parser (BendingSetup's own check).
     imperfection = args.imperfection
     if imperfection is None:

@@ -10,8 +10,9 @@ from .bend import (
     _field,
     _image_file,
     _input_file,
-    _output_file,
+    _vtu_file,
     refuse,
+    refuse_shared_paths,
 )
 from .scenario_options import (
     add_energy_tolerance_option,
@@ -114,7 +115,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         )
     p.add_argument(
         "--vtu",
-        type=_output_file,
+        type=_vtu_file,
         metavar="FILE.pvd",
         help="write the deformed set-up as a ParaView series (every 16th record: 50 Hz at 800 Hz "
         "samples; needs meshio)",
@@ -142,17 +143,21 @@ def run(args: argparse.Namespace) -> int:
 
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
 
+    refuse_shared_paths(args)
     if not args.experiment:
         for kind in ("min", "max"):
             if getattr(args, f"leave_aside_{kind}"):
                 refuse(args, f"--leave-aside-{kind} applies to the comparison with --experiment")
+    spec = spec_from_args(args, support=args.support)
     rate = args.sample_rate
     if rate is None:
+        # The support run, which ``--spec support=flexible`` sets too (it ran at the rigid
+        # clamp's 800 Hz, which does not resolve the support's vibration).
         rate = (
-            FLEXIBLE_SAMPLE_RATE if args.support == "flexible" else DeploymentSettings.sample_rate
+            FLEXIBLE_SAMPLE_RATE if spec.support == "flexible" else DeploymentSettings.sample_rate
         )
     settings = DeploymentSettings(
-        spec=spec_from_args(args, support=args.support),
+        spec=spec,
         sense=args.sense,
         sample_rate=rate,
         duration=args.duration,

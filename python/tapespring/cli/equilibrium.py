@@ -7,7 +7,7 @@ import argparse
 import functools
 from typing import TYPE_CHECKING
 
-from .bend import _checked
+from .bend import _checked, refuse_shared_paths
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -66,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
     folded equilibrium on the push path, or no comparison; 2 bad input or experiment file)."""
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
+    refuse_shared_paths(args)
     measured = None
     if args.experiment:
         from tapespring.protocols.identification import analyze_identification

@@ -17,7 +17,16 @@ import json
 import sys
 from functools import partial
 
-from .bend import _checked, _count, _field, _image_file, _output_file, refuse, warn
+from .bend import (
+    _checked,
+    _count,
+    _field,
+    _image_file,
+    _output_file,
+    refuse,
+    refuse_shared_paths,
+    warn,
+)
 from .scenario_options import add_json_and_progress_options, shows_progress
 
 __all__ = ["register", "run"]
@@ -171,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
     from tapespring.scenarios.max_mass import MaxMassSettings, max_mass, write_csv
     from tapespring.scenarios.setup import PAPER_BOUNDS, IdentificationBounds
 
+    refuse_shared_paths(args)
     if args.plot and (args.n_thickness < 2 or args.n_modulus < 2):
         print(
             "error: --plot draws contours and needs at least 2 values of t and of E "

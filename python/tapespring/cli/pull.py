@@ -6,7 +6,7 @@ import argparse
 import functools
 from typing import TYPE_CHECKING
 
-from .bend import _checked
+from .bend import _checked, refuse_shared_paths
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -64,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     comparison, 2 bad input or experiment file)."""
     from tapespring.scenarios.pull import PullSettings, pull
 
+    refuse_shared_paths(args)
     measured = None
     if args.experiment:
         from tapespring.protocols.pull import analyze_pull_trial

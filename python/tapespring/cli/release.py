@@ -14,7 +14,14 @@ import json
 import sys
 from typing import Any
 
-from .bend import _checked, _image_file, _output_file, add_tape_options, tape_fields
+from .bend import (
+    _checked,
+    _image_file,
+    _output_file,
+    add_tape_options,
+    refuse_shared_paths,
+    tape_fields,
+)
 from .scenario_options import (
     add_energy_tolerance_option,
     add_eta_option,
@@ -147,6 +154,7 @@ def run(args: argparse.Namespace) -> int:
     from tapespring.scenarios.bending import BendingSetup
     from tapespring.scenarios.release import ReleaseSetup, release
 
+    refuse_shared_paths(args)
     try:
         setup = ReleaseSetup(
             tape=BendingSetup(**tape_fields(args)),

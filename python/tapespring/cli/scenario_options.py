@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from .bend import _checked, _field, _image_file, _input_file, _output_file
+from .bend import _checked, _field, _image_file, _input_file, _output_file, _vtu_file
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -361,7 +361,7 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
     )
     p.add_argument(
         "--vtu",
-        type=_output_file,
+        type=_vtu_file,
         metavar="FILE.pvd",
         help=f"write the deformed set-up as a ParaView series ({vtu}; needs meshio)",
     )

@@ -83,6 +83,14 @@ def _n_peaks(text: str) -> int:
     return value
 
 
+def _trial_path(text: str) -> str:
+    """The ``PATH`` argparse type: a trial file or folder, refused when empty (pathlib reads
+    ``""`` as the current folder, whose trials ``tapespring trials analyze ""`` then analysed)."""
+    if text == "":
+        raise argparse.ArgumentTypeError("an empty path (the current folder is '.')")
+    return text
+
+
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``trials`` command (with its ``analyze`` sub-command) to a CLI.
 
@@ -110,7 +118,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "folder (CSV tables and PNG figures) and print a summary table. SI units."
         ),
     )
-    p.add_argument("paths", nargs="+", metavar="PATH", help="trial files or folders")
+    p.add_argument(
+        "paths", nargs="+", type=_trial_path, metavar="PATH", help="trial files or folders"
+    )
     p.add_argument("--kind", required=True, choices=KINDS, help="kind of test")
     p.add_argument(
         "--out",
@@ -245,6 +255,26 @@ def _check_kind_options(args: argparse.Namespace) -> None:
             refuse(args, f"{option} applies to --kind {kind} only, not --kind {args.kind}")
 
 
+def _check_report_folder(args: argparse.Namespace) -> None:
+    """Refuse an ``--out`` folder that holds trials given (a folder given, or the folder of a
+    file given): the report's CSV tables (``trials.csv``, ``summary.csv``, ...) would land among
+    the trials, where the next analysis of that folder reads them as trials and fails ("line 2,
+    column 'quantity': ... is not a number"), and a trial file of the same name would be
+    replaced."""
+    out = Path(args.out).resolve()
+    for raw in args.paths:
+        path = Path(raw)
+        folder = path if path.is_dir() else path.parent
+        if folder.resolve() == out:
+            refuse(
+                args,
+                f"--out {args.out} is the folder of the trials given ({raw}): the report's CSV "
+                "tables would be read as trials by the next analysis of that folder and could "
+                f"replace a trial file of the same name; give another folder (e.g. "
+                f"{Path(args.out) / 'report'})",
+            )
+
+
 def run_analyze(args: argparse.Namespace) -> int:
     """Handler of ``tapespring trials analyze``; returns the exit code.
 
@@ -261,6 +291,7 @@ def run_analyze(args: argparse.Namespace) -> int:
     from tapespring.trials.trial import TrialError
 
     _check_kind_options(args)
+    _check_report_folder(args)
     progress = not args.no_progress
     required = [args.markers[i] for i in protocol_for(args.kind).marker_roles]
     with warnings.catch_warnings(record=True) as caught:

@@ -8,7 +8,7 @@ import functools
 import warnings
 from typing import TYPE_CHECKING, Any
 
-from .bend import _checked, _field, print_warnings, refuse
+from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -167,6 +167,7 @@ def run(args: argparse.Namespace) -> int:
     comparison, 2 bad input or experiment file)."""
     from tapespring.scenarios.vibration import vibrate
 
+    refuse_shared_paths(args)
     _check(args)
     window = (args.window_mm[0] * 1e-3, args.window_mm[1] * 1e-3)
     if args.rho_inf_study:

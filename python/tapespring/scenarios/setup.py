@@ -599,11 +599,16 @@ class SetupSpec:
                 f"rod, which ends at x = {self.appendix_x} m (tape.length + interface_length + "
                 f"rod_width), for at least one element of mesh_plates = {self.mesh_plates} m"
             )
-        chord = 2.0 * self.tape.radius * math.sin(self.tape.alpha / 2.0)
+        # The section's extent across (along y): its chord up to a half circle; past it, the
+        # arc bulges beyond its chord to the full diameter (alpha = 300 deg and R = 25 mm: a chord
+        # of 25 mm, tapes 50 mm across, and at 40 mm spacing they were built through each other).
+        half = min(self.tape.alpha, math.pi) / 2.0
+        chord = 2.0 * self.tape.radius * math.sin(half)
         if self.tape_spacing <= chord:
+            across = "chord" if self.tape.alpha <= math.pi else "width across (a diameter)"
             raise ValueError(
-                f"tape_spacing {self.tape_spacing} m must exceed the tapes' chord {chord:.4g} m "
-                "(they would overlap)"
+                f"tape_spacing {self.tape_spacing} m must exceed the tapes' {across} "
+                f"{chord:.4g} m (they would overlap)"
             )
         if self.rod_length < self.tape_spacing + self.interface_width:
             raise ValueError(
