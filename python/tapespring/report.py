@@ -15,6 +15,7 @@ its protocol (`tapespring.protocols.Protocol`); the helpers it writes them with
 from __future__ import annotations
 
 import csv
+import io
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -63,7 +64,8 @@ def summary_json(s: Summary, deg: bool = False) -> dict:
     """
     out = {"mean": s.mean, "std": s.std, "max_diff": s.max_diff, "cv": s.cv, "count": s.count}
     if deg:
-        out |= {f"{k}_deg": float(np.rad2deg(out[k])) for k in ("mean", "std", "max_diff")}
+        with np.errstate(over="ignore"):  # beyond the floats in degrees: inf, written as None
+            out |= {f"{k}_deg": float(np.rad2deg(out[k])) for k in ("mean", "std", "max_diff")}
     return {k: jsonable(v) for k, v in out.items()}
 
 
@@ -170,12 +172,20 @@ def format_summary(analysis: TrialsAnalysis[Any]) -> str:
 
 
 def write_table(path: Path, header: Sequence[str], rows: Sequence[Sequence[object]]) -> Path:
-    """Write one CSV table (None and NaN as empty fields); return its path."""
+    """Write one CSV table (None and NaN as empty fields; lines end in ``\n``); return its path.
+
+    A field holding a line break of either kind (``\r`` or ``\n``: a file name, a problem's
+    text) is quoted. The csv module quotes only the characters of its line terminator, so with
+    ``\n`` alone a ``\r`` went out bare and readers split the row there.
+    """
     with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh, lineterminator="\n")
-        writer.writerow(header)
-        for row in rows:
-            writer.writerow(["" if v is None else v for v in (jsonable(x) for x in row)])
+        for row in [header, *rows]:
+            line = io.StringIO()
+            # "\r\n" makes the writer quote both characters; the row then ends in "\n".
+            csv.writer(line, lineterminator="\r\n").writerow(
+                ["" if v is None else v for v in (jsonable(x) for x in row)]
+            )
+            fh.write(line.getvalue()[:-2] + "\n")
     return path
 
 

@@ -10,7 +10,9 @@ import json
 import math
 import numbers
 import os
+import struct
 import zipfile
+import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -411,7 +413,21 @@ class Results:
             reason = "not a NumPy .npz archive" if "pickled" in str(exc) else str(exc)
             message = f"{path} is not a readable saved tapespring Results ({reason})"
             raise ValueError(message) from exc
-        except (OSError, EOFError, KeyError, TypeError, zipfile.BadZipFile) as exc:
+        except (
+            OSError,
+            EOFError,
+            KeyError,
+            TypeError,
+            zipfile.BadZipFile,
+            # A corrupted header can ask for a zip feature (version 6.4) or a compression zipfile
+            # lacks, flag a member as encrypted (a RuntimeError), give a compressed member's
+            # stream that zlib refuses, or fields struct cannot unpack.
+            NotImplementedError,
+            RuntimeError,
+            zlib.error,
+            struct.error,
+            OverflowError,
+        ) as exc:
             raise ValueError(
                 f"{path} is not a readable saved tapespring Results (truncated or corrupted: "
                 f"{type(exc).__name__}: {exc})"
