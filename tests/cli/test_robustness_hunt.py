@@ -191,3 +191,13 @@ def test_deploy_samples_at_the_rate_of_the_support_it_runs(argv, rate, monkeypat
     assert main(["deploy", *argv, "--no-progress"]) == 2
     assert capsys.readouterr().err == "error: stopped before the run\n"
     assert seen[0].sample_rate == rate
+
+
+@pytest.mark.parametrize("option", ["--frame", "--session", "--tape-pair"])
+@pytest.mark.parametrize("value", ["", "  "])
+def test_trials_refuse_an_empty_text_option(option, value, tmp_path, capsys):
+    # An empty --frame was the laboratory frame, an empty --session a session '' of every trial:
+    # an unset shell variable, taken silently.
+    _recording(tmp_path)
+    argv = ["trials", "analyze", str(tmp_path), "--kind", "deployment", option, value]
+    assert f"argument {option}: {option} is empty (got {value!r})" in refused(argv, capsys)

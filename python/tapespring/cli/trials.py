@@ -91,6 +91,19 @@ def _trial_path(text: str) -> str:
     return text
 
 
+def _text(option: str):
+    """An argparse type: a text that is not empty or blank, named `option` when it is. An empty
+    ``--frame`` was the default frame, an empty ``--session`` a session named '' of every trial:
+    most likely a shell variable that was not set (``--session "$SESSION"``)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"{option} is empty (got {text!r})")
+        return text
+
+    return parse
+
+
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``trials`` command (with its ``analyze`` sub-command) to a CLI.
 
@@ -146,6 +159,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--frame",
+        type=_text("--frame"),
         default=None,
         metavar="AXES",
         help=(
@@ -189,8 +203,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("--sense", choices=_SENSES, help="sense of bending of every trial given")
-    p.add_argument("--session", help="session of every trial given")
-    p.add_argument("--tape-pair", help="tape pair of every trial given")
+    p.add_argument("--session", type=_text("--session"), help="session of every trial given")
+    p.add_argument("--tape-pair", type=_text("--tape-pair"), help="tape pair of every trial given")
     p.add_argument(
         "--skip-bad",
         action="store_true",
