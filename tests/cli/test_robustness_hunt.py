@@ -201,3 +201,14 @@ def test_trials_refuse_an_empty_text_option(option, value, tmp_path, capsys):
     _recording(tmp_path)
     argv = ["trials", "analyze", str(tmp_path), "--kind", "deployment", option, value]
     assert f"argument {option}: {option} is empty (got {value!r})" in refused(argv, capsys)
+
+
+def test_vibrate_names_a_fixed_step_too_long_for_the_duration_in_steps(capsys):
+    # It said "at 1/time_step = 1e-308 Hz ... lengthen the duration to at least inf s or raise
+    # the 1/time_step".
+    line = refused(["vibrate", "--time-step", "1e308", "--no-progress"], capsys, by_parser=False)
+    assert line == (
+        "error: time_step = 1e+308 s makes fewer than 2 steps in duration = 8 s, too few for the "
+        "peak analysis; give a time_step of at most 4 s or lengthen the duration (see "
+        "MIN_SAMPLE_INTERVALS)"
+    )

@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from tapespring.scenarios.setup import (
     MAX_SAMPLE_RATE,
+    MIN_SAMPLE_INTERVALS,
     PAPER_MODEL,
     PAPER_SETUP,
     SetupSpec,
@@ -190,6 +191,17 @@ class VibrationSettings:
         # Every fixed step is a record: the same bounds as the samples (a fixed step longer than
         # half the duration leaves fewer than 2 of them).
         rate_name = "1/time_step" if self.time_step > 0.0 else "sample_rate"
+        if self.time_step > 0.0 and self.duration < MIN_SAMPLE_INTERVALS * self.time_step * (
+            1.0 - 1e-9
+        ):
+            # Said in the steps given: "at 1/time_step = 1e-308 Hz ... lengthen the duration to
+            # at least inf s or raise the 1/time_step" was the rate's message for a step of 1e308.
+            raise ValueError(
+                f"time_step = {shown(self.time_step)} s makes fewer than {MIN_SAMPLE_INTERVALS} "
+                f"steps in duration = {shown(self.duration)} s, too few for the peak analysis; "
+                f"give a time_step of at most {self.duration / MIN_SAMPLE_INTERVALS:.3g} s or "
+                "lengthen the duration (see MIN_SAMPLE_INTERVALS)"
+            )
         check_sampling(
             ("duration", self.duration), sample_rate=self.record_rate, rate_name=rate_name
         )
