@@ -212,3 +212,31 @@ def test_vibrate_names_a_fixed_step_too_long_for_the_duration_in_steps(capsys):
         "peak analysis; give a time_step of at most 4 s or lengthen the duration (see "
         "MIN_SAMPLE_INTERVALS)"
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "interval"),
+    [
+        ([], 0),
+        (["--vtu", "{d}/v.pvd", "--duration", "0.0025"], 16),
+        (["--snapshots", "{d}/s.png"], 16),
+        # Six snapshots of 2.5 ms were one kept record drawn six times ("t = 2.002 s" six times).
+        (["--snapshots", "{d}/s.png", "--duration", "0.0025"], 1),
+        (["--snapshots", "{d}/s.png", "--vtu", "{d}/v.pvd", "--duration", "0.05"], 4),
+    ],
+)
+def test_deploy_keeps_fields_often_enough_for_distinct_snapshots(
+    argv, interval, tmp_path, monkeypatch, capsys
+):
+    import tapespring.scenarios.deployment as deployment
+
+    seen = []
+
+    def deploy(settings, progress):
+        seen.append(settings)
+        raise ValueError("stopped before the run")
+
+    monkeypatch.setattr(deployment, "deploy", deploy)
+    assert main(["deploy", *(a.format(d=tmp_path) for a in argv), "--no-progress"]) == 2
+    assert capsys.readouterr().err == "error: stopped before the run\n"
+    assert seen[0].field_interval == interval
