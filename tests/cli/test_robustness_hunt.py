@@ -240,3 +240,12 @@ def test_deploy_keeps_fields_often_enough_for_distinct_snapshots(
     assert main(["deploy", *(a.format(d=tmp_path) for a in argv), "--no-progress"]) == 2
     assert capsys.readouterr().err == "error: stopped before the run\n"
     assert seen[0].field_interval == interval
+
+
+def test_vibrate_refuses_a_radius_repeated_in_the_study(capsys):
+    # Each radius runs the whole test: `--rho-inf-study 0.7 0.7` ran it twice for a duplicate row
+    # (0.0 and -0.0 are one radius).
+    line = refused(["vibrate", "--rho-inf-study", "0.7", "0.5", "0.70", "0", "-0.0"], capsys)
+    assert line.endswith(
+        "error: --rho-inf-study gives 0, 0.7 more than once: give each radius once"
+    )

@@ -63,6 +63,11 @@ def _check(args: argparse.Namespace) -> None:
     except ValueError as e:
         refuse(args, f"--window-mm {low:g} {high:g}: {e}")
     if args.rho_inf_study:
+        repeated = sorted({r for r in args.rho_inf_study if args.rho_inf_study.count(r) > 1})
+        if repeated:
+            # Each radius runs the whole test: a repeat doubled the run for a duplicate row.
+            twice = ", ".join(f"{r:g}" for r in repeated)
+            refuse(args, f"--rho-inf-study gives {twice} more than once: give each radius once")
         if args.rho_inf is not None:
             refuse(args, "--rho-inf is not used with --rho-inf-study, which gives the radii")
         for option in ("experiment", "vtu"):
