@@ -249,3 +249,21 @@ def test_vibrate_refuses_a_radius_repeated_in_the_study(capsys):
     assert line.endswith(
         "error: --rho-inf-study gives 0, 0.7 more than once: give each radius once"
     )
+
+
+def test_pull_ending_before_the_force_peaks_is_a_failure(capsys):
+    # "maximum force 6.322 N at 5.03 mm", set beside the paper's 7.6 N at 10.1 mm with exit code
+    # 0: the force of the last state, still rising, long before the tapes buckle.
+    assert main([*_COARSE_PULL, "--max-displacement", "5e-3"]) == 1
+    out, err = capsys.readouterr()
+    assert "maximum force 6.322 N at 5.03 mm" in out
+    assert err == (
+        "error: the force is largest at the end of the pull (6.322 N at 5.03 mm of marker 2): "
+        "the maximum before the tapes buckle is not reached, or not seen; pull further "
+        "(--max-displacement 0.005 m given; the paper's buckling is near 10 mm)\n"
+    )
+
+
+def test_pull_past_the_peak_succeeds(capsys):
+    assert main([*_COARSE_PULL, "--max-displacement", "0.02", "--json"]) == 0
+    assert capsys.readouterr().err == ""

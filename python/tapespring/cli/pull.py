@@ -6,6 +6,8 @@ import argparse
 import functools
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from .bend import _checked, refuse_shared_paths
 from .scenario_options import (
     add_comparison_options,
@@ -59,6 +61,13 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _still_rising(result: PullResult) -> bool:
+    """Whether the pull ended before the force's maximum: the largest force is at the last state
+    and is no extremum located on the path."""
+    force = result.force_N
+    return bool(force.size) and not result.located and force[-1] >= np.max(force)
+
+
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring pull``; returns the exit code (0, 1 stopped early or no
     comparison, 2 bad input or experiment file)."""
@@ -81,6 +90,15 @@ def run(args: argparse.Namespace) -> int:
             field_interval=1 if args.vtu else 0,
         )
         result = pull(settings, progress=shows_progress(args))
+        if _still_rising(result):
+            # The largest force is the last state's: the tapes have not buckled, and that force
+            # is no maximum to set beside the paper's (it was, with exit code 0).
+            problems.append(
+                f"the force is largest at the end of the pull ({result.force_N[-1]:.3f} N at "
+                f"{result.displacement_m[-1] * 1e3:.2f} mm of marker 2): the maximum before the "
+                "tapes buckle is not reached, or not seen; pull further (--max-displacement "
+                f"{args.max_displacement:g} m given; the paper's buckling is near 10 mm)"
+            )
         if measured is not None:
             compare = functools.partial(result.compare, measured)
             result = with_comparison(result, compare, args.experiment, problems)
