@@ -267,3 +267,25 @@ def test_pull_ending_before_the_force_peaks_is_a_failure(capsys):
 def test_pull_past_the_peak_succeeds(capsys):
     assert main([*_COARSE_PULL, "--max-displacement", "0.02", "--json"]) == 0
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("option", ["--plot", "--snapshots"])
+def test_a_pgf_figure_without_its_tex_program_is_refused_before_the_run(
+    option, tmp_path, monkeypatch, capsys
+):
+    # matplotlib writes PGF through xelatex: without it the run ended in a traceback
+    # ("RuntimeError: 'xelatex' not found") after the simulation.
+    import shutil
+
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    line = refused(["deploy", option, str(tmp_path / "fig.PGF")], capsys)
+    assert f"argument {option}: cannot write {tmp_path / 'fig.PGF'}: matplotlib writes" in line
+    assert "with xelatex, which is not installed" in line
+
+
+def test_a_pgf_figure_is_taken_where_its_tex_program_is(tmp_path, monkeypatch):
+    import shutil
+
+    monkeypatch.setattr(shutil, "which", lambda name: f"/usr/bin/{name}")
+    args = build_parser().parse_args(["pull", "--plot", str(tmp_path / "fig.pgf")])
+    assert args.plot == str(tmp_path / "fig.pgf")

@@ -193,6 +193,19 @@ def _image_file(text: str) -> str:
             f"cannot write {text}: '.{suffix}' is not an image format matplotlib writes "
             f"({', '.join(sorted(formats))})"
         )
+    if suffix == "pgf":
+        # matplotlib writes PGF through a TeX program: without it the figure failed after the
+        # run with a traceback ("RuntimeError: 'xelatex' not found").
+        import shutil
+
+        from matplotlib import rcParams
+
+        tex = rcParams["pgf.texsystem"]
+        if shutil.which(tex) is None:
+            raise argparse.ArgumentTypeError(
+                f"cannot write {text}: matplotlib writes '.pgf' with {tex}, which is not "
+                "installed (not on PATH); choose another format, such as .pdf or .svg"
+            )
     return text
 
 
