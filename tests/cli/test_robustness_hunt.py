@@ -289,3 +289,15 @@ def test_a_pgf_figure_is_taken_where_its_tex_program_is(tmp_path, monkeypatch):
     monkeypatch.setattr(shutil, "which", lambda name: f"/usr/bin/{name}")
     args = build_parser().parse_args(["pull", "--plot", str(tmp_path / "fig.pgf")])
     assert args.plot == str(tmp_path / "fig.pgf")
+
+
+@pytest.mark.parametrize("command", ["deploy", "pull", "vibrate", "equilibrium"])
+def test_a_series_without_meshio_is_refused_before_the_run(command, tmp_path, monkeypatch, capsys):
+    # meshio is optional: without it the writer's ImportError ended the run in a traceback,
+    # after the simulation.
+    import sys
+
+    monkeypatch.setitem(sys.modules, "meshio", None)  # as if not installed
+    line = refused([command, "--vtu", str(tmp_path / "s.pvd")], capsys)
+    assert "ParaView series need meshio, which is not installed (pip install meshio" in line
+    assert list(tmp_path.iterdir()) == []

@@ -214,7 +214,15 @@ def _vtu_file(text: str) -> str:
     `_output_file`), ``.pvd`` added if missing, as `tapespring.io.vtu.write_pvd` adds it; the
     series' VTU files go into the folder of the same name without suffix, which must not be an
     existing file (``out.pvd`` beside a file ``out``: the writer failed after the whole run with
-    "[Errno 17] File exists: 'out'")."""
+    "[Errno 17] File exists: 'out'"). The writer needs meshio, an optional dependency: without
+    it the run ended in an ImportError traceback after the simulation."""
+    import importlib.util
+
+    if importlib.util.find_spec("meshio") is None:
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text}: ParaView series need meshio, which is not installed "
+            "(pip install meshio, or the extra tapespring[vtu])"
+        )
     _output_file(text)
     path = Path(text)
     if path.suffix != ".pvd":
