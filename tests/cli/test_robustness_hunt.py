@@ -301,3 +301,26 @@ def test_a_series_without_meshio_is_refused_before_the_run(command, tmp_path, mo
     line = refused([command, "--vtu", str(tmp_path / "s.pvd")], capsys)
     assert "ParaView series need meshio, which is not installed (pip install meshio" in line
     assert list(tmp_path.iterdir()) == []
+
+
+_LONG = "a" * 300  # longer than a file name may be (255 bytes on most file systems)
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["pull", "--csv", f"{_LONG}.csv"], "--csv"),
+        (["pull", "--plot", _LONG], "--plot"),
+        (["pull", "--vtu", f"{_LONG}.pvd"], "--vtu"),
+        (["deploy", "--snapshots", f"{_LONG}.png"], "--snapshots"),
+        (["deploy", "--experiment", f"{_LONG}.csv"], "--experiment"),
+        (["trials", "analyze", ".", "--kind", "deployment", "--out", _LONG], "--out"),
+    ],
+)
+def test_a_path_too_long_for_the_file_system_is_refused_by_the_parser(
+    argv, option, tmp_path, monkeypatch, capsys
+):
+    # The parser's path checks raised "OSError: [Errno 36] File name too long" in a traceback.
+    monkeypatch.chdir(tmp_path)
+    line = refused(argv, capsys)
+    assert f"argument {option}: {_LONG}" in line and line.endswith(": File name too long")

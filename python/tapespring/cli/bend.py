@@ -105,6 +105,23 @@ def _count(name: str, what: str = "an integer >= 1"):
     return parse
 
 
+def _path_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
+    """An argparse type for a path (`parse`), whose file-system queries' OSError is refused as
+    argparse refuses a bad value: a name longer than the file system takes ("[Errno 36] File
+    name too long", 256 letters and more on most) raised out of the parser in a traceback."""
+    import functools
+
+    @functools.wraps(parse)
+    def checked(text: str) -> Any:
+        try:
+            return parse(text)
+        except OSError as exc:
+            raise argparse.ArgumentTypeError(f"{text}: {exc.strerror or exc}") from None
+
+    return checked
+
+
+@_path_type
 def _input_file(text: str) -> str:
     """An argparse type: a file the command will read, that exists (checked before anything
     runs); its content is checked by the reader."""
@@ -134,6 +151,7 @@ def _writable(folder: Path) -> bool:
     return True
 
 
+@_path_type
 def _output_file(text: str) -> str:
     """An argparse type: a file the command will write, in a folder that exists and is writable
     (checked before anything runs, so that a mistyped path does not cost the run).
@@ -153,6 +171,7 @@ def _output_file(text: str) -> str:
     return text
 
 
+@_path_type
 def _output_folder(text: str) -> Path:
     """An argparse type: a folder the command will write into (created with its parents if
     missing) whose nearest existing folder is writable (checked before anything runs, as
@@ -171,6 +190,7 @@ def _output_folder(text: str) -> Path:
     return path
 
 
+@_path_type
 def _image_file(text: str) -> str:
     """An argparse type: an image file the command will write (as `_output_file`), in a format
     matplotlib writes, given by its extension.
@@ -209,6 +229,7 @@ def _image_file(text: str) -> str:
     return text
 
 
+@_path_type
 def _vtu_file(text: str) -> str:
     """An argparse type: the ``.pvd`` file of a ParaView series the command will write (as
     `_output_file`), ``.pvd`` added if missing, as `tapespring.io.vtu.write_pvd` adds it; the
