@@ -234,6 +234,25 @@ def test_a_section_value_of_any_magnitude_is_refused_by_name_or_gives_finite_rec
         assert r.total_reaction("uz")[-1] == pytest.approx(-1e-3, rel=1e-6)
 
 
+def test_a_load_below_the_force_resolution_stops_the_step_by_name():
+    """The long profile's case: a 10 m thick section under 1 mN. The internal forces are resolved
+    in floating point to about 1.8e-3 N, above the load, and the step accepted a state 79 % out
+    of equilibrium with error=None. Now the step stops and says why; 1 N is resolved."""
+    section = {**SECTION, "thickness": 10.0}
+    for load, resolved in ((1e-3, False), (1.0, True)):
+        model = Model(NODES, QUADS, node_sets=SETS, **section)
+        model.fix("x0")
+        model.add_load(NODES.shape[0] - 1, "uz", load)
+        r = run(model, [Step.static("s", increments=1)], raise_on_error=False)
+        if resolved:
+            assert r.error is None
+            assert r.total_reaction("uz")[-1] == pytest.approx(-load, rel=1e-9)
+        else:
+            assert "below the model's force resolution" in str(r.error)
+            with pytest.raises(ConvergenceError, match="force resolution"):
+                run(model, [Step.static("s", increments=1)])
+
+
 @examples(ci=25, long=300)
 @given(
     what=st.sampled_from(["mass", "centre_of_mass", "inertia", "velocity"]),
