@@ -22,3 +22,17 @@ def test_bending_angle_is_unwrapped_past_180_degrees():
 def test_bending_angle_ignores_lateral_coordinate():
     p2 = np.array([[1.0, 5.0, -1.0]])
     assert bending_angle(np.zeros((1, 3)), p2)[0] == pytest.approx(np.pi / 4)
+
+
+def test_markers_coinciding_in_the_xz_plane_have_no_angle():
+    # atan2(0, 0) is 0: two markers on top of each other (a labelling slip, a marker stuck on
+    # another) read as a straight tape. No direction is no angle: NaN, as a missing sample, and
+    # the unwrapping goes on across it.
+    m1 = np.zeros((4, 3))
+    m2 = np.array([[1.0, 0.0, 0.0], [0.0, 5.0, 0.0], [-1.0, 0.0, -1e-9], [-1.0, 0.0, 1e-9]])
+    theta = bending_angle(m1, m2)
+    assert theta[0] == 0.0
+    assert np.isnan(theta[1])
+    # Unwrapped through the gap: pi - 1e-9 then pi + 1e-9, not -pi + 1e-9.
+    assert theta[2] == pytest.approx(np.pi, abs=1e-8)
+    assert theta[3] == pytest.approx(np.pi, abs=1e-8)

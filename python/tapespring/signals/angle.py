@@ -32,7 +32,8 @@ def bending_angle(marker_1: np.ndarray, marker_2: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (n,)
         ``atan2(-(z2 - z1), x2 - x1)`` [rad], unwrapped in time (NaN where a
-        marker is missing). Subtract the deployed-equilibrium value
+        marker is missing, or where the two coincide in the x-z plane: no direction, where
+        ``atan2(0, 0)`` would say 0). Subtract the deployed-equilibrium value
         (`equilibrium_value`) to get the paper's bending angle.
 
     Raises
@@ -51,6 +52,7 @@ def bending_angle(marker_1: np.ndarray, marker_2: np.ndarray) -> np.ndarray:
     unit = power_of_two_scale(np.concatenate((p1.ravel(), p2.ravel())))
     d = p2 / unit - p1 / unit
     angle = np.arctan2(-d[:, 2], d[:, 0])
+    angle[(d[:, 0] == 0.0) & (d[:, 2] == 0.0)] = np.nan
     valid = np.isfinite(angle)
     angle[valid] = np.unwrap(angle[valid])
     return angle
