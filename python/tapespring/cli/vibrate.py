@@ -195,6 +195,12 @@ def run(args: argparse.Namespace) -> int:
             interval = max(1, round(settings.record_rate / VTU_RATE))
             settings = dataclasses.replace(settings, field_interval=interval)
         result = vibrate(settings, progress=shows_progress(args))
+        if result.fit is None:
+            # The test's figures are the fitted damping ratio and period: without them the run
+            # has not done what it was asked (it exited 0 with "no damping fit" in its summary).
+            problems.append(
+                f"no damping fit, so no damping ratio or transient period: {result.fit_error}"
+            )
         if measured is not None:
             compare = functools.partial(result.compare, measured)
             result = with_comparison(result, compare, args.experiment, problems)
