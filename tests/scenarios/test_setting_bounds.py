@@ -35,7 +35,7 @@ from tapespring.scenarios.setup import (
 )
 from tapespring.scenarios.vibration import VibrationSettings, VibrationSimulation
 
-S = replace(PAPER_SETUP, mesh_tape=10e-3, mesh_plates=20e-3)
+S = replace(PAPER_SETUP, mesh_tape=7.5e-3, mesh_plates=20e-3)
 
 
 def _refused(obj: object, *fragments: str) -> str:
