@@ -80,3 +80,24 @@ def test_without_meshio_the_error_says_how_to_install_it(bent, tmp_path, monkeyp
     monkeypatch.setitem(sys.modules, "meshio", None)
     with pytest.raises(ImportError, match="pip install meshio"):
         write_pvd(r, model, tmp_path / "x.pvd")
+
+
+@pytest.mark.parametrize(
+    ("corrupt", "message"),
+    [
+        (lambda mesh: mesh["quads"][0].__setitem__(0, 99), "quads refer to nodes 1..99 of 15"),
+        (lambda mesh: mesh["quads"][0].__setitem__(0, -1), "quads refer to nodes -1..13 of 15"),
+        (lambda mesh: mesh["nodes"][0].__setitem__(0, float("nan")), "non-finite node"),
+        (lambda mesh: mesh["nodes"][0].pop(), ".*inhomogeneous"),
+    ],
+)
+def test_a_corrupt_saved_mesh_is_refused(bent, tmp_path, corrupt, message):
+    # Results read back from a damaged or hand-edited file: meshio wrote cells that pointed
+    # nowhere (or failed with an IndexError) where the mesh is now refused by name.
+    import copy
+
+    _, _, r = bent
+    damaged = copy.deepcopy(r)
+    corrupt(damaged.settings["model"]["mesh"])
+    with pytest.raises(ValueError, match=f"saved model mesh is corrupt: {message}"):
+        write_pvd(damaged, None, tmp_path / "damaged.pvd")

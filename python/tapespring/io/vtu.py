@@ -75,6 +75,16 @@ def reference_mesh(
             raise ValueError(
                 "the results' settings hold no model mesh: pass the model that was run"
             ) from None
+        except ValueError as exc:
+            raise ValueError(f"the results' saved model mesh is corrupt: {exc}") from None
+        # A saved file edited or damaged by hand: meshio would write cells pointing nowhere.
+        if not np.all(np.isfinite(nodes)):
+            raise ValueError("the results' saved model mesh is corrupt: non-finite node positions")
+        if quads.size and (quads.min() < 0 or quads.max() >= nodes.shape[0]):
+            raise ValueError(
+                f"the results' saved model mesh is corrupt: quads refer to nodes "
+                f"{quads.min()}..{quads.max()} of {nodes.shape[0]}"
+            )
     n_fields = results.displacements.shape[1] if results.displacements.ndim == 3 else None
     if n_fields is not None and n_fields != nodes.shape[0]:
         raise ValueError(
