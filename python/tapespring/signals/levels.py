@@ -7,6 +7,7 @@ import numbers
 import numpy as np
 from scipy.signal import find_peaks
 
+from .peaks import check_time
 from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["equilibrium_value", "release_index", "swing_midline"]
@@ -31,6 +32,12 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
     -------
     float
         Median of the finite samples with ``time >= time[-1] - tail``.
+
+    Raises
+    ------
+    ValueError
+        If `time` is not finite and strictly increasing in seconds (``peaks.check_time``), the
+        shapes differ, `tail` is not positive, or the tail holds no finite sample.
     """
     time = real_array(time, "time")
     y = real_array(y, "y")
@@ -41,6 +48,9 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
             f"time and y must be 1-D arrays of one length >= 1, got shapes {time.shape} and "
             f"{y.shape}"
         )
+    # The tail is the samples after time[-1] - tail: only if time increases (a NaN last time
+    # selected nothing, and a record out of order the wrong samples).
+    check_time(time)
     last = y[time >= float(time[-1]) - float(tail)]  # Python floats: no overflow warning
     last = last[np.isfinite(last)]
     if last.size == 0:
