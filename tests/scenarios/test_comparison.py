@@ -9,7 +9,6 @@ paper's eta, so that 0.4 s of motion brings peaks into the 0.4-4 mm window.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from dataclasses import replace
 
@@ -62,7 +61,7 @@ def scaled(trial: Trial, *, time: float = 1.0, marker: str = "", motion: float =
         )
         for p in trial.force_plates
     )
-    return dataclasses.replace(trial, time=trial.time * time, markers=markers, force_plates=plates)
+    return replace(trial, time=trial.time * time, markers=markers, force_plates=plates)
 
 
 def test_pull_compared_with_itself_through_csv_differs_by_nothing(pulled, tmp_path) -> None:
@@ -80,6 +79,18 @@ def test_pull_compared_with_itself_through_csv_differs_by_nothing(pulled, tmp_pa
     trial = read_csv(path)
     assert trial.rate == pytest.approx(800.0) and trial.force_plate(0).rate == pytest.approx(4e3)
     assert trial.time[-1] - trial.time[0] == pytest.approx(0.5 + 16.0, abs=1e-3)
+
+
+def test_the_simulated_recording_is_pulled_at_the_spec_pull_rate(pulled) -> None:
+    # SetupSpec.pull_rate was read nowhere: the trial was timed by a constant of its own, so
+    # --spec pull_rate=... changed nothing. 16 mm at 2 mm/s after the 0.5 s rest: 8.5 s.
+    assert pulled.to_trial().time[-1] == pytest.approx(0.5 + 16.0, abs=1e-3)
+    faster = replace(
+        pulled,
+        settings=replace(pulled.settings, spec=replace(pulled.settings.spec, pull_rate=2e-3)),
+    )
+    assert faster.to_trial().time[-1] == pytest.approx(0.5 + 8.0, abs=1e-3)
+    assert faster.to_trial(speed=1e-3).time[-1] == pytest.approx(0.5 + 16.0, abs=1e-3)
 
 
 def test_pull_against_a_scaled_recording_gives_the_scale_back(pulled) -> None:

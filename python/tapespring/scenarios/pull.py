@@ -53,9 +53,10 @@ __all__ = [
     "rest_before",
 ]
 
-#: Pulling speed of the paper's model [m/s] (Sec. 6.2: 1 mm/s imposed on the rod's middle); the
-#: time scale of a simulated pull turned into a trial.
-PULL_SPEED = 1e-3
+#: Pulling speed of the paper's model [m/s] (Sec. 6.2: 1 mm/s imposed on the rod's middle): the
+#: paper's set-up's ``pull_rate``, the default time scale of a simulated pull turned into a trial
+#: (:meth:`PullResult.to_trial` takes the run's own ``spec.pull_rate``).
+PULL_SPEED = PAPER_SETUP.pull_rate
 
 #: Trial marker names of the bare set-up's markers (marker 2, the middle of the rod, is pulled).
 TRIAL_MARKERS = {"marker1": "M1", "marker2": "M2"}
@@ -268,7 +269,7 @@ class PullResult:
     def to_trial(
         self,
         *,
-        speed: float = PULL_SPEED,
+        speed: float | None = None,
         rate_hz: float = 800.0,
         force_rate_hz: float = 4000.0,
         hold: float = 0.5,
@@ -282,8 +283,9 @@ class PullResult:
 
         Parameters
         ----------
-        speed : float
-            Pulling speed [m/s], > 0 (the paper's model: 1 mm/s).
+        speed : float or None
+            Pulling speed [m/s], > 0. None: the set-up's ``spec.pull_rate`` (the paper's model:
+            1 mm/s, :data:`PULL_SPEED`).
         rate_hz, force_rate_hz : float
             Marker and force-plate sampling rates [Hz] (the paper's cameras: 800 Hz; its force
             plate: 4 kHz, where the protocol's 101-sample smoothing spans 25 ms).
@@ -309,6 +311,8 @@ class PullResult:
 
         from tapespring.trials.trial import ForcePlate, Metadata
 
+        if speed is None:
+            speed = self.settings.spec.pull_rate
         if not (np.isfinite(speed) and speed > 0.0):
             raise ValueError(f"speed must be finite and > 0 m/s (got {speed})")
         if self.setup is None:

@@ -417,7 +417,8 @@ class SetupSpec:
         leads to (``DeploymentSettings.settle`` simulates one).
     pull_rate : float
         Speed of the quasi-static pull [m/s] (paper: 1 mm/s), in
-        (0, :data:`MAX_QUASI_STATIC_RATE`]. The pull is a static path here, its slow limit.
+        (0, :data:`MAX_QUASI_STATIC_RATE`]. The pull is a static path here, its slow limit;
+        the rate is its time scale when read as a recording (``PullResult.to_trial``).
     support : str
         ``"rigid"`` (the clamped ends fixed) or ``"flexible"`` (the shell model of the support);
         see :data:`SUPPORTS`.
