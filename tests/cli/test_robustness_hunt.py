@@ -324,3 +324,15 @@ def test_a_path_too_long_for_the_file_system_is_refused_by_the_parser(
     monkeypatch.chdir(tmp_path)
     line = refused(argv, capsys)
     assert f"argument {option}: {_LONG}" in line and line.endswith(": File name too long")
+
+
+@pytest.mark.parametrize("command", ["pull", "equilibrium"])
+@pytest.mark.parametrize("name", ["eta", "support_eta"])
+def test_a_viscosity_is_refused_by_the_static_commands_spec_too(command, name, capsys):
+    # --eta is not an option of the static commands; --spec eta=... was taken, recorded in the
+    # results' spec and acted on nothing.
+    assert main([command, "--no-progress", "--spec", f"{name}=1e-4"]) == 2
+    assert capsys.readouterr().err == (
+        f"error: --spec {name}: this test is static (a path without rates), so a viscosity acts "
+        "on nothing; leave it out\n"
+    )

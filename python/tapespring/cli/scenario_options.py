@@ -72,6 +72,8 @@ def add_spec_options(
     add_youngs_modulus_option(g, s.tape.youngs_modulus, name="tape.youngs_modulus")
     if eta:
         add_eta_option(g, s.eta)
+    else:
+        p.set_defaults(static_spec=True)
     g.add_argument(
         "--spec",
         type=spec_assignment,
@@ -235,6 +237,10 @@ def add_energy_tolerance_option(p: argparse._ActionsContainer, default: float) -
     )
 
 
+#: SetupSpec fields that act on rates only: refused by the static commands' ``--spec``.
+STATIC_IGNORED = ("eta", "support_eta")
+
+
 def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
     """The :class:`SetupSpec` of the parsed options: the dedicated ones and `fields` (a
     command's own options, such as deploy's ``support``), then ``--spec``'s assignments."""
@@ -242,6 +248,15 @@ def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
 
     from tapespring.scenarios.setup import PAPER_SETUP
 
+    if getattr(args, "static_spec", False):
+        # As --eta, which a static command does not have: a viscosity set there would be
+        # recorded in the results' spec and act on nothing.
+        for name, _ in getattr(args, "spec", []):
+            if name in STATIC_IGNORED:
+                raise ValueError(
+                    f"--spec {name}: this test is static (a path without rates), so a viscosity "
+                    "acts on nothing; leave it out"
+                )
     tape = replace(PAPER_SETUP.tape, thickness=args.thickness, youngs_modulus=args.youngs_modulus)
     spec = replace(
         PAPER_SETUP,
