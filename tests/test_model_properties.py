@@ -210,6 +210,8 @@ MAGNITUDES = st.one_of(
     ),
     value=MAGNITUDES,
 )
+@example(key="shear_factor", value=1.5607499630921114e-09)
+@example(key="thickness", value=10.0)
 def test_a_section_value_of_any_magnitude_is_refused_by_name_or_gives_finite_records(key, value):
     """A thickness of 1e300 m or a shear factor of 1e300 once built a model whose first record
     held NaN reactions; E = 1e30 Pa made a static step accept reactions thousands of times its
@@ -230,8 +232,13 @@ def test_a_section_value_of_any_magnitude_is_refused_by_name_or_gives_finite_rec
         return
     assert np.all(np.isfinite(r.reactions)) and np.all(np.isfinite(r.kinetic_energy))
     if r.error is None:
-        # Equilibrium: the clamp carries the load.
-        assert r.total_reaction("uz")[-1] == pytest.approx(-1e-3, rel=1e-6)
+        # Equilibrium: the clamp carries the load, to within the state's residual. The internal
+        # forces balance among themselves, so R + F is minus the sum of the free uz residuals,
+        # at most 2 |r| over this plate's 4 free nodes. Where the residual's round-off floor
+        # decides convergence (a section value far from steel's), |r| may reach 1e-3 of the load
+        # (the static solver's RESOLUTION; beyond, the step stops): a shear factor of 1.56e-9
+        # leaves 1.6e-7 N, and R + F = -2.7e-8 N.
+        assert abs(r.total_reaction("uz")[-1] + 1e-3) <= 1e-12 + 2.0 * r.residual[-1]
 
 
 def test_a_load_below_the_force_resolution_stops_the_step_by_name():

@@ -245,8 +245,9 @@ impl Driver<'_> {
     /// floor is above the force tolerance, when that residual is more than [`RESOLUTION`] of the
     /// largest load norm `max_load` of the path so far: the loads are then below what the model
     /// resolves (a stiff section under a tiny load, or a unit slip), and the displacements they
-    /// give are round-off. Nothing is checked without loads (a prescribed motion, a rigid
-    /// turn: the reactions are the forces then, and a zero reaction is no error).
+    /// give are round-off. Raised for the step's last state only (`Walk::finish`). Nothing is
+    /// checked without loads (a prescribed motion, a rigid turn: the reactions are the forces
+    /// then, and a zero reaction is no error).
     fn unresolved(&self, residual: f64, max_load: f64, lambda: f64, iterations: usize) -> Option<Error> {
         let floor_only = residual > self.conv.tol_force * self.reference_force();
         (max_load > 0.0 && floor_only && residual > RESOLUTION * max_load).then(|| Error::NotConverged {
@@ -257,9 +258,10 @@ impl Driver<'_> {
             residual,
             detail: format!(
                 "the loads ({max_load:.3e} N at most) are below the model's force resolution: its \
-                 internal forces are resolved in floating point to about {:.3e} N (machine epsilon \
-                 times Young's modulus, thickness and size), and this state misses equilibrium by \
-                 {residual:.3e} N; raise the loads or check the section's units",
+                 internal forces cancel in floating point only to about {:.3e} N (the residual's \
+                 round-off floor, from Young's modulus, thickness, size and mesh), and the step's \
+                 last state misses equilibrium by {residual:.3e} N, more than {RESOLUTION:e} of \
+                 the loads; raise the loads or check the section's units",
                 self.conv.round_off
             ),
         })
@@ -697,6 +699,12 @@ struct PathState {
     closing_in: bool,
     /// Largest norm of the external loads at the states recorded so far \[N\].
     max_load: f64,
+    /// The error for the last state recorded from Newton if that state is not resolved (see
+    /// `Driver::unresolved`): raised if it is the step's last.
+    unresolved: Option<Error>,
+    /// Load factor and load norm \[N\] of the first state recorded unresolved: named if the
+    /// step fails later.
+    first_unresolved: Option<(f64, f64)>,
     /// Accepted steps in a row that crawled (see `Walk::crawling`).
     crawl: usize,
 }
@@ -927,6 +935,8 @@ impl<'a, 'b> Walk<'a, 'b> {
                 neutral_reached: false,
                 closing_in: false,
                 max_load: 0.0,
+                unresolved: None,
+                first_unresolved: None,
                 crawl: 0,
             },
             path: StaticPath::default(),
@@ -1475,12 +1485,11 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// (recorded on the path).
     fn record_step(&mut self, state: &State, out: &Outcome) -> Option<bool> {
         self.p.max_load = self.p.max_load.max(self.s.force_norm(&self.s.asm.f_ext));
-        if let Some(e) = self
+        self.p.unresolved = self
             .s
-            .unresolved(out.residual, self.p.max_load, state.t, out.iterations)
-        {
-            self.path.error = Some(e);
-            return None;
+            .unresolved(out.residual, self.p.max_load, state.t, out.iterations);
+        if self.p.unresolved.is_some() && self.p.first_unresolved.is_none() {
+            self.p.first_unresolved = Some((state.t, self.p.max_load));
         }
         let mut step = match self.s.record(state, out) {
             Ok(st) => st,
@@ -1528,6 +1537,7 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// increment, a restarting load increment, a new location history holding it); `false` if the
     /// analysis must stop (a failed record, or the progress callback's wish).
     fn push_relaxed(&mut self, state: &State, relaxed: Relaxed) -> bool {
+        self.p.unresolved = None;
         let outcome = Outcome {
             iterations: 0,
             residual: 0.0,
@@ -1592,6 +1602,22 @@ impl<'a, 'b> Walk<'a, 'b> {
                     target: end,
                 });
             }
+        }
+        // Only the step's end is judged: on the way its first increments may carry loads the
+        // model cannot resolve while the step's own load is resolved. A step that fails after
+        // such states says so (there, Newton stalls at the next increments: a 10 m thick steel
+        // plate loaded to 1 N in 1000 increments, from 1 mN, failed at 1.9 mN).
+        let last = self.p.unresolved.take();
+        if let (Some(e), None, false) = (last, &self.path.error, self.path.cancelled) {
+            self.path.error = Some(e);
+        } else if let (Some(Error::NotConverged { detail, .. }), Some((lambda, load))) =
+            (&mut self.path.error, self.p.first_unresolved)
+        {
+            detail.push_str(&format!(
+                "; at load factor {lambda:.6e} the step's loads ({load:.3e} N) were below the \
+                 model's force resolution (a state out of equilibrium by more than {RESOLUTION:e} \
+                 of them): raise the loads or check the section's units"
+            ));
         }
         if self.locate {
             self.path.steps.sort_by(|a, b| a.arc.total_cmp(&b.arc));
