@@ -255,3 +255,15 @@ def test_a_directory_entry_asking_for_what_zipfile_lacks_is_refused_by_name(
     path.write_bytes(bytes(corrupted))
     with pytest.raises(ValueError, match=f"truncated or corrupted: {escaped}"):
         Results.load(path)
+
+
+@pytest.mark.parametrize("field", ["a\rb", "a\r\nb", "a\nb", 'say "\r"'])
+def test_a_line_break_in_a_field_stays_in_its_row(tmp_path, field):
+    # The csv module quotes only its line terminator's characters: with "\n" alone a bare "\r"
+    # went out unquoted, and readers split the row there.
+    import csv
+
+    path = write_table(tmp_path / "t.csv", ["name", "n"], [[field, 1]])
+    with path.open(newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    assert rows == [["name", "n"], [field, "1"]]

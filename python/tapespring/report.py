@@ -172,7 +172,7 @@ def format_summary(analysis: TrialsAnalysis[Any]) -> str:
 
 
 def write_table(path: Path, header: Sequence[str], rows: Sequence[Sequence[object]]) -> Path:
-    """Write one CSV table (None and NaN as empty fields; lines end in ``\n``); return its path.
+    r"""Write one CSV table (None and NaN as empty fields; lines end in ``\n``); return its path.
 
     A field holding a line break of either kind (``\r`` or ``\n``: a file name, a problem's
     text) is quoted. The csv module quotes only the characters of its line terminator, so with

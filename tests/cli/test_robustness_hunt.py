@@ -15,7 +15,7 @@ import pytest
 from _cli import refused
 from tapespring.cli import build_parser, main
 
-#: The cheapest scenario run: the pull on 10 mm elements (about 0.3 s).
+#: The cheapest scenario run: the pull on 7.5 mm tapes and 10 mm plates (about 0.3 s).
 _COARSE_PULL = ["pull", "--mesh-tape", "7.5e-3", "--mesh-plates", "1e-2", "--no-progress"]
 
 

@@ -21,7 +21,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from hypothesis import assume, given
+from hypothesis import assume, example, given
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from property_settings import examples
@@ -134,6 +134,9 @@ def test_smooth_of_values_near_the_float_limits_scales_exactly(y, span):
 
 @examples(ci=12, long=200)
 @given(y=hnp.arrays(np.float64, st.integers(3, 40), elements=FINITE), c=POWERS)
+# Values near the float limit, which the drawn ones (at most 1e6 * 2^700) do not reach: the
+# differences overflowed before the values were scaled.
+@example(y=np.array([0.75, -0.75, 0.75, -0.5, 0.25]), c=2.0**1023)
 def test_noise_std_scales_with_the_signal(y, c):
     assume(np.all(np.isfinite(y * c)) and np.all(np.abs(y[y != 0] * c) >= 2.0**-1000))
     assert signals.noise_std(y * c) == signals.noise_std(y) * c
@@ -201,6 +204,7 @@ def test_a_damping_fit_does_not_depend_on_the_unit_of_z(seed, exponent):
     a=hnp.arrays(np.float64, st.integers(2, 40), elements=MODERATE),
     c=st.floats(1e-290, 1e290),
 )
+@example(a=np.array([1.5, -1.5, 0.5]), c=1e308)  # the interpolation's difference overflowed
 def test_crossings_are_the_interpolated_sign_changes_at_any_magnitude(a, c):
     t = np.arange(a.size) * 0.01
     got = _checked(lambda: signals.force_at_crossings(t, a * c, np.ones_like(a)))
@@ -218,6 +222,7 @@ def test_crossings_are_the_interpolated_sign_changes_at_any_magnitude(a, c):
     f=hnp.arrays(np.float64, 40, elements=st.floats(-1e3, 1e3)),
     c=POWERS,
 )
+@example(f=np.linspace(1.5, 1.9, 40), c=2.0**1023)  # the baseline's median overflowed
 def test_crossing_peaks_scale_with_the_force(f, c):
     t = np.arange(40) * 0.01
     angle = np.cos(2 * np.pi * 2.0 * t)
@@ -256,9 +261,17 @@ def test_a_circle_of_any_size_is_found(exponent, centre, arc, start):
 
 @examples(ci=12, long=300)
 @given(y=hnp.arrays(np.float64, st.integers(1, 30), elements=FINITE), c=POWERS)
+@example(y=np.full(20, 1.5), c=2.0**1023)  # the reference's median overflowed
 def test_lateral_excursion_and_midline_scale_with_the_signal(y, c):
     assume(np.all(np.isfinite(y * c)) and np.all((y == 0) | (np.abs(y * c) >= 2.0**-1000)))
     assert signals.max_lateral_displacement(y * c) == signals.max_lateral_displacement(y) * c
+    assert signals.swing_midline(y * c, 0.5 * c) == signals.swing_midline(y, 0.5) * c
+
+
+def test_the_midline_of_a_swing_near_the_float_limit_scales_exactly():
+    # The swing's range (its prominence bound) overflowed before the values were scaled.
+    y = np.array([1.9, -1.7, 1.9, -1.7, 1.9, -1.7, 1.9])
+    c = 2.0**1023
     assert signals.swing_midline(y * c, 0.5 * c) == signals.swing_midline(y, 0.5) * c
 
 

@@ -43,7 +43,7 @@
 //! DOFs on the 2 mm tape, whose halves fill more than the whole (354k factor entries against
 //! 291k) but factorise in parallel: 1.2 ms instead of 1.4 to 1.6 ms (criterion, 2 cores), and
 //! the damped release (`bench_release.py --eta 1.73e-4`) in 9.0 to 9.7 s instead of 12.4 to
-//! 12.7 s (docs/dynamics.md).
+//! 12.7 s (docs/performance.md).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;

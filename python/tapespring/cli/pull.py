@@ -39,7 +39,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "then pulled down by static displacement control past the buckling of the tapes. "
             "Prints the maximum force and its displacement against the paper's model (Table 9); "
             "with --experiment, against a recorded pull test too, both analysed as 'tapespring "
-            "trials' does (the simulation sampled as a trial pulled at 1 mm/s)."
+            "trials' does (the simulation sampled as a trial pulled at the spec's pull_rate, the "
+            "paper's 1 mm/s)."
         ),
     )
     p.add_argument(

@@ -12,12 +12,12 @@ equilibrium, goes through the same maximum analysis as the measured curves
 and the located maximum of the force (a monitored extremum of the path) is reported beside it.
 
 Comparison with a recorded pull test (Table 9, Fig. 34): :meth:`PullResult.to_trial` samples the
-path like a recording (at rest for ``hold`` seconds, then pulled at the paper's 1 mm/s, markers
-at 800 Hz, the force plate under the clamp at 4 kHz), and :meth:`PullResult.compare` puts that
-trial and the recorded one through the same protocol function
-(:func:`tapespring.protocols.pull.analyze_pull_trial`, force smoothed over 101 samples): the
-maximum force and its displacement of both, their differences, and the paper's model beside
-them (:class:`PullComparison`).
+path like a recording (at rest for ``hold`` seconds, then pulled at the spec's ``pull_rate``, the
+paper's 1 mm/s, markers at 800 Hz, the force plate under the clamp at 4 kHz), and
+:meth:`PullResult.compare` puts that trial and the recorded one through the same protocol
+function (:func:`tapespring.protocols.pull.analyze_pull_trial`, force smoothed over 101
+samples): the maximum force and its displacement of both, their differences, and the paper's
+model beside them (:class:`PullComparison`).
 """
 
 from __future__ import annotations

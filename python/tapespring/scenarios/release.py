@@ -243,8 +243,8 @@ def release_steps(setup: ReleaseSetup, tip: int) -> list[Any]:
         "max_step": RELEASE_MAX_STEP,
         # With Kelvin-Voigt damping the plain iteration matrix, undamped the mixed-stress one:
         # measured on the 2 mm release's first second, with the paper's eta 12.0 s instead of
-        # 17.5 s (8.4 s instead of 11.8 s since the factorisation is split in two); undamped
-        # 217 s instead of 245 s (docs/dynamics.md).
+        # 17.5 s (one run each, re-measured once the factorisation was split in two: 8.4 s
+        # instead of 11.8 s); undamped 217 s instead of 245 s (docs/performance.md).
         "mixed_stress": setup.eta == 0.0,
     }
     if setup.tolerance > 0.0:

@@ -149,7 +149,11 @@ def force_at_crossings(
         raise ValueError(f"start ({lo}) is after end ({hi})")
     if baseline is None:
         after = t >= lo
-        baseline = float(np.median(f[after] if after.any() else f))
+        rest = f[after] if after.any() else f
+        # On values divided by a power of two (exact): the median of two values near 1e308
+        # overflowed in their mean.
+        unit = power_of_two_scale(rest)
+        baseline = float(np.median(rest / unit)) * unit
     elif not math.isfinite(baseline):
         raise ValueError(f"baseline must be a finite force [N], got {baseline}")
     # The deviations and the crossings' interpolation on values divided by powers of two

@@ -50,7 +50,7 @@ def equilibrium_value(time: np.ndarray, y: np.ndarray, *, tail: float = 1.0) -> 
         )
     # The tail is the samples after time[-1] - tail: only if time increases (a NaN last time
     # selected nothing, and a record out of order the wrong samples).
-    check_time(time)
+    check_time(time, "time")
     last = y[time >= float(time[-1]) - float(tail)]  # Python floats: no overflow warning
     last = last[np.isfinite(last)]
     if last.size == 0:

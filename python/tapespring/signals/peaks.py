@@ -371,27 +371,30 @@ MIN_TIME_STEP = 1e-9
 MAX_TIME_STEP = 1e3
 
 
-def check_time(t: np.ndarray) -> None:
+def check_time(t: np.ndarray, name: str = "t") -> None:
     """Raise ValueError unless the sampling instants `t` [s] are finite and strictly increasing,
-    with a mean step from `MIN_TIME_STEP` to `MAX_TIME_STEP` (times in seconds).
+    with a mean step from `MIN_TIME_STEP` to `MAX_TIME_STEP` (times in seconds); the message
+    calls them `name`.
 
     Uniform steps are assumed (the peak refinement uses the mean step) but not checked: a
     simulated series with slightly uneven steps is still analysed as before.
     """
     if not np.all(np.isfinite(t)):
-        raise ValueError(f"t must be finite: it has {np.count_nonzero(~np.isfinite(t))} NaN or inf")
+        raise ValueError(
+            f"{name} must be finite: it has {np.count_nonzero(~np.isfinite(t))} NaN or inf"
+        )
     bad = np.flatnonzero(t[1:] <= t[:-1])  # not np.diff, which overflows near 1e308
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"t must be strictly increasing: t[{i + 1}] = {t[i + 1]:.6g} s follows "
-            f"t[{i}] = {t[i]:.6g} s ({bad.size} such step(s))"
+            f"{name} must be strictly increasing: {name}[{i + 1}] = {t[i + 1]:.6g} s follows "
+            f"{name}[{i}] = {t[i]:.6g} s ({bad.size} such step(s))"
         )
     # Python floats: a span beyond the floats is inf (refused below), not a RuntimeWarning.
     step = (float(t[-1]) - float(t[0])) / (t.size - 1) if t.size > 1 else MIN_TIME_STEP
     if not MIN_TIME_STEP <= step <= MAX_TIME_STEP:
         raise ValueError(
-            f"t must be in seconds: its mean step of {step:.3g} s is outside "
+            f"{name} must be in seconds: its mean step of {step:.3g} s is outside "
             f"[{MIN_TIME_STEP:g}, {MAX_TIME_STEP:g}] s (MIN_TIME_STEP, MAX_TIME_STEP)"
         )
 
