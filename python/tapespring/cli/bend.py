@@ -244,12 +244,12 @@ def _vtu_file(text: str) -> str:
             f"cannot write {text}: ParaView series need meshio, which is not installed "
             "(pip install meshio, or the extra tapespring[vtu])"
         )
+    from tapespring.io.vtu import pvd_paths
+
     _output_file(text)
-    path = Path(text)
-    if path.suffix != ".pvd":
-        path = path.with_name(path.name + ".pvd")
+    path, folder = pvd_paths(text)
+    if str(path) != text:
         _output_file(str(path))
-    folder = path.with_suffix("")
     if folder.exists() and not folder.is_dir():
         raise argparse.ArgumentTypeError(
             f"cannot write {text}: its VTU files go into the folder {str(folder)!r}, which is "
@@ -292,7 +292,9 @@ def refuse_shared_paths(args: argparse.Namespace) -> None:
         option = f"--{name} {text}"
         paths = [Path(text)]
         if name == "vtu":
-            paths.append(Path(text).with_suffix(""))  # the folder of the VTU files
+            from tapespring.io.vtu import pvd_paths
+
+            paths.append(pvd_paths(text)[1])  # the folder of the VTU files
         for path in paths:
             key = path.resolve()
             if key in read:

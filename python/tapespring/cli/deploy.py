@@ -117,8 +117,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--vtu",
         type=_vtu_file,
         metavar="FILE.pvd",
-        help="write the deformed set-up as a ParaView series (every 16th record: 50 Hz at 800 Hz "
-        "samples; more often with --snapshots on a short run; needs meshio)",
+        help=f"write the deformed set-up as a ParaView series (every {VTU_INTERVAL}th record: "
+        f"{800 / VTU_INTERVAL:g} Hz at 800 Hz samples; more often with --snapshots on a short "
+        "run; needs meshio)",
     )
     p.add_argument(
         "--snapshots",

@@ -5,7 +5,8 @@ Modules
 vtu
     `write_pvd`: one VTU file per recorded field (deformed shell mesh, displacement and rotation
     as point data) and the PVD collection that lists them with their times (meshio, imported
-    only when a file is written); `reference_mesh`: the model's nodes and quads.
+    only when a file is written); `reference_mesh`: the model's nodes and quads; `pvd_paths`:
+    the ``.pvd`` file and the VTU files' folder a series name gives.
 
 The names below are imported on first use.
 """
@@ -17,8 +18,10 @@ from tapespring._lazy import lazy_exports
 if TYPE_CHECKING:
     # What the lazy __getattr__ below returns, for the type checker (not imported at run time):
     # without it each name is an `object` to mypy.
-    from .vtu import reference_mesh, write_pvd
+    from .vtu import pvd_paths, reference_mesh, write_pvd
 
-__all__ = ["reference_mesh", "write_pvd"]
+__all__ = ["pvd_paths", "reference_mesh", "write_pvd"]
 
-__getattr__, __dir__ = lazy_exports(__name__, __all__, {"vtu": ["reference_mesh", "write_pvd"]})
+__getattr__, __dir__ = lazy_exports(
+    __name__, __all__, {"vtu": ["pvd_paths", "reference_mesh", "write_pvd"]}
+)

@@ -34,7 +34,17 @@ if TYPE_CHECKING:
     from tapespring.analysis import Model
     from tapespring.results import Results
 
-__all__ = ["reference_mesh", "write_pvd"]
+__all__ = ["pvd_paths", "reference_mesh", "write_pvd"]
+
+
+def pvd_paths(path: str | Path) -> tuple[Path, Path]:
+    """The ``.pvd`` file a series named `path` is written to (the suffix added if missing) and
+    the folder of its VTU files beside it (the same name without suffix): ``out/run`` gives
+    ``out/run.pvd`` and ``out/run/``."""
+    pvd = Path(path)
+    if pvd.suffix != ".pvd":
+        pvd = pvd.with_name(pvd.name + ".pvd")
+    return pvd, pvd.with_suffix("")
 
 
 def reference_mesh(
@@ -169,10 +179,7 @@ def write_pvd(
     if isolated.size:
         cells.append(("vertex", isolated.reshape(-1, 1)))
 
-    path = Path(path)
-    if path.suffix != ".pvd":
-        path = path.with_name(path.name + ".pvd")
-    folder = path.with_suffix("")
+    path, folder = pvd_paths(path)
     folder.mkdir(parents=True, exist_ok=True)
     root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
     collection = ET.SubElement(root, "Collection")

@@ -629,11 +629,11 @@ class SetupSpec:
             check_element_count(name, size, self.tape.length, width)
         # As the mesher counts them: the arc over the size, rounded half away from zero (Rust's
         # round, not Python's half to even), at least 2, made even.
-        across = max(math.floor(width / self.mesh_tape + 0.5), 2)
-        across += across % 2
-        if across < MIN_ELEMENTS_ACROSS:
+        n_across = max(math.floor(width / self.mesh_tape + 0.5), 2)
+        n_across += n_across % 2
+        if n_across < MIN_ELEMENTS_ACROSS:
             raise ValueError(
-                f"mesh_tape {self.mesh_tape} m gives {across} elements across the tapes' "
+                f"mesh_tape {self.mesh_tape} m gives {n_across} elements across the tapes' "
                 f"{width * 1e3:.2f} mm section, a V rather than a curved section: at least "
                 f"{MIN_ELEMENTS_ACROSS} are needed (mesh_tape <= {width / 2.5:.4g} m; see "
                 "setup.MIN_ELEMENTS_ACROSS)"

@@ -11,6 +11,8 @@ white measurement noise on a smooth signal.
 from __future__ import annotations
 
 import math
+import warnings
+from typing import overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,20 +43,27 @@ def real_array(values: ArrayLike, name: str) -> np.ndarray:
     return np.asarray(a, dtype=float)
 
 
-def power_of_two_scale(values: np.ndarray) -> float:
+@overload
+def power_of_two_scale(values: ArrayLike, axis: None = None) -> float: ...
+@overload
+def power_of_two_scale(values: ArrayLike, axis: int) -> np.ndarray: ...
+def power_of_two_scale(values: ArrayLike, axis: int | None = None) -> float | np.ndarray:
     """The power of two at or just below the largest finite ``|values|`` (1.0 if there is none, or
-    it is 0).
+    it is 0); with `axis`, one per slice along it, the axis kept (length 1) so that it
+    broadcasts against `values`.
 
     Dividing by it is exact and brings the values below 2 in magnitude, so that sums and squares
     neither overflow (values near 1e308) nor underflow (near 1e-200), and a computation that is
     homogeneous in the values gives, scaled back, the very bits it gives on values of order one.
     """
     a = np.abs(np.asarray(values, dtype=float))
-    a = a[np.isfinite(a)]
-    top = float(a.max()) if a.size else 0.0
-    if top == 0.0:
-        return 1.0
-    return float(np.ldexp(1.0, int(np.frexp(top)[1]) - 1))
+    a = np.where(np.isfinite(a), a, np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN slice: no scale, 1.0
+        top = np.nanmax(a, axis=axis, keepdims=axis is not None) if a.size else np.float64(0.0)
+    top = np.where(np.isfinite(top) & (top > 0.0), top, 1.0)
+    scale = np.ldexp(1.0, np.frexp(top)[1] - 1)
+    return float(scale) if axis is None else scale
 
 
 def smooth(y: np.ndarray, span: int = 5) -> np.ndarray:

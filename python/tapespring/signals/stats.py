@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .smoothing import real_array
+from .smoothing import power_of_two_scale, real_array
 
 __all__ = ["Summary", "summarize"]
 
@@ -82,9 +82,7 @@ def summarize(values: ArrayLike, axis: int | None = None) -> Summary:
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns give NaN, on purpose
         # Each quantity divided by the power of two of its largest value (exact): the squares of
         # the deviations neither overflow (1e300) nor underflow (1e-200, whose spread read 0).
-        top = np.nanmax(np.abs(x), axis=axis, keepdims=axis is not None)
-        top = np.where(np.isfinite(top) & (top > 0), top, 1.0)
-        scale = np.ldexp(1.0, np.frexp(top)[1] - 1)
+        scale = np.asarray(power_of_two_scale(x, axis=axis))
         scaled = x / scale
         if axis is not None:
             scale = np.squeeze(scale, axis=axis)
