@@ -336,3 +336,24 @@ def test_a_viscosity_is_refused_by_the_static_commands_spec_too(command, name, c
         f"error: --spec {name}: this test is static (a path without rates), so a viscosity acts "
         "on nothing; leave it out\n"
     )
+
+
+def test_an_analysis_message_naming_trials_options_says_where_they_are(tmp_path, capsys):
+    # "check the marker names (markers=, --markers)": options the scenario commands lack.
+    import dataclasses
+
+    import numpy as np
+    from tapespring.trials.csv import write_csv
+    from tapespring.trials.samples import make_deployment_trial
+
+    trial, _ = make_deployment_trial(duration=2.0)
+    markers = dict(trial.markers)
+    markers["M1"] = np.full_like(markers["M1"], np.nan)
+    path = write_csv(dataclasses.replace(trial, markers=markers), tmp_path / "no_m1.csv")
+    assert main(["deploy", "--no-progress", f"--experiment={path}"]) == 2
+    err = capsys.readouterr().err
+    assert "marker 'M1' is never seen" in err
+    assert err.rstrip().endswith(
+        "(the scenario commands read the recording with the analysis' defaults; "
+        "'tapespring trials analyze' and the protocols' functions take those options)"
+    )

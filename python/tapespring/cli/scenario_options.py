@@ -382,6 +382,11 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
     )
 
 
+#: Options of ``tapespring trials analyze`` and the protocols' functions that the analyses'
+#: messages suggest and the scenario commands' ``--experiment`` does not take.
+TRIALS_ONLY_OPTIONS = ("--markers", "--frame", "--max-gap", "markers=", "frame=", "control=")
+
+
 def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
     """Read a recorded trial (C3D or CSV) and analyse it with `analyze` (a protocol function).
 
@@ -412,6 +417,13 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
     message = str(failure)
     if isinstance(failure, OSError) and failure.strerror:
         message = failure.strerror
+    if any(option in message for option in TRIALS_ONLY_OPTIONS):
+        # The analyses' messages name the options of 'tapespring trials analyze' and of the
+        # Python functions, which the scenario commands do not have.
+        message += (
+            " (the scenario commands read the recording with the analysis' defaults; "
+            "'tapespring trials analyze' and the protocols' functions take those options)"
+        )
     if str(path) not in message and str(Path(path)) not in message:
         message = f"{path}: {message}"
     print(f"error: {message}", file=sys.stderr)
