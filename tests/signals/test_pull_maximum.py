@@ -84,3 +84,15 @@ def test_an_even_span_is_recorded_as_the_odd_span_used():
     np.testing.assert_array_equal(
         test.force_smoothed, analyze_pull_test(d, f, span=99).force_smoothed
     )
+
+
+def test_a_raw_end_sample_above_the_peak_is_not_the_maximum():
+    # MATLAB's smooth shrinks its window at the record's ends down to the raw samples: a last
+    # sample above the smoothed peak (noise on the force after buckling) read as the maximum,
+    # at the record's end. The maximum is taken where the window is complete.
+    d, f = _ramp()
+    f[-1] = 1.5 * F_MAX
+    test = analyze_pull_test(d, f, span=101)
+    i_drop = np.flatnonzero(d <= D_MAX)[-1]
+    assert test.index_at_max == i_drop - 50
+    assert test.buckled

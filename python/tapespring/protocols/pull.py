@@ -15,8 +15,9 @@ swings gave a "maximum force" 394 % off). A pull test, as `analyze_pull_trial` c
 - mostly one way: it turns back by more than a fifth of its travel at most once (a return
   after the pull);
 - and the force rises to a maximum: the smoothed force goes above 3 times the force noise;
-- inside the record: a maximum in the last half smoothing span, with no buckling drop after it,
-  is where a record stopped early was cut (its force still rising), and is refused.
+- inside the record: a maximum within a smoothing span of the last complete window (the
+  maximum is taken where the smoothing window is complete), with no buckling drop after it, is
+  where a record stopped early was cut (its force still rising), and is refused.
 """
 
 from __future__ import annotations
@@ -231,21 +232,25 @@ def _check_pull_record(
 def _check_maximum_inside(trial: Trial, time: np.ndarray, test: PullTest) -> None:
     """Refuse a maximum force at the record's end with no drop after it (module docs).
 
-    In the last half span the smoothing windows shrink down to the raw last sample, so a maximum
-    there is where a force still rising was cut, not the peak before buckling (a pull cut at 2 s
-    reported the 1.5 N of its last sample for the 9.9 N of the whole test).
+    The maximum is taken where the smoothing window is complete (`analyze_pull_test`); on a
+    force still rising where the record was cut, the noise of the smoothed force (the raw
+    noise over sqrt(span)) places it up to tens of samples before the last complete window,
+    so a maximum within a span of that window, with no buckling drop after it, is where a force
+    still rising was cut, not the peak before buckling (a pull cut at 2 s reported the 1.5 N
+    of its last sample for the 9.9 N of the whole test).
     """
     n = test.force_smoothed.size
     i = test.index_at_max
-    if test.buckled or i < n - 1 - test.span // 2:
+    last = n - 1 - test.span // 2  # the last complete window
+    if test.buckled or i < last - test.span:
         return
     raise TrialError(
         trial.metadata.label,
         f"the force record ends before its maximum: the smoothed force is highest "
         f"({test.max_force:.3g} N) at t = {time[i]:.4g} s, {n - 1 - i} sample(s) before the "
-        f"last (within half the {test.span}-sample smoothing span), with no drop after it, so "
-        "the maximum before buckling is not in the record (a capture stopped early, or a file "
-        "cut short?)",
+        f"last (within {test.span // 2 + test.span} samples of it: half the {test.span}-sample "
+        "smoothing span and one span), with no drop after it, so the maximum before buckling is "
+        "not in the record (a capture stopped early, or a file cut short?)",
     )
 
 

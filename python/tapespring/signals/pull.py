@@ -3,7 +3,11 @@
 The raw force is smoothed with a moving average of ``span`` samples (MATLAB
 ``smooth`` semantics, `smooth`; paper: span 101, i.e. 25.3 ms of its force
 record). The maximum force before buckling is the maximum of the smoothed force,
-and its displacement is the displacement at that sample. The test is flagged as
+and its displacement is the displacement at that sample. The maximum is taken where
+the window is complete: in the record's first and last half spans MATLAB's
+``smooth`` shrinks it down to the raw end samples, whose noise could outrun the
+smoothed peak (a raw last sample 2.6 noise deviations above the force after buckling
+read as a maximum at the record's end). The test is flagged as
 buckled when the smoothed force afterwards falls below ``(1 - drop_fraction)``
 times that maximum (the sudden drop of Fig. 19).
 """
@@ -14,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .smoothing import effective_span, real_array, smooth
+from .smoothing import complete_windows, effective_span, real_array, smooth
 
 __all__ = ["PullTest", "analyze_pull_test", "check_span"]
 
@@ -111,9 +115,10 @@ def analyze_pull_test(
         raise ValueError(f"drop_fraction must satisfy 0 < drop_fraction < 1, got {drop_fraction}")
     check_span(span, f.size)
     fs = smooth(f, span)
-    if not np.any(np.isfinite(fs)):
-        raise ValueError("the force record has no finite sample")
-    i = int(np.nanargmax(fs))
+    full = complete_windows(f.size, span)
+    if not np.any(np.isfinite(fs[full])):
+        raise ValueError("the force record has no finite sample where the smoothing is complete")
+    i = full.start + int(np.nanargmax(fs[full]))
     f_max = float(fs[i])
     after = fs[i:]
     buckled = bool(np.nanmin(after) < (1.0 - drop_fraction) * f_max) if f_max > 0 else False
