@@ -26,6 +26,8 @@ CLEAR = (
     "truncated C3D data",
     "not a readable C3D file",
     "infinite coordinate",
+    # A scale or a unit flipped: the marker range check (test_marker_range.py).
+    "is no position in a laboratory",
     "POINT:LABELS",
     "invalid POINT:RATE",
     "unknown marker unit",
@@ -208,6 +210,9 @@ def test_truncated_file_is_a_trial_error(child, valid, tmp_path, cut):
 # Found by the long profile: a byte that shortens the stored sense to 'pposite' was refused by the
 # trial's check without naming the parameter it came from.
 @example(flips=[(628, 0)])
+# And a flip that turns the point scale into a km-sized one, refused by the marker range check
+# with a clear message that the list of phrases above lacked.
+@example(flips=[(83, 66)])
 def test_byte_flipped_parameter_section_gives_a_trial_or_a_clear_error(
     child, valid, tmp_path, flips
 ):
