@@ -405,7 +405,7 @@ class Results:
         if not isinstance(path, str | os.PathLike):
             raise TypeError(f"path must be a str or an os.PathLike (got {path!r})")
         try:
-            return cls._read(Path(path))
+            fields = cls._read(Path(path))
         except (FileNotFoundError, IsADirectoryError, PermissionError, _NotResults):
             raise
         except ValueError as exc:
@@ -432,9 +432,13 @@ class Results:
                 f"{path} is not a readable saved tapespring Results (truncated or corrupted: "
                 f"{type(exc).__name__}: {exc})"
             ) from exc
+        # Outside the try: the fields are checked, and an exception from here on is a bug of
+        # this code, not a corrupted file.
+        return cls.from_dict(fields)
 
     @classmethod
-    def _read(cls, path: Path) -> Results:
+    def _read(cls, path: Path) -> dict[str, Any]:
+        """The checked fields of a saved file, for :meth:`from_dict`."""
         # The file is opened here, not by np.load, which leaves it open when it fails.
         with path.open("rb") as handle, _npz(np.load(handle, allow_pickle=False), path) as f:
             if "meta" not in f:
@@ -474,7 +478,7 @@ class Results:
             # Files of formats 1 and 2 have no modes.
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
         d["modes"] = modes
-        return cls.from_dict(d)
+        return d
 
 
 def _dof_name(dof: object) -> str:
