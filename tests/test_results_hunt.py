@@ -14,10 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _plate import plate
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
-from tapespring import Model, Outputs, Results, Step, run, shell
+from tapespring import Outputs, Results, Step, run
 from tapespring.io import write_pvd
 from tapespring.report import jsonable, jsonable_tree, summary_json, summary_row, write_table
 from tapespring.signals import Summary
@@ -26,17 +27,8 @@ from tapespring.signals import Summary
 @pytest.fixture(scope="module")
 def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Results, Path, bytes]:
     """A static run with fields and a modal step with its matrices, saved."""
-    mesh = shell.flat_plate_mesh(0.2, 0.02, 4, 1)
-    model = Model(
-        *mesh[:2],
-        node_sets=mesh[2],
-        thickness=2e-3,
-        youngs_modulus=2e11,
-        poisson=0.0,
-        density=7850.0,
-    )
-    model.fix("x0")
-    tip = int(np.argmax(mesh[0][:, 0]))
+    model = plate(thickness=2e-3, poisson=0.0)
+    tip = int(np.argmax(np.asarray(model.nodes)[:, 0]))
     model.add_load(tip, "uz", 10.0)
     model.add_marker("tip", tip)
     steps = [Step.static("s", increments=2), Step.modal("m", modes=2, matrices=True)]
