@@ -155,6 +155,10 @@ def test_marker_of_wrong_shape_is_a_trial_error(n, shape):
 @given(time=st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=2, max_size=20))
 # Found by the long profile: a subnormal step overflowed the rate (1 / 5e-324).
 @example(time=[-5e-324, 0.0])
+# And times whose differences overflow (a RuntimeWarning leaked): increasing, or not.
+@example(time=[-2.9937604643020797e292, 0.0, 1.7976931348623155e308])
+@example(time=[1.7976931348623157e308, -9.9792015476736e291])
+@example(time=[-1.7e308, 1.7e308])
 def test_time_vector_is_uniform_and_finite_or_a_trial_error(time):
     t = np.array(time)
     try:

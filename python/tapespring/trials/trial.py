@@ -19,6 +19,7 @@ touch either end of the record, stay NaN.
 from __future__ import annotations
 
 import dataclasses
+import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -108,10 +109,17 @@ def _check_time(time: np.ndarray, source: str | None, what: str) -> float:
         raise TrialError(source, f"{what} time vector needs at least 2 samples, got {time.size}")
     if not np.all(np.isfinite(time)):
         raise TrialError(source, f"{what} time vector contains NaN or inf")
-    dt = np.diff(time)
-    mean_dt = (time[-1] - time[0]) / (time.size - 1)
-    if mean_dt <= 0 or np.any(dt <= 0):
+    if np.any(time[1:] <= time[:-1]):  # not np.diff, which overflows near 1e308
         raise TrialError(source, f"{what} time vector is not strictly increasing")
+    total = float(time[-1]) - float(time[0])  # Python floats: inf, not a RuntimeWarning
+    if not math.isfinite(total):
+        raise TrialError(
+            source,
+            f"{what} time vector runs from {time[0]:.6g} to {time[-1]:.6g} s: a span beyond the "
+            "floating-point range",
+        )
+    dt = np.diff(time)
+    mean_dt = total / (time.size - 1)
     # A step that the times cannot resolve, or whose rate overflows, is no sampling.
     span = max(abs(time[0]), abs(time[-1]))
     if mean_dt <= 1.0 / np.finfo(float).max or mean_dt <= 16 * np.finfo(float).eps * span:
