@@ -259,3 +259,21 @@ def test_a_line_break_in_a_field_stays_in_its_row(tmp_path, field):
     with path.open(newline="", encoding="utf-8") as fh:
         rows = list(csv.reader(fh))
     assert rows == [["name", "n"], [field, "1"]]
+
+
+@pytest.mark.parametrize("header", [b"} , } , o , o", b"'''\x00", b"((((("])
+def test_a_member_whose_header_is_no_python_literal_is_refused_by_name(saved, tmp_path, header):
+    # The long profile's: a byte of a deflated member garbled its .npy header (the CRC is
+    # checked only once the member is read), and numpy's parse of it raised a SyntaxError, then
+    # a tokenize.TokenError, past the loader. Here the header itself is garbled, the CRC right.
+    _, path, _ = saved
+    out = tmp_path / "r.npz"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(out, "w") as dst:
+        for name in src.namelist():
+            data = src.read(name)
+            if name == "t.npy":
+                start = data.index(b"'fortran_order'")
+                data = data[:start] + header + data[start + len(header) :]
+            dst.writestr(name, data)
+    with pytest.raises(ValueError, match="is not a readable saved tapespring Results"):
+        Results.load(out)

@@ -11,6 +11,7 @@ import math
 import numbers
 import os
 import struct
+import tokenize
 import zipfile
 import zlib
 from collections.abc import Mapping, Sequence
@@ -421,7 +422,10 @@ class Results:
             zipfile.BadZipFile,
             # A corrupted header can ask for a zip feature (version 6.4) or a compression zipfile
             # lacks, flag a member as encrypted (a RuntimeError), give a compressed member's
-            # stream that zlib refuses, or fields struct cannot unpack.
+            # stream that zlib refuses, or fields struct cannot unpack; a member's header garbled
+            # in a deflated stream fails numpy's parse as Python source.
+            SyntaxError,
+            tokenize.TokenError,
             NotImplementedError,
             RuntimeError,
             zlib.error,
