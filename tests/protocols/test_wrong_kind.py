@@ -54,6 +54,19 @@ pytestmark = pytest.mark.filterwarnings("ignore::tapespring.trials.TrialWarning"
     start=0.5859375,
     seed=65535,
 )
+# And a record that ends 25 ms after a drop to 75 %, which the smoothing shows as 89 % (no
+# "buckled"): its maximum is 124 samples before the end, which a check reaching 151 samples
+# back refused.
+@example(
+    log_speed=-2.0,
+    travel=0.001,
+    buckle_at=0.75,
+    max_force=2.0,
+    noise=0.0,
+    residual=0.75,
+    start=1.0,
+    seed=0,
+)
 def test_generated_pull_tests_pass_the_pull_check(
     log_speed, travel, buckle_at, max_force, noise, residual, start, seed
 ):
