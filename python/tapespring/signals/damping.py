@@ -356,24 +356,23 @@ def fit_damping(
     # power of two that brings them to order one (exact; values near 1e200 overflowed the
     # squares of the residuals, near 1e-200 underflowed them).
     unit = power_of_two_scale(value)
-    value_m = value
-    value = value / unit
+    scaled = value / unit
     tau = time - time[0]
-    a0 = max(np.log(abs(value[0]) / abs(value[-1])) / max(tau[-1], h), 1e-6)
+    a0 = max(np.log(abs(scaled[0]) / abs(scaled[-1])) / max(tau[-1], h), 1e-6)
 
     def value_model(p: np.ndarray) -> np.ndarray:
         c, amp, rate = p
         return c + sign * amp * np.exp(-rate * tau)
 
     def value_residual(p: np.ndarray) -> np.ndarray:
-        return value_model(p) - value
+        return value_model(p) - scaled
 
     def value_jac(p: np.ndarray) -> np.ndarray:
         _, amp, rate = p
         e = np.exp(-rate * tau)
         return np.column_stack((np.ones_like(tau), sign * e, -sign * amp * tau * e))
 
-    fit_z = least_squares(value_residual, x0=[0.0, abs(value[0]), a0], jac=value_jac, method="trf")
+    fit_z = least_squares(value_residual, x0=[0.0, abs(scaled[0]), a0], jac=value_jac, method="trf")
     if not fit_z.success:
         _raise_undetermined(fit_z, sign)
     c, amp, rate = fit_z.x
@@ -397,7 +396,7 @@ def fit_damping(
         var_omega_d = (np.pi / h**2) ** 2 * cov_t[1, 1]
         eps_std = float(np.sqrt(d_rate**2 * cov_z[2, 2] + d_omega_d**2 * var_omega_d))
     _check_decay(rate, tau[-1], epsilon, eps_std, n)
-    ss_tot = np.sum((value - value.mean()) ** 2)
+    ss_tot = np.sum((scaled - scaled.mean()) ** 2)
     r2 = float(1.0 - np.sum(fit_z.fun**2) / ss_tot) if ss_tot > 0 else np.nan
     return DampingFit(
         damping_ratio=epsilon,
@@ -408,7 +407,7 @@ def fit_damping(
         damping_ratio_std=eps_std,
         period_std=per_std,
         peak_time=time,
-        peak_value=value_m,
+        peak_value=value,
         rms_amplitude_residual=float(np.sqrt(np.mean(fit_z.fun**2))) * unit,
         rms_time_residual=float(np.sqrt(np.mean(fit_t.fun**2))),
         r_squared=r2,
