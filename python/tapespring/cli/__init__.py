@@ -41,8 +41,9 @@ def build_parser() -> argparse.ArgumentParser:
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
     from . import bend, deploy, equilibrium, max_mass, pull, release, trials, vibrate
+    from .parser import ArgumentParser
 
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="tapespring",
         description="Nonlinear shell simulation and experimental analysis of tape springs.",
     )

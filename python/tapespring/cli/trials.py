@@ -30,6 +30,7 @@ from tapespring.trials.common import LENGTH
 from tapespring.trials.trial import check_max_gap
 
 from .bend import _checked, _count, _output_folder, print_warnings, refuse
+from .parser import ArgumentParser
 
 __all__ = ["main", "register", "run_analyze"]
 
@@ -351,7 +352,7 @@ def run_analyze(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Stand-alone entry point (``python -m tapespring.cli.trials``)."""
-    parser = argparse.ArgumentParser(prog="tapespring")
+    parser = ArgumentParser(prog="tapespring")
     register(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args(argv)
     try:
