@@ -38,13 +38,15 @@ def test_csv_round_trip_keeps_markers_forces_gaps_and_metadata(tmp_path):
     trial = _with_gap(trial)
     path = write_csv(trial, tmp_path / "t.csv")
     back = read_csv(path)
-    # 10 significant digits of values below 300 mm: 3e-8 mm.
-    _assert_markers_equal(trial, back, atol=1e-10)
+    # Shortest round-trip floats: times and forces come back exactly; the markers' values
+    # below 0.3 m through two roundings (m to mm, mm to m) to within 2 ulps of 0.3 m.
+    _assert_markers_equal(trial, back, atol=1.2e-16)
     assert [(g.start, g.stop) for g in back.gaps()] == [(100, 110)]
+    np.testing.assert_array_equal(back.time, trial.time)
     fp, fp_back = trial.force_plates[0], back.force_plates[0]
-    np.testing.assert_allclose(fp_back.time, fp.time, atol=1e-12)
-    np.testing.assert_allclose(fp_back.force, fp.force, rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(fp_back.moment, fp.moment, rtol=1e-9, atol=1e-12)
+    np.testing.assert_array_equal(fp_back.time, fp.time)
+    np.testing.assert_array_equal(fp_back.force, fp.force)
+    np.testing.assert_array_equal(fp_back.moment, fp.moment)
     assert (back.metadata.sense, back.metadata.tape_pair, back.metadata.session) == (
         "equal",
         "A",
@@ -52,6 +54,17 @@ def test_csv_round_trip_keeps_markers_forces_gaps_and_metadata(tmp_path):
     )
     assert back.metadata.units["markers"] == "mm"
     assert back.metadata.source == path
+
+
+def test_csv_round_trip_keeps_times_past_ten_digits(tmp_path):
+    # A record starting at 1e4 s sampled at 1 MHz: written with 10 significant digits its
+    # first ten times were all "10000" and the file was refused as non-uniform.
+    time = 1e4 + np.arange(50) * 1e-6
+    xyz = np.column_stack([np.linspace(0.0, 0.1, 50), np.zeros(50), np.full(50, 0.2)])
+    trial = Trial(time, {"M1": xyz})
+    back = read_csv(write_csv(trial, tmp_path / "late.csv", length_unit="m"))
+    np.testing.assert_array_equal(back.time, time)
+    np.testing.assert_array_equal(back.markers["M1"], xyz)
 
 
 def test_c3d_round_trip_keeps_markers_force_plate_and_metadata(tmp_path):
