@@ -261,3 +261,22 @@ def test_tape_spring_with_tied_ends_bends_like_a_beam_at_small_angles():
     np.testing.assert_allclose(r.reaction(clamped, "ry")[-1], -moment, rtol=1e-6)
     np.testing.assert_allclose(r.total_reaction("uz"), 0.0, atol=1e-8 * moment / length)
     assert model.constrained()[-1] == (driven, "ry")
+
+
+@pytest.mark.parametrize("size", [1e-3, 2e-3, 3.79e-3, 7.58e-3, 7.6e-3, 0.03, 1.0])
+def test_tape_divisions_count_the_mesh_without_building_it(size):
+    # The set-up's check of elements across the section asks this count; it must be the mesh's.
+    length, radius, alpha = 0.1, 15.55e-3, np.radians(69.85)
+    along, across = shell.tape_spring_divisions(length, radius, alpha, size)
+    mesh = shell.tape_spring_mesh(length, radius, alpha, size)
+    assert len(mesh.quads) == along * across
+    assert across % 2 == 0 and across >= 2
+    # The even count across puts a row of along + 1 nodes on the symmetry plane.
+    assert len(mesh.node_sets["midline"]) == along + 1
+
+
+def test_tape_divisions_refuse_what_the_mesher_refuses():
+    with pytest.raises(ValueError, match="radius"):
+        shell.tape_spring_divisions(0.1, -1.0, 1.0, 1e-3)
+    with pytest.raises(ValueError, match="more than"):
+        shell.tape_spring_divisions(1e300, 0.01, 1.0, 1e-3)

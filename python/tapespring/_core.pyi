@@ -23,6 +23,7 @@ __all__ = [
     "run",
     "step_defaults",
     "tape_section_centroid_z",
+    "tape_spring_divisions",
     "tape_spring_mesh",
 ]
 __version__: str
@@ -189,6 +190,9 @@ def tape_spring_mesh(
     length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0
 ) -> _MeshTuple: ...
 def tape_section_centroid_z(radius: float, alpha: float) -> float: ...
+def tape_spring_divisions(
+    length: float, radius: float, alpha: float, mesh_size: float
+) -> tuple[int, int]: ...
 def flat_plate_mesh(lx: float, ly: float, nx: int, ny: int) -> _MeshTuple: ...
 def cylindrical_panel_mesh(
     radius: float, length: float, phi0: float, phi1: float, n_axial: int, n_arc: int

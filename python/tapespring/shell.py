@@ -46,6 +46,7 @@ __all__ = [
     "flat_plate_mesh",
     "model_from_mesh",
     "solve_static",
+    "tape_spring_divisions",
     "tape_spring_mesh",
 ]
 
@@ -102,6 +103,28 @@ def tape_spring_mesh(
         For a non-positive size or ``alpha >= 2 pi``.
     """
     return Mesh(*_core.tape_spring_mesh(length, radius, alpha, mesh_size, twist=twist))
+
+
+def tape_spring_divisions(
+    length: float, radius: float, alpha: float, mesh_size: float
+) -> tuple[int, int]:
+    """Elements along and across the tape that :func:`tape_spring_mesh` makes with these
+    arguments, counted without building it.
+
+    The length and the arc ``radius * alpha`` over `mesh_size`, rounded half away from zero, at
+    least 1 along and 2 across, the count across made even.
+
+    Returns
+    -------
+    tuple of int
+        ``(along, across)``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`tape_spring_mesh`, for a bad geometry or size.
+    """
+    return _core.tape_spring_divisions(length, radius, alpha, mesh_size)
 
 
 def flat_plate_mesh(lx: float, ly: float, nx: int, ny: int) -> Mesh:

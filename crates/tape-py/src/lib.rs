@@ -19,7 +19,8 @@ mod _core {
     use super::analysis::{generalized_alpha_decay, run, step_defaults};
     #[pymodule_export]
     use super::mesh::{
-        _panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_section_centroid_z, tape_spring_mesh,
+        _panic_for_tests, cylindrical_panel_mesh, flat_plate_mesh, tape_section_centroid_z, tape_spring_divisions,
+        tape_spring_mesh,
     };
     #[pymodule_export]
     use super::model::PyModel;

@@ -106,6 +106,23 @@ pub fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
     py.detach(|| guard(|| -> PyResult<()> { panic!("deliberate panic for the test-suite") }))
 }
 
+/// Elements `(along, across)` of the tape-spring mesh `tape_spring_mesh` makes with these
+/// arguments, without building it.
+#[pyfunction]
+pub fn tape_spring_divisions(
+    length: &Bound<'_, PyAny>,
+    radius: &Bound<'_, PyAny>,
+    alpha: &Bound<'_, PyAny>,
+    mesh_size: &Bound<'_, PyAny>,
+) -> PyResult<(usize, usize)> {
+    let (length, radius) = (convert::float(length, "length")?, convert::float(radius, "radius")?);
+    let (alpha, mesh_size) = (convert::float(alpha, "alpha")?, convert::float(mesh_size, "mesh_size")?);
+    to_py(generate::tape_spring_divisions(
+        &TapeGeometry { length, radius, alpha },
+        mesh_size,
+    ))
+}
+
 /// Height of the centroid of a tape spring's cross-section arc above the arc's middle point \[m\]:
 /// `R (1 - sin(alpha/2) / (alpha/2))`.
 #[pyfunction]

@@ -627,10 +627,11 @@ class SetupSpec:
             if size > self.tape.length / 4.0:
                 raise ValueError(f"{name} {size} m is too coarse (at most a quarter of a tape)")
             check_element_count(name, size, self.tape.length, width)
-        # As the mesher counts them: the arc over the size, rounded half away from zero (Rust's
-        # round, not Python's half to even), at least 2, made even.
-        n_across = max(math.floor(width / self.mesh_tape + 0.5), 2)
-        n_across += n_across % 2
+        from tapespring.shell import tape_spring_divisions
+
+        _, n_across = tape_spring_divisions(
+            self.tape.length, self.tape.radius, self.tape.alpha, self.mesh_tape
+        )
         if n_across < MIN_ELEMENTS_ACROSS:
             raise ValueError(
                 f"mesh_tape {self.mesh_tape} m gives {n_across} elements across the tapes' "

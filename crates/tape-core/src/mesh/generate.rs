@@ -121,15 +121,15 @@ impl TapeGeometry {
 /// or wrap the counts (the set-up and bending scenarios refuse far fewer, a million per tape).
 pub const MAX_GENERATED_ELEMENTS: f64 = 2e7;
 
-/// Tape-spring mesh with elements of size about `h` \[m\] (the arc count is rounded up to an even
-/// number so that a line of nodes lies on the symmetry plane).
-///
-/// Node sets: `end0` (x = 0), `end1` (x = L), `side0`, `side1` (the free edges), `midline`
-/// (symmetry line y = 0), `all`.
+/// Elements along and across a tape spring that [`tape_spring`] makes at the size `h` \[m\]:
+/// the length and the arc over `h`, rounded half away from zero, at least 1 along and 2 across,
+/// the count across made even. The one home of that rule (the set-up's scenarios ask it how many
+/// elements span the section before they build anything).
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a bad geometry or element size.
-pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
+/// [`Error::InvalidParameter`] for a bad geometry or size, or more than
+/// [`MAX_GENERATED_ELEMENTS`].
+pub fn tape_spring_divisions(geometry: &TapeGeometry, h: f64) -> Result<(usize, usize)> {
     geometry.validate()?;
     check_positive("mesh size h [m]", h)?;
     // Counted in floating point first: an absurd ratio must be refused, not wrapped by the cast.
@@ -145,8 +145,20 @@ pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
         )));
     }
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let (nx, mut na) = (nx_f as usize, na_f as usize);
-    na += na % 2;
+    let (nx, na) = (nx_f as usize, na_f as usize);
+    Ok((nx, na + na % 2))
+}
+
+/// Tape-spring mesh with elements of size about `h` \[m\] (the arc count is rounded up to an even
+/// number so that a line of nodes lies on the symmetry plane).
+///
+/// Node sets: `end0` (x = 0), `end1` (x = L), `side0`, `side1` (the free edges), `midline`
+/// (symmetry line y = 0), `all`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad geometry or element size.
+pub fn tape_spring(geometry: &TapeGeometry, h: f64) -> Result<Mesh> {
+    let (nx, na) = tape_spring_divisions(geometry, h)?;
     let g = *geometry;
     let mut mesh = grid(nx, na, |s, r| g.point(s * g.length, (r - 0.5) * g.alpha))?;
     rename(
@@ -199,6 +211,25 @@ mod tests {
         }
         let side = mesh.nodes[mesh.node_set("side1").unwrap()[0]];
         assert!((side.y.atan2(g.radius - side.z) - g.alpha / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn divisions_round_half_away_and_make_the_arc_even() {
+        // The paper's tape, arc 18.96 mm: 2.5 arc widths round to 3, made 4; 5.5 to 6.
+        let g = TapeGeometry {
+            length: 0.1,
+            radius: 15.55e-3,
+            alpha: 69.85_f64.to_radians(),
+        };
+        let arc = g.radius * g.alpha;
+        assert_eq!(tape_spring_divisions(&g, arc / 2.5).unwrap().1, 4);
+        assert_eq!(tape_spring_divisions(&g, arc / 2.49).unwrap().1, 2);
+        assert_eq!(tape_spring_divisions(&g, arc / 5.5).unwrap().1, 6);
+        assert_eq!(tape_spring_divisions(&g, 1.0).unwrap(), (1, 2));
+        for h in [1e-3, 2e-3, 3.3e-3, 7.58e-3, 0.05] {
+            let (along, across) = tape_spring_divisions(&g, h).unwrap();
+            assert_eq!(tape_spring(&g, h).unwrap().quads.len(), along * across, "h = {h}");
+        }
     }
 
     #[test]
