@@ -5,7 +5,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import pytest
 import tapespring
-from tapespring.report import FIGURE_DPI, save_figure
+from tapespring.report import FIGURE_DPI, save_figure, write_table
 
 
 def test_save_figure_takes_a_str_path_and_returns_a_path(tmp_path):
@@ -42,3 +42,14 @@ def test_every_figure_of_the_package_is_saved_by_save_figure():
         if "savefig(" in line
     ]
     assert bypass == []
+
+
+def test_table_comment_is_one_line_read_past_by_numpy(tmp_path: Path) -> None:
+    import numpy as np
+
+    path = write_table(tmp_path / "t.csv", ["a", "b"], [[0.1, 1e-300]], comment='run: {"x": 1}')
+    assert path.read_text() == '# run: {"x": 1}\na,b\n0.1,1e-300\n'
+    assert np.loadtxt(path, delimiter=",", skiprows=2).tolist() == [0.1, 1e-300]
+    for bad in ("two\nlines", "carriage\rreturn"):
+        with pytest.raises(ValueError, match="one line"):
+            write_table(tmp_path / "u.csv", ["a"], [[1]], comment=bad)

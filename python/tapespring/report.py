@@ -171,14 +171,27 @@ def format_summary(analysis: TrialsAnalysis[Any]) -> str:
     return "\n".join(lines)
 
 
-def write_table(path: Path, header: Sequence[str], rows: Sequence[Sequence[object]]) -> Path:
+def write_table(
+    path: Path,
+    header: Sequence[str],
+    rows: Sequence[Sequence[object]],
+    *,
+    comment: str | None = None,
+) -> Path:
     r"""Write one CSV table (None and NaN as empty fields; lines end in ``\n``); return its path.
 
     A field holding a line break of either kind (``\r`` or ``\n``: a file name, a problem's
     text) is quoted. The csv module quotes only the characters of its line terminator, so with
-    ``\n`` alone a ``\r`` went out bare and readers split the row there.
+    ``\n`` alone a ``\r`` went out bare and readers split the row there. A `comment` (one line,
+    such as the settings that produced the table as JSON) goes first, after ``# ``, as the
+    bending and maximum-mass files write theirs (``np.loadtxt`` and pandas' ``comment="#"``
+    skip it). Floats are written in full (``repr``).
     """
+    if comment is not None and ("\n" in comment or "\r" in comment):
+        raise ValueError("a table's comment must be one line")
     with path.open("w", newline="", encoding="utf-8") as fh:
+        if comment is not None:
+            fh.write(f"# {comment}\n")
         for row in [header, *rows]:
             line = io.StringIO()
             # "\r\n" makes the writer quote both characters; the row then ends in "\n".

@@ -53,18 +53,23 @@ def test_csv_and_plot_of_a_short_release(tmp_path, capsys, runs):
     assert code == 0
     (result,) = runs
     with open(csv_path, newline="") as fh:
+        comment = fh.readline()
         header, *rows = list(csv.reader(fh))
+    # First the settings that produced the file, as the summary gives them.
+    prefix = "# tapespring release: "
+    assert comment.startswith(prefix)
+    assert json.loads(comment[len(prefix) :]) == result.summary()["settings"]
     # The columns `--help` names: time, the end's angle, the clamp's moment, then every energy
     # term [J] (ReleaseResult.energy).
     assert header == ["time_s", "theta_deg", "moment_Nm", *(f"{e}_J" for e in ENERGIES)]
     # One row per record of the free motion, the release's state first (measured: 13 rows,
-    # 12 steps of which the first is 1e-5 s), each written to 9 significant digits.
+    # 12 steps of which the first is 1e-5 s), each value in full (read back exactly).
     assert len(rows) == result.time_s.size == result.summary()["steps"] + 1 > 5
     table = np.array(rows, dtype=float)
     expected = np.column_stack(
         [result.time_s, result.theta_deg, result.moment_Nm, *(result.energy[e] for e in ENERGIES)]
     )
-    np.testing.assert_allclose(table, expected, rtol=1e-8, atol=0.0)
+    np.testing.assert_array_equal(table, expected)
     assert table[0, 0] == 0.0 and table[-1, 0] == pytest.approx(0.003, rel=1e-9)
     assert np.all(np.diff(table[:, 0]) > 0.0)
     # From the fold at 60 degrees, the tape begins to open: the stored strain energy (84 mJ)

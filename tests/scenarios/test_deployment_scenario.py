@@ -271,8 +271,12 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert main([*args, f"--experiment={path}", *extra]) == 0
     out = json.loads(capsys.readouterr().out)
     # The CSV has a row per sample, as a recording at 800 Hz, where the JSON has every step.
-    table = np.loadtxt(csv, delimiter=",", skiprows=1)
-    assert csv.read_text().splitlines()[0] == "time_s,angle_deg,clamp_force_N"
+    table = np.loadtxt(csv, delimiter=",", skiprows=2)  # the settings line, the header
+    comment, header = csv.read_text().splitlines()[:2]
+    assert header == "time_s,angle_deg,clamp_force_N"
+    # The settings that produced the file, as the JSON's.
+    assert comment.startswith("# tapespring deploy: {")
+    assert json.loads(comment.split(": ", 1)[1]) == json.loads(json.dumps(out["settings"]))
     np.testing.assert_array_equal(table[:, 0], np.arange(241) / 800.0)
     assert len(out["time_s"]) > 241
     assert out["comparison"]["left_aside"] == {"max": [1], "min": []}

@@ -277,7 +277,8 @@ def test_vibrate_command_records_at_the_sample_rate_it_is_given(tmp_path, capsys
     assert "error: no damping fit" in captured.err
     assert json.loads(captured.out)["settings"]["sample_rate"] == 800.0
     # One CSV row per 800 Hz sample from the release (not the default 400 Hz).
-    t = np.loadtxt(csv_path, delimiter=",", skiprows=1, usecols=0)
+    t = np.loadtxt(csv_path, delimiter=",", skiprows=2, usecols=0)  # the settings, the header
+    assert csv_path.read_text().startswith('# tapespring vibrate: {"spec": {')
     np.testing.assert_allclose(t, np.arange(81) / 800.0, rtol=0, atol=1e-12)
     # --vtu keeps about 50 Hz at any rate: every 16th record at 800 Hz (8th at 400), and the last.
     index = sorted(int(f.stem.rsplit("_", 1)[1]) for f in (tmp_path / "decay").glob("*.vtu"))
@@ -301,7 +302,9 @@ def test_pull_command_writes_json_csv_and_plot(tmp_path, capsys) -> None:
     out = json.loads(capsys.readouterr().out)
     assert out["max_force_N"] > 0 and math.isfinite(out["max_force_displacement_m"])
     assert out["settings"]["spec"]["tape_spacing"] == PAPER_SETUP.tape_spacing
-    assert csv_path.read_text().startswith("displacement_m,force_N")
+    comment, header = csv_path.read_text().splitlines()[:2]
+    assert header.startswith("displacement_m,force_N")
+    assert json.loads(comment.removeprefix("# tapespring pull: ")) == out["settings"]
     assert png.stat().st_size > 10_000
 
 

@@ -9,9 +9,9 @@ scenario (`tapespring.scenarios.release`) and matplotlib are imported by `run`.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
+from pathlib import Path
 from typing import Any
 
 from .bend import (
@@ -28,6 +28,7 @@ from .scenario_options import (
     add_json_and_progress_options,
     add_rho_inf_option,
     add_tolerance_option,
+    settings_comment,
     shows_progress,
 )
 
@@ -117,7 +118,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--csv",
         type=_output_file,
-        help="write time_s, theta_deg, moment_Nm and the energies to this CSV",
+        help="write time_s, theta_deg, moment_Nm and the energies to this CSV, after a '#' "
+        "line of the settings as JSON",
     )
     p.add_argument("--plot", type=_image_file, help="write the angle and energy histories as a PNG")
     add_json_and_progress_options(p)
@@ -125,20 +127,22 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _write_csv(result: Any, path: str) -> None:
+def _write_csv(result: Any, path: str, comment: str) -> None:
+    """The free motion's histories: time, the end's angle, the clamp's moment and every energy
+    term, one row per record, after the `comment` line (the settings)."""
+    import numpy as np
+
+    from tapespring.report import write_table
+
     names = list(result.energy)
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time_s", "theta_deg", "moment_Nm", *(f"{n}_J" for n in names)])
-        for k in range(result.time_s.size):
-            w.writerow(
-                [
-                    f"{result.time_s[k]:.9g}",
-                    f"{result.theta_deg[k]:.9g}",
-                    f"{result.moment_Nm[k]:.9g}",
-                    *(f"{result.energy[n][k]:.9g}" for n in names),
-                ]
-            )
+    columns = [result.time_s, result.theta_deg, result.moment_Nm]
+    columns += [result.energy[n] for n in names]
+    write_table(
+        Path(path),
+        ["time_s", "theta_deg", "moment_Nm", *(f"{n}_J" for n in names)],
+        np.column_stack(columns).tolist(),
+        comment=comment,
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -179,8 +183,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"error: {exc}", file=sys.stderr)
             return 1
         result, failure = exc.result, str(exc)
+    summary = result.summary()
     if args.csv:
-        _write_csv(result, args.csv)
+        _write_csv(result, args.csv, settings_comment(args, summary["settings"]))
     if args.plot:
         import matplotlib
 
@@ -189,7 +194,6 @@ def run(args: argparse.Namespace) -> int:
         from tapespring.report import save_figure
 
         save_figure(plot_release(result), args.plot)
-    summary = result.summary()
     if args.json:
         json.dump(summary, sys.stdout)
         sys.stdout.write("\n")

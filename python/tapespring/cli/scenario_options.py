@@ -287,7 +287,11 @@ def add_sample_rate_option(p: argparse.ArgumentParser, *, recorded: str, default
 
 def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
     """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
-    p.add_argument("--csv", type=_output_file, help=f"write {csv_what} to this CSV file")
+    p.add_argument(
+        "--csv",
+        type=_output_file,
+        help=f"write {csv_what} to this CSV file, after a '#' line of the settings as JSON",
+    )
     p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
     add_json_and_progress_options(p)
 
@@ -341,7 +345,12 @@ def finish(
         failure = str(exc)
     if args.csv:
         table = columns(result)
-        write_table(Path(args.csv), list(table), list(zip(*table.values(), strict=True)))
+        write_table(
+            Path(args.csv),
+            list(table),
+            list(zip(*table.values(), strict=True)),
+            comment=settings_comment(args, result.summary()["settings"]),
+        )
     if args.plot:
         import matplotlib
 
@@ -362,6 +371,15 @@ def finish(
         print(f"error: {failure}", file=sys.stderr)
         return 1
     return 1 if problems else 0
+
+
+def settings_comment(args: argparse.Namespace, settings: object) -> str:
+    """The first line of a command's CSV file, after ``# ``: the command and the settings that
+    produced the table, as one line of JSON (``tapespring deploy: {"spec": ...}``)."""
+    from tapespring.report import jsonable_tree
+
+    text = json.dumps(jsonable_tree(settings), default=str)
+    return f"tapespring {getattr(args, 'command', '')}: {text}"
 
 
 def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: str) -> None:
