@@ -78,14 +78,45 @@ def constant() -> str:
     return "constant"
 
 
+def _real(value: Any, what: str) -> float:
+    """`value` as a float; TypeError naming `what` unless it is a real number.
+
+    ``float()`` took the string ``"0.5"`` and the bool ``True`` (as 1.0) without a word. A 0-d
+    NumPy array of integers or floats is a number.
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value[()]
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{what} must be a number, not {type(value).__name__}: {value!r}")
+    return float(value)
+
+
 def ramp(start: float, end: float) -> dict[str, Any]:
-    """Time function rising linearly from 0 at `start` to 1 at `end`, constant outside."""
-    return {"kind": "ramp", "start": float(start), "end": float(end)}
+    """Time function rising linearly from 0 at `start` to 1 at `end`, constant outside.
+
+    Raises TypeError if `start` or `end` is not a real number (a bool or a string included);
+    the model refuses a ramp whose times are not finite with ``start < end``.
+    """
+    return {"kind": "ramp", "start": _real(start, "ramp start"), "end": _real(end, "ramp end")}
 
 
 def table(points: Iterable[tuple[float, float]]) -> dict[str, Any]:
-    """Piecewise-linear time function through ``(t, f)`` points, constant beyond the ends."""
-    return {"kind": "table", "points": [(float(t), float(f)) for t, f in points]}
+    """Piecewise-linear time function through ``(t, f)`` points, constant beyond the ends.
+
+    Raises TypeError if `points` is not a sequence of ``(t, f)`` pairs of real numbers (a bool
+    or a string included); the model refuses times that are not finite and increasing.
+    """
+    if isinstance(points, str | bytes) or not isinstance(points, Iterable):
+        raise TypeError(f"table points must be a sequence of (t, f) pairs, not {points!r}")
+    pairs = []
+    for k, point in enumerate(points):
+        if isinstance(point, str | bytes) or not isinstance(point, Iterable):
+            raise TypeError(f"table point {k} must be a (t, f) pair, not {point!r}")
+        pair = tuple(point)
+        if len(pair) != 2:
+            raise TypeError(f"table point {k} must be a (t, f) pair, not {point!r}")
+        pairs.append((_real(pair[0], f"table point {k}: t"), _real(pair[1], f"table point {k}: f")))
+    return {"kind": "table", "points": pairs}
 
 
 def step_options(control: str = "load") -> dict[str, Any]:
@@ -142,9 +173,22 @@ def modal_step_options() -> dict[str, Any]:
     return options
 
 
-def _ids(ids: str | Iterable[str]) -> tuple[str, ...]:
-    """`ids` as a tuple; a single string is one id (``tuple("push")`` would be four)."""
-    return (ids,) if isinstance(ids, str) else tuple(ids)
+def _ids(ids: str | Iterable[str], what: str = "ids") -> tuple[str, ...]:
+    """`ids` as a tuple; a single string is one id (``tuple("push")`` would be four).
+
+    Raises TypeError naming `what` unless `ids` is a string or an iterable of strings: bytes
+    were iterated as their codes (``b"push"`` became the ids 112, 117, ...), None failed as
+    "not iterable".
+    """
+    if isinstance(ids, str):
+        return (ids,)
+    if isinstance(ids, bytes | bytearray) or not isinstance(ids, Iterable):
+        raise TypeError(f"{what} must be an id (a str) or a sequence of ids, not {ids!r}")
+    out = tuple(ids)
+    for k, one in enumerate(out):
+        if not isinstance(one, str):
+            raise TypeError(f"{what}[{k}] must be an id (a str), not {type(one).__name__}: {one!r}")
+    return out
 
 
 def _index(value: Any, what: str, pair: tuple[Any, Any] | None = None) -> int:
@@ -182,6 +226,10 @@ def _index(value: Any, what: str, pair: tuple[Any, Any] | None = None) -> int:
     return index
 
 
+#: The keys of a step's flat form that are `Step` fields, not options.
+_STEP_KEYS = frozenset({"name", "kind", "activate", "deactivate"})
+
+
 @dataclass(frozen=True)
 class Step:
     """An analysis step: what it computes, and what it switches on and off at its start.
@@ -211,9 +259,28 @@ class Step:
         if not isinstance(self.name, str):
             # The core refuses other types, but takes None for a missing name ("").
             raise TypeError(f"name must be a str, got {self.name!r}")
+        # The core takes None for the default kind: Step("s", kind=None) ran a static step.
+        if not isinstance(self.kind, str):
+            raise TypeError(
+                f"kind must be a str ('static', 'dynamic' or 'modal'), got {self.kind!r}"
+            )
+        if not isinstance(self.options, Mapping):
+            raise TypeError(
+                f"options must be a mapping of option names to values, not "
+                f"{type(self.options).__name__}"
+            )
+        # The flat form puts the options after these keys: options={"kind": "modal"} ran a
+        # modal step in a Step whose kind said static, and options={"name": ...},
+        # {"activate": ...} replaced the step's own name and ids.
+        clash = sorted(set(self.options) & _STEP_KEYS)
+        if clash:
+            raise ValueError(
+                f"step {self.name!r}: {', '.join(map(repr, clash))} cannot be given as an option "
+                "(they are the Step's own fields: name, kind, activate, deactivate)"
+            )
         # Also for a Step built directly: a string given as ids would be split into letters.
-        object.__setattr__(self, "activate", _ids(self.activate))
-        object.__setattr__(self, "deactivate", _ids(self.deactivate))
+        object.__setattr__(self, "activate", _ids(self.activate, "activate"))
+        object.__setattr__(self, "deactivate", _ids(self.deactivate, "deactivate"))
 
     @classmethod
     def static(
@@ -229,7 +296,13 @@ class Step:
         `activate` and `deactivate` are the ids switched on and off at its start: a sequence of
         strings, or one string for one id (``deactivate="push"``).
         """
-        return cls(name, "static", _ids(activate), _ids(deactivate), dict(options))
+        return cls(
+            name,
+            "static",
+            _ids(activate, "activate"),
+            _ids(deactivate, "deactivate"),
+            dict(options),
+        )
 
     @classmethod
     def dynamic(
@@ -249,7 +322,11 @@ class Step:
         at its start: a sequence of strings, or one string for one id.
         """
         return cls(
-            name, "dynamic", _ids(activate), _ids(deactivate), {"duration": duration, **options}
+            name,
+            "dynamic",
+            _ids(activate, "activate"),
+            _ids(deactivate, "deactivate"),
+            {"duration": duration, **options},
         )
 
     @classmethod
@@ -291,8 +368,8 @@ class Step:
         return cls(
             name,
             "modal",
-            _ids(activate),
-            _ids(deactivate),
+            _ids(activate, "activate"),
+            _ids(deactivate, "deactivate"),
             {"modes": modes, "shift": shift, "matrices": matrices, **options},
         )
 

@@ -244,10 +244,14 @@ class Results:
 
         Raises
         ------
+        TypeError
+            If `node` is not a number (a string included) or `dof` not a string.
+        ValueError
+            If `node` is a bool or not an integer (``1.5`` is refused, not read as node 1).
         KeyError
             If that (node, dof) was not recorded.
         """
-        key = (int(node), _dof_name(dof))
+        key = (_node_index(node), _dof_name(dof))
         try:
             column = self.reaction_dofs.index(key)
         except ValueError:
@@ -321,9 +325,41 @@ class Results:
         plate from the reactions at `force_nodes`, with the sign a plate under the support reads).
 
         See :func:`tapespring.trials.simulated.results_to_trial` for the parameters.
+
+        Raises
+        ------
+        TypeError
+            If `markers` is not a mapping, `steps` not a sequence of integer step indices
+            (``1.5``, ``True`` and ``"1"`` were read as step 1), or a rate not a number (``True``
+            was 1 Hz).
+        ValueError
+            As ``results_to_trial``; also for a finite rate above the trials' 1 MHz (a rate of
+            1e300 Hz failed allocating its time grid, naming neither).
         """
         from tapespring.trials.simulated import results_to_trial
+        from tapespring.trials.trial import MAX_RATE
 
+        if not isinstance(markers, Mapping):
+            # A list failed with an AttributeError, a string was read letter by letter.
+            raise TypeError(
+                f"markers must map the results' marker names to the trial's, e.g. "
+                f"{{'tip': 'M1'}} (got {type(markers).__name__}: {markers!r})"
+            )
+        if steps is not None:
+            if isinstance(steps, str | bytes) or not isinstance(steps, Sequence | np.ndarray):
+                raise TypeError(f"steps must be a sequence of step indices (got {steps!r})")
+            for k in steps:
+                if isinstance(k, bool | np.bool_) or not isinstance(k, numbers.Integral):
+                    raise TypeError(f"steps must hold integer step indices (got {k!r})")
+        for what, rate in (("rate_hz", rate_hz), ("force_rate_hz", force_rate_hz)):
+            if isinstance(rate, bool | np.bool_) or not isinstance(rate, numbers.Real):
+                raise TypeError(f"{what} must be a number [Hz] (got {rate!r})")
+            # Rates that are not finite and > 0 are refused by results_to_trial.
+            if math.isfinite(rate) and rate > MAX_RATE:
+                raise ValueError(
+                    f"{what} must be at most {MAX_RATE:g} Hz, the highest sampling rate of a "
+                    f"trial (got {rate!r})"
+                )
         return results_to_trial(
             self,
             markers=markers,
@@ -336,7 +372,25 @@ class Results:
         )
 
     def in_step(self, step: int) -> NDArray[np.int64]:
-        """Indices of the records of analysis step `step` (the initial state belongs to none)."""
+        """Indices of the records of analysis step `step` (the initial state belongs to none).
+
+        Empty for a step that recorded nothing (a modal step, a step the run did not reach).
+
+        Raises
+        ------
+        TypeError
+            If `step` is not an integer (``1.5``, ``"1"`` and ``True`` matched nothing or step
+            1 instead of being refused).
+        IndexError
+            If `step` is negative or beyond the steps of the analysis.
+        """
+        if isinstance(step, bool | np.bool_) or not isinstance(step, numbers.Integral):
+            raise TypeError(f"step must be an integer step index (got {step!r})")
+        steps = self.settings.get("steps")
+        n_steps = len(steps) if isinstance(steps, list) else None
+        if step < 0 or (n_steps is not None and step >= n_steps):
+            bound = "" if n_steps is None else f" (the analysis has {n_steps} steps)"
+            raise IndexError(f"step {step} out of range{bound}")
         idx = np.nonzero(self.step == step)[0]
         return idx[idx > 0]
 
@@ -483,6 +537,24 @@ class Results:
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
         d["modes"] = modes
         return d
+
+
+def _node_index(node: object) -> int:
+    """`node` as a node index, as `Outputs` takes it: an integer, or a float of integral value.
+
+    ``int()`` read 1.5 as node 1, ``True`` as node 1 and ``"3"`` as node 3, and failed on an
+    infinite float with an OverflowError.
+    """
+    if isinstance(node, bool | np.bool_):
+        raise ValueError(f"node must be an integer node index (got the bool {node})")
+    if isinstance(node, numbers.Integral):
+        return int(node)
+    if isinstance(node, numbers.Real):
+        value = float(node)
+        if math.isfinite(value) and value.is_integer():
+            return int(value)
+        raise ValueError(f"node must be an integer node index (got the value {node})")
+    raise TypeError(f"node must be an integer node index (got {type(node).__name__}: {node!r})")
 
 
 def _dof_name(dof: object) -> str:

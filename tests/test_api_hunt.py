@@ -1,0 +1,281 @@
+"""Robustness hunt of the Python model-building and analysis API (analysis, shell, modes,
+results): what the earlier hunts (test_api_input_checks, test_audit_inputs,
+test_core_input_checks, test_model_properties, test_results_hunt) did not try.
+
+Defects found and fixed in the Python layer, each with its regression test here:
+
+* a step's options could hold its own fields: ``Step("s", options={"kind": "modal"})`` ran a
+  modal step although ``step.kind`` said static, ``Step.static("s", kind="dynamic")`` made a
+  dynamic step, ``options={"name": ...}`` or ``{"activate": ...}`` replaced the step's name or
+  ids in the flat form the core reads; ``Step("s", kind=None)`` ran as a static step;
+* ids given as bytes were iterated into their codes (``activate=b"f"`` became the id 102);
+* ``ramp`` and ``table`` read ``True`` as 1.0 and the string ``"0.5"`` as 0.5 (``float()``);
+* ``Results.reaction`` truncated its node with ``int()``: ``reaction(0.5, "uz")`` gave node 0's
+  history, ``"3"`` was node 3, ``True`` node 1, an infinite float an OverflowError;
+* ``Results.in_step`` compared anything: ``in_step(1.5)`` and ``in_step("1")`` gave no records,
+  ``in_step(True)`` step 1's, ``in_step(-1)`` or a step beyond the analysis silently none;
+* ``Results.to_trial`` read steps ``[1.5]``, ``[True]`` and ``["1"]`` as step 1, a rate of
+  ``True`` as 1 Hz, failed on a list of markers with an AttributeError, read a string of
+  markers letter by letter, and a rate of 1e300 Hz failed allocating its grid ("Maximum
+  allowed size exceeded").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from tapespring import Model, Outputs, Step, run, shell
+from tapespring.analysis import ramp, table
+
+# ---------------------------------------------------------------------------------------------
+# Shared tiny models
+
+
+def tip_model(*, mass: float = 0.01) -> tuple[Model, int]:
+    """A 3 x 1 steel strip 200 x 20 x 1 mm clamped at x = 0 (id ``clamp``), its tip section tied
+    to a reference node carrying `mass` [kg] and a marker ``tip``; returns it and the node."""
+    nodes, quads, sets = shell.flat_plate_mesh(0.2, 0.02, 3, 1)
+    model = Model(
+        nodes,
+        quads,
+        node_sets=sets,
+        thickness=1e-3,
+        youngs_modulus=2e11,
+        poisson=0.3,
+        density=7850.0,
+    )
+    model.fix("x0", id="clamp")
+    tip = model.add_node([0.2, 0.01, 0.0])
+    model.tie("x1", tip)
+    model.add_point_mass(tip, mass)
+    model.add_marker("tip", tip)
+    return model, tip
+
+
+@pytest.fixture(scope="module")
+def two_step_results():
+    """A tip load on for a static step and off for the next: 5 records, fields kept."""
+    model, tip = tip_model()
+    model.add_load(tip, "uz", 1.0, id="f")
+    steps = [
+        Step.static("on", increments=2),
+        Step.static("off", lambda_end=2.0, increments=2, deactivate="f"),
+    ]
+    return run(model, steps, outputs=Outputs(field_interval=1))
+
+
+# ---------------------------------------------------------------------------------------------
+# Step: its own fields are not options, its kind is a string, ids are strings
+
+
+@pytest.mark.parametrize(
+    "make, clash",
+    [
+        (lambda: Step.static("s", kind="dynamic"), "'kind'"),
+        (lambda: Step.dynamic("d", duration=1e-3, kind="static"), "'kind'"),
+        (lambda: Step.modal("m", kind="static"), "'kind'"),
+        (lambda: Step("s", options={"kind": "modal"}), "'kind'"),
+        (lambda: Step("s", options={"name": "other", "increments": 2}), "'name'"),
+        (lambda: Step("s", options={"activate": ["f"]}), "'activate'"),
+        (lambda: Step("s", options={"deactivate": "f", "kind": "modal"}), "'deactivate'"),
+    ],
+)
+def test_a_step_s_own_fields_given_as_options_are_refused(make, clash):
+    with pytest.raises(ValueError, match="cannot be given as an option") as info:
+        make()
+    assert clash in str(info.value)
+
+
+def test_an_option_named_kind_no_longer_turns_a_static_step_modal():
+    # Before the fix, this ran a modal step (one record, a Modes entry) as a 'static' Step.
+    model, tip = tip_model()
+    model.add_load(tip, "uz", 1.0)
+    with pytest.raises(ValueError, match="'kind' cannot be given as an option"):
+        run(model, [Step("s", options={"kind": "modal"})])
+    results = run(model, [Step("s", options={"increments": 2})])
+    assert results.n_records == 3 and results.modes == ()
+
+
+@pytest.mark.parametrize("kind", [None, 1, b"static"])
+def test_a_step_kind_that_is_not_a_string_is_a_type_error(kind):
+    with pytest.raises(TypeError, match="kind must be a str"):
+        Step("s", kind=kind)
+
+
+@pytest.mark.parametrize("options", [None, [("increments", 2)], "increments"])
+def test_step_options_that_are_not_a_mapping_are_a_type_error(options):
+    with pytest.raises(TypeError, match="options must be a mapping"):
+        Step("s", options=options)
+
+
+@pytest.mark.parametrize(
+    "ids, message",
+    [
+        (b"f", "activate must be an id"),
+        (bytearray(b"f"), "activate must be an id"),
+        (None, "activate must be an id"),
+        (3, "activate must be an id"),
+        ([1], r"activate\[0\] must be an id"),
+        (["f", None], r"activate\[1\] must be an id"),
+    ],
+)
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda ids: Step.static("s", activate=ids),
+        lambda ids: Step.dynamic("d", duration=1e-3, activate=ids),
+        lambda ids: Step.modal("m", activate=ids),
+        lambda ids: Step("s", activate=ids),
+    ],
+)
+def test_ids_that_are_not_strings_are_a_type_error(make, ids, message):
+    with pytest.raises(TypeError, match=message):
+        make(ids)
+
+
+def test_deactivate_names_itself_in_its_type_error():
+    with pytest.raises(TypeError, match="deactivate must be an id"):
+        Step.static("s", deactivate=b"push")
+
+
+def test_valid_steps_are_unchanged():
+    step = Step.static("s", activate=["a"], deactivate="b", increments=3)
+    assert step.to_dict() == {
+        "name": "s",
+        "kind": "static",
+        "activate": ["a"],
+        "deactivate": ["b"],
+        "increments": 3,
+    }
+    assert Step.modal("m").to_dict()["kind"] == "modal"
+    assert Step("d", "dynamic", options={"duration": 1e-3}).to_dict()["duration"] == 1e-3
+
+
+# ---------------------------------------------------------------------------------------------
+# Time functions: numbers only
+
+
+@pytest.mark.parametrize("start, end", [(True, 2.0), ("0.5", 1.0), (0.0, "1"), (0.0, None)])
+def test_a_ramp_of_a_bool_or_a_string_is_a_type_error(start, end):
+    with pytest.raises(TypeError, match="ramp (start|end) must be a number"):
+        ramp(start, end)
+
+
+@pytest.mark.parametrize(
+    "points, message",
+    [
+        ([(True, 1.0), (2.0, 3.0)], "table point 0: t must be a number"),
+        ([(0.0, 1.0), (1.0, "2")], "table point 1: f must be a number"),
+        ([(0.0, 1.0, 2.0)], "table point 0 must be a .t, f. pair"),
+        ([5.0], "table point 0 must be a .t, f. pair"),
+        ("ab", "table points must be a sequence"),
+        (None, "table points must be a sequence"),
+    ],
+)
+def test_a_table_of_anything_but_number_pairs_is_a_type_error(points, message):
+    with pytest.raises(TypeError, match=message):
+        table(points)
+
+
+def test_numeric_time_functions_are_unchanged():
+    assert ramp(np.float32(0.5), np.array(2)) == {"kind": "ramp", "start": 0.5, "end": 2.0}
+    assert table(np.array([[0, 0], [1, 2]])) == {
+        "kind": "table",
+        "points": [(0.0, 0.0), (1.0, 2.0)],
+    }
+
+
+# ---------------------------------------------------------------------------------------------
+# Results accessors
+
+
+@pytest.mark.parametrize("node", [0.5, 1.9, True, np.bool_(False), float("nan"), float("inf")])
+def test_a_reaction_node_that_is_not_an_integer_is_refused_not_truncated(two_step_results, node):
+    with pytest.raises(ValueError, match="node must be an integer node index"):
+        two_step_results.reaction(node, "uz")
+
+
+@pytest.mark.parametrize("node", ["0", None, [0]])
+def test_a_reaction_node_that_is_not_a_number_is_a_type_error(two_step_results, node):
+    with pytest.raises(TypeError, match="node must be an integer node index"):
+        two_step_results.reaction(node, "uz")
+
+
+def test_a_reaction_node_given_as_an_integral_number_is_that_node(two_step_results):
+    r = two_step_results
+    expected = r.reaction(0, "uz")
+    assert np.any(expected != 0)
+    for node in (np.int64(0), 0.0, np.float64(0.0)):
+        np.testing.assert_array_equal(r.reaction(node, "uz"), expected)
+
+
+@pytest.mark.parametrize("step", [1.5, True, "1", None, [1]])
+def test_in_step_refuses_a_step_that_is_not_an_integer(two_step_results, step):
+    with pytest.raises(TypeError, match="step must be an integer step index"):
+        two_step_results.in_step(step)
+
+
+@pytest.mark.parametrize("step", [-1, 2, 2**70])
+def test_in_step_refuses_a_step_the_analysis_does_not_have(two_step_results, step):
+    with pytest.raises(IndexError, match=f"step {step} out of range .the analysis has 2 steps"):
+        two_step_results.in_step(step)
+
+
+def test_in_step_gives_each_step_s_records(two_step_results):
+    r = two_step_results
+    np.testing.assert_array_equal(r.in_step(0), [1, 2])
+    np.testing.assert_array_equal(r.in_step(np.int64(1)), [3, 4])
+
+
+@pytest.fixture(scope="module")
+def dynamic_results():
+    """A tip pushed up statically, released for 20 ms, then a modal step; markers M1-M3."""
+    model, tip = tip_model()
+    for k, name in enumerate(("M1", "M2", "M3")):
+        model.add_marker(name, tip, offset=[0.0, 0.0, 0.01 * k])
+    model.prescribe(tip, "uz", 0.01, id="push")
+    steps = [
+        Step.static("push", increments=2),
+        Step.dynamic("free", duration=0.02, deactivate="push"),
+        Step.modal("m", modes=2),
+    ]
+    return run(model, steps)
+
+
+MARKERS = {"M1": "M1", "M2": "M2", "M3": "M3"}
+
+
+@pytest.mark.parametrize("steps", [[1.5], [True], ["1"], [np.float64(1.0)], 1, "1"])
+def test_to_trial_refuses_steps_that_are_not_integer_indices(dynamic_results, steps):
+    with pytest.raises(TypeError, match="steps must"):
+        dynamic_results.to_trial(markers=MARKERS, steps=steps)
+
+
+@pytest.mark.parametrize("markers", [["M1"], "M1", None])
+def test_to_trial_refuses_markers_that_are_not_a_mapping(dynamic_results, markers):
+    with pytest.raises(TypeError, match="markers must map"):
+        dynamic_results.to_trial(markers=markers)
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, message",
+    [
+        ({"rate_hz": True}, TypeError, "rate_hz must be a number"),
+        ({"rate_hz": "800"}, TypeError, "rate_hz must be a number"),
+        ({"rate_hz": 1e300}, ValueError, r"rate_hz must be at most 1e\+06 Hz"),
+        ({"rate_hz": 2e6}, ValueError, r"rate_hz must be at most 1e\+06 Hz"),
+        ({"force_rate_hz": 1e300, "force_nodes": [0]}, ValueError, "force_rate_hz must be at most"),
+    ],
+)
+def test_to_trial_names_a_bad_rate(dynamic_results, kwargs, error, message):
+    with pytest.raises(error, match=message):
+        dynamic_results.to_trial(markers=MARKERS, **kwargs)
+
+
+def test_to_trial_still_samples_the_dynamic_step(dynamic_results):
+    r = dynamic_results
+    trial = r.to_trial(markers=MARKERS, steps=[np.int64(1), 2], rate_hz=1000)
+    free = r.in_step(1)
+    assert trial.time[0] == pytest.approx(r.t[free[0] - 1])
+    assert trial.time[-1] == pytest.approx(r.t[free[-1]])
+    assert trial.markers["M1"].shape == (trial.time.size, 3)
