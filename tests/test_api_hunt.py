@@ -279,3 +279,93 @@ def test_to_trial_still_samples_the_dynamic_step(dynamic_results):
     assert trial.time[0] == pytest.approx(r.t[free[0] - 1])
     assert trial.time[-1] == pytest.approx(r.t[free[-1]])
     assert trial.markers["M1"].shape == (trial.time.size, 3)
+
+
+# ---------------------------------------------------------------------------------------------
+# modes: the SciPy cross-check refuses a shift that loses K's digits, as the native step does
+
+
+@pytest.fixture(scope="module")
+def clamped_matrices():
+    """K and M of the clamped 3 x 1 strip and its tip node (30 free equations)."""
+    from tapespring.analysis import system_matrices
+
+    model, _ = tip_model()
+    return model, system_matrices(model)
+
+
+@pytest.mark.parametrize("shift_hz", [1e20, -1e20, 1e50, 1e100, 1e150])
+def test_modal_scipy_refuses_a_shift_too_far_from_the_spectrum(clamped_matrices, shift_hz):
+    # Before: 1e20 Hz gave 2.4e12 Hz modes on a model whose highest is 1.5e6 Hz, -1e20 Hz
+    # negative frequencies on a stable model, 1e100 Hz an ArpackError.
+    from tapespring.modes import modal_scipy
+
+    _, matrices = clamped_matrices
+    with pytest.raises(ValueError, match="too far from the frequencies"):
+        modal_scipy(matrices, 2, shift_hz=shift_hz)
+
+
+def test_modal_scipy_still_matches_the_native_modes(clamped_matrices):
+    from tapespring.modes import modal_scipy
+
+    model, matrices = clamped_matrices
+    native = run(model, [Step.modal("m", modes=3)]).modes[0].frequencies_hz
+    for shift_hz in (None, 0.0, 10.0):
+        found = modal_scipy(matrices, 3, shift_hz=shift_hz).frequencies_hz
+        np.testing.assert_allclose(found, native, rtol=1e-7)
+
+
+@pytest.mark.parametrize("f", [1e200, -1e160, float("nan"), float("inf")])
+def test_shift_from_hz_refuses_what_has_no_finite_shift(f):
+    from tapespring.modes import shift_from_hz
+
+    # 1e200 raised an OverflowError, NaN gave a NaN shift.
+    with pytest.raises(ValueError, match="shift frequency must be finite"):
+        shift_from_hz(f)
+
+
+@pytest.mark.parametrize("f", [True, "1", None])
+def test_shift_from_hz_refuses_what_is_not_a_number(f):
+    from tapespring.modes import shift_from_hz
+
+    with pytest.raises(TypeError, match="shift frequency must be a number"):
+        shift_from_hz(f)
+
+
+def test_shift_from_hz_is_the_signed_square():
+    from tapespring.modes import shift_from_hz
+
+    assert shift_from_hz(1.0) == pytest.approx((2 * np.pi) ** 2, rel=1e-15)
+    assert shift_from_hz(-2) == pytest.approx(-((4 * np.pi) ** 2), rel=1e-15)
+    assert shift_from_hz(0.0) == 0.0
+    assert shift_from_hz(np.float32(1.0)) > 0
+
+
+@pytest.mark.parametrize(
+    "vector, n_nodes, error, message",
+    [
+        (np.ones(3), 9, ValueError, r"vector must have shape \(30,\)"),
+        (np.ones((30, 2)), 9, ValueError, r"vector must have shape \(30,\)"),
+        (np.ones(30) * 1j, 9, TypeError, "vector must be real"),
+        (np.ones(30), 8, ValueError, r"n_nodes = 8 does not hold .* \(up to node 8\)"),
+        (np.ones(30), 8.5, TypeError, "n_nodes must be an integer"),
+        (np.ones(30), True, TypeError, "n_nodes must be an integer"),
+    ],
+)
+def test_to_nodal_names_a_bad_vector_or_node_count(
+    clamped_matrices, vector, n_nodes, error, message
+):
+    _, matrices = clamped_matrices
+    assert matrices.n == 30  # 9 nodes, 2 clamped, 2 tied to the tip node
+    with pytest.raises(error, match=message):
+        matrices.to_nodal(vector, n_nodes)
+
+
+def test_to_nodal_places_the_free_equations():
+    from tapespring.modes import SystemMatrices
+
+    free = SystemMatrices(stiffness=None, mass=None, free_dofs=np.array([[1, 2], [3, 0]]))
+    out = free.to_nodal(np.array([5.0, 7.0]), 4)
+    expected = np.zeros((4, 6))
+    expected[1, 2], expected[3, 0] = 5.0, 7.0
+    np.testing.assert_array_equal(out, expected)

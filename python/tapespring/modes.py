@@ -35,11 +35,29 @@ __all__ = [
 _DOFS = ("ux", "uy", "uz", "rx", "ry", "rz")
 #: Factor of the automatic shift ``-factor * min(K_ii / M_ii)`` (as in the native solver).
 _AUTO_SHIFT_FACTOR = 1e-6
+#: Largest relative difference between an eigenvalue and its vector's Rayleigh quotient (as the
+#: native modal step's check: converged pairs agree to about 1e-10).
+_RAYLEIGH_MISMATCH_MAX = 1e-6
 
 
 def shift_from_hz(f: float) -> float:
-    """Eigenvalue shift [rad^2/s^2] of a signed shift frequency `f` [Hz]: ``sign(f) (2 pi f)^2``."""
-    return float(np.sign(f) * (2.0 * np.pi * f) ** 2)
+    """Eigenvalue shift [rad^2/s^2] of a signed shift frequency `f` [Hz]: ``sign(f) (2 pi f)^2``.
+
+    Raises
+    ------
+    TypeError
+        If `f` is not a real number (a bool included).
+    ValueError
+        If `f` or the shift is not finite (beyond about 1.6e153 Hz the square overflowed with an
+        OverflowError; a NaN gave a NaN shift).
+    """
+    if isinstance(f, bool | np.bool_) or not isinstance(f, numbers.Real):
+        raise TypeError(f"the shift frequency must be a number [Hz] (got {f!r})")
+    f = float(f)
+    omega = 2.0 * math.pi * f
+    if not (math.isfinite(omega) and abs(omega) < math.sqrt(np.finfo(float).max)):
+        raise ValueError(f"the shift frequency must be finite, its (2 pi f)^2 too (got {f!r})")
+    return math.copysign(omega * omega, f) if f != 0.0 else 0.0
 
 
 def frequency_hz(eigenvalues: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -101,9 +119,31 @@ class SystemMatrices:
         """A free-equation vector as nodal rows ``(n_nodes, 6)`` (0 where not free).
 
         Tied nodes, whose DOFs are not equations, are left at 0.
+
+        Raises
+        ------
+        TypeError
+            If `n_nodes` is not an integer, or `vector` is complex (its imaginary part was
+            dropped with a mere warning).
+        ValueError
+            If `vector` is not of shape ``(n,)`` or `n_nodes` does not hold the free equations'
+            nodes.
         """
-        out = np.zeros((n_nodes, 6))
-        out[self.free_dofs[:, 0], self.free_dofs[:, 1]] = np.asarray(vector, dtype=float)
+        if isinstance(n_nodes, bool | np.bool_) or not isinstance(n_nodes, numbers.Integral):
+            raise TypeError(f"n_nodes must be an integer (got {n_nodes!r})")
+        needed = int(self.free_dofs[:, 0].max()) + 1 if self.n else 0
+        if n_nodes < needed:
+            raise ValueError(
+                f"n_nodes = {n_nodes} does not hold the free equations' nodes (up to node "
+                f"{needed - 1})"
+            )
+        values = np.asarray(vector)
+        if np.iscomplexobj(values):
+            raise TypeError("vector must be real (got a complex array)")
+        if values.shape != (self.n,):
+            raise ValueError(f"vector must have shape ({self.n},), got {values.shape}")
+        out = np.zeros((int(n_nodes), 6))
+        out[self.free_dofs[:, 0], self.free_dofs[:, 1]] = values.astype(float)
         return out
 
 
@@ -253,10 +293,12 @@ def modal_scipy(
     TypeError
         If `modes` is not an integer or `shift_hz` not a number.
     ValueError
-        If `modes` is not from 1 to ``n - 1`` (eigsh's bound), or `shift_hz` or its squared
-        pulsation is not finite.
+        If `modes` is not from 1 to ``n - 1`` (eigsh's bound), `shift_hz` or its squared
+        pulsation is not finite, or the shift is too far from the frequencies for the pairs
+        found to be right (an eigenvalue that is not its vector's Rayleigh quotient, as the
+        native modal step checks; or eigsh failing there).
     """
-    from scipy.sparse.linalg import eigsh
+    from scipy.sparse.linalg import ArpackError, eigsh
 
     n = matrices.n
     # eigsh truncates 2.5 to 2 and fails on 0 or n with messages that name neither the option
@@ -273,19 +315,48 @@ def modal_scipy(
         # A NaN or infinite shift was a "singular factor" from SciPy, one beyond 1e153 Hz an
         # OverflowError.
         try:
-            finite = math.isfinite(shift_from_hz(shift_hz))
-        except OverflowError:
-            finite = False
-        if not finite:
-            raise ValueError(f"shift_hz must be finite, its (2 pi f)^2 too (got {shift_hz!r})")
+            shift_from_hz(shift_hz)
+        except ValueError:
+            raise ValueError(
+                f"shift_hz must be finite, its (2 pi f)^2 too (got {shift_hz!r})"
+            ) from None
     k = matrices.stiffness
     k_sym = ((k + k.T) * 0.5).tocsc()
     m = matrices.mass.tocsc()
     sigma = auto_shift(matrices) if shift_hz is None else shift_from_hz(shift_hz)
-    values, vectors = eigsh(k_sym, k=int(modes), M=m, sigma=sigma, which="LM")
+    far = (
+        f"the shift sigma = {sigma:.6e} rad^2/s^2 (shift_hz = {shift_hz!r}) is too far from the "
+        "frequencies for K - sigma M to keep K's digits; choose a shift near the frequencies "
+        "sought, or none (the default lies below the lowest)"
+    )
+    try:
+        values, vectors = eigsh(k_sym, k=int(modes), M=m, sigma=sigma, which="LM")
+    except ArpackError as exc:
+        # A shift of 1e100 Hz: "ARPACK error -9: Starting vector is zero."
+        raise ValueError(f"eigsh failed ({exc}): {far}") from exc
     order = np.argsort(values)
     values = values[order]
     vectors = vectors[:, order]
+    # As the native modal step: each eigenvalue must be its vector's Rayleigh quotient on the
+    # unshifted problem. With a shift far above the spectrum eigsh's pairs were wrong without a
+    # word (2.4e12 Hz on a strip whose highest mode is 1.5e6 Hz; negative frequencies below it).
+    rayleigh = np.einsum("ij,ij->j", vectors, k_sym @ vectors) / np.einsum(
+        "ij,ij->j", vectors, m @ vectors
+    )
+    diagonal = k_sym.diagonal()
+    mass = m.diagonal()
+    ok = (diagonal > 0) & (mass > 0)
+    scale = 1e-9 * float(np.max(diagonal[ok] / mass[ok])) if np.any(ok) else 0.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mismatch = np.abs(rayleigh - values) / (np.abs(values) + np.abs(rayleigh) + scale)
+    bad = np.flatnonzero(~(mismatch <= _RAYLEIGH_MISMATCH_MAX))
+    if bad.size:
+        j = int(bad[0])
+        raise ValueError(
+            f"the mode found at {float(frequency_hz(values[j])):.6e} Hz has a Rayleigh quotient "
+            f"of {float(frequency_hz(rayleigh[j])):.6e} Hz (relative difference "
+            f"{mismatch[j]:.1e}): {far}"
+        )
     return ScipyModes(
         eigenvalues=values,
         frequencies_hz=frequency_hz(values),
