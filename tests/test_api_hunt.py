@@ -369,3 +369,38 @@ def test_to_nodal_places_the_free_equations():
     expected = np.zeros((4, 6))
     expected[1, 2], expected[3, 0] = 5.0, 7.0
     np.testing.assert_array_equal(out, expected)
+
+
+# ---------------------------------------------------------------------------------------------
+# shell: a cylindrical panel of more than one turn, or of angles beyond their digits
+
+
+@pytest.mark.parametrize(
+    "phi0, phi1, message",
+    [
+        (0.0, 7.0, "more than one turn"),
+        (0.0, 3 * np.pi, "more than one turn"),
+        (-2.0, 2 * np.pi - 1.0, "more than one turn"),
+        (-1e300, 1e300, "phi0 = -1e\\+300 rad is beyond 1e\\+06 rad"),
+        (1e20, 1e20 + 1e5, "phi0 = 1e\\+20 rad is beyond"),
+        (0.0, 2e6, "phi1 = 2000000.0 rad is beyond"),
+    ],
+)
+def test_a_panel_that_wraps_onto_itself_or_loses_its_angles_is_refused(phi0, phi1, message):
+    # Before: 0 to 7 rad gave a panel lying on itself, -1e300 to 1e300 rad nodes at sin() of
+    # round-off, each a Mesh without a word.
+    with pytest.raises(ValueError, match=message):
+        shell.cylindrical_panel_mesh(0.1, 0.2, phi0, phi1, 2, 4)
+
+
+def test_a_panel_of_up_to_one_turn_is_meshed():
+    nodes, quads, _ = shell.cylindrical_panel_mesh(0.1, 0.2, 0.0, 2 * np.pi, 2, 8)
+    assert quads.shape == (16, 4)
+    np.testing.assert_allclose(np.hypot(nodes[:, 1], nodes[:, 2]), 0.1, rtol=1e-14)
+    nodes, _, _ = shell.cylindrical_panel_mesh(0.1, 0.2, -1e6, -1e6 + 0.5, 1, 1)
+    np.testing.assert_allclose(np.hypot(nodes[:, 1], nodes[:, 2]), 0.1, rtol=1e-12)
+    # Types and bad spans are still the generator's to name.
+    with pytest.raises(TypeError):
+        shell.cylindrical_panel_mesh(0.1, 0.2, "0", 1.0, 2, 2)
+    with pytest.raises(ValueError, match="angular span"):
+        shell.cylindrical_panel_mesh(0.1, 0.2, 1.0, 0.5, 2, 2)
