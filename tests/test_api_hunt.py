@@ -285,6 +285,39 @@ def test_to_trial_still_samples_the_dynamic_step(dynamic_results):
 
 
 # ---------------------------------------------------------------------------------------------
+# A reaction asked twice was summed twice by total_reaction
+
+
+@pytest.mark.parametrize(
+    "reactions",
+    [((0, "uz"), (0, "UZ")), ((0, "uz"), (0.0, "uz")), ((4, "ry"), (0, "uz"), (np.int64(4), "RY"))],
+)
+def test_outputs_refuse_a_reaction_asked_twice(reactions):
+    with pytest.raises(ValueError, match="Outputs.reactions asks for .* twice"):
+        Outputs(reactions=reactions)
+
+
+def test_total_reaction_counts_a_column_recorded_twice_once():
+    import dataclasses
+
+    model, tip = tip_model()
+    model.add_load(tip, "uz", 1.0)
+    clamped = (0, 4)  # the clamped nodes of the 3 x 1 strip
+    outputs = Outputs(reactions=tuple((n, "uz") for n in clamped))
+    r = run(model, [Step.static("s", increments=1)], outputs=outputs)
+    assert r.total_reaction("uz")[-1] == pytest.approx(-1.0, rel=1e-9)
+    # A Results holding node 0's column twice (as Outputs took (0, "uz") and (0, "UZ"), and as
+    # files saved then load): the total is still the balance of the 1 N load, not -1 + R0.
+    doubled = dataclasses.replace(
+        r,
+        reaction_dofs=((0, "uz"), (0, "uz"), (4, "uz")),
+        reactions=r.reactions[:, [0, 0, 1]],
+    )
+    assert doubled.total_reaction("uz")[-1] == pytest.approx(-1.0, rel=1e-9)
+    assert abs(r.reaction(0, "uz")[-1]) > 0.1  # double counting would show
+
+
+# ---------------------------------------------------------------------------------------------
 # modes: the SciPy cross-check refuses a shift that loses K's digits, as the native step does
 
 

@@ -401,7 +401,8 @@ class Outputs:
     Node indices and `field_interval` are integers >= 0 (an integral float such as ``2.0`` is
     accepted, as by the `Model` methods). A fractional value (``1.5`` is refused, not
     truncated), a bool or a negative one raises ValueError naming ``Outputs.reactions`` or
-    ``Outputs.field_interval``; a value that is not a number, a dof that is not a string or an
+    ``Outputs.field_interval``, and so does a ``(node, dof)`` asked twice (``"UZ"`` is
+    ``"uz"``); a value that is not a number, a dof that is not a string or an
     entry of `reactions` that is not a ``(node, dof)`` pair raises TypeError.
     """
 
@@ -438,7 +439,11 @@ def _reaction_dofs(reactions: Any) -> tuple[tuple[int, str], ...]:
         if not isinstance(dof, str):
             raise TypeError(f"{what}[{k}]: the dof must be a DOF name such as 'uz' (got {dof!r})")
         # Lower case, as the Model methods and Results.reaction take DOF names ("UZ" is "uz").
-        pairs.append((_index(node, what, (node, dof)), dof.lower()))
+        key = (_index(node, what, (node, dof)), dof.lower())
+        if key in pairs:
+            # Recorded twice, it was counted twice by Results.total_reaction.
+            raise ValueError(f"{what} asks for {key!r} twice ({what}[{k}] is {pair!r})")
+        pairs.append(key)
     return tuple(pairs)
 
 

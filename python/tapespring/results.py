@@ -261,13 +261,21 @@ class Results:
     def total_reaction(self, dof: str) -> NDArray[np.float64]:
         """Sum of the recorded forces at `dof` over their nodes, shape (n,).
 
+        A ``(node, dof)`` recorded in more than one column is counted once.
+
         Raises
         ------
         KeyError
             If no force at that DOF was recorded (or the name is not a DOF).
         """
         name = _dof_name(dof)
-        columns = [i for i, (_, d) in enumerate(self.reaction_dofs) if d == name]
+        # The first column of each node: a pair recorded twice (Outputs.reactions took
+        # (0, "uz") and (0, "UZ")) was summed twice.
+        first: dict[int, int] = {}
+        for i, (node, d) in enumerate(self.reaction_dofs):
+            if d == name:
+                first.setdefault(node, i)
+        columns = list(first.values())
         if not columns:
             raise KeyError(f"no reaction at {dof!r} was recorded (recorded: {self.reaction_dofs})")
         return self.reactions[:, columns].sum(axis=1)
