@@ -348,14 +348,20 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
 
     result = equilibrium(EquilibriumSettings(spec=COARSE))
     assert result.found
-    # The equilibrium lies between two successive states of the push path whose pushing forces
-    # straddle zero, after the force's maximum (the buckle), and its marker 3 between theirs.
+    # The pushing force is positive while it pushes the weight down (the driver's force on it),
+    # up to the buckle; then the folding set-up pulls the weight down and the driver holds it
+    # back. The equilibrium lies between two successive states after the largest holding force
+    # whose pushing forces rise through zero, and its marker 3 between theirs; there the force
+    # grows with the push, so it is as stable as the held structure (stable, 0 modes).
     f, u = result.force_N, result.push_m
-    peak = int(np.argmax(f))
-    sign = np.flatnonzero((f[peak:-1] > 0.0) & (f[peak + 1 :] <= 0.0))
-    assert sign.size >= 1
-    k = peak + int(sign[0])
+    hold = int(np.argmin(f))
+    buckle = int(np.argmax(f[:hold]))
+    assert f[1] > 0.0 and f[buckle] > 0.0 > f[hold]
+    rise = np.flatnonzero((f[hold:-1] < 0.0) & (f[hold + 1 :] >= 0.0))
+    assert rise.size >= 1
+    k = hold + int(rise[0])
     assert min(u[k], u[k + 1]) <= result.marker3_m[2] <= max(u[k], u[k + 1])
+    assert result.unstable_modes == 0
     # Table 6 pinned the weight and the markers' height on the paper's meshes (within 1.0 %
     # there); this 5 mm mesh is within 2.5 % of those values (25.05/76.81/43.28/109.84 mm against
     # 25.65/77.86/43.56/110.51) and within 2.6 % of Table 6: the issue's 5 % holds here too.
@@ -373,11 +379,30 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert rel == pytest.approx(result.marker3_m[2] / p.marker3_dz - 1.0)
 
 
+def test_folded_crossing_counts_the_push_direction() -> None:
+    from tapespring.scenarios.equilibrium import folded_crossing
+
+    # Pushing (+), buckle, holding back (-), then the force rises through zero: between states
+    # 5 and 6, 3/4 of the way (-0.75 to +0.25 N). Where the load factor grows there, the force
+    # grows with the push: no unstable mode more than the held structure's.
+    force = np.array([0.0, 2.0, 6.0, 1.0, -1.25, -0.75, 0.25, 0.5])
+    load = np.array([1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7])
+    assert folded_crossing(force, load) == (5, 0.75, 0)
+    # The same zero on a stretch where the arc-length path turns back (the load factor falls):
+    # the force rises as the push falls, so it falls as the push grows: one unstable mode more.
+    back = load.copy()
+    back[6] = 1.45
+    assert folded_crossing(force, back) == (5, 0.75, 1)
+    # No holding force rising through zero: none (pushing all along, or still holding back).
+    assert folded_crossing(np.array([0.0, 1.0, 2.0, 3.0]), load[:4]) is None
+    assert folded_crossing(np.array([0.0, 2.0, -1.0, -2.0]), load[:4]) is None
+
+
 def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
-    # 10 mm does not buckle the tapes: the force never changes sign after a maximum, and the
-    # reference state's round-off force is not that maximum (it once gave zero displacements).
+    # 10 mm does not buckle the tapes: the pushing force stays positive, and the reference
+    # state's round-off force is not taken for a holding force (it once gave zero displacements).
     result = equilibrium(EquilibriumSettings(spec=COARSE, push=0.01))
     assert not result.found
     assert np.isnan(result.marker3_m).all() and result.unstable_modes == -1

@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         fig, ax = plt.subplots(figsize=(6.5, 4.5))
         ax.plot(result.push_m * 1e3, result.force_N, "-o", ms=2.5, color="tab:red")
         ax.axhline(0.0, color="0.5", lw=0.6)
-        ax.set_xlabel("push of the weight's tip [mm]")
+        ax.set_xlabel("drop of marker 3, at the weight's end [mm]")
         ax.set_ylabel("pushing force [N]")
         ax.set_title("the folded equilibrium is where the force vanishes")
         ax.grid(True, lw=0.3, alpha=0.5)

@@ -38,8 +38,9 @@ The displacements are not corrected for it (the paper reports absolute displacem
 
 A set of trials: the statistics of each displacement (mean, std, ...), as Table 3's rows.
 Markers as in `tapespring.protocols.markers`: ``markers=(m1, m2, m3)``, default
-``("M1", "M2", "M3")``: marker 1 on a small interface, marker 2 in the middle of the rod (the
-paper's second small interface), marker 3 at the tip of the additional weight.
+``("M1", "M2", "M3")``: markers 1 and 2 on the two small interfaces (Sec. 5.1: equal in
+theory, so averaged), marker 3 at the tip of the additional weight. (The simulation's marker 2
+is the deployment's, in the middle of the rod: see `tapespring.scenarios.equilibrium`.)
 """
 
 from __future__ import annotations
