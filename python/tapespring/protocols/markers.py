@@ -24,7 +24,7 @@ from tapespring.trials.trial import Trial, TrialError
 
 __all__ = ["DEFAULT_MARKERS", "check_markers", "finite_marker"]
 
-#: Default marker names: support, middle of the rod, tip.
+#: Default marker names: markers 1 (a small interface), 2 (middle of the rod), 3 (tip).
 DEFAULT_MARKERS = ("M1", "M2", "M3")
 
 

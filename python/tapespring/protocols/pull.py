@@ -267,7 +267,7 @@ def analyze_pull_group(
     trials : iterable of Trial
         The trials.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip); the rod marker is pulled.
+        Names of markers 1 (a small interface), 2 (rod) and 3 (tip); the rod marker is pulled.
     span : int
         Force smoothing span [samples].
 

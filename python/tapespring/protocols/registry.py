@@ -319,8 +319,8 @@ def analyze_trials(
     kind : {"deployment", "vibration", "quasi-static", "identification"}
         Kind of test.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip). Identification: markers 1-2 averaged,
-        and marker 0 (on the fixation support) is ``"M0"``
+        Names of markers 1 (a small interface), 2 (rod) and 3 (tip). Identification: markers
+        1-2 averaged, and marker 0 (on the fixation support) is ``"M0"``
         (`tapespring.protocols.identification.CONTROL_MARKER`).
     n_peaks : int
         Deployment: number of maxima and minima analysed, from 1 to `MAX_N_PEAKS` (1000).

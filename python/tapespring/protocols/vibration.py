@@ -235,7 +235,7 @@ def analyze_vibration_group(
     trials : iterable of Trial
         The trials.
     markers : (str, str, str)
-        Names of markers 1 (support), 2 (rod) and 3 (tip); the tip is analysed.
+        Names of markers 1 (a small interface), 2 (rod) and 3 (tip); the tip is analysed.
     window : (float, float)
         Range of absolute peak displacements fitted [m].
 

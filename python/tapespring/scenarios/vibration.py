@@ -131,9 +131,11 @@ class VibrationSettings:
         Downward displacement of marker 3, at the tip of the weight, before the release [m]
         (paper: about 8 mm), in [1e-6, :data:`MAX_INITIAL_DISPLACEMENT`).
     duration : float
-        Free decay simulated [s] (default 8 s, as the paper's recordings: with its eta the peaks
-        decay from 4 to 0.4 mm in about 7 s). A shorter run fits the peaks it has (at least 3 in
-        `window`: from the paper's 8 mm, the peaks fall below 4 mm only after about 2.5 s).
+        Free decay simulated [s] (default 8 s, as the paper's recordings). At the paper's eta
+        (a damping ratio of 0.49 %, envelope exp(-0.27 t) on the paper's meshes) the peaks from
+        8 mm fall below 4 mm after about 2.5 s and reach 0.7 to 0.9 mm by 8 s, so the fit reads
+        the window's upper part; down to its 0.4 mm takes about 11 s. A shorter run fits the
+        peaks it has (at least 3 in `window`).
     rho_inf : float
         Spectral radius at infinity of generalised-alpha (paper: 0.7; Fig. 26 varies it).
     window : tuple of float
@@ -142,10 +144,10 @@ class VibrationSettings:
         Rate at which the decay is recorded [Hz]; the steps land on its multiples and are at
         most one sample long. Default 400 Hz, every other instant of the paper's 800 Hz motion
         capture: 45 samples a period, and steps of 2.5 ms (omega h = 0.14) at which the scheme
-        lengthens the period by 0.18 % and adds 7e-6 to the damping ratio (a seventh of a
-        percent of the paper's 0.5 %), in half the time of 800 Hz (measured on the paper's
-        meshes, 8 s, with the spec's earlier mass split: 0.493 % at either rate, a period of
-        0.1144 s against 0.1143 s, 52 s of wall time against 97 s).
+        lengthens the period by 0.18 % and changes the damping ratio by -1.1e-5 (-0.2 % of the
+        paper's 0.5 %; `numerical_damping.oscillator_decay`), in half the time of 800 Hz
+        (measured on the paper's meshes, 8 s, with the spec's earlier mass split: 0.493 % at
+        either rate, a period of 0.1144 s against 0.1143 s, 52 s of wall time against 97 s).
     tolerance : float
         Local error tolerance of the time steps [m] (0: the solver's default), at most
         :data:`~tapespring.scenarios.setup.MAX_TOLERANCE` (1 cm per step).

@@ -6,7 +6,7 @@ measured positively about the y axis::
     theta = atan2(-(z2 - z1), x2 - x1)        [rad]
 
 (a rotation by +theta about y takes the x axis to (cos theta, 0, -sin theta)).
-The history is unwrapped, then made relative to its value in the deployed
+The history is unwrapped; the caller makes it relative to its value in the deployed
 equilibrium (`tapespring.signals.levels.equilibrium_value`), so that theta > 0 is
 opposite-sense bending and theta < 0 equal-sense bending, as in the paper's figures.
 """

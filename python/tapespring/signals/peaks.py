@@ -1,17 +1,18 @@
 """Peak extraction: the first N maxima and minima of a signal.
 
 Peaks are picked with `scipy.signal.find_peaks` on ``y`` (maxima) and ``-y``
-(minima) with a prominence threshold, so that noise cannot create peaks:
-by default the threshold is ``8 sigma`` where ``sigma`` is the noise level
+(minima) with a prominence threshold, so that noise cannot create peaks: by
+default the threshold is ``8 sigma`` where ``sigma`` is the noise level
 estimated from the signal (`noise_std`), but never less than 0.1 % of the
 signal's range (noise-free simulated signals). The paper's marker precision is
-0.05 mm, i.e. about 0.05 deg of bending angle over the 82 mm between markers 1
-and 2. The prominence of a noise maximum is its height above the lowest samples
-either side, as far as the nearest higher sample: over a long stretch of noise
-it grows with the stretch's range. Of 2000 records of white noise, none of 800
-samples had a peak of 8 sigma prominence, and 0.65 % of those of 3200 samples
-(a 4 s tail at 800 Hz) had one; analyses of peak values keep their own floor
-above the noise (the damping fit's window: 0.4 mm, 8 sigma of the markers).
+0.05 mm, i.e. about 0.2 deg of bending angle over the 12.5 mm between the
+model's markers 1 and 2 (a small interface, the middle of the rod). The
+prominence of a noise maximum is its height above the lowest samples either
+side, as far as the nearest higher sample: over a long stretch of noise it grows
+with the stretch's range. Of 2000 records of white noise, none of 800 samples
+had a peak of 8 sigma prominence, and 0.65 % of those of 3200 samples (a 4 s
+tail at 800 Hz) had one; analyses of peak values keep their own floor above the
+noise (the damping fit's window: 0.4 mm, 8 sigma of the markers).
 
 Each peak is then refined by a least-squares parabola through the samples
 around it that lie within ``4 sigma`` of the top, and within a quarter of its
