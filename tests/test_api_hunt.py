@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from _plate import plate
-from hypothesis import assume, given
+from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
 from tapespring import ConvergenceError, Model, Outputs, Step, TapeError, run, shell
@@ -484,15 +484,9 @@ def test_any_step_sequence_is_refused_by_name_or_ends_its_static_steps_in_equili
     t = 0.0
     active = {"load": True, "hold": False, "gravity": True, "clamp": True}
     ends = []  # (step index, t at its end, ids active at its end)
-    renumbered = False  # a modal step switched a constraint since the last recording step
     for k, (kind, on, off) in enumerate((kind, on, off) for kind, on, off, _ in plan):
         off = [i for i in off if i not in on]
         dt = plan[k][3]
-        switched = {"hold", "clamp"} & {*on, *off}
-        # The tape-core bug of the xfail tests below (a static step releasing a constraint
-        # after a modal step renumbered them): known, not searched again here.
-        assume(not (kind == "static" and renumbered and {"hold", "clamp"} & set(off)))
-        renumbered = (renumbered or bool(switched)) if kind == "modal" else False
         if kind == "static":
             steps.append(
                 Step.static(f"s{k}", lambda_end=t + dt, increments=2, activate=on, deactivate=off)
@@ -537,9 +531,11 @@ def test_any_step_sequence_is_refused_by_name_or_ends_its_static_steps_in_equili
 
 
 # ---------------------------------------------------------------------------------------------
-# Found here, to be fixed in tape-core (crates/tape-core/src/analysis.rs, release_loads): a
-# static step releasing a constraint that a modal step switched on takes the released reaction
-# by the constraint's position in the new numbering from reactions recorded under the old one.
+# Found here, fixed in tape-core (crates/tape-core/src/analysis.rs): a static step releasing a
+# constraint that a modal step switched on took the released reaction by the constraint's
+# position in the new numbering from reactions recorded under the old one (a panic, "index out
+# of bounds", or another DOF's reaction released as a load). The released reactions are now
+# those of the state the step starts from, in the numbering of the constraints active until then.
 
 
 def _release_after_modal_model(hold_first: bool) -> Model:
@@ -556,9 +552,6 @@ def _release_after_modal_model(hold_first: bool) -> Model:
     return model
 
 
-@pytest.mark.xfail(
-    strict=True, raises=TapeError, reason="tape-core: index out of bounds in release_loads"
-)
 def test_releasing_a_constraint_a_modal_step_switched_on_does_not_panic():
     model = _release_after_modal_model(hold_first=False)
     steps = [
@@ -566,14 +559,13 @@ def test_releasing_a_constraint_a_modal_step_switched_on_does_not_panic():
         Step.modal("b", modes=2, activate="hold"),
         Step.static("s", lambda_end=2.0, increments=2, deactivate="hold"),
     ]
-    run(model, steps)  # TapeError: internal error in tape-core ... index out of bounds
+    run(model, steps)  # was a TapeError: internal error in tape-core ... index out of bounds
 
 
-@pytest.mark.xfail(strict=True, reason="tape-core: the released load is another DOF's reaction")
 def test_releasing_a_constraint_a_modal_step_switched_on_applies_its_own_reaction():
     # The hold, switched on by the modal step at an equilibrium where the tip's uz was free,
     # carries nothing: releasing it must leave the clamp's reactions as they are. With the bug
-    # the clamp's ux reaction (about -100 N) is released at the tip's uz over the step.
+    # the clamp's ux reaction (about -100 N) was released at the tip's uz over the step.
     outputs = Outputs(reactions=((0, "uz"),))
     model = _release_after_modal_model(hold_first=True)
     steps = [Step.static("p", increments=1), Step.static("s", lambda_end=2.0, increments=4)]

@@ -360,14 +360,15 @@ fn apply_initial_velocities(model: &Model, state: &mut State) {
 }
 
 /// The loads that release what step `step` switches off: the reactions of released constraints
-/// and the loads (and gravity) switched off, each decreasing linearly to zero between the
-/// current time `t0` and the step's final load factor.
+/// (`reactions`, the static reactions at the current state, in `system`'s numbering of the
+/// constraints active `before`) and the loads (and gravity) switched off, each decreasing
+/// linearly to zero between the current time `t0` and the step's final load factor.
 fn release_loads(
     model: &Model,
     system: &System,
     before: &Activity,
     after: &Activity,
-    last_reactions: &[f64],
+    reactions: &[f64],
     t0: f64,
     t1: f64,
 ) -> Result<(Vec<Load>, Option<TimeFunction>)> {
@@ -391,7 +392,7 @@ fn release_loads(
                 id: None,
                 node: c.node,
                 dof: c.dof,
-                value: last_reactions[i],
+                value: reactions[i],
                 function: to_zero(1.0),
                 active: true,
             });
@@ -495,7 +496,6 @@ pub fn run(
     history.reaction_dofs.clone_from(&reaction_dofs);
     let stability = steps[0].static_params().is_some_and(|p| p.stability);
     let first = initial_record(&mut system, &state, stability, interval > 0)?;
-    let mut last_reactions = first.reactions.clone();
     history.push(0, first, interval > 0);
     let mut symbolic = 1;
     for (k, step) in steps.iter().enumerate() {
@@ -513,8 +513,27 @@ pub fn run(
                 Control::Displacement { .. } => state.t,
             });
             let (released, gravity_off) = match t1 {
-                Some(t1) => release_loads(model, &system, &before, &activity, &last_reactions, state.t, t1)
-                    .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?,
+                Some(t1) => {
+                    // The released constraints' reactions at the state the step starts from, in
+                    // the numbering of the constraints active until now: those recorded by the
+                    // last static or dynamic step are numbered as they were then (a modal step
+                    // may have switched constraints since) and, after a dynamic step, hold the
+                    // inertia that a static step leaves out.
+                    let reactions = if before
+                        .constraints
+                        .iter()
+                        .zip(&activity.constraints)
+                        .any(|(b, a)| *b && !*a)
+                    {
+                        let mut asm = Assembled::default();
+                        system.assemble(&state, false, &mut asm);
+                        asm.reactions()
+                    } else {
+                        Vec::new()
+                    };
+                    release_loads(model, &system, &before, &activity, &reactions, state.t, t1)
+                        .map_err(|e| e.context(&format!("step {k} '{}'", step.name)))?
+                }
                 None => (Vec::new(), None),
             };
             let gravity = system.gravity.clone();
@@ -639,9 +658,6 @@ pub fn run(
         );
         result.stats.add(&stats);
         result.step_stats.push(stats);
-        if let Some(last) = records.last() {
-            last_reactions.clone_from(&last.reactions);
-        }
         for s in records {
             let keep = interval > 0 && history.len() % interval == 0;
             history.push(k, s, keep);

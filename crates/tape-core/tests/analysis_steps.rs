@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 use tape_core::mesh::generate::flat_plate;
 use tape_core::model::Constraint;
 use tape_core::samples::TapeBending;
-use tape_core::solver::{Control, NewtonParams, StaticParams};
+use tape_core::solver::{Control, ModalParams, NewtonParams, StaticParams};
 use tape_core::{run, Dof, Model, Outputs, Result, Step, TimeFunction};
 
 /// The pre-refactor curves are reproduced point by point: same number of equilibria, same angles
@@ -219,6 +219,75 @@ fn released_prescribed_displacement_leaves_the_state_continuous() -> Result<()> 
     // The numbering changed once: two symbolic analyses.
     assert_eq!(result.stats.symbolic_analyses, 2);
     assert_eq!(h.ndof, [h.ndof[0], h.ndof[0] + 1]);
+    Ok(())
+}
+
+/// A constraint switched on by a modal step and released by the static step after it: the
+/// released reaction is the constraint's own at the state the step starts from. The reactions
+/// recorded by the last static step were numbered without it: taken by its position in the new
+/// numbering, one past their end, they panicked ("index out of bounds"), or, declared before the
+/// clamp, released the clamp's first reaction (about -100 N, against the 100 N tip load along x)
+/// at the tip's uz. Switched on at an equilibrium where the tip's uz was free, the hold carries
+/// nothing (to the Newton tolerance), so the release leaves the path as it was without the hold.
+#[test]
+fn releasing_a_constraint_switched_on_by_a_modal_step_releases_its_own_reaction() -> Result<()> {
+    for hold_first in [false, true] {
+        let mut section = common::section(2e-3, 2e11, 0.0);
+        section.density = 7850.0;
+        let mut model = Model::try_new(flat_plate(0.2, 0.02, 4, 2)?, section)?;
+        let x0 = model.mesh.node_set("x0")?.to_vec();
+        let x1 = model.mesh.node_set("x1")?.to_vec();
+        model.fix(&x0, &Dof::ALL)?;
+        let tip = model.add_node(Vector3::new(0.2, 0.01, 0.0))?;
+        model.tie(&x1, tip)?;
+        let hold = Constraint {
+            id: Some("hold".into()),
+            node: tip,
+            dof: Dof::Uz,
+            value: 0.0,
+            function: TimeFunction::Constant,
+            active: false,
+        };
+        if hold_first {
+            model.constraints.insert(0, hold);
+        } else {
+            model.add_constraint(hold)?;
+        }
+        model.add_load(tip, Dof::Uz, 1.0)?;
+        model.add_load(tip, Dof::Ux, 100.0)?;
+        let outputs = Outputs {
+            reactions: vec![(0, Dof::Uz)],
+            field_interval: 0,
+        };
+        let plain = [load_step("load", 1.0, 2), load_step("more", 2.0, 4)];
+        let reference = run(&model, &plain, &outputs, &mut |_| true)?;
+        let mut modal = Step::new_modal(
+            "modes",
+            ModalParams {
+                modes: 2,
+                ..ModalParams::default()
+            },
+        );
+        modal.activate.push("hold".into());
+        let mut release = load_step("more", 2.0, 4);
+        release.deactivate.push("hold".into());
+        let steps = [load_step("load", 1.0, 2), modal, release];
+        let released = run(&model, &steps, &outputs, &mut |_| true)?;
+        assert!(
+            released.error.is_none(),
+            "hold first {hold_first}: {:?}",
+            released.error
+        );
+        let want = reference.history.reaction(0, Dof::Uz).expect("recorded");
+        let got = released.history.reaction(0, Dof::Uz).expect("recorded");
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g - w).abs() <= 1e-8 * 100.0,
+                "hold first {hold_first}: {got:?} vs {want:?}"
+            );
+        }
+    }
     Ok(())
 }
 
