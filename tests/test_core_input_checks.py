@@ -155,6 +155,12 @@ def test_absurd_magnitudes_are_refused_where_they_are_given():
         model.add_rigid_body(5, 1.0, inertia=np.diag([1e300, 1e300, 1e300]))
     with pytest.raises(ValueError, match="faster than light"):
         model.set_initial_velocity(5, velocity=[0, 0, 1e200])
+    # No body has these principal moments about its centre of mass (J_1 + J_2 - J_3 is twice
+    # its second moment along axis 3); a flat disc's (J_3 = J_1 + J_2) and a rod's are bodies.
+    with pytest.raises(ValueError, match="largest exceeds the sum of the other two"):
+        model.add_rigid_body(5, 1.0, inertia=np.diag([1.0, 1.0, 3.0]))
+    model.add_rigid_body(6, 1.0, inertia=np.diag([0.234375, 0.234375, 0.46875]))
+    model.add_rigid_body(7, 1.0, inertia=np.diag([0.0, 1.0, 1.0]))
     # A heavy but plausible body is fine: a thousand tonnes.
     model.add_rigid_body(5, 1e6, inertia=np.diag([1e6, 1e6, 1e6]))
 

@@ -332,42 +332,11 @@ class Results:
         """The history sampled like a motion-capture trial (markers at `rate_hz` [Hz], the force
         plate from the reactions at `force_nodes`, with the sign a plate under the support reads).
 
-        See :func:`tapespring.trials.simulated.results_to_trial` for the parameters.
-
-        Raises
-        ------
-        TypeError
-            If `markers` is not a mapping, `steps` not a sequence of integer step indices
-            (``1.5``, ``True`` and ``"1"`` were read as step 1), or a rate not a number (``True``
-            was 1 Hz).
-        ValueError
-            As ``results_to_trial``; also for a finite rate above the trials' 1 MHz (a rate of
-            1e300 Hz failed allocating its time grid, naming neither).
+        See :func:`tapespring.trials.simulated.results_to_trial` for the parameters and the
+        errors (TypeError, ValueError) it raises.
         """
         from tapespring.trials.simulated import results_to_trial
-        from tapespring.trials.trial import MAX_RATE
 
-        if not isinstance(markers, Mapping):
-            # A list failed with an AttributeError, a string was read letter by letter.
-            raise TypeError(
-                f"markers must map the results' marker names to the trial's, e.g. "
-                f"{{'tip': 'M1'}} (got {type(markers).__name__}: {markers!r})"
-            )
-        if steps is not None:
-            if isinstance(steps, str | bytes) or not isinstance(steps, Sequence | np.ndarray):
-                raise TypeError(f"steps must be a sequence of step indices (got {steps!r})")
-            for k in steps:
-                if isinstance(k, bool | np.bool_) or not isinstance(k, numbers.Integral):
-                    raise TypeError(f"steps must hold integer step indices (got {k!r})")
-        for what, rate in (("rate_hz", rate_hz), ("force_rate_hz", force_rate_hz)):
-            if isinstance(rate, bool | np.bool_) or not isinstance(rate, numbers.Real):
-                raise TypeError(f"{what} must be a number [Hz] (got {rate!r})")
-            # Rates that are not finite and > 0 are refused by results_to_trial.
-            if math.isfinite(rate) and rate > MAX_RATE:
-                raise ValueError(
-                    f"{what} must be at most {MAX_RATE:g} Hz, the highest sampling rate of a "
-                    f"trial (got {rate!r})"
-                )
         return results_to_trial(
             self,
             markers=markers,

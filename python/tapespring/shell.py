@@ -124,7 +124,9 @@ def tape_spring_divisions(
     Raises
     ------
     ValueError
-        As :func:`tape_spring_mesh`, for a bad geometry or size.
+        As :func:`tape_spring_mesh`, for a bad geometry or size, or more elements than it makes.
+        It counts only: the mesh may still be refused when built (elements too small for the
+        floats, a tape 1e-300 m long).
     """
     return _core.tape_spring_divisions(length, radius, alpha, mesh_size)
 

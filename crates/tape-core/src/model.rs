@@ -515,7 +515,7 @@ impl Model {
     /// # Errors
     /// [`Error::InvalidModel`] for an unknown node, a second body on the same node, a negative or
     /// non-finite mass, a non-finite offset, or an inertia tensor that is not symmetric positive
-    /// semi-definite.
+    /// semi-definite or whose largest principal moment exceeds the sum of the other two.
     pub fn add_rigid_body(&mut self, body: RigidBody) -> Result<()> {
         self.check_rigid_body(&body)?;
         if self.rigid_bodies.iter().any(|b| b.node == body.node) {
@@ -561,6 +561,16 @@ impl Model {
         if eigen.iter().any(|&l| l < -1e-12 * scale) {
             return Err(Error::InvalidParameter(format!(
                 "rigid body at node {n}: the inertia tensor must be positive semi-definite (eigenvalues {:?})",
+                eigen.as_slice()
+            )));
+        }
+        // About the centre of mass, each principal moment is at most the sum of the other two
+        // (`J_1 + J_2 - J_3 = 2 int z^2 dm >= 0`): a tensor that breaks it is no body's.
+        let (largest, sum) = (eigen.max(), eigen.sum());
+        if 2.0 * largest > sum + 1e-12 * scale {
+            return Err(Error::InvalidParameter(format!(
+                "rigid body at node {n}: the inertia tensor's principal moments {:?} kg m^2 are no \
+                 body's about its centre of mass: the largest exceeds the sum of the other two",
                 eigen.as_slice()
             )));
         }

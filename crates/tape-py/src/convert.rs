@@ -11,20 +11,33 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyComplex, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use serde_json::{Map, Number, Value};
 use tape_core::mesh::Mesh;
 use tape_core::output::History;
 use tape_core::{Dof, TimeFunction};
 
-/// `numpy.asarray(obj, dtype=float64)` as an n-dimensional array.
+/// `numpy.asarray(obj, dtype=float64)` as an n-dimensional array, of real numbers only: numpy
+/// would cast complex values to their real part (with a `ComplexWarning`), booleans to 0 and 1
+/// and strings of digits to their values.
 fn float_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let py = obj.py();
+    let np = py.import("numpy")?;
+    let raw = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| PyValueError::new_err(format!("{what} must be an array of numbers: {e}")))?;
+    let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+    let size: usize = raw.getattr("size")?.extract()?;
+    if size > 0 && !matches!(kind.as_str(), "f" | "i" | "u" | "O") {
+        let dtype = raw.getattr("dtype")?.str()?.to_string();
+        return Err(PyValueError::new_err(format!(
+            "{what} must be an array of numbers (real ones; got dtype {dtype})"
+        )));
+    }
     let kwargs = PyDict::new(py);
     kwargs.set_item("dtype", "float64")?;
-    let arr = py
-        .import("numpy")?
-        .call_method("asarray", (obj,), Some(&kwargs))
+    let arr = np
+        .call_method("asarray", (raw,), Some(&kwargs))
         .map_err(|e| PyValueError::new_err(format!("{what} must be an array of numbers: {e}")))?;
     Ok(arr.cast_into::<PyArrayDyn<f64>>()?)
 }
@@ -40,7 +53,16 @@ fn int_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, Py
     let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     match kind.as_str() {
-        "i" | "u" => {}
+        "i" => {}
+        "u" if size > 0 => {
+            // Cast to int64, an unsigned index past its range would wrap (2**64 - 1 became -1).
+            let max: u64 = arr.call_method0("max")?.extract()?;
+            if i64::try_from(max).is_err() {
+                return Err(PyValueError::new_err(format!(
+                    "{what} holds an index too large for a node (got {max})"
+                )));
+            }
+        }
         _ if size == 0 => {}
         "f" => {
             let f = float_array(&arr, what)?;
@@ -136,7 +158,17 @@ fn shown(obj: &Bound<'_, PyAny>) -> String {
 /// # Errors
 /// `TypeError` naming the argument `what`.
 pub fn float(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
-    if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyString>() {
+    // A complex number (Python's, or a numpy complex scalar, whose `__float__` drops the
+    // imaginary part with a ComplexWarning) is no real number either.
+    let complex = obj.is_instance_of::<PyComplex>()
+        || (!obj.is_instance_of::<PyFloat>()
+            && !obj.is_instance_of::<PyInt>()
+            && obj
+                .getattr("dtype")
+                .and_then(|d| d.getattr("kind"))
+                .and_then(|k| k.extract::<String>())
+                .is_ok_and(|k| k == "c"));
+    if complex || obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyString>() {
         return Err(PyTypeError::new_err(format!(
             "{what} must be a number (got {} of type {})",
             shown(obj),

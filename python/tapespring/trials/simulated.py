@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .trial import ForcePlate, Metadata, Trial
+from .trial import MAX_RATE, ForcePlate, Metadata, Trial
 
 if TYPE_CHECKING:
     from tapespring.results import Results
@@ -96,16 +96,39 @@ def results_to_trial(
 
     Raises
     ------
+    TypeError
+        If `markers` is not a mapping, `steps` not a sequence of integer step indices
+        (``1.5``, ``True`` and ``"1"`` were read as step 1), or a rate not a number (``True``
+        was 1 Hz).
     ValueError
         If a marker or a force node is unknown or incomplete, a force node is not an integer
         index, `origin` is not a finite point or is given without `force_nodes`, a rate is not
-        positive, no record is selected, the selected times do not increase strictly, or they
-        span less than one sampling interval.
+        positive or above the trials' 1 MHz (1e300 Hz failed allocating its time grid), no
+        record is selected, the selected times do not increase strictly, or they span less than
+        one sampling interval.
     """
-    if not rate_hz > 0 or not np.isfinite(rate_hz):
-        raise ValueError(f"rate_hz must satisfy rate_hz > 0, got {rate_hz}")
-    if not force_rate_hz > 0 or not np.isfinite(force_rate_hz):
-        raise ValueError(f"force_rate_hz must satisfy force_rate_hz > 0, got {force_rate_hz}")
+    if not isinstance(markers, Mapping):
+        # A list failed with an AttributeError, a string was read letter by letter.
+        raise TypeError(
+            f"markers must map the results' marker names to the trial's, e.g. "
+            f"{{'tip': 'M1'}} (got {type(markers).__name__}: {markers!r})"
+        )
+    if steps is not None:
+        if isinstance(steps, str | bytes) or not isinstance(steps, Sequence | np.ndarray):
+            raise TypeError(f"steps must be a sequence of step indices (got {steps!r})")
+        for k in steps:
+            if isinstance(k, bool | np.bool_) or not isinstance(k, numbers.Integral):
+                raise TypeError(f"steps must hold integer step indices (got {k!r})")
+    for what, rate in (("rate_hz", rate_hz), ("force_rate_hz", force_rate_hz)):
+        if isinstance(rate, bool | np.bool_) or not isinstance(rate, numbers.Real):
+            raise TypeError(f"{what} must be a number [Hz] (got {rate!r})")
+        if not rate > 0 or not np.isfinite(rate):
+            raise ValueError(f"{what} must satisfy {what} > 0, got {rate}")
+        if rate > MAX_RATE:
+            raise ValueError(
+                f"{what} must be at most {MAX_RATE:g} Hz, the highest sampling rate of a trial "
+                f"(got {rate!r})"
+            )
     if origin is not None and force_nodes is None:
         # The origin is the force plate's: without one it would be ignored.
         raise ValueError("origin is the force plate's moment origin: give force_nodes too")
