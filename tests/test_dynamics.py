@@ -151,8 +151,11 @@ def test_dynamic_step_options_and_errors():
     with pytest.raises(ValueError, match="needs 2.000e5 steps, more than max_steps"):
         run(model, [Step.dynamic(duration=2.0, initial_step=1e-5, adaptive=False)])
     pushed = [Step.static("push", activate=["push"], increments=1)]
-    with pytest.raises(ValueError, match=r"duration \[s\] \(1e-300\) is below the resolution"):
-        run(model, [*pushed, Step.dynamic(duration=1e-300, deactivate=["push"])])
+    with pytest.raises(ValueError, match=r"duration \[s\] \(1e-12\) is below the resolution"):
+        run(model, [*pushed, Step.dynamic(duration=1e-12, deactivate=["push"])])
+    # Below a picosecond, whatever the time: the mass term overflowed ("non-finite entry").
+    with pytest.raises(ValueError, match=r"duration \[s\] \(1e-300\) is below 1e-12 s"):
+        run(model, [Step.dynamic(duration=1e-300)])
     massless = Model(*flat_plate_mesh(L, B, 4, 1)[:2], thickness=T, youngs_modulus=E, poisson=0.0)
     massless.fix(0, "all")
     massless.fix(5, "all")
