@@ -151,6 +151,8 @@ def test_absurd_magnitudes_are_refused_where_they_are_given():
         model.add_point_mass(5, 1e300)
     with pytest.raises(ValueError, match=r"centre of mass must be finite and within 1e50 m"):
         model.add_rigid_body(5, 1.0, centre_of_mass=[1e200, 0, 0])
+    with pytest.raises(ValueError, match=r"offset must be finite and within 1e50 m"):
+        model.add_marker("far", 5, offset=[0, 0, 1e300])
     with pytest.raises(ValueError, match=r"inertia tensor's entries must be at most 1e15"):
         model.add_rigid_body(5, 1.0, inertia=np.diag([1e300, 1e300, 1e300]))
     with pytest.raises(ValueError, match="faster than light"):

@@ -641,10 +641,12 @@ impl Model {
                 marker.name
             )));
         }
-        if !finite3(&marker.offset) {
+        // Bounded as coordinates and centres of mass are: an offset of 1e300 m was taken.
+        if !(finite3(&marker.offset) && marker.offset.amax() <= MAX_COORDINATE) {
             return Err(Error::InvalidModel(format!(
-                "marker '{}': offset must be finite",
-                marker.name
+                "marker '{}': offset must be finite and within {MAX_COORDINATE:e} m (got {:?})",
+                marker.name,
+                marker.offset.as_slice()
             )));
         }
         self.markers.push(marker);
