@@ -743,7 +743,10 @@ impl Model {
         }
         for (i, m) in self.markers.iter().enumerate() {
             self.check_node(m.node)?;
-            if m.name.is_empty() || self.markers[..i].iter().any(|o| o.name == m.name) || !finite3(&m.offset) {
+            if m.name.is_empty()
+                || self.markers[..i].iter().any(|o| o.name == m.name)
+                || !(finite3(&m.offset) && m.offset.amax() <= MAX_COORDINATE)
+            {
                 return Err(Error::InvalidModel(format!(
                     "marker '{}' is invalid or repeated",
                     m.name
