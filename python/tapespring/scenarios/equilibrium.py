@@ -4,10 +4,9 @@ The set-up with the additional weight (configuration ``"weight"``, opposite sens
 gravity (the deployed equilibrium, the reference of the displacements); then the weight's
 reference node, where it is tied to the rod, is pushed down by displacement control on an
 arc-length path past the buckling of the tapes, far enough to fold them (``push``). Along that
-path the pushing force passes through zero
-where the folded structure is in equilibrium without it: that state is the folded equilibrium of
-the paper's test, located between the two states that bracket the zero (linear interpolation of
-the marker positions in the force). The paper reaches it by releasing the push and letting the
+path the pushing force passes through zero where the folded structure is in equilibrium without
+it: that state is the folded equilibrium of the paper's test, located between the two states
+that bracket the zero (linear interpolation of the marker positions in the force). The paper reaches it by releasing the push and letting the
 set-up settle; the located state is the same equilibrium, and its stability under the weight is
 reported (a static release of the push on this set-up has run into limit points just before the
 push vanished, and on a 3 mm mesh into a collapse: see the issue notes).
