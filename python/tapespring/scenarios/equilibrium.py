@@ -1,15 +1,15 @@
 """The static identification configuration (paper Sec. 5.1, Figs. 21-22, Tables 3 and 6).
 
 The set-up with the additional weight (configuration ``"weight"``, opposite sense) sags under
-gravity (the deployed equilibrium, the reference of the displacements); then the weight's
-reference node, where it is tied to the rod, is pushed down by displacement control on an
-arc-length path past the buckling of the tapes, far enough to fold them (``push``). Along that
-path the pushing force passes through zero where the folded structure is in equilibrium without
-it: that state is the folded equilibrium of the paper's test, located between the two states
-that bracket the zero (linear interpolation of the marker positions in the force). The paper reaches it by releasing the push and letting the
-set-up settle; the located state is the same equilibrium, and its stability under the weight is
-reported (a static release of the push on this set-up has run into limit points just before the
-push vanished, and on a 3 mm mesh into a collapse: see the issue notes).
+gravity (the deployed equilibrium, the reference of the displacements); then the weight's reference
+node, where it is tied to the rod, is pushed down by displacement control on an arc-length path
+past the buckling of the tapes, far enough to fold them (``push``). Along that path the pushing
+force passes through zero where the folded structure is in equilibrium without it: that state is
+the folded equilibrium of the paper's test, located between the two states that bracket the zero
+(linear interpolation of the marker positions in the force). The paper reaches it by releasing the
+push and letting the set-up settle; the located state is the same equilibrium, and its stability
+under the weight is reported (a static release of the push on this set-up has run into limit points
+just before the push vanished, and on a 3 mm mesh into a collapse: see the issue notes).
 
 Displacements are in absolute values, as in Tables 3 and 6, of markers 1-2 (their mean) and 3.
 The model's markers 1 and 2 are the deployment's, on a small interface and in the middle of the
