@@ -67,6 +67,19 @@ pytestmark = pytest.mark.filterwarnings("ignore::tapespring.trials.TrialWarning"
     start=1.0,
     seed=0,
 )
+# And one ending 12.5 ms (50 samples) after that drop: its maximum 86 samples before the end,
+# 36 before the last complete window, within the half span the check reads as a record cut
+# while rising; the smoothed force falls by 11 % after it, which a rising force does not.
+@example(
+    log_speed=-2.0,
+    travel=0.001,
+    buckle_at=0.875,
+    max_force=2.0,
+    noise=0.0,
+    residual=0.75,
+    start=1.0,
+    seed=0,
+)
 def test_generated_pull_tests_pass_the_pull_check(
     log_speed, travel, buckle_at, max_force, noise, residual, start, seed
 ):

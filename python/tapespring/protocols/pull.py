@@ -23,6 +23,7 @@ swings gave a "maximum force" 394 % off). A pull test, as `analyze_pull_trial` c
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -61,6 +62,11 @@ _MAX_TURNS = 1
 # 101 samples has a standard deviation of sigma / 10, its maximum over a minute at 4 kHz stays
 # under 0.5 sigma; the synthetic pull tests rise to 20 sigma (9.8 N over 0.5 N).
 _MIN_FORCE_SIGMA = 3.0
+
+# A fall of the smoothed force after its maximum larger than this many standard deviations of the
+# smoothed noise is a drop, not noise (the peaks' 8 sigma, `tapespring.signals.peaks`).
+_FALL_SIGMA = 8.0
+
 # Smoothing of the displacement for the checks [s]: 25 ms, the force's span at 4 kHz.
 _CHECK_SPAN_TIME = 0.025
 
@@ -240,12 +246,20 @@ def _check_maximum_inside(trial: Trial, time: np.ndarray, test: PullTest) -> Non
     still rising was cut, not the peak before buckling (a pull cut at 2 s reported the 1.5 N
     of its last sample for the 9.9 N of the whole test). Not further: a record that ends 25 ms
     after a small drop (to 75 %, which the smoothing shows as 89 %: no "buckled") has its
-    maximum 74 samples before that window, and is a pull test.
+    maximum 74 samples before that window, and is a pull test. Nor where the smoothed force
+    falls after the maximum by more than its noise (8 sigma of the raw force over the square
+    root of the span) and 0.1 % of the maximum (round-off of noise-free records): a force still
+    rising when the record was cut does not; a record ending 12.5 ms after a drop to 75 % (50
+    samples, its maximum 36 before the last complete window) does.
     """
     n = test.force_smoothed.size
     i = test.index_at_max
     last = n - 1 - test.span // 2  # the last complete window
     if test.buckled or i < last - test.span // 2:
+        return
+    fall = test.max_force - float(np.nanmin(test.force_smoothed[i : last + 1]))
+    noise = _FALL_SIGMA * noise_std(test.force) / math.sqrt(test.span)
+    if fall > max(noise, 1e-3 * test.max_force):
         return
     raise TrialError(
         trial.metadata.label,
