@@ -16,7 +16,9 @@ The 5e-4 m of issue 8 is the bound of a public regression test (Kynema's
 node at the centre of mass, free in translation, and the pin as a spherical joint held by a
 Lagrange multiplier (index 3), at rho_inf = 0.9. The same scheme on that model is far closer to
 the reference at the same step: 6.7e-4 m at 2 s with h = 2e-4 s (7.1e-4 m at rho_inf = 0.7),
-measured with `joint_top` below; 15 times closer than on the pinned body at h = 1e-3 s (tested).
+measured with `joint_top` below, and 1.4e-4 m with its angular velocities spatial (`R_{n+1} =
+exp(h D) R_n`, the pinned top's form above); 15 times closer than on the pinned body at h = 1e-3
+s (tested).
 The core has no joints held by multipliers (its ties eliminate unknowns), and issue 8 asks for
 the body whose reference node is not its centre of mass, so the core's top is the pinned body.
 """
