@@ -343,13 +343,15 @@ def finish(
             print(f"error: {exc}", file=sys.stderr)
             return 1
         failure = str(exc)
+    # Once, for the CSV's settings line and the JSON object.
+    summary = result.summary()
     if args.csv:
         table = columns(result)
         write_table(
             Path(args.csv),
             list(table),
             list(zip(*table.values(), strict=True)),
-            comment=settings_comment(args, result.summary()["settings"]),
+            comment=settings_comment(args, summary["settings"]),
         )
     if args.plot:
         import matplotlib
@@ -357,7 +359,7 @@ def finish(
         matplotlib.use("Agg")  # files only: no display needed
         plot(result, args.plot)
     if args.json:
-        print(json.dumps(jsonable_tree(result.summary()), default=str))
+        print(json.dumps(jsonable_tree(summary), default=str))
     else:
         print(result.describe())
         for name in ("csv", "plot"):
