@@ -115,6 +115,23 @@ impl Assembled {
     }
 }
 
+/// External forces of one assembly, per node, before they are split into free and constrained
+/// DOFs.
+struct External {
+    /// Forces and moments on independent nodes [N, N m].
+    f: Vec<[f64; 6]>,
+    /// Their rates (see [`System::external`]).
+    df: Vec<[f64; 6]>,
+    /// Forces applied at tied nodes, for the lever terms of the tangent [N].
+    f_node: Vec<Vector3<f64>>,
+    /// Rigid bodies' reference node, lever to the centre of mass [m] and weight's reaction [N].
+    body_terms: Vec<(usize, Vector3<f64>, Vector3<f64>)>,
+    /// Gravity's potential energy [J].
+    gravity_energy: f64,
+    /// Sum of mass times position [kg m].
+    mass_moment: Vector3<f64>,
+}
+
 /// A model prepared for analysis: elements, masses, DOF map, sparsity pattern, linear solver and
 /// buffers.
 pub struct System {
@@ -708,6 +725,106 @@ impl System {
         }
     }
 
+    /// External forces on every node at `state.t` and their rates, condensed onto independent
+    /// nodes (tied nodes and centres of mass add their lever's moment). `rate` gives the rate of a
+    /// time function: its one-sided slope for the assembly, or a secant over an increment for
+    /// the static predictor ([`System::load_secant`]).
+    fn external(&self, state: &State, rate: impl Fn(&TimeFunction) -> f64) -> External {
+        let t = state.t;
+        let n_nodes = state.x.len();
+        let mut f_ext = vec![[0.0; 6]; n_nodes];
+        let mut df_ext = vec![[0.0; 6]; n_nodes];
+        let mut f_ext_node = vec![Vector3::zeros(); n_nodes];
+        let mut apply = |node: usize, force: [f64; 6], rate: [f64; 6]| {
+            let owner = self.dofs.owner(node);
+            for d in 0..6 {
+                f_ext[owner][d] += force[d];
+                df_ext[owner][d] += rate[d];
+            }
+            if owner != node {
+                let lever = state.x[node] - state.x[owner];
+                let (m, dm) = (
+                    lever.cross(&Vector3::new(force[0], force[1], force[2])),
+                    lever.cross(&Vector3::new(rate[0], rate[1], rate[2])),
+                );
+                for i in 0..3 {
+                    f_ext[owner][3 + i] += m[i];
+                    df_ext[owner][3 + i] += dm[i];
+                }
+                f_ext_node[node] += Vector3::new(force[0], force[1], force[2]);
+            }
+        };
+        for load in &self.loads {
+            let (mut force, mut load_rate) = ([0.0; 6], [0.0; 6]);
+            force[load.dof.index()] = load.value * load.function.value(t);
+            load_rate[load.dof.index()] = load.value * rate(&load.function);
+            apply(load.node, force, load_rate);
+        }
+        let mut gravity_energy = 0.0;
+        let mut mass_moment = Vector3::zeros();
+        let mut body_terms = Vec::new();
+        if let Some((g, function)) = &self.gravity {
+            let (gt, dg) = (g * function.value(t), g * rate(function));
+            for (n, &m) in self.node_mass.iter().enumerate() {
+                if m == 0.0 {
+                    continue;
+                }
+                let force = [m * gt.x, m * gt.y, m * gt.z, 0.0, 0.0, 0.0];
+                let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
+                apply(n, force, rate);
+                mass_moment += m * state.x[n];
+            }
+            for body in &self.bodies {
+                let r = body.node;
+                let lever = self.node_rotation(state, r) * body.centre_of_mass;
+                let (w, dw) = (gt * body.mass, dg * body.mass);
+                let (m, dm) = (lever.cross(&w), lever.cross(&dw));
+                for i in 0..3 {
+                    f_ext[r][i] += w[i];
+                    df_ext[r][i] += dw[i];
+                    f_ext[r][3 + i] += m[i];
+                    df_ext[r][3 + i] += dm[i];
+                }
+                mass_moment += body.mass * (state.x[r] + lever);
+                body_terms.push((r, lever, -w));
+            }
+            gravity_energy = -gt.dot(&mass_moment);
+        }
+        External {
+            f: f_ext,
+            df: df_ext,
+            f_node: f_ext_node,
+            body_terms,
+            gravity_energy,
+            mass_moment,
+        }
+    }
+
+    /// The static load vector's secant over the load-factor increment `dt` from `state.t`, on
+    /// the free DOFs: `(f_ext(t + dt) - f_ext(t)) / dt`, the loads' levers held at `state`'s
+    /// geometry. Equal to [`Assembled::df_ext`] for linear and constant time functions; over a
+    /// ramp's end or a table's corner it is the load the increment actually adds, where the
+    /// slope at `t` (a ramp over a microsecond: 1e6 per unit) would extrapolate it.
+    #[must_use]
+    pub fn load_secant(&self, state: &State, dt: f64) -> Vec<f64> {
+        let t = state.t;
+        let df = self
+            .external(state, |function| function.increment(t, dt) / dt)
+            .df;
+        let mut out = vec![0.0; self.dofs.n_free];
+        for (i, slots) in self.dofs.slots.iter().enumerate() {
+            if self.dofs.master[i].is_some() {
+                continue;
+            }
+            for d in 0..6 {
+                if let Slot::Free(eq) = slots[d] {
+                    out[eq] = df[i][d];
+                }
+            }
+        }
+        out
+    }
+
     #[allow(clippy::too_many_lines)]
     fn assemble_with(
         &mut self,
@@ -836,67 +953,17 @@ impl System {
         // External forces on every node at time t and their rates, condensed onto independent
         // nodes; forces at a lever arm (tied nodes, centres of mass) add the lever's moment and,
         // in the tangent, the second-order term of its rotation.
-        let t = state.t;
-        let dir = self.time_direction;
-        let mut f_ext = vec![[0.0; 6]; n_nodes];
-        let mut df_ext = vec![[0.0; 6]; n_nodes];
-        // External forces applied at tied nodes (before condensation), for the lever terms.
-        let mut f_ext_node = vec![Vector3::zeros(); n_nodes];
-        let mut apply = |node: usize, force: [f64; 6], rate: [f64; 6]| {
-            let owner = self.dofs.owner(node);
-            for d in 0..6 {
-                f_ext[owner][d] += force[d];
-                df_ext[owner][d] += rate[d];
-            }
-            if owner != node {
-                let lever = state.x[node] - state.x[owner];
-                let (m, dm) = (
-                    lever.cross(&Vector3::new(force[0], force[1], force[2])),
-                    lever.cross(&Vector3::new(rate[0], rate[1], rate[2])),
-                );
-                for i in 0..3 {
-                    f_ext[owner][3 + i] += m[i];
-                    df_ext[owner][3 + i] += dm[i];
-                }
-                f_ext_node[node] += Vector3::new(force[0], force[1], force[2]);
-            }
-        };
-        for load in &self.loads {
-            let (mut force, mut rate) = ([0.0; 6], [0.0; 6]);
-            force[load.dof.index()] = load.value * load.function.value(t);
-            rate[load.dof.index()] = load.value * load.function.derivative(t, dir);
-            apply(load.node, force, rate);
-        }
-        out.gravity_energy = 0.0;
-        out.mass_moment = Vector3::zeros();
-        let mut body_terms = Vec::new();
-        if let Some((g, function)) = &self.gravity {
-            let (gt, dg) = (g * function.value(t), g * function.derivative(t, dir));
-            for (n, &m) in self.node_mass.iter().enumerate() {
-                if m == 0.0 {
-                    continue;
-                }
-                let force = [m * gt.x, m * gt.y, m * gt.z, 0.0, 0.0, 0.0];
-                let rate = [m * dg.x, m * dg.y, m * dg.z, 0.0, 0.0, 0.0];
-                apply(n, force, rate);
-                out.mass_moment += m * state.x[n];
-            }
-            for body in &self.bodies {
-                let r = body.node;
-                let lever = self.node_rotation(state, r) * body.centre_of_mass;
-                let (w, dw) = (gt * body.mass, dg * body.mass);
-                let (m, dm) = (lever.cross(&w), lever.cross(&dw));
-                for i in 0..3 {
-                    f_ext[r][i] += w[i];
-                    df_ext[r][i] += dw[i];
-                    f_ext[r][3 + i] += m[i];
-                    df_ext[r][3 + i] += dm[i];
-                }
-                out.mass_moment += body.mass * (state.x[r] + lever);
-                body_terms.push((r, lever, -w));
-            }
-            out.gravity_energy = -gt.dot(&out.mass_moment);
-        }
+        let (t, dir) = (state.t, self.time_direction);
+        let External {
+            f: f_ext,
+            df: df_ext,
+            f_node: f_ext_node,
+            body_terms,
+            gravity_energy,
+            mass_moment,
+        } = self.external(state, |function| function.derivative(t, dir));
+        out.gravity_energy = gravity_energy;
+        out.mass_moment = mass_moment;
 
         if tangent {
             // Second-order terms of the exact rigid motion of tied nodes (lever arms rotate).

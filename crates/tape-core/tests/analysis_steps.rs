@@ -222,6 +222,79 @@ fn released_prescribed_displacement_leaves_the_state_continuous() -> Result<()> 
     Ok(())
 }
 
+/// A load and a prescribed motion switched on by time functions far steeper than the step's
+/// increments (a ramp over 1e-6 of the load factor, a table's jump within 1e-10) reach the same
+/// equilibria as when they are applied in full from the start (the load) or linearly (the
+/// motion): the load-control predictor takes the secant of the loads and motions over the
+/// increment, not their slope at its start, which extrapolated a 0.5 increment of the ramp to
+/// 5e5 times its value ("Newton did not converge", or a non-finite residual for the table). The
+/// paths share no iterate, so they agree to the Newton tolerance (1e-10 of the force) amplified
+/// by the strip's conditioning: within 1e-9 of the tip's deflection.
+#[test]
+fn steep_time_functions_are_followed_by_their_secant() -> Result<()> {
+    let outputs = Outputs {
+        reactions: vec![],
+        field_interval: 1,
+    };
+    let steep = [
+        TimeFunction::Ramp { start: 0.0, end: 1e-6 },
+        TimeFunction::Table {
+            points: vec![(0.0, 0.0), (1e-10, 1.0)],
+        },
+    ];
+    let tip_after = |model: &Model, tip: usize| -> Result<Vector3<f64>> {
+        let result = run(model, &[load_step("on", 1.0, 2)], &outputs, &mut |_| true)?;
+        assert!(result.error.is_none(), "{:?}", result.error);
+        let last = result.history.fields.last().expect("fields");
+        Ok(Vector3::from(last.displacements[tip]))
+    };
+    let loaded = |function: TimeFunction| -> Result<Vector3<f64>> {
+        let (mut model, tip) = cantilever(8)?;
+        model.add_load_with(tape_core::model::Load {
+            id: None,
+            node: tip,
+            dof: Dof::Uz,
+            value: -20.0,
+            function,
+            active: true,
+        })?;
+        tip_after(&model, tip)
+    };
+    let pushed = |function: TimeFunction| -> Result<Vector3<f64>> {
+        let (mut model, tip) = cantilever(8)?;
+        model.add_constraint(Constraint {
+            id: None,
+            node: tip,
+            dof: Dof::Uz,
+            value: 5e-3,
+            function,
+            active: true,
+        })?;
+        // A free DOF beside the motion, which the predictor must carry along.
+        model.add_load(tip, Dof::Ux, 1.0)?;
+        tip_after(&model, tip)
+    };
+    for (name, case, reference) in [
+        (
+            "load",
+            &loaded as &dyn Fn(TimeFunction) -> Result<Vector3<f64>>,
+            TimeFunction::Constant,
+        ),
+        ("motion", &pushed, TimeFunction::Linear),
+    ] {
+        let expected = case(reference)?;
+        assert!(expected.z.abs() > 1e-3, "{name}: a visible deflection {expected:?}");
+        for function in &steep {
+            let got = case(function.clone())?;
+            assert!(
+                (got - expected).norm() <= 1e-9 * expected.norm(),
+                "{name}, {function:?}: {got:?} against {expected:?}"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A constraint switched on by a modal step and released by the static step after it: the
 /// released reaction is the constraint's own at the state the step starts from. The reactions
 /// recorded by the last static step were numbered without it: taken by its position in the new

@@ -11,7 +11,9 @@
 //! no real root, the correction takes the quadratic's closest approach twice, then keeps to the
 //! plane normal to the increment so far (Ramm 1981), which a correction from a nearly singular
 //! tangent always cuts, where cutting the increment back only crept towards the singular point.
-//! The first
+//! A load-control increment's predictor solves with the loads' and motions' secant over the
+//! increment instead of `b`, so that a time function far steeper than the increment (a ramp over
+//! a microsecond) adds what it adds, not its slope times the increment. The first
 //! predictor follows the tangent in the requested direction; later ones follow the tangent at the
 //! converged state (when its factorisation is at hand from the stability count) oriented like the
 //! previous increment (Feng et al. 1996), or else, and always after a cut-back, extrapolate the
@@ -286,6 +288,34 @@ impl Driver<'_> {
         b
     }
 
+    /// The response `K^-1 b_s` to the load's secant over the load-control increment `dl`,
+    /// `b_s = (f_ext(t + dl) - f_ext(t) - K_fc (c(t + dl) - c(t))) / dl`, where `dq_b` is the
+    /// response to its slope at `t`, [`Self::load_vector`]. The two are the same for linear and
+    /// constant time functions (no second solve then); where a ramp ends or a table turns within
+    /// the increment the slope would extrapolate the load (a ramp over a microsecond: a million
+    /// times it over a unit increment) and the predictor would start Newton out of reach.
+    fn secant_response(&mut self, state: &State, dl: f64, dq_b: Vec<f64>) -> Result<Vec<f64>> {
+        let mut b = self.system.load_secant(state, dl);
+        let dc: Vec<f64> = self
+            .system
+            .constrained_increments(state.t, dl)
+            .iter()
+            .map(|c| c / dl)
+            .collect();
+        let mut kv = vec![0.0; b.len()];
+        self.system.pattern_fc.mul_add(&self.asm.k_fc, &dc, &mut kv);
+        for (bi, k) in b.iter_mut().zip(kv) {
+            *bi -= k;
+        }
+        if b == self.load_vector() {
+            return Ok(dq_b);
+        }
+        let t = Instant::now();
+        self.system.linear.solve_in_place(&mut b)?;
+        self.stats.solve_s += t.elapsed().as_secs_f64();
+        Ok(b)
+    }
+
     /// Factorises the current tangent (if not done yet).
     pub fn factorise(&mut self) -> Result<()> {
         if !self.factorised {
@@ -383,24 +413,25 @@ impl Driver<'_> {
             ) => (fraction * chord_lambda, chord.iter().map(|c| fraction * c).collect()),
             _ => {
                 let (dq_r, dq_b) = self.solve_pair()?;
-                let (dlambda0, mut dq) = match inc {
+                // (load factor increment, correction at the fixed load, the load's response)
+                let (dlambda0, mut dq, direction) = match inc {
                     Increment::Load(dl) => {
                         self.load_carried(&dq_b)?;
-                        (*dl, dq_r)
+                        (*dl, dq_r, self.secant_response(state, *dl, dq_b)?)
                     }
                     Increment::Displacement { eq, delta } => {
                         if dq_b[*eq].abs() < 1e-300 {
                             return Err(Rejection::NoResponse);
                         }
-                        ((delta - dq_r[*eq]) / dq_b[*eq], dq_r)
+                        ((delta - dq_r[*eq]) / dq_b[*eq], dq_r, dq_b)
                     }
                     Increment::Arc { ds, direction } => {
                         let norm = (self.dot_w(&dq_b, &dq_b) + self.c_lambda).sqrt();
-                        (direction * ds / norm, vec![0.0; dq_b.len()])
+                        (direction * ds / norm, vec![0.0; dq_b.len()], dq_b)
                     }
                     Increment::Plane { .. } => unreachable!("handled above"),
                 };
-                for (d, b) in dq.iter_mut().zip(&dq_b) {
+                for (d, b) in dq.iter_mut().zip(&direction) {
                     *d += dlambda0 * b;
                 }
                 (dlambda0, dq)
