@@ -196,14 +196,35 @@ def test_numeric_time_functions_are_unchanged():
 
 @pytest.mark.parametrize("node", [0.5, 1.9, True, np.bool_(False), float("nan"), float("inf")])
 def test_a_reaction_node_that_is_not_an_integer_is_refused_not_truncated(two_step_results, node):
-    with pytest.raises(ValueError, match="node must be an integer node index"):
+    with pytest.raises(ValueError, match="node must hold integer node indices"):
         two_step_results.reaction(node, "uz")
 
 
 @pytest.mark.parametrize("node", ["0", None, [0]])
 def test_a_reaction_node_that_is_not_a_number_is_a_type_error(two_step_results, node):
-    with pytest.raises(TypeError, match="node must be an integer node index"):
+    with pytest.raises(TypeError, match="node must hold integer node indices"):
         two_step_results.reaction(node, "uz")
+
+
+def test_a_negative_reaction_node_is_refused_as_outputs_refuses_it(two_step_results):
+    # It reached the records' lookup and came out as a KeyError; the node checks of `Outputs`,
+    # `Results.reaction` and `to_trial`'s force nodes now share one rule (tapespring._indices).
+    with pytest.raises(ValueError, match=r"node must hold node indices >= 0 \(got -1\)"):
+        two_step_results.reaction(-1, "uz")
+
+
+@pytest.mark.parametrize(
+    ("node", "error", "message"),
+    [
+        (1.5, ValueError, "got the value 1.5"),
+        (True, ValueError, "got the bool True"),
+        (-2, ValueError, "hold node indices >= 0 .got -2"),
+        ("0", TypeError, "got a str"),
+    ],
+)
+def test_force_nodes_follow_the_same_node_rule(two_step_results, node, error, message):
+    with pytest.raises(error, match=f"force_nodes must .*{message}"):
+        two_step_results.to_trial(markers={"tip": "M"}, force_nodes=[node], steps=[0, 1])
 
 
 def test_a_reaction_node_given_as_an_integral_number_is_that_node(two_step_results):
@@ -683,7 +704,7 @@ def test_any_model_calls_are_refused_by_name_or_end_in_equilibrium(calls):
 
 
 # ---------------------------------------------------------------------------------------------
-# Found here, to be fixed in the native module (crates/): strict xfails as reproducers
+# Found here, fixed in the native module (crates/)
 
 
 @pytest.mark.parametrize(
@@ -710,12 +731,11 @@ def test_complex_scalars_are_refused_not_cast(value):
         )
 
 
-@pytest.mark.xfail(strict=True, raises=ConvergenceError, reason="tape-core: static predictor")
 def test_a_load_switched_on_by_a_steep_ramp_is_solved_statically():
     # A 1 N tip load applied over t in [0, 1e-6] by ramp(0, 1e-6): the same linear problem as
-    # a constant load, but the static step's predictor extrapolates the load's slope (1e6 per
-    # unit load factor) over the increment and no cut-back recovers ("Newton did not converge",
-    # "the residual became non-finite" for steeper ramps).
+    # a constant load. The static step's predictor extrapolated the load's slope (1e6 per unit
+    # load factor) over the increment and no cut-back recovered ("Newton did not converge",
+    # "the residual became non-finite" for steeper ramps); it now takes the load's secant.
     model, tip = tip_model()
     model.add_load(tip, "uz", 1.0, function=ramp(0.0, 1e-6))
     steep = run(model, [Step.static("s", increments=2)]).marker("tip")[-1]

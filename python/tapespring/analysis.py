@@ -32,7 +32,6 @@ Example
 
 from __future__ import annotations
 
-import math
 import numbers
 import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -43,6 +42,7 @@ import numpy as np
 
 from tapespring import _core
 from tapespring._core import ConvergenceError, Model, TapeError
+from tapespring._indices import index
 from tapespring.modes import SystemMatrices
 from tapespring.results import Results
 
@@ -189,41 +189,6 @@ def _ids(ids: str | Iterable[str], what: str = "ids") -> tuple[str, ...]:
         if not isinstance(one, str):
             raise TypeError(f"{what}[{k}] must be an id (a str), not {type(one).__name__}: {one!r}")
     return out
-
-
-def _index(value: Any, what: str, pair: tuple[Any, Any] | None = None) -> int:
-    """`value` as an int >= 0: `field_interval` named `what`, or the node of `pair` in `what`.
-
-    An integral float is accepted, as by the `Model` methods; a fractional one is refused, not
-    truncated, and so is a bool (``True`` is not the index 1). The messages are worded as the
-    `Model` methods' ("node must hold integer node indices (got the value 1.5)").
-
-    Raises
-    ------
-    TypeError
-        If `value` is not a number.
-    ValueError
-        If it is a bool, not an integer, or negative.
-    """
-    if pair is None:
-        integer, positive, where = "be an integer", "be >= 0", ""
-    else:
-        integer, positive = "hold integer node indices", "hold node indices >= 0"
-        where = f" in {pair!r}"
-    if isinstance(value, bool | np.bool_):
-        raise ValueError(f"{what} must {integer} (got the bool {value}{where})")
-    if isinstance(value, numbers.Integral):
-        index = int(value)
-    elif isinstance(value, numbers.Real):
-        number = float(value)
-        if not (math.isfinite(number) and number.is_integer()):
-            raise ValueError(f"{what} must {integer} (got the value {value}{where})")
-        index = int(number)
-    else:
-        raise TypeError(f"{what} must {integer} (got a {type(value).__name__}: {value!r}{where})")
-    if index < 0:
-        raise ValueError(f"{what} must {positive} (got {index}{where})")
-    return index
 
 
 #: The keys of a step's flat form that are `Step` fields, not options.
@@ -413,7 +378,7 @@ class Outputs:
         # Checked here, where the mistake is made: int() in to_dict truncated 1.5 to node 1.
         object.__setattr__(self, "reactions", _reaction_dofs(self.reactions))
         object.__setattr__(
-            self, "field_interval", _index(self.field_interval, "Outputs.field_interval")
+            self, "field_interval", index(self.field_interval, "Outputs.field_interval")
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -439,7 +404,7 @@ def _reaction_dofs(reactions: Any) -> tuple[tuple[int, str], ...]:
         if not isinstance(dof, str):
             raise TypeError(f"{what}[{k}]: the dof must be a DOF name such as 'uz' (got {dof!r})")
         # Lower case, as the Model methods and Results.reaction take DOF names ("UZ" is "uz").
-        key = (_index(node, what, (node, dof)), dof.lower())
+        key = (index(node, what, nodes=True, where=f" in {(node, dof)!r}"), dof.lower())
         if key in pairs:
             # Recorded twice, it was counted twice by Results.total_reaction.
             raise ValueError(f"{what} asks for {key!r} twice ({what}[{k}] is {pair!r})")

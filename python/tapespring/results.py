@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tapespring._indices import index
 from tapespring.modes import Modes, SystemMatrices
 
 if TYPE_CHECKING:
@@ -251,7 +252,7 @@ class Results:
         KeyError
             If that (node, dof) was not recorded.
         """
-        key = (_node_index(node), _dof_name(dof))
+        key = (index(node, "node", nodes=True), _dof_name(dof))
         try:
             column = self.reaction_dofs.index(key)
         except ValueError:
@@ -514,24 +515,6 @@ class Results:
             modes = [_load_modes(f, i, entry) for i, entry in enumerate(meta.get("modes", []))]
         d["modes"] = modes
         return d
-
-
-def _node_index(node: object) -> int:
-    """`node` as a node index, as `Outputs` takes it: an integer, or a float of integral value.
-
-    ``int()`` read 1.5 as node 1, ``True`` as node 1 and ``"3"`` as node 3, and failed on an
-    infinite float with an OverflowError.
-    """
-    if isinstance(node, bool | np.bool_):
-        raise ValueError(f"node must be an integer node index (got the bool {node})")
-    if isinstance(node, numbers.Integral):
-        return int(node)
-    if isinstance(node, numbers.Real):
-        value = float(node)
-        if math.isfinite(value) and value.is_integer():
-            return int(value)
-        raise ValueError(f"node must be an integer node index (got the value {node})")
-    raise TypeError(f"node must be an integer node index (got {type(node).__name__}: {node!r})")
 
 
 def _dof_name(dof: object) -> str:

@@ -30,13 +30,14 @@ from its clamp gives ``F_z = -m g``: the convention of the laboratory's plates a
 
 from __future__ import annotations
 
-import math
 import numbers
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from tapespring._indices import index
 
 from .trial import MAX_RATE, ForcePlate, Metadata, Trial
 
@@ -254,7 +255,7 @@ def _plate_history(
     """Force [N] and moment [N m] on the plate at every record, shapes (n, 3)."""
     if isinstance(force_nodes, str | bytes):
         raise ValueError(f"force_nodes must be a sequence of node indices (got {force_nodes!r})")
-    nodes = [_node_index(node) for node in force_nodes]
+    nodes = [index(node, "force_nodes", nodes=True) for node in force_nodes]
     if not nodes:
         raise ValueError("force_nodes is empty (pass None for a trial without force plate)")
     if len(set(nodes)) != len(nodes):
@@ -278,20 +279,6 @@ def _plate_history(
         o = x[0] if origin is None else _origin(origin)
         moment = moment + np.cross(x - o, forces).sum(axis=1)
     return -forces.sum(axis=1), -moment
-
-
-def _node_index(node: object) -> int:
-    """`node` as a node index: an integer >= 0, or an integral float (``1.5`` is refused, not
-    truncated to node 1)."""
-    if isinstance(node, bool | np.bool_) or not isinstance(node, numbers.Real):
-        raise ValueError(f"force_nodes must hold node indices (got {node!r})")
-    try:
-        value = float(node)
-    except OverflowError:  # an int beyond floats, e.g. 10**400
-        value = math.inf
-    if not (math.isfinite(value) and value.is_integer() and value >= 0):
-        raise ValueError(f"force_nodes must hold integer node indices >= 0 (got {node!r})")
-    return int(value)
 
 
 def _origin(origin: ArrayLike) -> NDArray[np.float64]:
