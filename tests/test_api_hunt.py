@@ -450,9 +450,9 @@ def test_to_nodal_places_the_free_equations():
         (0.0, 7.0, "more than one turn"),
         (0.0, 3 * np.pi, "more than one turn"),
         (-2.0, 2 * np.pi - 1.0, "more than one turn"),
-        (-1e300, 1e300, "phi0 = -1e\\+300 rad is beyond 1e\\+06 rad"),
-        (1e20, 1e20 + 1e5, "phi0 = 1e\\+20 rad is beyond"),
-        (0.0, 2e6, "phi1 = 2000000.0 rad is beyond"),
+        (-1e300, 1e300, "phi0 = -1e300 rad is beyond 1e6 rad"),
+        (1e20, 1e20 + 1e5, "phi0 = 1e20 rad is beyond"),
+        (0.0, 2e6, "phi1 = 2000000 rad is beyond"),
     ],
 )
 def test_a_panel_that_wraps_onto_itself_or_loses_its_angles_is_refused(phi0, phi1, message):

@@ -23,8 +23,6 @@ Example
 from __future__ import annotations
 
 import itertools
-import math
-import numbers
 import sys
 from collections.abc import Callable
 from typing import Any, NamedTuple
@@ -175,37 +173,7 @@ def cylindrical_panel_mesh(
         turn (``phi1 - phi0 > 2 pi``: the panel would lie on itself, layer over layer), or an
         angle beyond 1e6 rad (where the angles of the nodes lose their digits).
     """
-    _check_panel_angles(phi0, phi1)
     return Mesh(*_core.cylindrical_panel_mesh(radius, length, phi0, phi1, n_axial, n_arc))
-
-
-#: Largest angle of a panel [rad], as a part's placement rotation: beyond it the node angles
-#: ``phi0 + k dphi`` lose their digits (a ulp of 1e16 rad is 2 rad).
-MAX_PANEL_ANGLE = 1e6
-
-
-def _check_panel_angles(phi0: object, phi1: object) -> None:
-    """Refuse a panel that wraps onto itself or whose angles lose their digits (the generator
-    meshed 0 to 100 rad as 16 layers on one cylinder, and -1e300 to 1e300 rad as sin() of
-    round-off). Anything but two finite real numbers is left to the generator's own checks."""
-    if not all(
-        isinstance(a, numbers.Real) and not isinstance(a, bool | np.bool_) for a in (phi0, phi1)
-    ):
-        return
-    a0, a1 = float(phi0), float(phi1)  # type: ignore[arg-type]
-    if not (math.isfinite(a0) and math.isfinite(a1)):
-        return
-    for name, a in (("phi0", a0), ("phi1", a1)):
-        if abs(a) > MAX_PANEL_ANGLE:
-            raise ValueError(
-                f"{name} = {a!r} rad is beyond {MAX_PANEL_ANGLE:g} rad: the nodes' angles would "
-                "lose their digits; give the angles within one turn"
-            )
-    if a1 - a0 > 2.0 * math.pi:
-        raise ValueError(
-            f"the angular span phi1 - phi0 = {a1 - a0!r} rad is more than one turn (2 pi): the "
-            "panel would lie on itself"
-        )
 
 
 def model_from_mesh(mesh: Mesh | tuple[Any, Any, Any], **section: float) -> Model:

@@ -52,17 +52,39 @@ pub fn flat_plate(lx: f64, ly: f64, nx: usize, ny: usize) -> Result<Mesh> {
     Ok(mesh)
 }
 
+/// Largest angle of a cylindrical panel \[rad\]: beyond it the node angles `phi0 + k dphi` lose
+/// their digits (a ulp of 1e16 rad is 2 rad).
+pub const MAX_PANEL_ANGLE: f64 = 1e6;
+
 /// Cylindrical panel of radius `radius` about the x axis: points `(x, R sin(phi), R cos(phi))`
 /// for `x` in `[0, length]` and `phi` in `[phi0, phi1]` \[rad\]; normals point away from the axis.
 ///
 /// Node sets: `x0`, `x1` (curved edges), `phi0`, `phi1` (straight edges), `all`.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for non-positive sizes, `phi1 <= phi0` or zero element counts.
+/// [`Error::InvalidParameter`] for non-positive sizes, `phi1 <= phi0`, a span of more than one
+/// turn (the panel would lie on itself, layer over layer), an angle beyond
+/// [`MAX_PANEL_ANGLE`] or zero element counts.
 pub fn cylindrical_panel(radius: f64, length: f64, phi0: f64, phi1: f64, n_axial: usize, n_arc: usize) -> Result<Mesh> {
     check_positive("radius [m]", radius)?;
     check_positive("length [m]", length)?;
     check_positive("angular span phi1 - phi0 [rad]", phi1 - phi0)?;
+    for (name, angle) in [("phi0", phi0), ("phi1", phi1)] {
+        if angle.abs() > MAX_PANEL_ANGLE {
+            return Err(Error::InvalidParameter(format!(
+                "{name} = {} rad is beyond {MAX_PANEL_ANGLE:e} rad: the nodes' angles would lose \
+                 their digits; give the angles within one turn",
+                shown(angle)
+            )));
+        }
+    }
+    if phi1 - phi0 > 2.0 * std::f64::consts::PI {
+        return Err(Error::InvalidParameter(format!(
+            "the angular span phi1 - phi0 = {} rad is more than one turn (2 pi): the panel would lie \
+             on itself",
+            shown(phi1 - phi0)
+        )));
+    }
     let mut mesh = grid(n_axial, n_arc, |s, r| {
         let phi = phi0 + r * (phi1 - phi0);
         Vector3::new(s * length, radius * phi.sin(), radius * phi.cos())
@@ -193,6 +215,26 @@ fn rename(mesh: &mut Mesh, pairs: &[(&str, &str)]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// 0 to 7 rad gave a panel lying on itself, -1e300 to 1e300 rad nodes at sin() of round-off;
+    /// one full turn, and a half radian near the largest angle, are meshes.
+    #[test]
+    fn a_panel_is_at_most_one_turn_of_angles_that_keep_their_digits() {
+        let refused = |phi0: f64, phi1: f64| match cylindrical_panel(0.1, 0.2, phi0, phi1, 2, 4) {
+            Err(Error::InvalidParameter(m)) => m,
+            other => panic!("{phi0} to {phi1}: {other:?}"),
+        };
+        assert!(refused(0.0, 7.0).contains("phi1 - phi0 = 7 rad is more than one turn"));
+        assert!(refused(-1e300, 1e300).contains("phi0 = -1e300 rad is beyond 1e6 rad"));
+        assert!(refused(0.0, 2e6).contains("phi1 = 2000000 rad is beyond"));
+        assert!(refused(f64::NAN, 1.0).contains("angular span"));
+        let turn = cylindrical_panel(0.1, 0.2, 0.0, 2.0 * std::f64::consts::PI, 2, 8).expect("one turn");
+        assert_eq!(turn.quads.len(), 16);
+        let far = cylindrical_panel(0.1, 0.2, -MAX_PANEL_ANGLE, -MAX_PANEL_ANGLE + 0.5, 1, 1).expect("far");
+        for x in &far.nodes {
+            assert!((x.y.hypot(x.z) - 0.1).abs() < 1e-12 * 0.1);
+        }
+    }
 
     #[test]
     fn tape_spring_section_is_the_requested_arc() {
