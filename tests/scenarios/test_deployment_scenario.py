@@ -73,8 +73,16 @@ def test_clamp_force_peaks_when_the_angle_crosses_zero(opposite: DeploymentSimul
     assert np.all(x.ratio >= 2.0), x.ratio
     # ... and close to the crossing: the swing's half-period is about 0.2 s.
     assert np.all(np.abs(x.peak_time - x.time) < 0.015)
-    s = opposite.summary()["clamp_force_at_crossings"]
-    assert s["time_s"] == pytest.approx(x.time.tolist())
+    # Each a true extremum of the force inside its window, not a flank at the window's edge.
+    assert np.all(x.local)
+    s = opposite.summary()
+    assert s["clamp_force_at_crossings"]["time_s"] == pytest.approx(x.time.tolist())
+    forces = s["clamp_force_at_crossings"]["peak_force_N"]
+    assert forces == pytest.approx(np.interp(x.peak_time, opposite.time_s, opposite.clamp_force_N))
+    # The largest force is reported with its sign and instant, as the force plate measures it.
+    k = np.argmax(np.abs(opposite.clamp_force_N))
+    assert s["max_clamp_force_N"] == opposite.clamp_force_N[k]
+    assert s["max_clamp_force_time_s"] == opposite.time_s[k]
 
 
 def test_energy_only_decreases(opposite: DeploymentSimulation) -> None:

@@ -35,12 +35,20 @@ def test_a_pulse_at_each_crossing_stands_out() -> None:
     # The pulse (5 N) over the swing's largest value in the flanking half-cycles (at most 1 N).
     assert np.all(r.ratio > 4.0), r.ratio
     np.testing.assert_allclose(r.peak, 5.0, atol=0.1)
+    # Each a maximum of the deviation, at the force's own value (signed).
+    assert np.all(r.local)
+    np.testing.assert_array_equal(r.peak_force, np.interp(r.peak_time, T, SWING + PULSES))
+    np.testing.assert_allclose(r.peak_force, 5.0 - 0.8, atol=0.1)
 
 
 def test_a_force_that_follows_the_angle_has_no_peak_at_the_crossings() -> None:
     r = force_at_crossings(T, ANGLE, SWING, baseline=-0.8)
     # Within an eighth of a period of a crossing the swing is below sin(pi/4) of its envelope.
     assert np.all(r.ratio < 0.75), r.ratio
+    # Its largest deviation in a window lies on the window's edge, still rising beyond it: no
+    # peak at the crossing.
+    assert not np.any(r.local), r.local
+    assert r.as_dict()["peak_is_local_maximum"] == [False] * r.time.size
 
 
 def test_start_and_end_select_the_crossings() -> None:
@@ -87,6 +95,9 @@ def test_any_finite_record_gives_consistent_arrays(angle, force, fraction) -> No
     n = min(len(angle), len(force))
     t = np.arange(n) * 0.01
     r = force_at_crossings(t, angle[:n], force[:n], fraction=fraction)
-    assert r.time.size == r.peak.size == r.window.size == r.elsewhere.size
+    assert r.time.size == r.peak.size == r.window.size == r.elsewhere.size == r.local.size
+    # The peak's signed force is the record's own value there, its deviation the peak.
+    j = np.searchsorted(t, r.peak_time)
+    np.testing.assert_array_equal(r.peak_force, np.asarray(force[:n])[j])
     assert np.all(r.peak >= 0.0) and np.all((r.time >= t[0]) & (r.time <= t[-1]))
     assert np.all(np.abs(r.peak_time - r.time) <= np.maximum(r.window, 0.01) + 1e-12)

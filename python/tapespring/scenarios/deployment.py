@@ -395,6 +395,7 @@ class DeploymentSimulation:
         lateral = (
             float(np.max(np.abs(self.tip_m[:, 1] - self.tip_m[0, 1]))) if self.tip_m.size else 0.0
         )
+        k = int(np.argmax(np.abs(self.clamp_force_N))) if self.clamp_force_N.size else None
         return {
             "sense": self.settings.sense,
             "support": self.settings.spec.support,
@@ -402,9 +403,9 @@ class DeploymentSimulation:
             "final_angle_deg": float(self.angle_deg[-1]) if self.angle_deg.size else None,
             "peaks": peaks,
             "phases": phases,
-            "max_clamp_force_N": float(np.max(np.abs(self.clamp_force_N)))
-            if self.clamp_force_N.size
-            else None,
+            # The force of largest magnitude, with its sign (at rest it is negative: the weight).
+            "max_clamp_force_N": float(self.clamp_force_N[k]) if k is not None else None,
+            "max_clamp_force_time_s": float(self.time_s[k]) if k is not None else None,
             "max_lateral_tip_displacement_m": lateral,
             "clamp_force_at_crossings": self.clamp_force_at_crossings().as_dict()
             if self.time_s.size >= 2
@@ -464,17 +465,18 @@ class DeploymentSimulation:
             )
         lines.append(phases)
         if s["max_clamp_force_N"] is not None:
-            lines.append(f"  largest vertical clamp force {s['max_clamp_force_N']:.2f} N")
+            lines.append(
+                f"  largest vertical clamp force {s['max_clamp_force_N']:+.2f} N at "
+                f"{s['max_clamp_force_time_s']:.3f} s (the force plate's Fz, with its sign)"
+            )
         x = s["clamp_force_at_crossings"]
         if x is not None and x["time_s"]:
-            items = ", ".join(
-                f"{p:.1f} N at {t:.3f} s ({r:.1f}x)" if r is not None else f"{p:.1f} N at {t:.3f} s"
-                for t, p, r in zip(x["time_s"], x["peak_N"], x["ratio"], strict=True)
-            )
             lines.append(
-                "  clamp force at the angle's zero crossings before phase III (deviation from "
-                f"{x['baseline_N']:+.2f} N; its ratio to the rest of the half-cycles): {items}"
+                "  clamp force at the angle's zero crossings before phase III (the force where it "
+                f"deviates most from {x['baseline_N']:+.2f} N within an eighth of a period of the "
+                "crossing; that deviation's ratio to the rest of the flanking half-cycles):"
             )
+            lines.extend(f"    {item}" for item in _crossing_items(x))
         c = self.comparison
         if c is not None:
             amp = [abs(v) for v in c["max_amplitude_deg"] + c["min_amplitude_deg"] if v is not None]
@@ -579,3 +581,19 @@ def deploy(
     )
     raise_if_stopped(results, out, "deployment")
     return out
+
+
+def _crossing_items(x: dict[str, Any]) -> list[str]:
+    """One line per crossing of `CrossingPeaks.as_dict()` for the summary text."""
+    items = []
+    for k, crossing in enumerate(x["time_s"]):
+        force, at, ratio = x["peak_force_N"][k], x["peak_time_s"][k], x["ratio"][k]
+        if not x["peak_is_local_maximum"][k]:
+            items.append(
+                f"crossing at {crossing:.3f} s: no peak (the largest deviation, {force:+.1f} N at "
+                f"{at:.3f} s, lies on a flank at the window's edge)"
+            )
+            continue
+        share = f", {ratio:.1f} times the rest" if ratio is not None else ""
+        items.append(f"crossing at {crossing:.3f} s: {force:+.1f} N at {at:.3f} s{share}")
+    return items

@@ -10,7 +10,9 @@ between samples. Crossing ``k`` at ``c_k`` is flanked by two half-cycles, from t
 crossing (or the record's start) to the next one (or the record's end). Around it, a window of
 half-width ``w_k = fraction * min(c_k - c_{k-1}, c_{k+1} - c_k)`` (default a quarter of the
 shorter half-cycle: an eighth of a period either side). The *peak* is the largest
-``|f - baseline|`` inside the window; *elsewhere* is the largest outside it in the two flanking
+``|f - baseline|`` inside the window, and *local* where it is a local maximum of that deviation
+(not on the window's edge with the deviation still rising beyond it: then the force's extremum
+lies outside the window, on no crossing); *elsewhere* is the largest outside it in the two flanking
 half-cycles, each trimmed by ``w_k`` at its far end so that the neighbouring crossings' own
 windows are left out. A crossing has a peak of its own when ``ratio = peak / elsewhere`` is well
 above one. Measured on the paper's meshes (opposite sense, 10 s): ratios 3.5 to 7.3 at the four
@@ -44,6 +46,11 @@ class CrossingPeaks:
         Largest ``|f - baseline|`` within the window [unit of the force, N].
     peak_time : ndarray
         Instant of that largest value [s].
+    peak_force : ndarray
+        The force at that instant, with its sign [N].
+    local : ndarray of bool
+        Whether the peak is a local maximum of ``|f - baseline|`` (False: it lies on the
+        window's edge on a flank of the force, whose extremum is outside the window).
     elsewhere : ndarray
         Largest ``|f - baseline|`` in the flanking half-cycles outside the window (NaN if no
         sample lies there).
@@ -55,6 +62,8 @@ class CrossingPeaks:
     window: NDArray[np.float64]
     peak: NDArray[np.float64]
     peak_time: NDArray[np.float64]
+    peak_force: NDArray[np.float64]
+    local: NDArray[np.bool_]
     elsewhere: NDArray[np.float64]
     baseline: float
 
@@ -72,9 +81,11 @@ class CrossingPeaks:
 
         return {
             "time_s": listed(self.time),
-            "peak_N": listed(self.peak),
-            "peak_offset_s": listed(self.peak_time - self.time),
-            "elsewhere_N": listed(self.elsewhere),
+            "peak_force_N": listed(self.peak_force),
+            "peak_time_s": listed(self.peak_time),
+            "peak_deviation_N": listed(self.peak),
+            "peak_is_local_maximum": [bool(v) for v in self.local],
+            "elsewhere_deviation_N": listed(self.elsewhere),
             "ratio": listed(self.ratio),
             "baseline_N": float(self.baseline),
         }
@@ -173,7 +184,8 @@ def force_at_crossings(
     reach = np.concatenate(([0.0], window, [0.0]))
     n = int(np.count_nonzero(c <= hi))
     c, window = c[:n], window[:n]
-    peak, peak_time, elsewhere = (np.empty(n) for _ in range(3))
+    peak, peak_time, peak_force, elsewhere = (np.empty(n) for _ in range(4))
+    local = np.zeros(n, dtype=bool)
     for k in range(n):
         near = (t >= c[k] - window[k]) & (t <= c[k] + window[k])
         if not near.any():
@@ -181,13 +193,16 @@ def force_at_crossings(
             near = np.abs(t - c[k]) == np.min(np.abs(t - c[k]))
         rest = (t > bounds[k] + reach[k]) & (t < bounds[k + 2] - reach[k + 2]) & ~near
         j = np.flatnonzero(near)[np.argmax(dev[near])]
-        peak[k], peak_time[k] = dev[j] * scale, t[j]
+        peak[k], peak_time[k], peak_force[k] = dev[j] * scale, t[j], f[j]
+        local[k] = (j == 0 or dev[j] >= dev[j - 1]) and (j == t.size - 1 or dev[j] >= dev[j + 1])
         elsewhere[k] = dev[rest].max() * scale if rest.any() else np.nan
     return CrossingPeaks(
         time=c,
         window=window,
         peak=peak,
         peak_time=peak_time,
+        peak_force=peak_force,
+        local=local,
         elsewhere=elsewhere,
         baseline=float(baseline),
     )
