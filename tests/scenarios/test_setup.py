@@ -377,6 +377,10 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     # Relative figures carry no unit suffix (they were "differences" keyed "..._m").
     rel = out["relative_to_paper_model"]["marker3_dz_relative"]
     assert rel == pytest.approx(result.marker3_m[2] / p.marker3_dz - 1.0)
+    # The paper's measured displacements (Table 3) stand beside its model's, in the JSON and in
+    # the lines for a person.
+    assert out["paper_experiment_marker_displacements_m"]["marker3_dz_m"] == p.marker3_dz_exp
+    assert "the paper's experiment:  110.9 mm" in result.describe()
 
 
 def test_folded_crossing_counts_the_push_direction() -> None:

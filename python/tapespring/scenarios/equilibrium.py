@@ -200,15 +200,12 @@ class EquilibriumComparison:
         return "\n".join(lines)
 
 
-def _paper_table6() -> dict[str, float]:
-    """Table 6's Num. column [m] (`PAPER_MODEL`)."""
+def _paper_table6(experiment: bool = False) -> dict[str, float]:
+    """Table 6's Num. column [m] (`PAPER_MODEL`), or with `experiment` the paper's measured
+    displacements (Table 3, the Exp. column of Table 6)."""
     p = PAPER_MODEL
-    return {
-        "markers12_dx_m": p.markers12_dx,
-        "markers12_dz_m": p.markers12_dz,
-        "marker3_dx_m": p.marker3_dx,
-        "marker3_dz_m": p.marker3_dz,
-    }
+    suffix = "_exp" if experiment else ""
+    return {key: getattr(p, key.removesuffix("_m") + suffix) for key, _, _ in TABLE6_ROWS}
 
 
 @dataclass(frozen=True)
@@ -307,7 +304,8 @@ class EquilibriumResult:
 
     def summary(self) -> dict[str, Any]:
         """The figures as JSON-ready values [m, N, s], with Table 6 beside them
-        (``paper_model_marker_displacements_m``) and our figures relative to it
+        (``paper_model_marker_displacements_m``; the paper's measured ones in
+        ``paper_experiment_marker_displacements_m``) and our figures relative to the model
         (``relative_to_paper_model``: ``markers12_dx_relative`` ... = ours / paper - 1), and the
         comparison with a recording (``comparison``: :meth:`EquilibriumComparison.summary`, or
         None)."""
@@ -319,6 +317,7 @@ class EquilibriumResult:
             "found": self.found,
             "marker_displacements_m": ours,
             "paper_model_marker_displacements_m": paper,
+            "paper_experiment_marker_displacements_m": _paper_table6(experiment=True),
             # Relative (ours / paper - 1): named without the figures' unit suffix.
             "relative_to_paper_model": (
                 {k.removesuffix("_m") + "_relative": ours[k] / paper[k] - 1.0 for k in ours}
@@ -345,9 +344,10 @@ class EquilibriumResult:
         if not self.found:
             lines.append("  no folded equilibrium on the push path (push further)")
             return "\n".join(lines)
-        ours, paper, diff = (
+        ours, paper, measured, diff = (
             s["marker_displacements_m"],
             s["paper_model_marker_displacements_m"],
+            s["paper_experiment_marker_displacements_m"],
             s["relative_to_paper_model"],
         )
         for key, label in (
@@ -357,8 +357,9 @@ class EquilibriumResult:
             ("marker3_dz_m", "marker 3    z"),
         ):
             lines.append(
-                f"  {label}: {ours[key] * 1e3:6.1f} mm (Table 6: {paper[key] * 1e3:6.1f} mm, "
-                f"{diff[key.removesuffix('_m') + '_relative']:+.1%})"
+                f"  {label}: {ours[key] * 1e3:6.1f} mm (Table 6's model: {paper[key] * 1e3:6.1f} "
+                f"mm, {diff[key.removesuffix('_m') + '_relative']:+.1%}; the paper's experiment: "
+                f"{measured[key] * 1e3:6.1f} mm)"
             )
         stable = "stable" if self.unstable_modes == 0 else f"{self.unstable_modes} unstable mode(s)"
         lines.append(f"  the equilibrium under the weight: {stable}")
