@@ -231,6 +231,11 @@ def test_release_command_json(capsys):
     assert out["time_s"][-1] == pytest.approx(0.003)
     assert out["theta_deg"][0] == pytest.approx(40.0, abs=1e-6)
     assert set(out["energy"]) >= {"kinetic", "strain", "viscous", "numerical"}
+    # The settings hold the fold's angle once: the bending curve's own end angle, jump and
+    # unloading, which the release overrides or ignores, are left out of the tape's.
+    assert out["settings"]["fold_deg"] == 40.0
+    assert {"theta_max_deg", "jump", "unload"}.isdisjoint(out["settings"]["tape"])
+    assert out["settings"]["tape"]["mesh_size"] == 4e-3
 
 
 def test_release_command_refuses_bad_input(capsys):

@@ -355,7 +355,7 @@ class ReleaseResult:
             "completed": r.completed,
             "error": r.error,
             "settings": {k: v for k, v in asdict(self.setup).items() if k != "tape"}
-            | {"tape": asdict(self.setup.tape)},
+            | {"tape": _tape_settings(self.setup)},
         }
 
 
@@ -407,3 +407,14 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         err.result = out
         raise err
     return out
+
+
+#: The bending set-up's fields the release sets itself or does not read: the fold goes to
+#: `fold_deg`, jumping at the snap, and is not unloaded.
+_NOT_READ = ("theta_max_deg", "jump", "unload")
+
+
+def _tape_settings(setup: ReleaseSetup) -> dict[str, Any]:
+    """The tape's settings as the release uses them (those of the bending curve it overrides or
+    ignores left out, where they would contradict `fold_deg`)."""
+    return {k: v for k, v in asdict(setup.tape).items() if k not in _NOT_READ}
