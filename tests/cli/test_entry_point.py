@@ -122,10 +122,19 @@ def test_a_peak_left_aside_is_numbered_from_one_before_the_run(value, capsys):
 
 
 @pytest.mark.parametrize("command", ["deploy", "pull", "vibrate"])
-@pytest.mark.parametrize(("name", "problem"), [("", "empty file name"), (".", "is a folder")])
-def test_an_experiment_that_is_no_file_is_refused_before_the_run(command, name, problem, capsys):
-    line = refused([command, "--experiment", name], capsys)
-    assert "argument --experiment" in line and problem in line
+def test_an_empty_experiment_name_is_a_usage_error(command, capsys):
+    line = refused([command, "--experiment", ""], capsys)
+    assert "argument --experiment" in line and "empty file name" in line
+
+
+@pytest.mark.parametrize("command", ["deploy", "pull", "vibrate", "equilibrium"])
+def test_an_experiment_that_is_a_folder_is_one_error_line_before_the_run(
+    command, monkeypatch, capsys
+):
+    # As a missing file (tests/cli/test_input_files.py): named, no usage, exit code 1.
+    monkeypatch.setattr(f"tapespring.cli.{command}.finish", lambda *a, **k: pytest.fail("ran"))
+    assert main([command, "--experiment", ".", "--no-progress"]) == 1
+    assert capsys.readouterr() == ("", "error: .: a folder, not a file\n")
 
 
 @pytest.mark.parametrize(

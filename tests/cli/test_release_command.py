@@ -81,8 +81,8 @@ def test_csv_and_plot_of_a_short_release(tmp_path, capsys, runs):
     assert table[-1, 3] > 1e-3
     png = png_path.read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
-    assert f"histories written to {csv_path}" in out
-    assert f"plot written to {png_path}" in out
+    # The one form of every command's completion lines (tapespring.cli.bend.wrote).
+    assert f"  wrote {csv_path}\n  wrote {png_path}\n" in out
     assert "1014 DOFs" in out
 
 

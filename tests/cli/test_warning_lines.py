@@ -31,5 +31,5 @@ def test_an_analysis_warning_of_another_kind_is_not_turned_into_a_line(tmp_path,
         return t.name
 
     with pytest.warns(RuntimeWarning, match="invalid value"):
-        assert analyze_experiment(str(path), analyze) == "trial"
+        assert analyze_experiment(str(path), analyze, test="a deployment") == "trial"
     assert "warning:" not in capsys.readouterr().err

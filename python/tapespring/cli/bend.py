@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 __all__ = [
+    "CommandError",
     "add_tape_options",
     "refuse",
     "refuse_shared_paths",
@@ -26,7 +27,13 @@ __all__ = [
     "run",
     "tape_fields",
     "warn",
+    "wrote",
 ]
+
+#: Twist imperfection amplitude [deg] ``tapespring bend`` gives an equal-sense run when
+#: ``--imperfection`` is not given: equal-sense bending is a bifurcation, and a small twist
+#: selects the physical branch (opposite sense: none).
+EQUAL_SENSE_IMPERFECTION_DEG = 0.1
 
 
 def _checked(name: str, check: Callable[[float], object]):
@@ -68,6 +75,32 @@ def refuse(args: argparse.Namespace, message: str) -> NoReturn:
     # A Namespace's attributes are Any; the annotation gives `error` its NoReturn.
     parser: argparse.ArgumentParser = args.parser
     parser.error(message)
+
+
+class CommandError(Exception):
+    """A failure a command reports as one ``error: <message>`` line on stderr, without the
+    usage, and exits with `exit_code` (`tapespring.cli.main` prints it): e.g. a recording given
+    with ``--experiment`` that cannot be read (exit 1, as ``tapespring trials analyze`` exits
+    for a trial file it cannot read)."""
+
+    def __init__(self, message: str, exit_code: int) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+def os_error_message(exc: OSError) -> str:
+    """``FILE: problem`` of a file operation's OSError (``x.csv: Permission denied``, where its
+    text is ``[Errno 13] Permission denied: 'x.csv'``); the text of one raised with a message
+    of its own (the readers' ``x.csv: no such file``)."""
+    if exc.strerror and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror}"
+    return str(exc)
+
+
+def wrote(path: object) -> str:
+    """The line a command prints after its summary for each file it wrote: ``  wrote PATH``,
+    one form for every command and output (tables, figures, series, reports)."""
+    return f"  wrote {path}"
 
 
 def warn(message: str) -> None:
@@ -121,17 +154,14 @@ def _path_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
     return checked
 
 
-@_path_type
 def _input_file(text: str) -> str:
-    """An argparse type: a file the command will read, that exists (checked before anything
-    runs); its content is checked by the reader."""
-    path = Path(text)
+    """An argparse type: a file the command will read. Only an empty name is refused here (a
+    usage error, as ``trials analyze ""``); a file that is missing, a folder or cannot be read
+    is reported by the reader before the run (`scenario_options.analyze_experiment`): one
+    ``error: FILE: ...`` line without the usage, exit code 1, as ``tapespring trials analyze``
+    reports a trial file it cannot read."""
     if text == "":
         raise argparse.ArgumentTypeError("an empty file name")
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a folder, not a file")
-    if not path.exists():
-        raise argparse.ArgumentTypeError(f"no such file: {text}")
     return text
 
 
@@ -319,13 +349,17 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
     # scenario_options imports this module: its options are imported when the parser is built.
     from .scenario_options import add_thickness_option, add_youngs_modulus_option
 
-    p.add_argument("--length", type=_field("length"), default=d.length, help="L [m]")
-    p.add_argument("--radius", type=_field("radius"), default=d.radius, help="R [m]")
+    p.add_argument(
+        "--length", type=_field("length"), default=d.length, help="L [m] (default %(default)g m)"
+    )
+    p.add_argument(
+        "--radius", type=_field("radius"), default=d.radius, help="R [m] (default %(default)g m)"
+    )
     p.add_argument(
         "--alpha",
         type=_checked("alpha", check_alpha_deg),
         default=d.alpha_deg,
-        help="subtended angle of the cross-section [deg], in (0, 360)",
+        help="subtended angle of the cross-section [deg], in (0, 360) (default %(default)g deg)",
     )
     add_thickness_option(p, d.thickness)
     add_youngs_modulus_option(p, d.youngs_modulus, short=True)
@@ -333,13 +367,13 @@ def add_tape_options(p: argparse.ArgumentParser, d: Any) -> None:
         "--poisson",
         type=_checked("poisson", check_poisson),
         default=d.poisson,
-        help="Poisson's ratio nu, in (-1, 0.5)",
+        help="Poisson's ratio nu, in (-1, 0.5) (default %(default)g)",
     )
     p.add_argument(
         "--mesh-size",
         type=_field("mesh_size"),
         default=d.mesh_size,
-        help="element size [m] (default 0.002)",
+        help="element size [m] (default %(default)g m)",
     )
 
 
@@ -395,7 +429,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--theta-max",
         type=_checked("theta_max_deg", check_theta_max_deg),
         default=d.theta_max_deg,
-        help="final angle [deg] in (-360, 360) (default 90; negative for equal sense)",
+        help="final angle [deg] in (-360, 360) (default %(default)g deg; negative for equal sense)",
     )
     p.add_argument("--unload", action="store_true", help="unload back to 0 (hysteresis)")
     p.add_argument(
@@ -403,7 +437,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_checked("imperfection_deg", check_imperfection_deg),
         default=None,
         help=f"twist imperfection amplitude [deg] in [-{MAX_IMPERFECTION_DEG:g}, "
-        f"{MAX_IMPERFECTION_DEG:g}] (default 0.1 in equal sense, else 0)",
+        f"{MAX_IMPERFECTION_DEG:g}] (default {EQUAL_SENSE_IMPERFECTION_DEG:g} deg in equal "
+        "sense, else 0)",
     )
     p.add_argument(
         "--path",
@@ -455,7 +490,7 @@ def run(args: argparse.Namespace) -> int:
     imperfection = args.imperfection
     if imperfection is None:
         # Equal-sense bending is a bifurcation: a small twist selects the physical branch.
-        imperfection = 0.1 if args.theta_max < 0 else 0.0
+        imperfection = EQUAL_SENSE_IMPERFECTION_DEG if args.theta_max < 0 else 0.0
     jump = (args.path or ("jump" if args.theta_max < 0 else "full")) == "jump"
     if args.switch_branches and not jump:
         # The full path traces every branch: there is none to switch to. (--no-switch-branches
@@ -522,10 +557,7 @@ def run(args: argparse.Namespace) -> int:
             lines.append(f"  snap ({what}) at theta = {s.theta_snap_deg:+.2f} deg")
         if s.theta_heel_deg is not None:
             lines.append(f"  fold disappears on unloading at theta = {s.theta_heel_deg:+.2f} deg")
-        if args.csv:
-            lines.append(f"  curve written to {args.csv}")
-        if args.plot:
-            lines.append(f"  plot written to {args.plot}")
+        lines += [wrote(path) for path in (args.csv, args.plot) if path]
         print("\n".join(lines))
     if result.cancelled:
         print("warning: the run was stopped before the final angle", file=sys.stderr)

@@ -66,26 +66,32 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "--mesh-tape 2e-3 --mesh-plates 3e-3 --duration 10."
         ),
     )
-    p.add_argument("--sense", choices=("opposite", "equal"), default=d.sense)
+    p.add_argument(
+        "--sense",
+        choices=("opposite", "equal"),
+        default=d.sense,
+        help="sense of the initial fold: opposite (the tapes' centre of curvature above them, "
+        "folded downwards) or equal (the block turned upside down) (default %(default)s)",
+    )
     p.add_argument(
         "--support",
         choices=SUPPORTS,
         default=d.spec.support,
         help="model of the fixation support: the tapes' ends clamped (rigid, the paper's model) "
         "or a shell model of the support standing on the force plate (flexible, Fig. 33); the "
-        "clamp force is the vertical force under it",
+        "clamp force is the vertical force under it (default %(default)s)",
     )
     add_sample_rate_option(
         p,
         recorded="histories",
-        default=f"{d.sample_rate:g}; {FLEXIBLE_SAMPLE_RATE:g} with --support flexible, which "
-        "resolves the support's vibration at 164 Hz",
+        default=f"{d.sample_rate:g} Hz; {FLEXIBLE_SAMPLE_RATE:g} Hz with --support flexible, "
+        "which resolves the support's vibration at 164 Hz",
     )
     p.add_argument(
         "--duration",
         type=_field("duration"),
         default=DEFAULT_DURATION,
-        help=f"motion after the release [s] (default {DEFAULT_DURATION}; paper: 10)",
+        help="motion after the release [s] (default %(default)g s; paper: 10 s)",
     )
     add_rho_inf_option(p, d.rho_inf)
     add_tolerance_option(p, d.tolerance)
@@ -131,7 +137,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_output_options(
         p,
         "time_s, angle_deg and clamp_force_N at the samples (--sample-rate; the time steps "
-        "between them left out, as in a recording)",
+        "between them left out, as in a recording; --json has every time step)",
+        json_what="its histories time_s, angle_deg, clamp_force_N, ... at every time step of the "
+        "solver from the release, irregular where the steps adapt; --csv has the samples at "
+        "--sample-rate",
     )
     p.set_defaults(func=run, parser=p)
     return p
@@ -155,8 +164,9 @@ def _field_interval(args: argparse.Namespace, rate: float) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring deploy``; returns the exit code (0, 1 stopped early or no
-    comparison, 2 bad input or experiment file)."""
+    """Handler of ``tapespring deploy``; returns the exit code (0; 1 stopped early, no
+    comparison, or an experiment file that cannot be read; 2 bad input or a recording the
+    analysis refuses)."""
     import numpy as np
 
     from tapespring.scenarios.deployment import DeploymentSettings, deploy
@@ -189,9 +199,7 @@ def run(args: argparse.Namespace) -> int:
     if args.experiment:
         from tapespring.protocols.deployment import analyze_deployment
 
-        measured = analyze_experiment(args.experiment, analyze_deployment)
-        if measured is None:
-            return 2
+        measured = analyze_experiment(args.experiment, analyze_deployment, test="a deployment")
         # A recording of the other sense, refused before the run as the comparison would refuse
         # it after (main prints the ValueError, exit 2).
         settings.check_recording(measured)

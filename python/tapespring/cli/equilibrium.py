@@ -45,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--push",
         type=_checked("push", check_push),
         default=EquilibriumSettings.push,
-        help="push of the weight's tip [m]",
+        help="push of the weight's tip [m] (default %(default)g m)",
     )
     add_comparison_options(
         p,
@@ -63,7 +63,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring equilibrium``; returns the exit code (0; 1 stopped early, no
-    folded equilibrium on the push path, or no comparison; 2 bad input or experiment file)."""
+    folded equilibrium on the push path, no comparison, or an experiment file that cannot be
+    read; 2 bad input or a recording the analysis refuses)."""
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
     refuse_shared_paths(args)
@@ -72,9 +73,9 @@ def run(args: argparse.Namespace) -> int:
         from tapespring.protocols.identification import analyze_identification
 
         # Its warnings (marker 0 moved) printed as ``warning: ...`` on stderr.
-        measured = analyze_experiment(args.experiment, analyze_identification)
-        if measured is None:
-            return 2
+        measured = analyze_experiment(
+            args.experiment, analyze_identification, test="a static identification test"
+        )
     problems: list[str] = []
 
     def simulate() -> EquilibriumResult:

@@ -26,6 +26,7 @@ from .bend import (
     refuse,
     refuse_shared_paths,
     warn,
+    wrote,
 )
 from .scenario_options import add_json_and_progress_options, shows_progress
 
@@ -48,8 +49,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         The ``max-mass`` parser.
     """
     from tapespring.scenarios.max_mass import (
+        DEFAULT_POINTS,
         GRAVITY_RANGE,
         LEVER_ARM_RANGE,
+        MaxMassSettings,
         check_angle_deg,
         check_gravity,
         check_grid_value,
@@ -81,8 +84,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--sense",
         choices=tuple(_SENSES),
         default="equal",
-        help="sense of the fold: equal (default; the binding one, the paper's Fig. 7), "
-        "opposite, or both",
+        help="sense of the fold: equal (the binding one, the paper's Fig. 7), opposite, or both "
+        "(default %(default)s)",
     )
     p.add_argument(
         "--thickness-range",
@@ -90,7 +93,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_checked("thickness", partial(check_grid_value, "thicknesses", check=check_thickness)),
         metavar=("MIN", "MAX"),
         default=None,
-        help=f"t range [m] (default Table 4: {b.thickness_min:g} {b.thickness_max:g}); with "
+        help=f"t range [m] (default Table 4's: {b.thickness_min:g} {b.thickness_max:g} m); with "
         "--n-thickness 1, give MIN = MAX, the one value",
     )
     p.add_argument(
@@ -99,52 +102,54 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_checked("Young's modulus", check_youngs_modulus),
         metavar=("MIN", "MAX"),
         default=None,
-        help=f"E range [Pa] (default Table 4: {b.youngs_modulus_min:g} {b.youngs_modulus_max:g}); "
+        help="E range [Pa] (default Table 4's: "
+        f"{b.youngs_modulus_min:g} {b.youngs_modulus_max:g} Pa); "
         "with --n-modulus 1, give MIN = MAX, the one value",
     )
     p.add_argument(
         "--n-thickness",
         type=_count("n-thickness"),
-        default=5,
+        default=DEFAULT_POINTS,
         metavar="N",
-        help="values of t, evenly spaced from MIN to MAX (default 5; 1: MIN, the lower "
+        help="values of t, evenly spaced from MIN to MAX (default %(default)d; 1: MIN, the lower "
         "bound, with the default range)",
     )
     p.add_argument(
         "--n-modulus",
         type=_count("n-modulus"),
-        default=5,
+        default=DEFAULT_POINTS,
         metavar="N",
-        help="values of E, evenly spaced from MIN to MAX (default 5; 1: MIN, the lower "
+        help="values of E, evenly spaced from MIN to MAX (default %(default)d; 1: MIN, the lower "
         "bound, with the default range)",
     )
     p.add_argument(
         "--mesh-size",
         type=_field("mesh_size"),
-        default=4e-3,
-        help="element size [m] (default 0.004; 0.002 is the paper's, 1.3 to 5.7 times the cost "
-        "per run)",
+        default=MaxMassSettings.mesh_size,
+        help="element size [m] (default %(default)g m; 0.002 m is the paper's, 1.3 to 5.7 times "
+        "the cost per run)",
     )
     p.add_argument(
         "--angle",
         type=_checked("angle", check_angle_deg),
-        default=90.0,
-        help="fold angle at which M* is taken [deg], in [1e-6, 180) (default 90)",
+        default=MaxMassSettings.angle_deg,
+        help="fold angle at which M* is taken [deg], in [1e-6, 180) (default %(default)g deg)",
     )
     (l_lo, l_hi), (g_lo, g_hi) = LEVER_ARM_RANGE, GRAVITY_RANGE
     p.add_argument(
         "--lever-arm",
         type=_checked("lever arm", check_lever_arm),
         default=None,
-        help=f"lever arm l from the fold to the mass [m] (default L/2 = {PAPER_TAPE.length / 2:g}),"
-        f" in [{l_lo:g}, {l_hi:g}]: from beyond the fold (about 20 mm long) to a hundred times "
-        "the tape's length, whose own weight eq. 1 leaves out",
+        help="lever arm l from the fold to the mass [m] (default L/2 = "
+        f"{PAPER_TAPE.length / 2:g} m), in [{l_lo:g}, {l_hi:g}]: from beyond the fold (about "
+        "20 mm long) to a hundred times the tape's length, whose own weight eq. 1 leaves out",
     )
     p.add_argument(
         "--gravity",
         type=_checked("gravity", check_gravity),
         default=PAPER_SETUP.gravity,
-        help=f"g [m/s^2] (default {PAPER_SETUP.gravity:g}), in [{g_lo:g}, {g_hi:g}]: from a "
+        help="g [m/s^2] (default %(default)g m/s^2), in "
+        f"[{g_lo:g}, {g_hi:g}]: from a "
         "hundredth of the Earth's (below the Moon's 1.62) to ten times it (Jupiter's: 24.8)",
     )
     p.add_argument(
@@ -252,10 +257,7 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write("\n")
     else:
         lines = [result.summary()]
-        if args.csv:
-            lines.append(f"  table written to {args.csv}")
-        if args.plot:
-            lines.append(f"  plot written to {args.plot}")
+        lines += [wrote(path) for path in (args.csv, args.plot) if path]
         print("\n".join(lines))
     if result.cancelled:
         print("warning: the study was stopped before the end of the grid", file=sys.stderr)

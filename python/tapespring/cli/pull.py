@@ -47,13 +47,15 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--max-displacement",
         type=_checked("max displacement", check_max_displacement),
         default=PullSettings.max_displacement,
-        help="displacement of marker 2 at the end of the pull [m] (default 0.02)",
+        help="displacement of marker 2 at the end of the pull [m] (default %(default)g m)",
     )
     add_comparison_options(
         p,
         experiment="a pull test (marker M2 pulled, force plate under the support): its force "
         "against the displacement drawn under the simulation (Fig. 34), its maximum force and "
-        "displacement compared with the simulation's and the paper's model (Table 9)",
+        "displacement compared with the simulation's and the paper's model (Table 9); the "
+        "table's 'difference' is the simulation's relative to the experiment, (simulation - "
+        "experiment) / experiment",
         vtu="every state of the pull path; the series' time is the path's load factor",
     )
     add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False)  # static
@@ -70,8 +72,9 @@ def _still_rising(result: PullResult) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring pull``; returns the exit code (0, 1 stopped early or no
-    comparison, 2 bad input or experiment file)."""
+    """Handler of ``tapespring pull``; returns the exit code (0; 1 stopped early, no
+    comparison, or an experiment file that cannot be read; 2 bad input or a recording the
+    analysis refuses)."""
     from tapespring.scenarios.pull import PullSettings, pull
 
     refuse_shared_paths(args)
@@ -79,9 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.experiment:
         from tapespring.protocols.pull import analyze_pull_trial
 
-        measured = analyze_experiment(args.experiment, analyze_pull_trial)
-        if measured is None:
-            return 2
+        measured = analyze_experiment(args.experiment, analyze_pull_trial, test="a pull test")
     problems: list[str] = []
 
     def simulate() -> PullResult:

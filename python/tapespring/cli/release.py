@@ -21,6 +21,7 @@ from .bend import (
     add_tape_options,
     refuse_shared_paths,
     tape_fields,
+    wrote,
 )
 from .scenario_options import (
     add_energy_tolerance_option,
@@ -77,27 +78,27 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_checked("fold_deg", check_fold_deg),
         default=d.fold_deg,
         help="fold angle [deg] in (-180, 180), positive opposite sense, negative equal sense "
-        "(default 60)",
+        "(default %(default)g deg)",
     )
     p.add_argument(
         "--tip-mass",
         type=_checked("tip_mass", check_tip_mass),
         default=d.tip_mass,
-        help=f"m [kg], at most {MAX_TIP_MASS:g}",
+        help=f"m [kg], at most {MAX_TIP_MASS:g} (default %(default)g kg)",
     )
     p.add_argument(
         "--tip-inertia",
         type=_checked("tip_inertia", check_tip_inertia),
         default=d.tip_inertia,
         help=f"moment of inertia of the tip body about each axis [kg m^2], at most "
-        f"{MAX_TIP_INERTIA:g}",
+        f"{MAX_TIP_INERTIA:g} (default %(default)g kg m^2)",
     )
     p.add_argument(
         "--duration",
         type=_checked("duration", check_duration),
         default=d.duration,
         help=f"free motion after the release [s], at most {MAX_DURATION:g} (the solver's step "
-        "limit times the largest step)",
+        "limit times the largest step) (default %(default)g s)",
     )
     add_eta_option(p, d.eta)
     add_rho_inf_option(p, d.rho_inf)
@@ -105,7 +106,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--gravity",
         type=_checked("gravity", check_gravity),
         default=d.gravity,
-        help=f"gravity along -z [m/s^2], in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] (default 0)",
+        help=f"gravity along -z [m/s^2], in [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] (default "
+        "%(default)g m/s^2)",
     )
     p.add_argument(
         "--planar",
@@ -199,10 +201,9 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write("\n")
     else:
         print(result.describe())
-        if args.csv:
-            print(f"  histories written to {args.csv}")
-        if args.plot:
-            print(f"  plot written to {args.plot}")
+        for path in (args.csv, args.plot):
+            if path:
+                print(wrote(path))
     if failure is not None:
         print(f"warning: the run stopped early: {failure}", file=sys.stderr)
         return 1

@@ -12,7 +12,17 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from .bend import _checked, _field, _image_file, _input_file, _output_file, _vtu_file
+from .bend import (
+    CommandError,
+    _checked,
+    _field,
+    _image_file,
+    _input_file,
+    _output_file,
+    _vtu_file,
+    os_error_message,
+    wrote,
+)
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -22,6 +32,7 @@ __all__ = [
     "add_eta_option",
     "add_json_and_progress_options",
     "add_output_options",
+    "add_progress_options",
     "add_rho_inf_option",
     "add_sample_rate_option",
     "add_spec_options",
@@ -60,18 +71,26 @@ def add_spec_options(
         "--mesh-tape",
         type=_field("mesh_tape"),
         default=mesh_tape,
-        help=f"element size of the tapes [m] (paper: 2e-3; default {mesh_tape:g})",
+        help="element size of the tapes [m] (paper: 2e-3 m; default %(default)g m)",
     )
     g.add_argument(
         "--mesh-plates",
         type=_field("mesh_plates"),
         default=mesh_plates,
-        help=f"element size of the rod and appendix [m] (paper: 3e-3; default {mesh_plates:g})",
+        help="element size of the rod and appendix [m] (paper: 3e-3 m; default %(default)g m)",
     )
-    add_thickness_option(g, s.tape.thickness, name="tape.thickness")
-    add_youngs_modulus_option(g, s.tape.youngs_modulus, name="tape.youngs_modulus")
+    spec = "the set-up spec's {}, "
+    add_thickness_option(
+        g, s.tape.thickness, name="tape.thickness", source=spec.format("tape.thickness")
+    )
+    add_youngs_modulus_option(
+        g,
+        s.tape.youngs_modulus,
+        name="tape.youngs_modulus",
+        source=spec.format("tape.youngs_modulus"),
+    )
     if eta:
-        add_eta_option(g, s.eta)
+        add_eta_option(g, s.eta, source=spec.format("eta"))
     else:
         p.set_defaults(static_spec=True)
     g.add_argument(
@@ -138,9 +157,11 @@ def with_spec_assignments(spec: Any, assignments: Sequence[tuple[str, Any]]) -> 
 
 
 def add_thickness_option(
-    p: argparse._ActionsContainer, default: float, *, name: str = "thickness"
+    p: argparse._ActionsContainer, default: float, *, name: str = "thickness", source: str = ""
 ) -> None:
-    """Add ``--thickness`` t [m], the settings' field `name`, to `p` (a parser or a group)."""
+    """Add ``--thickness`` t [m], the settings' field `name`, to `p` (a parser or a group); its
+    help gives the `default`, after `source` (where it comes from, such as "the set-up spec's
+    tape.thickness, "; empty: the settings' field default)."""
     from functools import partial
 
     from tapespring.scenarios.setup import MIN_THICKNESS, check_thickness
@@ -149,7 +170,7 @@ def add_thickness_option(
         "--thickness",
         type=_checked(name, partial(check_thickness, name=name)),
         default=default,
-        help=f"t [m], at least {MIN_THICKNESS:g}",
+        help=f"t [m], at least {MIN_THICKNESS:g} (default {source}%(default)g m)",
     )
 
 
@@ -159,8 +180,10 @@ def add_youngs_modulus_option(
     *,
     name: str = "youngs_modulus",
     short: bool = False,
+    source: str = "",
 ) -> None:
-    """Add ``--youngs-modulus`` E [Pa] (``-E`` too with `short`), the settings' field `name`."""
+    """Add ``--youngs-modulus`` E [Pa] (``-E`` too with `short`), the settings' field `name`;
+    `source` as in `add_thickness_option`."""
     from functools import partial
 
     from tapespring.scenarios.setup import (
@@ -174,19 +197,21 @@ def add_youngs_modulus_option(
         *(("-E",) if short else ()),
         type=_checked("Young's modulus", partial(check_youngs_modulus, name=name)),
         default=default,
-        help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e}",
+        help=f"E [Pa], from {MIN_YOUNGS_MODULUS:.0e} to {MAX_YOUNGS_MODULUS:.0e} (default "
+        f"{source}%(default)g Pa)",
     )
 
 
-def add_eta_option(p: argparse._ActionsContainer, default: float) -> None:
-    """Add ``--eta``, the tape's Kelvin-Voigt viscosity [s]."""
+def add_eta_option(p: argparse._ActionsContainer, default: float, *, source: str = "") -> None:
+    """Add ``--eta``, the tape's Kelvin-Voigt viscosity [s]; `source` as in
+    `add_thickness_option`."""
     from tapespring.scenarios.setup import MAX_ETA, check_eta
 
     p.add_argument(
         "--eta",
         type=_checked("eta", check_eta),
         default=default,
-        help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}]",
+        help=f"Kelvin-Voigt eta [s], in [0, {MAX_ETA:g}] (default {source}%(default)g s)",
     )
 
 
@@ -218,7 +243,7 @@ def add_tolerance_option(
         type=_checked("tolerance", check_tolerance),
         default=None if unset else default,
         help=f"local error tolerance of the adaptive time steps [m], in [0, {MAX_TOLERANCE:g}] "
-        f"(default {default:g}; 0: the solver's default{caveat})",
+        f"(default {default:g} m; 0: the solver's default{caveat})",
     )
 
 
@@ -285,28 +310,56 @@ def add_sample_rate_option(p: argparse.ArgumentParser, *, recorded: str, default
     )
 
 
-def add_output_options(p: argparse.ArgumentParser, csv_what: str) -> None:
-    """Add ``--csv``, ``--plot``, ``--json`` and ``--no-progress``."""
+def add_output_options(p: argparse.ArgumentParser, csv_what: str, json_what: str = "") -> None:
+    """Add ``--csv``, ``--plot``, ``--json`` and the progress options; `csv_what` says what the
+    table holds, `json_what` (if the JSON's histories are not the table's rows) what the JSON
+    object's histories hold."""
     p.add_argument(
         "--csv",
         type=_output_file,
         help=f"write {csv_what} to this CSV file, after a '#' line of the settings as JSON",
     )
     p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
-    add_json_and_progress_options(p)
+    add_json_and_progress_options(p, json_what)
 
 
-def add_json_and_progress_options(p: argparse.ArgumentParser) -> None:
-    """Add ``--json`` and ``--no-progress``, which every scenario command takes (the commands
-    with their own ``--csv`` and ``--plot`` add these two alone); read by `shows_progress`."""
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+def add_json_and_progress_options(p: argparse.ArgumentParser, json_what: str = "") -> None:
+    """Add ``--json``, ``--progress`` and ``--no-progress``, which every scenario command takes
+    (the commands with their own ``--csv`` and ``--plot`` add these alone); `json_what` as in
+    `add_output_options`; read by `shows_progress`."""
+    what = f" ({json_what})" if json_what else ""
+    p.add_argument("--json", action="store_true", help=f"print one JSON object on stdout{what}")
+    add_progress_options(p, "the progress bar", json_hides=True)
+
+
+def add_progress_options(p: argparse.ArgumentParser, bar: str, *, json_hides: bool) -> None:
+    """Add ``--progress`` and ``--no-progress`` (exclusive), read by `shows_progress`: `bar` is
+    drawn on stderr when stderr is a terminal (and, with `json_hides`, without ``--json``);
+    ``--progress`` draws it anyway, ``--no-progress`` never."""
+    unless = ", and not with --json" if json_hides else ""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument(
+        "--progress",
+        action="store_true",
+        help=f"draw {bar} on stderr even if stderr is no terminal (default: only on a "
+        f"terminal{unless})",
+    )
+    g.add_argument("--no-progress", action="store_true", help=f"never draw {bar}")
+    p.set_defaults(progress_with_json=not json_hides)
 
 
 def shows_progress(args: argparse.Namespace) -> bool:
-    """Whether the run shows its progress bar: not with ``--no-progress``, nor with ``--json``
-    (the output is then one JSON object)."""
-    return not (args.no_progress or args.json)
+    """Whether the run draws its progress bars on stderr: always with ``--progress``, never with
+    ``--no-progress``; else only when stderr is a terminal, and for the commands whose ``--json``
+    hides them (the scenario commands: their output is then one JSON object) not with
+    ``--json``. Redirected to a file, the bars' carriage-return updates filled it with kilobytes
+    of text."""
+    if args.progress:
+        return True
+    if args.no_progress or (args.json and not args.progress_with_json):
+        return False
+    isatty = getattr(sys.stderr, "isatty", None)
+    return bool(isatty is not None and isatty())
 
 
 def finish(
@@ -364,7 +417,7 @@ def finish(
         print(result.describe())
         for name in ("csv", "plot"):
             if getattr(args, name):
-                print(f"  wrote {getattr(args, name)}")
+                print(wrote(getattr(args, name)))
     if extra is not None:
         extra(result)
     for problem in problems:
@@ -407,36 +460,65 @@ def add_comparison_options(p: argparse.ArgumentParser, *, experiment: str, vtu: 
 TRIALS_ONLY_OPTIONS = ("--markers", "--frame", "--max-gap", "markers=", "frame=", "control=")
 
 
-def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
-    """Read a recorded trial (C3D or CSV) and analyse it with `analyze` (a protocol function).
+#: Exit code of a command whose ``--experiment`` recording cannot be read: missing, a folder,
+#: unreadable, or not a C3D or CSV trial (`analyze_experiment`), as ``tapespring trials
+#: analyze`` exits for a trial file it cannot read; argparse's usage errors exit with 2.
+UNREADABLE_INPUT = 1
+
+#: Exit code of a command whose ``--experiment`` recording is read but refused by the analysis
+#: (not the kind of test the command compares with, too short, ...): bad input, as a value the
+#: settings refuse.
+REFUSED_RECORDING = 2
+
+
+def analyze_experiment(path: str, analyze: Callable[[Any], Any], *, test: str) -> Any:
+    """Read a recorded trial (C3D or CSV) and analyse it with `analyze` (a protocol function);
+    `test` names the kind of test the command compares with ("a free decay"), for the hint of
+    a recording the analysis refuses.
 
     The reader's and the analysis' warnings (`TrialWarning`: a record that stops before the
     tape settles, a support that moved, ...) are printed as ``warning: ...`` lines on stderr,
     as ``tapespring trials analyze`` prints them (`print_warnings`, which re-issues any other
     category as it came).
 
-    Returns the analysis, or None after printing ``error: FILE: problem`` on stderr if the file
-    is missing, unreadable or corrupt, or the analysis refuses it (the caller exits with 2).
+    Returns
+    -------
+    Any
+        The analysis.
+
+    Raises
+    ------
+    CommandError
+        With the message ``FILE: problem`` (`tapespring.cli.main` prints it as one ``error:``
+        line, without the usage): `UNREADABLE_INPUT` (1) if the file is missing, a folder,
+        cannot be read or is no C3D or CSV trial; `REFUSED_RECORDING` (2) if the analysis
+        refuses it, with a hint to check the kind of test.
     """
     import warnings
 
     from tapespring.trials.load import read_trial
+    from tapespring.trials.trial import TrialError
 
     from .bend import print_warnings
 
     failure: OSError | ValueError | None = None
+    code = UNREADABLE_INPUT
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            measured = analyze(read_trial(path))
+            if Path(path).is_dir():  # "." was "unknown trial format ''"
+                raise IsADirectoryError(f"{path}: a folder, not a file")
+            trial = read_trial(path)
+            code = REFUSED_RECORDING
+            measured = analyze(trial)
         except (OSError, ValueError) as exc:
             failure = exc
     print_warnings(caught)
     if failure is None:
         return measured
-    message = str(failure)
-    if isinstance(failure, OSError) and failure.strerror:
-        message = failure.strerror
+    message = os_error_message(failure) if isinstance(failure, OSError) else str(failure)
+    if code == REFUSED_RECORDING and isinstance(failure, TrialError):
+        message += f" (check the kind of test: --experiment takes {test})"
     if any(option in message for option in TRIALS_ONLY_OPTIONS):
         # The analyses' messages name the options of 'tapespring trials analyze' and of the
         # Python functions, which the scenario commands do not have.
@@ -446,8 +528,7 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any]) -> Any | None:
         )
     if str(path) not in message and str(Path(path)) not in message:
         message = f"{path}: {message}"
-    print(f"error: {message}", file=sys.stderr)
-    return None
+    raise CommandError(message, code)
 
 
 def with_comparison(
@@ -474,4 +555,4 @@ def write_vtu(args: argparse.Namespace, results: Any, model: Any) -> None:
 
     path = write_pvd(results, model, args.vtu)
     if not args.json:
-        print(f"  wrote {path}")
+        print(wrote(path))

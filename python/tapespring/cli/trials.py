@@ -17,6 +17,7 @@ kind of test than ``--kind`` included (``--frame`` with ``--kind vibration``).
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import sys
 import warnings
@@ -25,12 +26,27 @@ from pathlib import Path
 from typing import TypedDict
 
 from tapespring.protocols.markers import DEFAULT_MARKERS
-from tapespring.protocols.registry import KINDS, MAX_N_PEAKS, check_n_peaks, check_span_time
+from tapespring.protocols.registry import (
+    KINDS,
+    MAX_N_PEAKS,
+    analyze_trials,
+    check_n_peaks,
+    check_span_time,
+)
 from tapespring.trials.common import LENGTH
 from tapespring.trials.trial import check_max_gap
 
-from .bend import _checked, _count, _output_folder, print_warnings, refuse
+from .bend import (
+    _checked,
+    _count,
+    _output_folder,
+    os_error_message,
+    print_warnings,
+    refuse,
+    wrote,
+)
 from .parser import ArgumentParser
+from .scenario_options import add_progress_options, shows_progress
 
 __all__ = ["main", "register", "run_analyze"]
 
@@ -140,7 +156,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--out",
         type=_output_folder,
         default=Path("tapespring-report"),
-        help="report folder (default: ./tapespring-report)",
+        help="report folder (default ./%(default)s)",
     )
     p.add_argument("--json", action="store_true", help="print the numbers as one JSON object")
     p.add_argument(
@@ -148,15 +164,18 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         nargs=3,
         default=list(DEFAULT_MARKERS),
         metavar=("SUPPORT", "ROD", "TIP"),
-        help="names of markers 1, 2 and 3 (default: M1 M2 M3)",
+        help=f"names of markers 1, 2 and 3 (default {' '.join(DEFAULT_MARKERS)})",
     )
     # The options of one kind default to None, so that one given with another kind, where it
-    # would have no effect, is refused (`_check_kind_options`).
+    # would have no effect, is refused (`_check_kind_options`); their help gives the default of
+    # the analysis, which then applies.
+    defaults = inspect.signature(analyze_trials).parameters
     p.add_argument(
         "--n-peaks",
         type=_n_peaks,
         default=None,
-        help=f"deployment: maxima and minima analysed, 1 to {MAX_N_PEAKS} (default 10)",
+        help=f"deployment: maxima and minima analysed, 1 to {MAX_N_PEAKS} (default "
+        f"{defaults['n_peaks'].default})",
     )
     p.add_argument(
         "--frame",
@@ -176,7 +195,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         nargs=2,
         default=None,
         metavar=("LOW", "HIGH"),
-        help="vibration: |peak| range fitted [m] (default 0.0004 0.004)",
+        help="vibration: |peak| range fitted [m] (default "
+        + " ".join(f"{w:g}" for w in defaults["window"].default)
+        + " m)",
     )
     span = p.add_mutually_exclusive_group()
     span.add_argument(
@@ -184,7 +205,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=_count("--span"),
         default=None,
         metavar="SAMPLES",
-        help="quasi-static: force smoothing span [samples] (default 101)",
+        help=f"quasi-static: force smoothing span [samples] (default {defaults['span'].default})",
     )
     span.add_argument(
         "--span-time",
@@ -219,7 +240,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="unit of CSV marker columns without one in the header",
     )
     p.add_argument("--no-figures", action="store_true", help="write the CSV tables only")
-    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    add_progress_options(p, "the progress bars", json_hides=False)
     p.set_defaults(func=run_analyze, parser=p)
     return trials
 
@@ -290,6 +311,15 @@ def _check_report_folder(args: argparse.Namespace) -> None:
             )
 
 
+#: Appended to the message of a trial that fails its protocol's checks: most often a recording
+#: of another kind of test (a free decay analysed with ``--kind deployment``: "the bending angle
+#: never leaves its initial value"). With ``--skip-bad`` such a trial is skipped, not reported.
+_KIND_HINT = (
+    " (check that --kind {kind} is the kind of test recorded; --skip-bad leaves out the trials "
+    "the analysis refuses and lists them)"
+)
+
+
 def run_analyze(args: argparse.Namespace) -> int:
     """Handler of ``tapespring trials analyze``; returns the exit code.
 
@@ -307,8 +337,9 @@ def run_analyze(args: argparse.Namespace) -> int:
 
     _check_kind_options(args)
     _check_report_folder(args)
-    progress = not args.no_progress
+    progress = shows_progress(args)
     required = [args.markers[i] for i in protocol_for(args.kind).marker_roles]
+    analysing = False  # a TrialError raised then: a trial fails its protocol's checks
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -323,6 +354,7 @@ def run_analyze(args: argparse.Namespace) -> int:
                 session=args.session,
                 tape_pair=args.tape_pair,
             )
+            analysing = True
             analysis = analyze_trials(
                 loaded.trials,
                 args.kind,
@@ -332,12 +364,16 @@ def run_analyze(args: argparse.Namespace) -> int:
                 skip_bad=args.skip_bad,
                 skipped=loaded.skipped,
             )
+            analysing = False
             write_report(analysis, args.out, figures=not args.no_figures)
         except (TrialError, OSError, ValueError) as exc:
             # OSError: a path that cannot be read, or a report folder that cannot be written
             # (--out an existing file, no permission): a message, under either entry point.
             print_warnings(caught)
-            print(f"error: {exc}", file=sys.stderr)
+            message = os_error_message(exc) if isinstance(exc, OSError) else str(exc)
+            if analysing and isinstance(exc, TrialError):
+                message += _KIND_HINT.format(kind=args.kind)
+            print(f"error: {message}", file=sys.stderr)
             return 1
     print_warnings(caught)
     notes = [str(w.message) for w in caught]
@@ -346,7 +382,7 @@ def run_analyze(args: argparse.Namespace) -> int:
         print(json.dumps(data, allow_nan=False))
     else:
         print(format_summary(analysis))
-        print(f"report written to {args.out}")
+        print(wrote(args.out))
     return 0
 
 
