@@ -21,15 +21,21 @@ _PARSER_ERROR = re.compile(r"tapespring(?: [a-z][a-z-]*)*: error: \S")
 
 
 def refused(
-    argv: Sequence[str], capsys: pytest.CaptureFixture[str], *, by_parser: bool = True
+    argv: Sequence[str],
+    capsys: pytest.CaptureFixture[str],
+    *,
+    by_parser: bool = True,
+    code: int = 2,
 ) -> str:
     """Run ``tapespring argv`` in-process and return its error line (the last line on stderr).
 
-    It must exit with code 2: by the parser's SystemExit with `by_parser`, else by `main`'s
-    return value. With `by_parser`, stderr must be the usage (a ``usage: `` line and its indented
+    It must exit with `code` (2, a refused input; 1, an input file that is missing or cannot be
+    read as a trial): by the parser's SystemExit with `by_parser`, else by `main`'s return
+    value. With `by_parser`, stderr must be the usage (a ``usage: `` line and its indented
     continuation lines) then exactly one ``<prog>: error: <message>`` line; else exactly one
     ``error: <message>`` line. Nothing may be on stdout.
     """
+    expected = code
     if by_parser:
         with pytest.raises(SystemExit) as exc:
             main(list(argv))
@@ -37,7 +43,7 @@ def refused(
     else:
         code = main(list(argv))
     out, err = capsys.readouterr()
-    assert code == 2, err
+    assert code == expected, err
     assert out == "", out
     assert err.endswith("\n") and "\n\n" not in err, err
     lines = err.splitlines()

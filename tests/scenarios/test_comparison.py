@@ -229,15 +229,15 @@ def test_bad_experiment_file_is_named(command, problem, tmp_path, capsys) -> Non
         # A pull test has no free decay; a free decay has no force plate.
         other = make_vibration_trial() if command == "pull" else make_pull_test_trial()
         write_csv(other, path)
+    # Before the run, one line naming the file: exit 1 where it cannot be read as a trial, 2
+    # where it is read but is not the test the command compares with.
+    code = 2 if problem == "wrong test" else 1
+    err = refused(
+        [command, "--no-progress", f"--experiment={path}"], capsys, by_parser=False, code=code
+    )
+    assert err.startswith(f"error: {path}" if code == 1 else "error: ") and path.name in err
     if problem == "missing":
-        # Refused by the parser, before the run (its usage line, then the error).
-        err = refused([command, "--no-progress", f"--experiment={path}"], capsys)
-        assert f"no such file: {path}" in err
-        return
-    assert main([command, "--no-progress", f"--experiment={path}"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("error: ") and path.name in err
-    assert "Traceback" not in err and len(err.splitlines()) == 1
+        assert f"{path}: no such file" in err
 
 
 def test_rest_before_keeps_the_samples_after_it(pulled) -> None:

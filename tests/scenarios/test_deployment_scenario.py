@@ -293,8 +293,10 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert png.stat().st_size > 10_000 and snaps.stat().st_size > 10_000
     # The ParaView series: one file per kept record (every 16th of 241, and the last).
     assert len(list((tmp_path / "run").glob("*.vtu"))) >= 15
-    # A recording that is not there is refused before the run, by the parser.
-    assert "no such file" in refused([*args, f"--experiment={tmp_path / 'missing.csv'}"], capsys)
+    # A recording that is not there is refused before the run: one line naming it, exit 1.
+    missing = tmp_path / "missing.csv"
+    err = refused([*args, f"--experiment={missing}"], capsys, by_parser=False, code=1)
+    assert err.startswith(f"error: {missing}: no such file")
 
 
 def test_deploy_prints_the_recordings_warnings_as_lines(tmp_path, capsys) -> None:

@@ -203,8 +203,9 @@ def test_bad_experiment_file_is_named(problem, tmp_path, capsys) -> None:
     path = tmp_path / f"{problem.replace(' ', '_')}.csv"
     trial = table3_trial()
     if problem == "missing":
-        err = refused([*ARGS, f"--experiment={path}"], capsys)
-        assert f"no such file: {path}" in err
+        # A file that cannot be read: one line naming it, exit 1, before the run.
+        err = refused([*ARGS, f"--experiment={path}"], capsys, by_parser=False, code=1)
+        assert err.startswith(f"error: {path}: no such file")
         return
     if problem == "corrupt":
         path.write_bytes(b"time [s],M2_x [mm]\n0.0,1.0,\x00\x01\n")
@@ -221,6 +222,8 @@ def test_bad_experiment_file_is_named(problem, tmp_path, capsys) -> None:
         "not at rest": "not at rest: marker 'M1'",
         "no M0": "missing marker 'M0', marker 0 on the fixation support",
     }[problem]
-    # Refused before the simulation: exit 2, one line naming the file.
-    err = refused([*ARGS, f"--experiment={path}"], capsys, by_parser=False)
+    # Refused before the simulation, one line naming the file: exit 1 where it cannot be read
+    # as a trial, 2 where its analysis refuses it.
+    code = 1 if problem == "corrupt" else 2
+    err = refused([*ARGS, f"--experiment={path}"], capsys, by_parser=False, code=code)
     assert path.name in err and expected in err

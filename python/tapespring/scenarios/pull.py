@@ -218,7 +218,7 @@ class PullComparison:
         ]
         lines = [
             f"pull test against {s['trial']} (Table 9)",
-            f"  {'':26}{'simulation':>12}{'paper model':>13}{'experiment':>12}{'difference':>12}",
+            f"  {'':26}{'simulation':>12}{'paper model':>13}{'experiment':>12}{'sim/exp - 1':>12}",
         ]
         for label, key, scale, rel in rows:
             lines.append(
@@ -406,7 +406,7 @@ class PullResult:
                 f"  maximum force {self.max_force_N:.3f} N at "
                 f"{self.max_force_displacement_m * 1e3:.2f} mm of marker 2 ({how})",
                 f"  paper's model: {s['paper_model_max_force_N']:.1f} N at "
-                f"{s['paper_model_displacement_m'] * 1e3:.1f} mm (differences "
+                f"{s['paper_model_displacement_m'] * 1e3:.1f} mm (ours relative to it: "
                 f"{s['max_force_difference']:+.1%}, {s['displacement_difference']:+.1%})",
             ]
             + ([f"  stopped early: {s['error']}"] if s["error"] else [])
