@@ -35,7 +35,9 @@ def _calls(results):
     dep, vib, pull = results
     a, b = dep
     return [
-        lambda ax: plot_angle_histories([(r.time, r.angle) for r in dep], phases=a.phases, ax=ax),
+        lambda ax: plot_angle_histories(
+            [(r.time, r.angle) for r in dep], phases=a.phases, ax=ax, since_release=False
+        ),
         lambda ax: plot_variation_coefficients(peak_statistics([a.peaks, b.peaks]), ax=ax),
         lambda ax: plot_tip_trajectory(
             a.tip_xz, points=a.tip_points, circles=[a.tip_circle], ax=ax
@@ -83,3 +85,34 @@ def test_angles_are_drawn_in_degrees(results):
     ax = plot_angle_histories([(a.time, a.angle)])
     np.testing.assert_allclose(ax.lines[0].get_ydata(), np.rad2deg(a.angle))
     plt.close(ax.figure)
+
+
+def test_time_axes_say_which_origin_they_count_from(results):
+    """The histories superposed at their release and the force-and-angle figure of one trial on
+    its record's clock read the same axis title "time [s]" (review F5): each says its origin."""
+    a, b = results[0]
+    ax = plot_angle_histories([(r.time - r.release_time, r.angle) for r in (a, b)])
+    assert ax.get_xlabel() == "time since release [s]"
+    plt.close(ax.figure)
+    ax = plot_angle_histories([(a.time, a.angle)], since_release=False)
+    assert ax.get_xlabel() == "time in the record [s]"
+    plt.close(ax.figure)
+
+    ax = plot_force_and_angle(a.force_time, a.force_z, a.time, a.angle)
+    assert ax.get_xlabel() == "time in the record [s]"
+    assert ax.lines[0].get_xdata()[0] == a.force_time[0]
+    plt.close(ax.figure)
+
+
+def test_force_and_angle_from_the_release_shifts_both_histories(results):
+    a = results[0][0]
+    ax = plot_force_and_angle(a.force_time, a.force_z, a.time, a.angle, release_time=a.release_time)
+    try:
+        assert ax.get_xlabel() == "time since release [s]"
+        (force,) = ax.lines
+        (twin,) = [other for other in ax.figure.axes if other is not ax]
+        (angle,) = twin.lines
+        assert np.allclose(force.get_xdata(), a.force_time - a.release_time)
+        assert np.allclose(angle.get_xdata(), a.time - a.release_time)
+    finally:
+        plt.close(ax.figure)

@@ -17,9 +17,10 @@ release
     The free motion of a released tape spring: end angle and energy balance (returns a Figure).
 
 setup, max_mass, numerical_damping, support, snapshots
-    The paper's tests on the set-up (deployment, pull, vibration; Figs. 27-34), the maximum mass
-    (Fig. 7), the numerical damping study (Fig. 26), the flexible support's clamp force (Fig.
-    33) and side views of the deformed model (Fig. 13). Some return a Figure rather than axes.
+    The paper's tests on the set-up (deployment, pull, vibration, Figs. 27-34; the push path to
+    the folded equilibrium, Sec. 5.1), the maximum mass (Fig. 7), the numerical damping study
+    (Fig. 26), the flexible support's clamp force (Fig. 33) and side views of the deformed model
+    (Fig. 13). Some return a Figure rather than axes.
 """
 
 from typing import TYPE_CHECKING
@@ -32,7 +33,7 @@ if TYPE_CHECKING:
     from .max_mass import plot_max_mass
     from .numerical_damping import plot_numerical_damping
     from .release import plot_release
-    from .setup import plot_deployment, plot_pull, plot_vibration
+    from .setup import plot_deployment, plot_equilibrium, plot_pull, plot_vibration
     from .snapshots import plot_snapshots
     from .support import plot_clamp_forces
     from .trials import (
@@ -53,6 +54,7 @@ __all__ = [
     "plot_clamp_forces",
     "plot_damping_series",
     "plot_deployment",
+    "plot_equilibrium",
     "plot_force_and_angle",
     "plot_free_decay",
     "plot_max_mass",
@@ -85,7 +87,7 @@ __getattr__, __dir__ = lazy_exports(
         ],
         "bending": ["plot_bending"],
         "release": ["plot_release"],
-        "setup": ["plot_deployment", "plot_pull", "plot_vibration"],
+        "setup": ["plot_deployment", "plot_equilibrium", "plot_pull", "plot_vibration"],
         "max_mass": ["plot_max_mass"],
         "numerical_damping": ["plot_numerical_damping"],
         "support": ["plot_clamp_forces"],

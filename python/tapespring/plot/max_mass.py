@@ -8,6 +8,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.contour import ContourSet
     from matplotlib.figure import Figure
 
     from tapespring.scenarios.max_mass import MaxMassResult
@@ -15,6 +16,96 @@ if TYPE_CHECKING:
 __all__ = ["plot_max_mass", "plot_max_mass_figure"]
 
 _EQUATION = {"opposite": "eq. (2)", "equal": "eq. (3)"}
+
+#: Where along a contour (fraction of its length on the axes) its label is tried, in order: the
+#: finite-element labels on the upper part of the lines, the analytical ones on the lower part,
+#: so that the two sets, whose lines run close together, do not put labels side by side.
+_FE_SPOTS = (0.3, 0.2, 0.4, 0.12, 0.5, 0.05)
+_ANALYTICAL_SPOTS = (0.7, 0.8, 0.6, 0.88, 0.5, 0.95)
+
+#: Clearance around a label [px at the figure's dpi].
+_LABEL_PAD_PX = 3.0
+
+
+def _rotated_box(
+    x: float, y: float, width: float, height: float, angle_deg: float, pad: float
+) -> tuple[float, float, float, float]:
+    """The axis-aligned box (x0, y0, x1, y1) [px] of a `width` x `height` label centred at
+    (x, y) and turned by `angle_deg`, grown by `pad`."""
+    c, s = abs(np.cos(np.radians(angle_deg))), abs(np.sin(np.radians(angle_deg)))
+    w, h = width * c + height * s, width * s + height * c
+    return (x - w / 2 - pad, y - h / 2 - pad, x + w / 2 + pad, y + h / 2 + pad)
+
+
+def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _label_contours(ax: Axes, sets: list[tuple[ContourSet, tuple[float, ...], float]]) -> None:
+    """Label each level of each contour set once, where the label overlaps no other label, no
+    marker or text of the axes, and stays inside them.
+
+    matplotlib's own placement (``clabel`` without positions) puts the labels of two sets
+    whose lines run close together at nearly the same spot, where they read as one number
+    ("60" over "60" read "600"). Here each level's label is tried at the set's spots along its
+    longest line (fractions of its length in display space), in order, and the first free
+    spot is kept; a level with no free spot keeps its line unlabelled. The layout is settled
+    first (a draw without rendering), so the geometry is that of the saved figure.
+    """
+    fig = ax.get_figure(root=True)
+    assert fig is not None  # an Axes is always in a figure
+    fig.draw_without_rendering()
+    dpi = fig.dpi
+    frame = ax.get_window_extent()
+    taken: list[tuple[float, ...]] = [tuple(t.get_window_extent().extents) for t in ax.texts]
+    for line in ax.get_lines():
+        if line.get_marker() in (None, "None", "none", "", " "):
+            continue
+        r = 0.5 * line.get_markersize() * dpi / 72.0
+        for px, py in ax.transData.transform(line.get_xydata()):
+            taken.append((px - r, py - r, px + r, py + r))
+    probe = ax.text(0.0, 0.0, "", transform=None)
+    for cs, spots, fontsize in sets:
+        positions = []
+        for level, segs in zip(cs.levels, cs.allsegs, strict=True):
+            if not segs:
+                continue
+            text = f"{level:g}"
+            probe.set_text(text)
+            probe.set_fontsize(fontsize)
+            size = probe.get_window_extent()
+            path = ax.transData.transform(max(segs, key=len))
+            step = np.hypot(*np.diff(path, axis=0).T)
+            arc = np.concatenate([[0.0], np.cumsum(step)])
+            if arc[-1] <= 0.0:
+                continue
+            for f in spots:
+                i = int(np.clip(np.searchsorted(arc, f * arc[-1]), 1, len(arc) - 1))
+                (x0, y0), (x1, y1) = path[i - 1], path[i]
+                angle = np.degrees(np.arctan2(y1 - y0, x1 - x0))
+                w = (f * arc[-1] - arc[i - 1]) / step[i - 1] if step[i - 1] > 0 else 0.0
+                cx, cy = x0 + w * (x1 - x0), y0 + w * (y1 - y0)
+                box = _rotated_box(cx, cy, size.width, size.height, angle, _LABEL_PAD_PX)
+                inside = (
+                    box[0] >= frame.x0
+                    and box[1] >= frame.y0
+                    and box[2] <= frame.x1
+                    and box[3] <= frame.y1
+                )
+                if inside and not any(_overlap(box, other) for other in taken):
+                    taken.append(box)
+                    positions.append(tuple(ax.transData.inverted().transform((cx, cy))))
+                    break
+        if positions:
+            ax.clabel(
+                cs,
+                fmt="%g",
+                fontsize=fontsize,
+                inline=True,
+                inline_spacing=3,
+                manual=positions,
+            )
+    probe.remove()
 
 
 def plot_max_mass(
@@ -93,10 +184,11 @@ def plot_max_mass(
         levels = np.asarray(levels, dtype=float)
 
     handles = []
+    labelled: list[tuple[ContourSet, tuple[float, ...], float]] = []
     if fe.count():
         filled = ax.contourf(x, y, fe, levels=levels, cmap="Blues", alpha=0.85, extend="both")
         lines = ax.contour(x, y, fe, levels=levels, colors="black", linewidths=0.9)
-        ax.clabel(lines, fmt="%g", fontsize=7.5, inline=True, inline_spacing=3)
+        labelled.append((lines, _FE_SPOTS, 7.5))
         if colorbar:
             cb = ax.figure.colorbar(filled, ax=ax, shrink=0.95, pad=0.02)
             cb.set_label(r"$m_{\max}$ [g] (finite elements)")
@@ -105,7 +197,7 @@ def plot_max_mass(
         lines_an = ax.contour(
             x, y, an, levels=levels, colors="tab:red", linewidths=1.0, linestyles="--"
         )
-        ax.clabel(lines_an, fmt="%g", fontsize=7, inline=True, inline_spacing=3)
+        labelled.append((lines_an, _ANALYTICAL_SPOTS, 7.0))
         handles.append(
             Line2D([], [], color="tab:red", linestyle="--", label=f"analytical, {_EQUATION[sense]}")
         )
@@ -164,6 +256,7 @@ def plot_max_mass(
         handlelength=1.8,
         columnspacing=1.2,
     )
+    _label_contours(ax, labelled)
     return ax
 
 

@@ -23,7 +23,8 @@ _ENERGY_STYLE = {
 def plot_release(result: ReleaseResult) -> Figure:
     """Two stacked panels sharing the time axis (from the release, in s): the rotation of the
     free end about y [deg], and the energy terms [mJ] with their sum, which stays at the energy
-    of the release when the balance closes.
+    of the release when the balance closes. The energy legend sits where it covers no curve:
+    in a free corner of the panel, else above it.
 
     Parameters
     ----------
@@ -36,10 +37,12 @@ def plot_release(result: ReleaseResult) -> Figure:
     """
     import matplotlib.pyplot as plt
 
+    from ._legend import place_legends
+
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.0))
     t = result.time_s
     top.plot(t, result.theta_deg, color="k", lw=1.2)
-    top.axhline(0.0, color="0.6", lw=0.6)
+    zero = top.axhline(0.0, color="0.6", lw=0.6)
     top.set_ylabel("end rotation about y [deg]")
     sense = "opposite" if result.setup.fold_deg > 0 else "equal"
     top.set_title(
@@ -58,8 +61,8 @@ def plot_release(result: ReleaseResult) -> Figure:
     bottom.plot(t, 1e3 * total, color="k", lw=0.8, label="sum")
     bottom.set_xlabel("time after release [s]")
     bottom.set_ylabel("energy [mJ]")
-    bottom.legend(fontsize=8, ncol=3, loc="center right")
     for ax in (top, bottom):
         ax.grid(True, lw=0.4, alpha=0.5)
-    fig.tight_layout()
+    # In a corner free of the curves if there is one, else above the panel.
+    place_legends(fig, [(bottom, {"fontsize": 8})], ignore=[zero])
     return fig

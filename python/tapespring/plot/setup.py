@@ -1,24 +1,47 @@
-"""Figures of the set-up's simulated tests: deployment (Figs. 27, 33), pull (Fig. 34) and small
-vibrations (Fig. 23), each optionally over a measured record."""
+"""Figures of the set-up's simulated tests: deployment (Figs. 27, 33), pull (Fig. 34), small
+vibrations (Fig. 23), each optionally over a measured record, and the push path to the folded
+equilibrium (Sec. 5.1, Table 6)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_deployment", "plot_pull", "plot_vibration"]
+__all__ = ["equilibrium_view", "plot_deployment", "plot_equilibrium", "plot_pull", "plot_vibration"]
 
 
 def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     """Bending angle [deg] with its peaks, and the clamp's vertical force [N], against time from
-    the release [s], the angle's zero crossings before phase III dotted and the force's peak at
-    each circled; a measured deployment (a `DeploymentResult` of the trial analysis) drawn under
-    the simulation if given."""
+    the release [s] (Figs. 27, 33).
+
+    The angle's zero crossings that the crossing analysis covers
+    (:meth:`DeploymentSimulation.clamp_force_at_crossings`: those before phase III, or all of
+    them when the run has no phase III) are dotted, the force's peak at each circled (a cross
+    where the largest deviation lies on the window's edge, no peak of its own); the starts of
+    phases II and III are dashed where the result has them (``sim.phases``). A measured
+    deployment (a `DeploymentResult` of the trial analysis) is drawn under the simulation if
+    given. The legends say what the result holds and sit where they hide no data.
+
+    Parameters
+    ----------
+    sim : tapespring.scenarios.deployment.DeploymentSimulation
+        The simulated deployment.
+    trial_result : tapespring.protocols.deployment.DeploymentResult, optional
+        A measured deployment, aligned at its release.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
+
+    from ._legend import place_legends
 
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6.0))
     if trial_result is not None:
@@ -32,49 +55,105 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
         )
     top.plot(sim.time_s, sim.angle_deg, color="tab:red", lw=1.2, label="simulation")
     if sim.peaks is not None:
-        for ext, marker in ((sim.peaks.maxima, "^"), (sim.peaks.minima, "v")):
-            top.plot(ext.time, np.degrees(ext.value), marker, color="k", ms=4, ls="none")
-    top.axhline(0.0, color="0.6", lw=0.6)
+        for ext, marker, name in (
+            (sim.peaks.maxima, "^", "maxima"),
+            (sim.peaks.minima, "v", "minima"),
+        ):
+            if np.size(ext.time):
+                top.plot(
+                    ext.time, np.degrees(ext.value), marker, color="k", ms=4, ls="none", label=name
+                )
+    zero = top.axhline(0.0, color="0.6", lw=0.6)
     top.set_ylabel("bending angle [deg]")
     top.set_title(f"deployment, {sim.settings.sense} sense")
-    top.legend(loc="upper right", frameon=False)
     if trial_result is not None and getattr(trial_result, "force_time", None) is not None:
         bottom.plot(
             trial_result.force_time - trial_result.release_time,
             trial_result.force_z,
             color="tab:blue",
             lw=0.6,
+            label="experiment",
         )
-    bottom.plot(sim.time_s, sim.clamp_force_N, color="tab:red", lw=0.8)
+    bottom.plot(sim.time_s, sim.clamp_force_N, color="tab:red", lw=0.8, label="simulation")
+    phase_iii = _draw_phases(top, bottom, sim.phases)
     if sim.time_s.size >= 2:
-        # The angle's zero crossings before phase III and the clamp force's peak at each (Sec. 6.1).
+        # The angle's zero crossings up to phase III and the clamp force's peak at each (Sec. 6.1).
         x = sim.clamp_force_at_crossings()
+        scope = "before phase III" if phase_iii is not None else "all: no phase III found"
         for ax in (top, bottom):
-            for c in x.time:
-                ax.axvline(c, color="0.5", lw=0.6, ls=":")
-        bottom.plot(
-            x.peak_time,
-            np.interp(x.peak_time, sim.time_s, sim.clamp_force_N),
-            "o",
-            mfc="none",
-            color="k",
-            ms=5,
-            label="peak at a zero crossing (phases I-II)",
-        )
-        if x.time.size:
-            # Framed: the force fills the panel, and an unframed handle reads as a data point.
-            bottom.legend(loc="best", fontsize="small", framealpha=0.9)
+            for k, c in enumerate(x.time):
+                ax.axvline(
+                    c,
+                    color="0.4",
+                    lw=0.7,
+                    ls=":",
+                    label=f"zero crossing of the angle ({scope})" if k == 0 and ax is top else None,
+                )
+        local = np.asarray(x.local, dtype=bool)
+        force = np.interp(x.peak_time, sim.time_s, sim.clamp_force_N)
+        if local.any():
+            bottom.plot(
+                x.peak_time[local],
+                force[local],
+                "o",
+                mfc="none",
+                color="k",
+                ms=5,
+                label="force peak at a zero crossing",
+            )
+        if (~local).any():
+            bottom.plot(
+                x.peak_time[~local],
+                force[~local],
+                "x",
+                color="k",
+                ms=5,
+                label="largest force deviation at a crossing, on a flank (no peak)",
+            )
     bottom.set_ylabel("clamp force $F_z$ [N]")
     bottom.set_xlabel("time from release [s]")
     for ax in (top, bottom):
         ax.grid(True, lw=0.3, alpha=0.5)
-    fig.tight_layout()
+    # Framed: the curves fill the panels, and an unframed handle reads as a data point.
+    style = {"fontsize": "small", "framealpha": 0.9}
+    place_legends(fig, [(top, style), (bottom, style)], ignore=[zero])
     return fig
+
+
+def _draw_phases(top: Any, bottom: Any, phases: Any) -> float | None:
+    """Dashed lines at the starts of phases II and III that `phases` holds, labelled in the top
+    panel; returns the start of phase III [s] or None."""
+    if phases is None:
+        return None
+    first = True
+    for name, start in (("II", phases.phase_ii_start), ("III", phases.phase_iii_start)):
+        if start is None:
+            continue
+        for ax in (top, bottom):
+            ax.axvline(
+                start,
+                color="0.2",
+                lw=0.9,
+                ls="--",
+                label="start of a phase" if first and ax is top else None,
+            )
+        first = False
+        top.annotate(
+            f"phase {name}, {start:.2f} s",
+            (start, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(3, -3),
+            textcoords="offset points",
+            va="top",
+            fontsize=8,
+        )
+    return phases.phase_iii_start
 
 
 def plot_pull(sim: Any, experiment: Any | None = None) -> Figure:
     """Pulling force [N] against the displacement of marker 2 [mm] (Fig. 34), the maximum marked,
-    with the paper's model maximum (Table 9).
+    with the paper's model maximum (Table 9). The title gives the maximum (or, with a
+    comparison, the differences from the experiment); the legend sits where it hides no data.
 
     Parameters
     ----------
@@ -92,6 +171,8 @@ def plot_pull(sim: Any, experiment: Any | None = None) -> Figure:
     import matplotlib.pyplot as plt
 
     from tapespring.scenarios.setup import PAPER_MODEL
+
+    from ._legend import place_legends
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     if experiment is not None:
@@ -147,6 +228,11 @@ def plot_pull(sim: Any, experiment: Any | None = None) -> Figure:
             f"{diff['displacement_at_max_relative']:+.1%}",
             fontsize=10,
         )
+    else:
+        ax.set_title(
+            f"pull test, maximum {sim.max_force_N:.2f} N at "
+            f"{sim.max_force_displacement_m * 1e3:.1f} mm of marker 2"
+        )
     if experiment is not None:
         # The recording runs on past the buckle and back: keep the simulated range in view.
         right = max(float(np.max(sim.displacement_m)), experiment.test.displacement_at_max)
@@ -154,9 +240,196 @@ def plot_pull(sim: Any, experiment: Any | None = None) -> Figure:
     ax.set_xlabel("displacement of marker 2 [mm]")
     ax.set_ylabel("force [N]")
     ax.grid(True, lw=0.3, alpha=0.5)
-    ax.legend(frameon=False, fontsize=8)
-    fig.tight_layout()
+    place_legends(fig, [(ax, {"frameon": False, "fontsize": 8})])
     return fig
+
+
+@dataclass(frozen=True)
+class EquilibriumView:
+    """What the equilibrium figure shows of a push path (:func:`equilibrium_view`).
+
+    Attributes
+    ----------
+    shown : int
+        The states ``0 .. shown - 1`` set the axes' limits.
+    xlim, ylim : (float, float)
+        Limits of the push [mm] and the force [N] axes.
+    equilibrium_mm : float or None
+        The folded equilibrium's push [mm] (the force's zero, linear between the two states
+        around it), or None when the path has none.
+    buckle : int or None
+        The state of the largest pushing force before the equilibrium (the buckle, where the
+        tapes snap), or None.
+    """
+
+    shown: int
+    xlim: tuple[float, float]
+    ylim: tuple[float, float]
+    equilibrium_mm: float | None
+    buckle: int | None
+
+
+def _padded(lo: float, hi: float, fraction: float) -> tuple[float, float]:
+    pad = fraction * (hi - lo) if hi > lo else 1.0
+    return lo - pad, hi + pad
+
+
+def equilibrium_view(push_m: Any, force_N: Any, *, beyond: float = 0.1) -> EquilibriumView:
+    """The part of a push path that the equilibrium figure shows.
+
+    Past the folded equilibrium the push closes the fold onto itself and the force grows by
+    orders of magnitude (33 kN at 169 mm on the default set-up, against 5 N at the buckle):
+    limits over the whole path would flatten the buckle and the equilibrium into the axis. The
+    view runs from the start to the first state more than `beyond` of the equilibrium's push
+    past it (at least the state after the crossing), and its force range is that of those
+    states, with zero. Without a folded equilibrium it is the whole path.
+
+    Parameters
+    ----------
+    push_m, force_N : array_like
+        The push path: marker 3's drop [m] and the pushing force [N]
+        (:class:`tapespring.scenarios.equilibrium.EquilibriumResult`).
+    beyond : float
+        How far past the equilibrium the view goes, as a fraction of its push, >= 0.
+
+    Returns
+    -------
+    EquilibriumView
+    """
+    from tapespring.scenarios.equilibrium import folded_crossing
+
+    push = 1e3 * np.asarray(push_m, dtype=float)
+    force = np.asarray(force_N, dtype=float)
+    n = force.size
+    # The load factor only tells folded_crossing whether the path turns back: not needed here.
+    crossing = folded_crossing(force, np.arange(n, dtype=float))
+    if crossing is None:
+        eq, buckle, shown = None, None, n
+    else:
+        k, w, _ = crossing
+        eq = float((1.0 - w) * push[k] + w * push[k + 1])
+        buckle = int(np.argmax(force[: k + 1]))
+        far = np.flatnonzero(push[k + 1 :] > eq + beyond * abs(eq - push[0]))
+        shown = k + 2 + int(far[0]) if far.size else n
+        shown = min(max(shown, k + 2), n)
+    x, y = push[:shown], force[:shown]
+    ylo, yhi = min(float(np.min(y)), 0.0), max(float(np.max(y)), 0.0)
+    return EquilibriumView(
+        shown=shown,
+        xlim=_padded(float(np.min(x)), float(np.max(x)), 0.03),
+        ylim=_padded(ylo, yhi, 0.08),
+        equilibrium_mm=eq,
+        buckle=buckle,
+    )
+
+
+def _force_text(value: float) -> str:
+    """A force for a legend: whole newtons with thousands separated when large."""
+    return f"{value:,.0f}" if abs(value) >= 100.0 else f"{value:.3g}"
+
+
+def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1) -> Axes:
+    """The push path to the folded equilibrium: the pushing force [N] against marker 3's drop
+    (the result's ``push_m``) [mm], the buckle and the folded equilibrium marked.
+
+    The axes show the path up to a little past the equilibrium (:func:`equilibrium_view`);
+    when the path goes on beyond them, a legend entry says how far and to what force.
+
+    Parameters
+    ----------
+    result : tapespring.scenarios.equilibrium.EquilibriumResult
+        The push path (``push_m``, ``force_N``) and the equilibrium's stability
+        (``unstable_modes``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure is made if None.
+    beyond : float
+        How far past the equilibrium the axes go, as a fraction of its push.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from ._legend import place_legends
+
+    new = ax is None
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.5, 4.5))
+    push, force = 1e3 * np.asarray(result.push_m), np.asarray(result.force_N)
+    view = equilibrium_view(result.push_m, result.force_N, beyond=beyond)
+    zero = ax.axhline(0.0, color="0.5", lw=0.6)
+    ax.plot(push, force, "-o", ms=2.5, color="tab:red", label="push path")
+    if view.buckle is not None:
+        b = view.buckle
+        ax.plot(
+            push[b],
+            force[b],
+            "^",
+            ms=8,
+            color="k",
+            ls="none",
+            label=f"buckle, where the tapes snap: {force[b]:.2f} N at {push[b]:.1f} mm",
+        )
+    if view.equilibrium_mm is not None:
+        modes = result.unstable_modes
+        state = "stable" if modes == 0 else f"{modes} unstable mode(s)"
+        ax.plot(
+            view.equilibrium_mm,
+            0.0,
+            "o",
+            ms=9,
+            mfc="gold",
+            mec="k",
+            ls="none",
+            zorder=5,
+            label=f"folded equilibrium ({state})",
+        )
+        ax.annotate(
+            f"folded equilibrium\npush_m = {view.equilibrium_mm:.1f} mm",
+            (view.equilibrium_mm, 0.0),
+            xytext=(-12, 28),
+            textcoords="offset points",
+            ha="right",
+            fontsize=8,
+            arrowprops={"arrowstyle": "-", "color": "0.3", "lw": 0.6},
+        )
+        title = "static identification: the folded equilibrium, where the push vanishes"
+    else:
+        title = "static identification: no folded equilibrium on the push path (push further)"
+    handles, _ = ax.get_legend_handles_labels()
+    if view.shown < push.size:
+        rest = slice(view.shown, None)
+        handles.append(
+            Line2D(
+                [],
+                [],
+                color="tab:red",
+                marker=r"$\rightarrow$",
+                ms=10,
+                ls="none",
+                label=(
+                    f"path goes on, off the axes, to {np.max(push[rest]):.0f} mm and "
+                    f"{_force_text(float(np.max(force[rest])))} N"
+                ),
+            )
+        )
+    ax.set_xlim(*view.xlim)
+    ax.set_ylim(*view.ylim)
+    ax.set_xlabel("drop of marker 3, at the weight's end (push_m) [mm]")
+    ax.set_ylabel("pushing force [N]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    fig = ax.get_figure(root=True)
+    assert fig is not None  # an Axes is always in a figure
+    place_legends(
+        fig,
+        [(ax, {"handles": handles, "fontsize": 8, "framealpha": 0.9})],
+        tight=new,
+        ignore=[zero],
+    )
+    return ax
 
 
 def _draw_fit(ax: Any, fit: Any, shift: float, color: str, label: str) -> None:

@@ -43,6 +43,10 @@ class _PeakStyle(TypedDict):
     color: str
 
 
+#: Time axis labels, by origin: the histories aligned at the release, or the records' clock.
+_SINCE_RELEASE = "time since release [s]"
+_IN_RECORD = "time in the record [s]"
+
 _MAX_STYLE: _PeakStyle = {"marker": "^", "color": "tab:red"}
 _MIN_STYLE: _PeakStyle = {"marker": "v", "color": "tab:blue"}
 
@@ -59,19 +63,24 @@ def plot_angle_histories(
     phases: Phases | None = None,
     title: str | None = None,
     ax: Axes | None = None,
+    since_release: bool = True,
 ) -> Axes:
     """Superposed bending-angle histories of many trials (paper Figs. 12, 14).
 
     Parameters
     ----------
     histories : sequence of (time [s], angle [rad])
-        One pair per trial (time is best counted from the release).
+        One pair per trial, best counted from each trial's release so that they superpose.
     phases : Phases, optional
-        Phase boundaries drawn as vertical lines (e.g. those of the first trial).
+        Phase boundaries drawn as vertical lines (e.g. those of the first trial), with times
+        counted from the same origin as the histories.
     title : str, optional
         Axes title.
     ax : Axes, optional
         Where to draw.
+    since_release : bool
+        Whether the times are counted from the release (the axis reads "time since release
+        [s]") or are the records' own (it reads "time in the record [s]").
 
     Returns
     -------
@@ -94,7 +103,7 @@ def plot_angle_histories(
                     fontsize=8,
                 )
     ax.axhline(0.0, color="0.6", lw=0.5)
-    ax.set_xlabel("time [s]")
+    ax.set_xlabel(_SINCE_RELEASE if since_release else _IN_RECORD)
     ax.set_ylabel("bending angle [deg]")
     if title:
         ax.set_title(title)
@@ -206,6 +215,7 @@ def plot_force_and_angle(
     angle: np.ndarray,
     *,
     ax: Axes | None = None,
+    release_time: float | None = None,
 ) -> Axes:
     """Vertical force with the bending angle on a second axis (Figs. 17, 18).
 
@@ -217,6 +227,10 @@ def plot_force_and_angle(
         Marker instants [s] and bending angle [rad].
     ax : Axes, optional
         Where to draw the force; the angle goes on ``ax.twinx()``.
+    release_time : float, optional
+        The release, on the records' clock [s]: given, both histories are drawn against the
+        time since it (the origin of :func:`plot_angle_histories`) and the axis says so;
+        otherwise against the records' own time, "time in the record [s]".
 
     Returns
     -------
@@ -224,11 +238,12 @@ def plot_force_and_angle(
         The force axes (the angle is drawn on a twin created with ``ax.twinx()``).
     """
     ax = _axes(ax)
-    ax.plot(force_time, force, lw=0.6, color="tab:blue")
-    ax.set_xlabel("time [s]")
+    t0 = 0.0 if release_time is None else float(release_time)
+    ax.plot(np.asarray(force_time) - t0, force, lw=0.6, color="tab:blue")
+    ax.set_xlabel(_IN_RECORD if release_time is None else _SINCE_RELEASE)
     ax.set_ylabel("force along z [N]", color="tab:blue")
     twin = ax.twinx()
-    twin.plot(time, np.rad2deg(angle), lw=0.8, color="tab:red")
+    twin.plot(np.asarray(time) - t0, np.rad2deg(angle), lw=0.8, color="tab:red")
     twin.set_ylabel("bending angle [deg]", color="tab:red")
     return ax
 
