@@ -40,6 +40,9 @@ def test_json_prints_exactly_one_object_with_the_summary(capsys):
     assert data["theta_heel_deg"] is None  # no unloading asked
     assert data["ndof"] == 1010  # 4 mm mesh
     assert data["wall_s"] > 0.0
+    # With the settings that produced it, as the CSV's comment lines.
+    assert data["settings"]["setup"]["mesh_size"] == 4e-3
+    assert data["settings"]["solver"]
 
 
 def test_json_without_progress_flag_keeps_stdout_clean(capsys):

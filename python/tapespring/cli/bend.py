@@ -15,6 +15,7 @@ import sys
 import tempfile
 import warnings
 from collections.abc import Callable
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -538,8 +539,10 @@ def run(args: argparse.Namespace) -> int:
             "ndof": s.ndof,
             "wall_s": s.wall_s,
             "error": result.error,
+            # What produced it, as the CSV's comment lines hold it.
+            "settings": {"setup": asdict(result.setup), "solver": result.settings},
         }
-        json.dump(out, sys.stdout)
+        json.dump(out, sys.stdout, default=str)
         sys.stdout.write("\n")
     else:
         sense = "opposite" if setup.theta_max_deg > 0 else "equal"
