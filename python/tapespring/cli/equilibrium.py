@@ -89,19 +89,10 @@ def run(args: argparse.Namespace) -> int:
         return result
 
     def plot(result: EquilibriumResult, path: str) -> None:
-        import matplotlib.pyplot as plt
-
+        from tapespring.plot.setup import plot_equilibrium
         from tapespring.report import save_figure
 
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-        ax.plot(result.push_m * 1e3, result.force_N, "-o", ms=2.5, color="tab:red")
-        ax.axhline(0.0, color="0.5", lw=0.6)
-        ax.set_xlabel("drop of marker 3, at the weight's end [mm]")
-        ax.set_ylabel("pushing force [N]")
-        ax.set_title("the folded equilibrium is where the force vanishes")
-        ax.grid(True, lw=0.3, alpha=0.5)
-        fig.tight_layout()
-        save_figure(fig, path)
+        save_figure(plot_equilibrium(result).figure, path)
 
     def columns(result: EquilibriumResult) -> dict:
         return {"push_m": result.push_m, "force_N": result.force_N}

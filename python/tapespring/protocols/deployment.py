@@ -646,7 +646,13 @@ def _write_files(
         ax.set_title(f"tip trajectory, {first.name}")
         files.append(save_figure(ax.figure, folder / f"tip_trajectory_{tag}.png"))
         if first.force_time is not None and first.force_z is not None:
-            ax = plot.plot_force_and_angle(first.force_time, first.force_z, first.time, first.angle)
+            ax = plot.plot_force_and_angle(
+                first.force_time,
+                first.force_z,
+                first.time,
+                first.angle,
+                release_time=first.release_time,
+            )
             ax.set_title(f"vertical force and bending angle, {first.name}")
             files.append(save_figure(ax.figure, folder / f"force_and_angle_{tag}.png"))
     return files
