@@ -370,8 +370,12 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     want = [p.markers12_dx, p.markers12_dz, p.marker3_dx, p.marker3_dz]
     np.testing.assert_allclose(got, want, rtol=0.05)
     json.dumps(result.summary())
-    code = main(["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--json"])
+    png = tmp_path / "equilibrium.png"
+    code = main(
+        ["equilibrium", "--mesh-tape=5e-3", "--mesh-plates=5e-3", "--json", f"--plot={png}"]
+    )
     assert code == 0
+    assert png.stat().st_size > 10_000
     out = json.loads(capsys.readouterr().out)
     assert out["marker_displacements_m"]["marker3_dz_m"] == pytest.approx(result.marker3_m[2])
     # Relative figures carry no unit suffix (they were "differences" keyed "..._m").
