@@ -16,7 +16,7 @@ legend went outside. A figure must not be laid out again after it with another f
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, get_args
 
 import numpy as np
 
@@ -39,17 +39,8 @@ _Loc = Literal[
     "lower center",
 ]
 
-#: Spots tried inside the axes, in order of preference.
-INSIDE: tuple[_Loc, ...] = (
-    "upper right",
-    "upper left",
-    "lower right",
-    "lower left",
-    "center right",
-    "center left",
-    "upper center",
-    "lower center",
-)
+#: Spots tried inside the axes, in order of preference (`_Loc`'s order).
+INSIDE: tuple[_Loc, ...] = get_args(_Loc)
 
 #: Clearance kept between a legend's box and the data [px at the figure's dpi].
 _CLEARANCE_PX = 3.0
