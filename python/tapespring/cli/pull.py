@@ -47,7 +47,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--max-displacement",
         type=_checked("max displacement", check_max_displacement),
         default=PullSettings.max_displacement,
-        help="displacement of marker 2 at the end of the pull [m] (default %(default)g m)",
+        help="downward pull of the rod's middle node, under marker 2, at the end of the pull "
+        "[m] (default %(default)g m; marker 2, above the node, moves slightly more)",
     )
     add_comparison_options(
         p,

@@ -77,7 +77,10 @@ class PullSettings:
     spec : SetupSpec
         The set-up (its ``configuration`` is ``"bare"``).
     max_displacement : float
-        Displacement of marker 2 at the end of the pull [m] (the paper's buckling is near 10 mm).
+        Downward displacement of the rod's middle node at the end of the pull [m], where the
+        pull is driven (the paper's buckling is near 10 mm). Marker 2 sits above that node (the
+        markers' height), so as the rod turns it moves slightly more (20.4 mm at the default's
+        end).
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th state of the path,
         for ParaView series (0: none; the last state is always kept when > 0).
