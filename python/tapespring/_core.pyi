@@ -27,7 +27,9 @@ __all__ = [
     "tape_spring_mesh",
 ]
 __version__: str
+#: Names of the six nodal degrees of freedom, in solver order: ux, uy, uz, rx, ry, rz.
 DOFS: list[str]
+#: Largest Young's modulus a section accepts [Pa] (1e13).
 MAX_YOUNGS_MODULUS: float
 
 class TapeError(Exception):
@@ -81,7 +83,9 @@ class Model:
     @property
     def quads(self) -> NDArray[np.int64]: ...
     @property
-    def parts(self) -> list[dict[str, Any]]: ...
+    def parts(self) -> list[dict[str, Any]]:
+        """The parts: dicts with ``name``, ``section`` and ``elements`` (a dict ``start``,
+        ``end``: the part's elements are ``start`` to ``end - 1``)."""
     @property
     def section(self) -> dict[str, float]: ...
     @property
@@ -158,7 +162,8 @@ class Model:
     def ties(self) -> list[tuple[int, NDArray[np.int64]]]: ...
     def to_json(self) -> str: ...
     @staticmethod
-    def from_json(text: str) -> Model: ...
+    def from_json(text: str) -> Model:
+        """The model of a JSON string written by :meth:`to_json`."""
     def __getstate__(self) -> str: ...
     def __setstate__(self, state: str) -> None: ...
     def __getnewargs__(self) -> tuple[int | None]: ...
@@ -185,7 +190,11 @@ def run(
 def generalized_alpha_decay(
     rho_inf: float, omega_h: float, xi: float = 0.0
 ) -> tuple[float, float]: ...
-def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]: ...
+def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]:
+    """Every option of a step of `kind` (and `control`) with its default value, in the flat
+    form `run` reads. With ``control="displacement"``, ``node``, ``dof`` and ``delta`` hold
+    placeholders (0, "ux", 1.0): they have no default and a step must give all three."""
+
 def tape_spring_mesh(
     length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0
 ) -> _MeshTuple: ...

@@ -94,6 +94,8 @@ def _real(value: Any, what: str) -> float:
 def ramp(start: float, end: float) -> dict[str, Any]:
     """Time function rising linearly from 0 at `start` to 1 at `end`, constant outside.
 
+    The times are in s (the load factor in static steps).
+
     Raises TypeError if `start` or `end` is not a real number (a bool or a string included);
     the model refuses a ramp whose times are not finite with ``start < end``.
     """
@@ -102,6 +104,8 @@ def ramp(start: float, end: float) -> dict[str, Any]:
 
 def table(points: Iterable[tuple[float, float]]) -> dict[str, Any]:
     """Piecewise-linear time function through ``(t, f)`` points, constant beyond the ends.
+
+    The times ``t`` are in s (the load factor in static steps).
 
     Raises TypeError if `points` is not a sequence of ``(t, f)`` pairs of real numbers (a bool
     or a string included); the model refuses times that are not finite and increasing.
@@ -125,7 +129,9 @@ def step_options(control: str = "load") -> dict[str, Any]:
     The options are documented in ``docs/python-api.md``; unknown ones, and ones that do not apply
     to the chosen control, are refused by :func:`run` with a message naming them. The arc-length
     monitor's ``monitor_node`` and ``monitor_dof`` have no default (no monitor) and are therefore
-    not in the dict; give both to monitor a reaction.
+    not in the dict; give both to monitor a reaction. With ``control="displacement"`` the dict
+    holds ``node=0``, ``dof="ux"`` and ``delta=1.0`` as placeholders: these have no default, and
+    a step without all three is refused.
     """
     options = dict(_core.step_defaults("static", control))
     for key in ("name", "kind", "activate", "deactivate"):
@@ -212,6 +218,10 @@ class Step:
     options : mapping
         The step's options (see :func:`step_options`), e.g. ``control="arc-length"``,
         ``lambda_end=1.0``, ``tol_force=1e-6``.
+
+    A `name` or `kind` that is not a str, `options` that are not a mapping, or an id that is not
+    a str raises TypeError; `options` holding ``name``, ``kind``, ``activate`` or
+    ``deactivate`` raise ValueError. The kind and the options are checked by :func:`run`.
     """
 
     name: str
@@ -428,6 +438,8 @@ def _check_progress(progress: object, arguments: str) -> None:
         )
 
 
+#: A `run` progress callback ``progress(step_index, step_name, t)``: a false value other than
+#: None stops the run.
 ProgressCallback = Callable[[int, str, float], "bool | None"]
 
 
@@ -454,10 +466,11 @@ def run(
         layer's dict form is not accepted here).
     progress : bool or callable, optional
         True shows a tqdm bar on stderr; a callable ``progress(step_index, step_name, t)`` is
-        called after each converged state and stops the run by returning a false value other
-        than None (the results then have ``cancelled`` set). Ctrl-C stops the run too: the
-        ``KeyboardInterrupt`` (like any exception the callback raises) propagates with the states
-        recorded until then in its ``result`` attribute (a `Results`).
+        called after each converged state (and once for each modal step) and stops the run by
+        returning a false value other than None (the results then have ``cancelled`` set).
+        Ctrl-C stops the run too: the ``KeyboardInterrupt`` (like any exception the callback
+        raises) propagates with the states recorded until then in its ``result`` attribute (a
+        `Results`).
     raise_on_error : bool, optional
         If True (default), an analysis that stops early (no convergence after all cut-backs, a
         singular tangent, the step limit) raises :class:`ConvergenceError` whose ``result``
@@ -475,8 +488,10 @@ def run(
         `outputs` is not an `Outputs`, `progress` is neither a bool, None nor callable, or
         `raise_on_error` is not a bool.
     ValueError
-        For an invalid model, step or output request (unknown or inapplicable options, unknown
-        ids, ...), before anything runs.
+        For an invalid model, step or output request (unknown or inapplicable options, an option
+        of the wrong type, unknown ids, ...), before anything runs.
+    MemoryError
+        If the analysis needs more memory than is available (or ``TAPESPRING_MEMORY_LIMIT``).
     ConvergenceError
         If the analysis stopped early and `raise_on_error` is True.
     """

@@ -245,7 +245,7 @@ class ScipyModes:
     frequencies_hz : ndarray, shape (n_modes,)
         Signed frequencies [Hz].
     vectors : ndarray, shape (n, n_modes)
-        Mass-normalised eigenvectors on the free equations.
+        Mass-normalised eigenvectors on the free equations [m/sqrt(kg), rad/sqrt(kg)].
     shift : float
         The shift used [rad^2/s^2].
     """
@@ -280,7 +280,7 @@ def modal_scipy(
     matrices : SystemMatrices
         From a modal step with ``matrices=True`` (or :func:`tapespring.analysis.system_matrices`).
     modes : int, optional
-        Number of eigenpairs (fewer than the number of free equations).
+        Number of eigenpairs (fewer than the number of free equations; default 10).
     shift_hz : float, optional
         Signed shift frequency [Hz] (``sigma = sign(f) (2 pi f)^2``); default: :func:`auto_shift`.
 

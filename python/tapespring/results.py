@@ -96,7 +96,8 @@ class Results:
     jump : ndarray of bool, shape (n,)
         Reached by a jump past a limit point.
     event : tuple of (str or None)
-        ``"limit_point"`` or ``"monitor_extremum"`` where a state was located as one.
+        ``"limit_point"``, ``"monitor_extremum"``, ``"refinement"``, ``"bifurcation"`` or
+        ``"branch_switch"`` where a state marks one; None elsewhere.
     strain_energy, gravity_energy : ndarray, shape (n,)
         Strain energy and potential energy of gravity [J].
     kinetic_energy : ndarray, shape (n,)
@@ -106,7 +107,7 @@ class Results:
         of the nodal loads (with, while gravity changes in time, the part of its work that the
         change of `gravity_energy` misses), work of the prescribed motions (the supports),
         energy dissipated by Kelvin-Voigt damping, and the remainder dissipated by the time
-        integrator (NaN in static steps).
+        integrator (NaN in static steps, 0 at the initial state).
     marker_names : tuple of str
         Marker names.
     marker_positions, marker_rotations : ndarray, shape (n, n_markers, 3)
@@ -209,12 +210,13 @@ class Results:
 
     @property
     def mode_shapes(self) -> tuple[NDArray[np.float64], ...]:
-        """Mass-normalised mode shapes of each modal step, shape (n_modes, n_nodes, 6) each."""
+        """Mass-normalised mode shapes of each modal step [m/sqrt(kg), rad/sqrt(kg)], shape
+        (n_modes, n_nodes, 6) each."""
         return tuple(m.mode_shapes for m in self.modes)
 
     @property
     def effective_masses(self) -> tuple[NDArray[np.float64], ...]:
-        """Effective masses of each modal step's modes, shape (n_modes, 6) each."""
+        """Effective masses of each modal step's modes [kg, kg m^2], shape (n_modes, 6) each."""
         return tuple(m.effective_masses for m in self.modes)
 
     @property
@@ -229,12 +231,13 @@ class Results:
 
     @property
     def stable(self) -> NDArray[np.bool_]:
-        """Whether each state is stable (positive definite tangent).
+        """Whether each state is stable (positive definite tangent), shape (n,).
 
         Raises
         ------
         ValueError
-            If the eigenvalue count was not computed (steps with ``stability=True``).
+            If the eigenvalue count was not computed at every record (it is computed by static
+            steps with ``stability=True`` only, so never for the records of a dynamic step).
         """
         if np.any(self.negative_eigenvalues < 0):
             raise ValueError("stability was not computed: run the steps with stability=True")
@@ -248,7 +251,8 @@ class Results:
         TypeError
             If `node` is not a number (a string included) or `dof` not a string.
         ValueError
-            If `node` is a bool or not an integer (``1.5`` is refused, not read as node 1).
+            If `node` is a bool, negative or not an integer (``1.5`` is refused, not read as
+            node 1).
         KeyError
             If that (node, dof) was not recorded.
         """
@@ -260,12 +264,14 @@ class Results:
         return self.reactions[:, column]
 
     def total_reaction(self, dof: str) -> NDArray[np.float64]:
-        """Sum of the recorded forces at `dof` over their nodes, shape (n,).
+        """Sum of the recorded forces at `dof` over their nodes [N or N m], shape (n,).
 
         A ``(node, dof)`` recorded in more than one column is counted once.
 
         Raises
         ------
+        TypeError
+            If `dof` is not a string.
         KeyError
             If no force at that DOF was recorded (or the name is not a DOF).
         """
@@ -296,7 +302,8 @@ class Results:
         return self.marker_positions[:, k, :]
 
     def field(self, record: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Nodal displacements and rotations at `record` (negative counts from the end).
+        """Nodal displacements [m] and rotation vectors [rad] at `record` (negative counts from
+        the end), shape (n_nodes, 3) each.
 
         Raises
         ------
@@ -375,7 +382,8 @@ class Results:
     def save(self, path: str | Path) -> Path:
         """Write to a NumPy ``.npz`` file; stats and settings are stored as JSON.
 
-        Read it back with :meth:`load`.
+        Read it back with :meth:`load`. Returns the path written: `path`, with ``.npz`` appended
+        if it does not end so (as :func:`numpy.savez` does).
         """
         path = Path(path)
         meta = {
@@ -425,7 +433,7 @@ class Results:
         TypeError
             If `path` is not a path (a str or an os.PathLike).
         FileNotFoundError
-            If there is no such file.
+            If there is no such file (IsADirectoryError, PermissionError: as opening it raises).
         ValueError
             If the file is not a saved `Results` (another file, or one truncated, corrupted or
             whose parts disagree: per-record arrays of other lengths than ``t``, sparse matrix

@@ -99,8 +99,13 @@ def tape_spring_mesh(
 
     Raises
     ------
+    TypeError
+        For an argument that is not a number.
     ValueError
-        For a non-positive size or ``alpha >= 2 pi``.
+        For a size that is not finite and positive, ``alpha >= 2 pi``, a twist that is not
+        finite, or more than 2e7 elements.
+    MemoryError
+        For a mesh larger than the memory available.
     """
     return Mesh(*_core.tape_spring_mesh(length, radius, alpha, mesh_size, twist=twist))
 
@@ -112,7 +117,8 @@ def tape_spring_divisions(
     arguments, counted without building it.
 
     The length and the arc ``radius * alpha`` over `mesh_size`, rounded half away from zero, at
-    least 1 along and 2 across, the count across made even.
+    least 1 along and 2 across, the count across made even. The arguments are those of
+    :func:`tape_spring_mesh` (lengths [m], `alpha` [rad]).
 
     Returns
     -------
@@ -143,6 +149,15 @@ def flat_plate_mesh(lx: float, ly: float, nx: int, ny: int) -> Mesh:
     -------
     Mesh
         Node sets ``x0``, ``x1`` (edges x = 0 and x = lx), ``y0``, ``y1`` and ``all``.
+
+    Raises
+    ------
+    TypeError
+        For a side that is not a number, or a count that is not an integer (a bool included).
+    ValueError
+        For a side that is not finite and positive, or a count below 1 or fractional.
+    MemoryError
+        For a mesh larger than the memory available.
     """
     return Mesh(*_core.flat_plate_mesh(lx, ly, nx, ny))
 
@@ -168,10 +183,14 @@ def cylindrical_panel_mesh(
 
     Raises
     ------
+    TypeError
+        For a size or angle that is not a number, or a count that is not an integer.
     ValueError
         For non-positive sizes or counts, ``phi1 <= phi0``, an angular span of more than one
         turn (``phi1 - phi0 > 2 pi``: the panel would lie on itself, layer over layer), or an
         angle beyond 1e6 rad (where the angles of the nodes lose their digits).
+    MemoryError
+        For a mesh larger than the memory available.
     """
     return Mesh(*_core.cylindrical_panel_mesh(radius, length, phi0, phi1, n_axial, n_arc))
 
@@ -186,11 +205,24 @@ def model_from_mesh(mesh: Mesh | tuple[Any, Any, Any], **section: float) -> Mode
     **section : float
         The section: ``thickness`` [m], ``youngs_modulus`` [Pa], ``poisson`` (required);
         ``density`` [kg/m^3], ``eta`` [s], ``shear_factor``, ``drilling_factor`` (optional).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    TypeError
+        If a required section value is missing.
+    ValueError
+        For an unknown section keyword or a value out of range (see docs/python-api.md).
     """
     nodes, quads, node_sets = mesh
     return Model(nodes, quads, node_sets=dict(node_sets), **section)
 
 
+#: A `solve_static` progress callback ``progress(index, t)``: a false value other than None
+#: stops the run.
 ProgressCallback = Callable[[int, float], "bool | None"]
 
 
@@ -202,7 +234,8 @@ def solve_static(
     progress: bool | ProgressCallback | None = None,
     **options: Any,
 ) -> Results:
-    """Follow the static equilibrium path of `model`: one static step of :func:`analysis.run`.
+    """Follow the static equilibrium path of `model`: one static step of
+    :func:`tapespring.analysis.run`.
 
     The residual ``f_int(q) - f_ext(t)`` is driven to zero at the free DOFs while the constrained
     DOFs follow their time functions; the load factor plays the role of time ``t``.
@@ -219,7 +252,8 @@ def solve_static(
         False, the error is returned in :attr:`Results.error`.
     progress : bool or callable, optional
         True shows a tqdm progress bar on stderr; a callable ``progress(index, t)`` is called
-        after each converged state and stops the run by returning False.
+        after each converged state (`index` counts from 0, the initial state not included) and
+        stops the run by returning a false value other than None.
     **options
         Options of a static step (see :func:`tapespring.analysis.step_options`): ``control``
         (``"load"``, ``"displacement"`` or ``"arc-length"``), ``lambda_end``, ``increments``,
