@@ -34,6 +34,18 @@ def strip(**section):
     return model, tip
 
 
+def test_displacement_options_have_no_stand_in_for_the_driven_dof():
+    # step_options("displacement") held node=0, dof="ux", delta=1.0 (the binding's stand-ins for
+    # parsing): passed back as a step's options, they drove node 0's ux by 1 m without a word.
+    options = step_options("displacement")
+    assert options["control"] == "displacement"
+    assert {"node", "dof", "delta"}.isdisjoint(options)
+    model, tip = strip()
+    model.add_load(tip, "uz", 1.0)
+    with pytest.raises(ValueError, match="node, dof and delta"):
+        run(model, [Step.static("s", **options)])
+
+
 def test_step_options_list_every_option_and_refuse_unknown_or_inapplicable_ones():
     arc = step_options("arc-length")
     assert arc["control"] == "arc-length" and {"initial_increment", "jump", "tol_force"} <= set(arc)

@@ -192,8 +192,8 @@ def generalized_alpha_decay(
 ) -> tuple[float, float]: ...
 def step_defaults(kind: str = "static", control: str = "load") -> dict[str, Any]:
     """Every option of a step of `kind` (and `control`) with its default value, in the flat
-    form `run` reads. With ``control="displacement"``, ``node``, ``dof`` and ``delta`` hold
-    placeholders (0, "ux", 1.0): they have no default and a step must give all three."""
+    form `run` reads. With ``control="displacement"`` it leaves out ``node``, ``dof`` and
+    ``delta``: they have no default and a step must give all three."""
 
 def tape_spring_mesh(
     length: float, radius: float, alpha: float, mesh_size: float, *, twist: float = 0.0

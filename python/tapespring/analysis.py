@@ -129,9 +129,8 @@ def step_options(control: str = "load") -> dict[str, Any]:
     The options are documented in ``docs/python-api.md``; unknown ones, and ones that do not apply
     to the chosen control, are refused by :func:`run` with a message naming them. The arc-length
     monitor's ``monitor_node`` and ``monitor_dof`` have no default (no monitor) and are therefore
-    not in the dict; give both to monitor a reaction. With ``control="displacement"`` the dict
-    holds ``node=0``, ``dof="ux"`` and ``delta=1.0`` as placeholders: these have no default, and
-    a step without all three is refused.
+    not in the dict; give both to monitor a reaction. Nor are displacement control's ``node``,
+    ``dof`` and ``delta``, which have no default either: a step without all three is refused.
     """
     options = dict(_core.step_defaults("static", control))
     for key in ("name", "kind", "activate", "deactivate"):

@@ -173,7 +173,9 @@ pub fn check_mesh(nodes: Option<usize>, elements: Option<usize>) -> Result<()> {
     let bytes = 3.0 * (24.0 * nodes as f64 + 32.0 * elements as f64);
     if bytes > limit as f64 {
         return Err(Error::OutOfMemory(format!(
-            "a mesh of {nodes} nodes and {elements} elements needs about {} to hold, more than {} ({source}); use              fewer elements, or set the environment variable {LIMIT_VARIABLE} (e.g. '32G', or 'none') to try anyway",
+            "a mesh of {nodes} nodes and {elements} elements needs about {} to hold, more than {} \
+             ({source}); use fewer elements, or set the environment variable {LIMIT_VARIABLE} \
+             (e.g. '32G', or 'none') to try anyway",
             human(bytes),
             human(limit as f64),
         )));

@@ -98,19 +98,31 @@ pub fn generalized_alpha_decay(rho_inf: f64, omega_h: f64, xi: f64) -> PyResult<
     Ok(alpha.apparent_damping(omega_h, xi))
 }
 
-/// Every option of a step of `kind` with its default value (the flat dict `run` reads).
+/// Options of displacement control that have no default: a step must give all three.
+const REQUIRED_DISPLACEMENT: [&str; 3] = ["node", "dof", "delta"];
+
+/// Every option of a step of `kind` with its default value (the flat dict `run` reads); for
+/// displacement control without `node`, `dof` and `delta`, which have none.
 #[pyfunction]
 #[pyo3(signature = (kind = "static", control = "load"))]
 pub fn step_defaults<'py>(py: Python<'py>, kind: &str, control: &str) -> PyResult<Bound<'py, PyAny>> {
     let mut value = serde_json::json!({ "kind": kind });
+    let displacement = kind == "static" && control == "displacement";
     if kind == "static" {
         value["control"] = control.into();
     }
-    if kind == "static" && control == "displacement" {
+    if displacement {
+        // Stand-ins for the parse only: handed out as defaults and passed back as a step's
+        // options, they drove node 0's ux by 1 m without a word.
         value["node"] = 0.into();
         value["dof"] = "ux".into();
         value["delta"] = 1.0.into();
     }
-    let step = to_py(Step::from_json(value))?;
-    convert::from_json(py, &step.to_json())
+    let mut options = to_py(Step::from_json(value))?.to_json();
+    if let (true, Some(map)) = (displacement, options.as_object_mut()) {
+        for key in REQUIRED_DISPLACEMENT {
+            map.remove(key);
+        }
+    }
+    convert::from_json(py, &options)
 }
