@@ -177,7 +177,8 @@ impl PyModel {
         convert::quads_to_numpy(py, &self.inner.mesh.quads)
     }
 
-    /// The parts: list of dicts with `name`, `section` and `elements` (`[first, end)`).
+    /// The parts: list of dicts with `name`, `section` and `elements` (a dict `{start, end}`: the
+    /// part's elements are `start` to `end - 1`).
     #[getter]
     fn parts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         convert::to_py_object(py, &self.inner.parts)
