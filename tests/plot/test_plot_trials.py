@@ -91,11 +91,17 @@ def test_time_axes_say_which_origin_they_count_from(results):
     """The histories superposed at their release and the force-and-angle figure of one trial on
     its record's clock read the same axis title "time [s]" (review F5): each says its origin."""
     a, b = results[0]
-    ax = plot_angle_histories([(r.time - r.release_time, r.angle) for r in (a, b)])
+    ax = plot_angle_histories(
+        [(r.time - r.release_time, r.angle) for r in (a, b)], since_release=True
+    )
     assert ax.get_xlabel() == "time since release [s]"
     plt.close(ax.figure)
     ax = plot_angle_histories([(a.time, a.angle)], since_release=False)
     assert ax.get_xlabel() == "time in the record [s]"
+    plt.close(ax.figure)
+    # Not told, it claims no origin.
+    ax = plot_angle_histories([(a.time, a.angle)])
+    assert ax.get_xlabel() == "time [s]"
     plt.close(ax.figure)
 
     ax = plot_force_and_angle(a.force_time, a.force_z, a.time, a.angle)

@@ -221,7 +221,7 @@ def test_equilibrium_figure_keeps_the_buckle_and_the_equilibrium_in_view_and_mar
         assert float(eq.get_ydata()[0]) == 0.0
         assert "buckle, where the tapes snap: 5.31 N at 14.2 mm" in lines
         notes = [t.get_text() for t in ax.texts]
-        assert "folded equilibrium\npush_m = 109.4 mm" in notes
+        assert "folded equilibrium\nmarker 3 down 109.4 mm" in notes
         texts = [t.get_text() for t in ax.get_legend().texts]
         assert "path goes on, off the axes, to 169 mm and 33,163 N" in texts
         assert "(push_m)" in ax.get_xlabel() and "marker 3" in ax.get_xlabel()
@@ -238,6 +238,25 @@ def test_equilibrium_figure_names_unstable_modes():
         assert "folded equilibrium (1 unstable mode(s))" in [
             ln.get_label() for ln in ax.get_lines()
         ]
+    finally:
+        plt.close(ax.figure)
+
+
+@pytest.mark.parametrize(
+    ("push", "force"),
+    [
+        ([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, np.nan, 2.0]),
+        ([0.0, np.nan, 2.0, 3.0], [0.0, 1.0, -1.0, 2.0]),
+        ([0.0, 1.0, 2.0], [0.0, np.inf, 1.0]),
+        ([], []),
+    ],
+)
+def test_equilibrium_figure_draws_a_path_with_gaps_or_none(push, force):
+    # The limits came from every value: a NaN or inf failed with "Axis limits cannot be NaN or
+    # Inf", an empty path in a zero-size reduction. They now come from the finite values.
+    ax = plot_equilibrium(_equilibrium(push, force))
+    try:
+        assert np.all(np.isfinite(ax.get_xlim())) and np.all(np.isfinite(ax.get_ylim()))
     finally:
         plt.close(ax.figure)
 

@@ -13,6 +13,7 @@ from .bend import (
     _vtu_file,
     refuse,
     refuse_shared_paths,
+    wrote,
 )
 from .scenario_options import (
     add_energy_tolerance_option,
@@ -242,7 +243,7 @@ def run(args: argparse.Namespace) -> int:
             ax = plot_snapshots(result.results, result.setup.model, times)
             save_figure(ax.figure, args.snapshots)
             if not args.json:
-                print(f"  wrote {args.snapshots}")
+                print(wrote(args.snapshots))
 
     def columns(result: DeploymentSimulation) -> dict:
         rows = result.sample_rows()

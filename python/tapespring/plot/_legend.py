@@ -143,17 +143,19 @@ def _layout(fig: Figure, tight: bool) -> None:
 
 
 def _above(ax: Axes, keywords: dict[str, Any]) -> Legend:
-    """The legend above the axes, in as few rows as fit their width, under their title (which
-    is raised by the legend's height)."""
+    """The legend above the axes, in as few rows as fit their width (at most the caller's
+    ``ncol`` columns), under their title (which is raised by the legend's height)."""
     from matplotlib import rcParams
 
+    keywords = dict(keywords)
     n = (
         len(ax.get_legend_handles_labels()[0])
         if "handles" not in keywords
         else len(keywords["handles"])
     )
+    most = min(max(n, 1), int(keywords.pop("ncol", n) or 1))
     width = ax.get_window_extent().width
-    for ncol in range(max(n, 1), 0, -1):
+    for ncol in range(max(most, 1), 0, -1):
         legend = ax.legend(
             loc="lower center",
             bbox_to_anchor=(0.5, 1.0),
@@ -191,10 +193,13 @@ def place_legends(
         The complete figure (every line drawn, labels and titles set).
     requests : sequence of (Axes, dict)
         The axes and the keywords of ``Axes.legend`` (``handles``, ``fontsize``, ``ncol``,
-        ``frameon``, ...; not ``loc`` nor ``bbox_to_anchor``, which this chooses).
+        ``frameon``, ...; not ``loc`` nor ``bbox_to_anchor``, which this chooses: ValueError).
+        Above the axes, ``ncol`` is the most columns used.
     tight : bool
         Lay the figure out with ``tight_layout`` (True), or leave it to its constrained
-        layout (False).
+        layout (False). With neither (a caller's figure without a layout engine), a legend
+        that finds no free spot inside stays inside at matplotlib's ``"best"`` spot rather than
+        going above the axes, where nothing would make room for it.
     ignore : sequence of artists
         Artists a legend may cover (reference lines).
 
@@ -203,6 +208,13 @@ def place_legends(
     list of Legend
         In the order of `requests`.
     """
+    for _, keywords in requests:
+        chosen = {"loc", "bbox_to_anchor"} & set(keywords)
+        if chosen:
+            raise ValueError(f"place_legends chooses {sorted(chosen)} itself; leave them out")
+    # Above the axes a legend needs room a layout makes (tight_layout, or the figure's own
+    # engine); on a caller's figure without either it would push the title off the figure.
+    room_above = tight or fig.get_layout_engine() is not None
     legends: list[Legend | None] = [None] * len(requests)
     outside = [False] * len(requests)
     for _ in range(len(requests) + 1):
@@ -216,6 +228,11 @@ def place_legends(
                 if not hides_data(ax, legend.get_window_extent(), ignore=ignore):
                     break
             else:
+                if not room_above:
+                    # No free spot and no room above: matplotlib's least-covered spot.
+                    legends[i] = ax.legend(loc="best", **keywords)
+                    outside[i] = True
+                    continue
                 legend = _above(ax, keywords)
                 outside[i] = moved = True
             legends[i] = legend

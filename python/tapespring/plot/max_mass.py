@@ -49,8 +49,10 @@ def _label_contours(ax: Axes, sets: list[tuple[ContourSet, tuple[float, ...], fl
     whose lines run close together at nearly the same spot, where they read as one number
     ("60" over "60" read "600"). Here each level's label is tried at the set's spots along its
     longest line (fractions of its length in display space), in order, and the first free
-    spot is kept; a level with no free spot keeps its line unlabelled. The layout is settled
-    first (a draw without rendering), so the geometry is that of the saved figure.
+    spot is kept. Where the run dots leave no free spot (a dense grid: on 20 x 20 they cover
+    the panel), the spots are tried again with the dots allowed under the label, never another
+    label or text; a level with no spot even then keeps its line unlabelled. The layout is
+    settled first (a draw without rendering), so the geometry is that of the saved figure.
     """
     fig = ax.get_figure(root=True)
     assert fig is not None  # an Axes is always in a figure
@@ -58,12 +60,13 @@ def _label_contours(ax: Axes, sets: list[tuple[ContourSet, tuple[float, ...], fl
     dpi = fig.dpi
     frame = ax.get_window_extent()
     taken: list[tuple[float, ...]] = [tuple(t.get_window_extent().extents) for t in ax.texts]
+    dots: list[tuple[float, ...]] = []
     for line in ax.get_lines():
         if line.get_marker() in (None, "None", "none", "", " "):
             continue
         r = 0.5 * line.get_markersize() * dpi / 72.0
         for px, py in ax.transData.transform(line.get_xydata()):
-            taken.append((px - r, py - r, px + r, py + r))
+            dots.append((px - r, py - r, px + r, py + r))
     probe = ax.text(0.0, 0.0, "", transform=None)
     for cs, spots, fontsize in sets:
         positions = []
@@ -79,6 +82,7 @@ def _label_contours(ax: Axes, sets: list[tuple[ContourSet, tuple[float, ...], fl
             arc = np.concatenate([[0.0], np.cumsum(step)])
             if arc[-1] <= 0.0:
                 continue
+            candidates = []
             for f in spots:
                 i = int(np.clip(np.searchsorted(arc, f * arc[-1]), 1, len(arc) - 1))
                 (x0, y0), (x1, y1) = path[i - 1], path[i]
@@ -93,9 +97,12 @@ def _label_contours(ax: Axes, sets: list[tuple[ContourSet, tuple[float, ...], fl
                     and box[3] <= frame.y1
                 )
                 if inside and not any(_overlap(box, other) for other in taken):
-                    taken.append(box)
-                    positions.append(tuple(ax.transData.inverted().transform((cx, cy))))
-                    break
+                    candidates.append((box, (cx, cy)))
+            clear = [c for c in candidates if not any(_overlap(c[0], d) for d in dots)]
+            if clear or candidates:
+                box, centre = (clear or candidates)[0]
+                taken.append(box)
+                positions.append(tuple(ax.transData.inverted().transform(centre)))
         if positions:
             ax.clabel(
                 cs,

@@ -90,7 +90,7 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
                     label=f"zero crossing of the angle ({scope})" if k == 0 and ax is top else None,
                 )
         local = np.asarray(x.local, dtype=bool)
-        force = np.interp(x.peak_time, sim.time_s, sim.clamp_force_N)
+        force = x.peak_force
         if local.any():
             bottom.plot(
                 x.peak_time[local],
@@ -252,8 +252,9 @@ class EquilibriumView:
     ----------
     shown : int
         The states ``0 .. shown - 1`` set the axes' limits.
-    xlim, ylim : (float, float)
-        Limits of the push [mm] and the force [N] axes.
+    xlim, ylim : (float, float) or None
+        Limits of the push [mm] and the force [N] axes, from the finite values shown; None
+        when there are none (an empty path: the axes keep matplotlib's limits).
     equilibrium_mm : float or None
         The folded equilibrium's push [mm] (the force's zero, linear between the two states
         around it), or None when the path has none.
@@ -263,8 +264,8 @@ class EquilibriumView:
     """
 
     shown: int
-    xlim: tuple[float, float]
-    ylim: tuple[float, float]
+    xlim: tuple[float, float] | None
+    ylim: tuple[float, float] | None
     equilibrium_mm: float | None
     buckle: int | None
 
@@ -302,17 +303,21 @@ def equilibrium_view(push_m: Any, force_N: Any, *, beyond: float = 0.1) -> Equil
     force = np.asarray(force_N, dtype=float)
     n = force.size
     # The load factor only tells folded_crossing whether the path turns back: not needed here.
-    crossing = folded_crossing(force, np.arange(n, dtype=float))
+    crossing = folded_crossing(force, np.arange(n, dtype=float)) if n >= 2 else None
     if crossing is None:
         eq, buckle, shown = None, None, n
     else:
         k, w, _ = crossing
         eq = float((1.0 - w) * push[k] + w * push[k + 1])
-        buckle = int(np.argmax(force[: k + 1]))
+        buckle = int(np.nanargmax(force[: k + 1])) if np.isfinite(force[: k + 1]).any() else None
         far = np.flatnonzero(push[k + 1 :] > eq + beyond * abs(eq - push[0]))
         shown = k + 2 + int(far[0]) if far.size else n
         shown = min(max(shown, k + 2), n)
     x, y = push[:shown], force[:shown]
+    finite = np.isfinite(x) & np.isfinite(y)
+    if not finite.any():
+        return EquilibriumView(shown=shown, xlim=None, ylim=None, equilibrium_mm=eq, buckle=buckle)
+    x, y = x[finite], y[finite]
     ylo, yhi = min(float(np.min(y)), 0.0), max(float(np.max(y)), 0.0)
     return EquilibriumView(
         shown=shown,
@@ -387,7 +392,7 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1
             label=f"folded equilibrium ({state})",
         )
         ax.annotate(
-            f"folded equilibrium\npush_m = {view.equilibrium_mm:.1f} mm",
+            f"folded equilibrium\nmarker 3 down {view.equilibrium_mm:.1f} mm",
             (view.equilibrium_mm, 0.0),
             xytext=(-12, 28),
             textcoords="offset points",
@@ -415,8 +420,9 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1
                 ),
             )
         )
-    ax.set_xlim(*view.xlim)
-    ax.set_ylim(*view.ylim)
+    if view.xlim is not None and view.ylim is not None:
+        ax.set_xlim(*view.xlim)
+        ax.set_ylim(*view.ylim)
     ax.set_xlabel("drop of marker 3, at the weight's end (push_m) [mm]")
     ax.set_ylabel("pushing force [N]")
     ax.set_title(title, fontsize=10)

@@ -63,7 +63,7 @@ def plot_angle_histories(
     phases: Phases | None = None,
     title: str | None = None,
     ax: Axes | None = None,
-    since_release: bool = True,
+    since_release: bool | None = None,
 ) -> Axes:
     """Superposed bending-angle histories of many trials (paper Figs. 12, 14).
 
@@ -78,9 +78,10 @@ def plot_angle_histories(
         Axes title.
     ax : Axes, optional
         Where to draw.
-    since_release : bool
+    since_release : bool, optional
         Whether the times are counted from the release (the axis reads "time since release
-        [s]") or are the records' own (it reads "time in the record [s]").
+        [s]") or are the records' own (it reads "time in the record [s]"); None, the default,
+        says neither ("time [s]"): only the caller knows which times it gave.
 
     Returns
     -------
@@ -103,7 +104,7 @@ def plot_angle_histories(
                     fontsize=8,
                 )
     ax.axhline(0.0, color="0.6", lw=0.5)
-    ax.set_xlabel(_SINCE_RELEASE if since_release else _IN_RECORD)
+    ax.set_xlabel({None: "time [s]", True: _SINCE_RELEASE, False: _IN_RECORD}[since_release])
     ax.set_ylabel("bending angle [deg]")
     if title:
         ax.set_title(title)

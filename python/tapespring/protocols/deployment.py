@@ -633,6 +633,7 @@ def _write_files(
         ax = plot.plot_angle_histories(
             [(r.time - r.release_time, r.angle) for r in g.results],
             phases=None,
+            since_release=True,
             title=f"deployment, {tag} sense ({len(g.results)} trials)",
         )
         files.append(save_figure(ax.figure, folder / f"angle_histories_{tag}.png"))
