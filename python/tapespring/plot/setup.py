@@ -121,33 +121,12 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
 
 
 def _draw_phases(top: Any, bottom: Any, phases: Any) -> float | None:
-    """Dashed lines at the starts of phases II and III that `phases` holds, labelled in the top
-    panel; returns the start of phase III [s] or None."""
-    if phases is None:
-        return None
-    first = True
-    for name, start in (("II", phases.phase_ii_start), ("III", phases.phase_iii_start)):
-        if start is None:
-            continue
-        for ax in (top, bottom):
-            ax.axvline(
-                start,
-                color="0.2",
-                lw=0.9,
-                ls="--",
-                label="start of a phase" if first and ax is top else None,
-            )
-        first = False
-        top.annotate(
-            f"phase {name}, {start:.2f} s",
-            (start, 1.0),
-            xycoords=("data", "axes fraction"),
-            xytext=(3, -3),
-            textcoords="offset points",
-            va="top",
-            fontsize=8,
-        )
-    return phases.phase_iii_start
+    """The phase starts in both panels, named in the top one with their times; returns the
+    start of phase III [s] or None."""
+    from .trials import draw_phase_starts
+
+    draw_phase_starts([top, bottom], phases, legend_label="start of a phase", with_time=True)
+    return None if phases is None else phases.phase_iii_start
 
 
 def plot_pull(sim: Any, experiment: Any | None = None) -> Figure:

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from tapespring.signals.pull import PullTest
 
 __all__ = [
+    "draw_phase_starts",
     "plot_angle_histories",
     "plot_damping_series",
     "plot_force_and_angle",
@@ -55,6 +56,37 @@ def _axes(ax: Axes | None, figsize: tuple[float, float] = (7.0, 4.0)) -> Axes:
     if ax is None:
         _, ax = plt.subplots(figsize=figsize, layout="constrained")
     return ax
+
+
+def draw_phase_starts(
+    axes: Sequence[Axes],
+    phases: Phases | None,
+    *,
+    legend_label: str | None = None,
+    with_time: bool = False,
+) -> None:
+    """Dashed lines at the starts of phases II and III that `phases` holds (None: nothing), in
+    each of `axes`, named at the top of the first ("phase III", or with `with_time` "phase III,
+    0.72 s"); the first line of the first axes carries `legend_label` in its legend."""
+    if phases is None:
+        return
+    first = True
+    for name, start in (("II", phases.phase_ii_start), ("III", phases.phase_iii_start)):
+        if start is None:
+            continue
+        for ax in axes:
+            label = legend_label if first and ax is axes[0] else None
+            ax.axvline(start, color="0.2", lw=0.9, ls="--", label=label)
+        first = False
+        axes[0].annotate(
+            f"phase {name}, {start:.2f} s" if with_time else f"phase {name}",
+            (start, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(3, -3),
+            textcoords="offset points",
+            va="top",
+            fontsize=8,
+        )
 
 
 def plot_angle_histories(
@@ -91,18 +123,7 @@ def plot_angle_histories(
     alpha = max(0.15, min(1.0, 3.0 / max(1, len(histories))))
     for t, angle in histories:
         ax.plot(t, np.rad2deg(angle), lw=0.7, alpha=alpha, color="tab:blue")
-    if phases is not None:
-        for label, t0 in (("II", phases.phase_ii_start), ("III", phases.phase_iii_start)):
-            if t0 is not None:
-                ax.axvline(t0, color="0.3", ls="--", lw=0.8)
-                ax.annotate(
-                    f"phase {label}",
-                    (t0, 1.0),
-                    xycoords=("data", "axes fraction"),
-                    xytext=(3, -12),
-                    textcoords="offset points",
-                    fontsize=8,
-                )
+    draw_phase_starts([ax], phases)
     ax.axhline(0.0, color="0.6", lw=0.5)
     ax.set_xlabel({None: "time [s]", True: _SINCE_RELEASE, False: _IN_RECORD}[since_release])
     ax.set_ylabel("bending angle [deg]")
