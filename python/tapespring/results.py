@@ -96,8 +96,9 @@ class Results:
     jump : ndarray of bool, shape (n,)
         Reached by a jump past a limit point.
     event : tuple of (str or None)
-        ``"limit_point"``, ``"monitor_extremum"``, ``"refinement"``, ``"bifurcation"`` or
-        ``"branch_switch"`` where a state marks one; None elsewhere.
+        ``"limit_point"``, ``"monitor_extremum"``, ``"refinement"``, ``"bifurcation"``,
+        ``"branch_switch"`` or ``"monitor_zero"`` (where the path stopped at a zero of the
+        monitored reaction) where a state marks one; None elsewhere.
     strain_energy, gravity_energy : ndarray, shape (n,)
         Strain energy and potential energy of gravity [J].
     kinetic_energy : ndarray, shape (n,)

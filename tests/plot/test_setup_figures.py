@@ -179,51 +179,51 @@ def test_pull_figure_has_a_title_naming_its_maximum_and_a_free_legend():
 
 
 # A push path shaped like the default equilibrium run's (3 mm mesh): the buckle at 14 mm and
-# 5.3 N, the snap to -0.9 N at 16 mm, the folded equilibrium at 109.4 mm, then the fold closing
-# on itself up to 33 kN.
+# 5.3 N, the snap to -0.9 N at 16 mm, the force rising to zero at the folded equilibrium at
+# 109.4 mm, where the push stops.
 _PUSH_MM = [0, 3.3, 6.8, 10.5, 14.2, 15.9, 16.1, 16.3, 16.6, 16.3, 16.5, 17.5, 20.9, 26.2,
-            32.5, 41.3, 50.6, 63.3, 79.4, 90.6, 103.4, 109.6, 116.1, 122.8, 129.4, 139.4,
-            147.6, 155.4, 157.7, 160.5, 163.4, 165.5, 168.1, 169.4]  # fmt: skip
+            32.5, 41.3, 50.6, 63.3, 79.4, 90.6, 103.4, 109.4]  # fmt: skip
 _FORCE_N = [0, 2.0, 3.74, 4.97, 5.31, 4.9, 3.45, 4.65, 4.13, -0.88, -0.9, -0.97, -1.11, -1.19,
-            -1.2, -1.16, -1.08, -0.94, -0.72, -0.52, -0.196, 0.008, 0.31, 0.77, 1.43, 3.77,
-            10.5, 38.3, 145.4, 227.0, 2096.0, 10052.0, 24407.0, 33163.0]  # fmt: skip
+            -1.2, -1.16, -1.08, -0.94, -0.72, -0.52, -0.196, 1e-8]  # fmt: skip
 
 
-def _equilibrium(push_mm=_PUSH_MM, force=_FORCE_N, modes=0) -> SimpleNamespace:
+def _equilibrium(push_mm=_PUSH_MM, force=_FORCE_N, modes=0, found=True) -> SimpleNamespace:
     return SimpleNamespace(
         push_m=1e-3 * np.asarray(push_mm, dtype=float),
         force_N=np.asarray(force, dtype=float),
         unstable_modes=modes,
+        found=found,
     )
 
 
-def test_equilibrium_view_stops_a_little_past_the_equilibrium():
-    view = equilibrium_view(1e-3 * np.asarray(_PUSH_MM), np.asarray(_FORCE_N))
-    # The zero between 103.4 mm (-0.196 N) and 109.6 mm (+0.008 N), linear in the force.
-    assert view.equilibrium_mm == pytest.approx(103.4 + 6.2 * 0.196 / 0.204)
+def test_equilibrium_view_marks_the_last_state_and_the_buckle():
+    view = equilibrium_view(1e-3 * np.asarray(_PUSH_MM), np.asarray(_FORCE_N), found=True)
+    assert view.equilibrium_mm == pytest.approx(109.4)
     assert _PUSH_MM[view.buckle] == 14.2
-    # Up to the first state more than 10 % of the push past it (122.8 mm), not to 169 mm.
-    assert _PUSH_MM[view.shown - 1] == 122.8
-    assert view.ylim[1] < 6.0 and view.ylim[0] < -1.2
-    assert view.xlim[0] < 0.0 < 122.8 < view.xlim[1] < 130.0
+    assert 5.31 < view.ylim[1] < 6.0 and view.ylim[0] < -1.2
+    assert view.xlim[0] < 0.0 < 109.4 < view.xlim[1] < 115.0
+    # Without the equilibrium (a push that stopped short of it) the buckle is still marked; a
+    # push that never buckled (the force largest at its last state) has none.
+    short = equilibrium_view(
+        1e-3 * np.asarray(_PUSH_MM[:15]), np.asarray(_FORCE_N[:15]), found=False
+    )
+    assert short.equilibrium_mm is None and _PUSH_MM[short.buckle] == 14.2
+    assert equilibrium_view([0.0, 1e-3, 2e-3], [0.0, 1.0, 2.0], found=False).buckle is None
 
 
 def test_equilibrium_figure_keeps_the_buckle_and_the_equilibrium_in_view_and_marks_them():
     ax = plot_equilibrium(_equilibrium())
     try:
         lo, hi = ax.get_ylim()
-        assert 5.31 < hi < 10.0, "the far branch (33 kN) must not set the scale"
+        assert 5.31 < hi < 10.0
         assert lo < -1.2
-        assert ax.get_xlim()[1] < 169.0
         lines = {ln.get_label(): ln for ln in ax.get_lines()}
         eq = lines["folded equilibrium (stable)"]
-        assert float(eq.get_xdata()[0]) == pytest.approx(103.4 + 6.2 * 0.196 / 0.204)
+        assert float(eq.get_xdata()[0]) == pytest.approx(109.4)
         assert float(eq.get_ydata()[0]) == 0.0
         assert "buckle, where the tapes snap: 5.31 N at 14.2 mm" in lines
         notes = [t.get_text() for t in ax.texts]
         assert "folded equilibrium\nmarker 3 down 109.4 mm" in notes
-        texts = [t.get_text() for t in ax.get_legend().texts]
-        assert "path goes on, off the axes, to 169 mm and 33,163 N" in texts
         assert "(push_m)" in ax.get_xlabel() and "marker 3" in ax.get_xlabel()
         assert "folded equilibrium" in ax.get_title()
         zero = [ln for ln in ax.get_lines() if list(ln.get_ydata()) == [0, 0]]
@@ -251,25 +251,26 @@ def test_equilibrium_figure_names_unstable_modes():
         ([], []),
     ],
 )
-def test_equilibrium_figure_draws_a_path_with_gaps_or_none(push, force):
+@pytest.mark.parametrize("found", [True, False])
+def test_equilibrium_figure_draws_a_path_with_gaps_or_none(push, force, found):
     # The limits came from every value: a NaN or inf failed with "Axis limits cannot be NaN or
     # Inf", an empty path in a zero-size reduction. They now come from the finite values.
-    ax = plot_equilibrium(_equilibrium(push, force))
+    ax = plot_equilibrium(_equilibrium(push, force, found=found))
     try:
         assert np.all(np.isfinite(ax.get_xlim())) and np.all(np.isfinite(ax.get_ylim()))
     finally:
         plt.close(ax.figure)
 
 
-def test_equilibrium_figure_without_a_crossing_shows_the_whole_path():
+def test_equilibrium_figure_without_the_equilibrium_shows_the_whole_path():
     push = _PUSH_MM[:21]
-    ax = plot_equilibrium(_equilibrium(push, _FORCE_N[:21]))
+    ax = plot_equilibrium(_equilibrium(push, _FORCE_N[:21], found=False))
     try:
         assert "no folded equilibrium" in ax.get_title()
         assert ax.get_xlim()[1] >= push[-1]
         labels = [ln.get_label() for ln in ax.get_lines()]
         assert not any(label.startswith("folded equilibrium") for label in labels)
-        assert not any("goes on" in t.get_text() for t in ax.get_legend().texts)
+        assert any(label.startswith("buckle") for label in labels)
     finally:
         plt.close(ax.figure)
 

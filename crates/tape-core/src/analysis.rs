@@ -33,7 +33,7 @@ use crate::options::Options;
 use crate::output::{Fields, History, Outputs};
 use crate::solver::{
     solve_dynamic, solve_modal, solve_static, Control, DynamicParams, EnergyBalance, ModalParams, StaticParams,
-    StaticStep, Stats,
+    StaticStep, Stats, ZeroStop,
 };
 use crate::state::State;
 use crate::time_function::TimeFunction;
@@ -222,7 +222,8 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                             )));
                         }
                     }
-                    Some(lambda_end)
+                    // A path that stops at a zero of its monitored reaction ends where that lies.
+                    (p.stop_at_monitor_zero == ZeroStop::Never).then_some(lambda_end)
                 }
                 Control::Displacement { .. } => None,
             },

@@ -86,6 +86,35 @@ pub struct Monitor {
     pub dof: Dof,
 }
 
+/// Where an arc-length path with a monitor stops at a zero of the monitored reaction: a state
+/// where the prescribed motion needs no force, so an equilibrium of the structure without that
+/// constraint (the folded equilibrium of a test that pushes a structure past its buckling).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ZeroStop {
+    /// The path goes on to `lambda_end`.
+    #[default]
+    Never,
+    /// At the first zero the path crosses.
+    Any,
+    /// At the first zero beyond which the structure resists the prescribed motion: the reaction
+    /// rises through zero along the motion (its stiffness against the motion is positive there, so
+    /// with a stable held structure the state is a stable equilibrium without the constraint).
+    Resisting,
+}
+
+impl ZeroStop {
+    /// Name in option maps.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Never => "never",
+            Self::Any => "any",
+            Self::Resisting => "resisting",
+        }
+    }
+}
+
 /// Settings of a static analysis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StaticParams {
@@ -130,6 +159,14 @@ pub struct StaticParams {
     pub refine_change: f64,
     /// See `refine_change` (load factor, > 0).
     pub refine_span: f64,
+    /// With a monitor: whether the path stops at a zero of the monitored reaction, located to
+    /// Newton's force tolerance (the reaction within `tol_force` of the reference force of zero,
+    /// as the residual of every state is) and recorded as the path's last state
+    /// ([`Event::MonitorZero`]); the step then ends there, and the next one starts from it. A
+    /// change of sign counts where the reaction on both sides exceeds `monitor_prominence` of its
+    /// largest magnitude on the path so far (round-off at the path's start is no zero).
+    #[serde(default)]
+    pub stop_at_monitor_zero: ZeroStop,
 }
 
 impl Default for StaticParams {
@@ -152,6 +189,7 @@ impl Default for StaticParams {
             monitor_prominence: 0.01,
             refine_change: 0.0,
             refine_span: 1e-2,
+            stop_at_monitor_zero: ZeroStop::Never,
         }
     }
 }
@@ -171,7 +209,7 @@ const ARC_OPTIONS: [&str; 5] = [
     "direction",
 ];
 /// Options that apply to arc-length control only (beside those of the control itself).
-const ARC_ONLY: [&str; 9] = [
+const ARC_ONLY: [&str; 10] = [
     "jump",
     "switch_branches",
     "locate_limit_points",
@@ -181,6 +219,7 @@ const ARC_ONLY: [&str; 9] = [
     "monitor_prominence",
     "refine_change",
     "refine_span",
+    "stop_at_monitor_zero",
 ];
 
 /// Names of every option of a static step (refused, as not applying, by dynamic steps).
@@ -308,6 +347,12 @@ impl StaticParams {
         if self.refine_change > 0.0 && self.monitor.is_none() {
             return bad("refine_change needs a monitor (monitor_node and monitor_dof)".into());
         }
+        if self.stop_at_monitor_zero != ZeroStop::Never && self.monitor.is_none() {
+            return bad(format!(
+                "stop_at_monitor_zero = '{}' needs a monitor (monitor_node and monitor_dof)",
+                self.stop_at_monitor_zero.name()
+            ));
+        }
         Ok(())
     }
 
@@ -380,6 +425,17 @@ impl StaticParams {
             p.monitor_prominence = o.take_or("monitor_prominence", d.monitor_prominence)?;
             p.refine_change = o.take_or("refine_change", d.refine_change)?;
             p.refine_span = o.take_or("refine_span", d.refine_span)?;
+            let stop: String = o.take_or("stop_at_monitor_zero", d.stop_at_monitor_zero.name().to_owned())?;
+            p.stop_at_monitor_zero = match stop.as_str() {
+                "never" => ZeroStop::Never,
+                "any" => ZeroStop::Any,
+                "resisting" => ZeroStop::Resisting,
+                other => {
+                    return Err(Error::InvalidParameter(format!(
+                        "stop_at_monitor_zero must be 'never', 'any' or 'resisting' (got '{other}')"
+                    )))
+                }
+            };
         }
         let others: Vec<&str> = LOAD_OPTIONS
             .iter()
@@ -438,6 +494,7 @@ impl StaticParams {
                 m.insert("monitor_prominence".into(), self.monitor_prominence.into());
                 m.insert("refine_change".into(), self.refine_change.into());
                 m.insert("refine_span".into(), self.refine_span.into());
+                m.insert("stop_at_monitor_zero".into(), self.stop_at_monitor_zero.name().into());
             }
         }
         self.newton.write(&mut m);
@@ -504,6 +561,9 @@ pub enum Event {
     Bifurcation,
     /// The stable state reached on the branch chosen at a bifurcation.
     BranchSwitch,
+    /// A zero of the monitored reaction where the path stopped (see
+    /// [`StaticParams::stop_at_monitor_zero`]).
+    MonitorZero,
 }
 
 /// One converged equilibrium state.

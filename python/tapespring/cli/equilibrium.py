@@ -35,8 +35,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="folded equilibrium of the set-up with the additional weight (Table 6)",
         description=(
             "The set-up with the additional weight sags under gravity; the weight's tip is "
-            "pushed down past the buckling of the tapes; the folded equilibrium is where the "
-            "pushing force vanishes. Prints the marker displacements against Table 6; with "
+            "pushed down past the buckling of the tapes until the pushing force vanishes, at "
+            "the folded equilibrium. Prints the marker displacements against Table 6; with "
             "--experiment, against a recorded static identification test too, analysed as "
             "'tapespring trials analyze --kind identification' does."
         ),
@@ -45,7 +45,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--push",
         type=_checked("push", check_push),
         default=EquilibriumSettings.push,
-        help="push of the weight's tip [m] (default %(default)g m)",
+        help=(
+            "largest push of the weight's tip [m]; the push stops at the folded equilibrium "
+            "(default %(default)g m)"
+        ),
     )
     add_comparison_options(
         p,

@@ -229,20 +229,17 @@ class EquilibriumView:
 
     Attributes
     ----------
-    shown : int
-        The states ``0 .. shown - 1`` set the axes' limits.
     xlim, ylim : (float, float) or None
-        Limits of the push [mm] and the force [N] axes, from the finite values shown; None
-        when there are none (an empty path: the axes keep matplotlib's limits).
+        Limits of the push [mm] and the force [N] axes, from the finite values (and zero force);
+        None when there are none (an empty path: the axes keep matplotlib's limits).
     equilibrium_mm : float or None
-        The folded equilibrium's push [mm] (the force's zero, linear between the two states
-        around it), or None when the path has none.
+        The folded equilibrium's push [mm] (the path's last state), or None when the path has
+        none.
     buckle : int or None
-        The state of the largest pushing force before the equilibrium (the buckle, where the
-        tapes snap), or None.
+        The state of the largest pushing force, where the tapes snap, or None when the force
+        never falls after its largest value (a push too short to buckle them).
     """
 
-    shown: int
     xlim: tuple[float, float] | None
     ylim: tuple[float, float] | None
     equilibrium_mm: float | None
@@ -254,52 +251,39 @@ def _padded(lo: float, hi: float, fraction: float) -> tuple[float, float]:
     return lo - pad, hi + pad
 
 
-def equilibrium_view(push_m: Any, force_N: Any, *, beyond: float = 0.1) -> EquilibriumView:
-    """The part of a push path that the equilibrium figure shows.
+def equilibrium_view(push_m: Any, force_N: Any, *, found: bool) -> EquilibriumView:
+    """What the equilibrium figure shows of a push path.
 
-    Past the folded equilibrium the push closes the fold onto itself and the force grows by
-    orders of magnitude (33 kN at 169 mm on the default set-up, against 5 N at the buckle):
-    limits over the whole path would flatten the buckle and the equilibrium into the axis. The
-    view runs from the start to the first state more than `beyond` of the equilibrium's push
-    past it (at least the state after the crossing), and its force range is that of those
-    states, with zero. Without a folded equilibrium it is the whole path.
+    The push stops at the folded equilibrium, a zero of the pushing force located by the
+    solver (``stop_at_monitor_zero``): when `found`, it is the path's last state. The buckle
+    is the state of the largest pushing force if the force falls after it.
 
     Parameters
     ----------
     push_m, force_N : array_like
         The push path: marker 3's drop [m] and the pushing force [N]
         (:class:`tapespring.scenarios.equilibrium.EquilibriumResult`).
-    beyond : float
-        How far past the equilibrium the view goes, as a fraction of its push, >= 0.
+    found : bool
+        Whether the path ends at the folded equilibrium.
 
     Returns
     -------
     EquilibriumView
     """
-    from tapespring.scenarios.equilibrium import folded_crossing
-
     push = 1e3 * np.asarray(push_m, dtype=float)
     force = np.asarray(force_N, dtype=float)
-    n = force.size
-    # The load factor only tells folded_crossing whether the path turns back: not needed here.
-    crossing = folded_crossing(force, np.arange(n, dtype=float)) if n >= 2 else None
-    if crossing is None:
-        eq, buckle, shown = None, None, n
-    else:
-        k, w, _ = crossing
-        eq = float((1.0 - w) * push[k] + w * push[k + 1])
-        buckle = int(np.nanargmax(force[: k + 1])) if np.isfinite(force[: k + 1]).any() else None
-        far = np.flatnonzero(push[k + 1 :] > eq + beyond * abs(eq - push[0]))
-        shown = k + 2 + int(far[0]) if far.size else n
-        shown = min(max(shown, k + 2), n)
-    x, y = push[:shown], force[:shown]
-    finite = np.isfinite(x) & np.isfinite(y)
+    finite = np.isfinite(push) & np.isfinite(force)
+    eq = float(push[-1]) if found and finite.size and finite[-1] else None
+    buckle = None
+    if finite.any():
+        k = int(np.flatnonzero(finite)[np.argmax(force[finite])])
+        if force[k] > 0.0 and np.any(force[k + 1 :][finite[k + 1 :]] < force[k]):
+            buckle = k
     if not finite.any():
-        return EquilibriumView(shown=shown, xlim=None, ylim=None, equilibrium_mm=eq, buckle=buckle)
-    x, y = x[finite], y[finite]
+        return EquilibriumView(xlim=None, ylim=None, equilibrium_mm=eq, buckle=buckle)
+    x, y = push[finite], force[finite]
     ylo, yhi = min(float(np.min(y)), 0.0), max(float(np.max(y)), 0.0)
     return EquilibriumView(
-        shown=shown,
         xlim=_padded(float(np.min(x)), float(np.max(x)), 0.03),
         ylim=_padded(ylo, yhi, 0.08),
         equilibrium_mm=eq,
@@ -307,34 +291,24 @@ def equilibrium_view(push_m: Any, force_N: Any, *, beyond: float = 0.1) -> Equil
     )
 
 
-def _force_text(value: float) -> str:
-    """A force for a legend: whole newtons with thousands separated when large."""
-    return f"{value:,.0f}" if abs(value) >= 100.0 else f"{value:.3g}"
-
-
-def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1) -> Axes:
+def plot_equilibrium(result: Any, *, ax: Axes | None = None) -> Axes:
     """The push path to the folded equilibrium: the pushing force [N] against marker 3's drop
-    (the result's ``push_m``) [mm], the buckle and the folded equilibrium marked.
-
-    The axes show the path up to a little past the equilibrium (:func:`equilibrium_view`);
-    when the path goes on beyond them, a legend entry says how far and to what force.
+    (the result's ``push_m``) [mm], the buckle and the folded equilibrium marked
+    (:func:`equilibrium_view`).
 
     Parameters
     ----------
     result : tapespring.scenarios.equilibrium.EquilibriumResult
-        The push path (``push_m``, ``force_N``) and the equilibrium's stability
-        (``unstable_modes``).
+        The push path (``push_m``, ``force_N``), whether it ends at the folded equilibrium
+        (``found``) and the equilibrium's stability (``unstable_modes``).
     ax : matplotlib Axes, optional
         Where to draw; a new figure is made if None.
-    beyond : float
-        How far past the equilibrium the axes go, as a fraction of its push.
 
     Returns
     -------
     matplotlib Axes
     """
     import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
 
     from ._legend import place_legends
 
@@ -342,7 +316,7 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1
     if ax is None:
         _, ax = plt.subplots(figsize=(6.5, 4.5))
     push, force = 1e3 * np.asarray(result.push_m), np.asarray(result.force_N)
-    view = equilibrium_view(result.push_m, result.force_N, beyond=beyond)
+    view = equilibrium_view(result.push_m, result.force_N, found=result.found)
     zero = ax.axhline(0.0, color="0.5", lw=0.6)
     ax.plot(push, force, "-o", ms=2.5, color="tab:red", label="push path")
     if view.buckle is not None:
@@ -383,22 +357,6 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None, beyond: float = 0.1
     else:
         title = "static identification: no folded equilibrium on the push path (push further)"
     handles, _ = ax.get_legend_handles_labels()
-    if view.shown < push.size:
-        rest = slice(view.shown, None)
-        handles.append(
-            Line2D(
-                [],
-                [],
-                color="tab:red",
-                marker=r"$\rightarrow$",
-                ms=10,
-                ls="none",
-                label=(
-                    f"path goes on, off the axes, to {np.max(push[rest]):.0f} mm and "
-                    f"{_force_text(float(np.max(force[rest])))} N"
-                ),
-            )
-        )
     if view.xlim is not None and view.ylim is not None:
         ax.set_xlim(*view.xlim)
         ax.set_ylim(*view.ylim)

@@ -3,13 +3,16 @@
 The set-up with the additional weight (configuration ``"weight"``, opposite sense) sags under
 gravity (the deployed equilibrium, the reference of the displacements); then the weight's reference
 node, where it is tied to the rod, is pushed down by displacement control on an arc-length path
-past the buckling of the tapes, far enough to fold them (``push``). Along that path the pushing
-force passes through zero where the folded structure is in equilibrium without it: that state is
-the folded equilibrium of the paper's test, located between the two states that bracket the zero
-(linear interpolation of the marker positions in the force). The paper reaches it by releasing the
-push and letting the set-up settle; the located state is the same equilibrium, and its stability
-under the weight is reported (a static release of the push on this set-up has run into limit points
-just before the push vanished, and on a 3 mm mesh into a collapse: see the issue notes).
+past the buckling of the tapes, up to ``push`` at most. Along that path the pushing force passes
+through zero where the folded structure is in equilibrium without it, and the set-up resists the
+push beyond it: the path stops there (the solver's ``stop_at_monitor_zero="resisting"`` on the
+push's reaction), and that state, located until the force is zero to Newton's tolerance, is the
+folded equilibrium of the paper's test. (The zero at the snap, where the force falls through zero,
+is the unstable equilibrium between the two folds: the path goes on past it.) The paper reaches
+the folded equilibrium by releasing the push and letting the set-up settle; the located state is
+the same equilibrium, and its stability under the weight is reported (a static release of the
+push on this set-up has run into limit points just before the push vanished, and on a 3 mm mesh
+into a collapse: see the issue notes).
 
 Displacements are in absolute values, as in Tables 3 and 6, of markers 1-2 (their mean) and 3.
 The model's markers 1 and 2 are the deployment's, on a small interface and in the middle of the
@@ -62,7 +65,6 @@ __all__ = [
     "EquilibriumSettings",
     "check_push",
     "equilibrium",
-    "folded_crossing",
 ]
 
 #: The displacements Table 6 compares: key (of the summaries, [m]), marker label, axis.
@@ -89,8 +91,9 @@ class EquilibriumSettings:
     spec : SetupSpec
         The set-up (configuration ``"weight"``).
     push : float
-        Downward displacement imposed on the weight's reference node (where it is tied to the
-        rod's far end) [m]: past the folded equilibrium (Table 6: marker 3 about 112 mm down).
+        Largest downward displacement imposed on the weight's reference node (where it is tied
+        to the rod's far end) [m]: the push stops at the folded equilibrium (at 0.080 m on the
+        default set-up; Table 6: marker 3 about 112 mm down), so it only needs to lie beyond it.
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th state of the push
         path, for ParaView series (0: none; the last state is always kept when > 0).
@@ -215,17 +218,19 @@ class EquilibriumResult:
     Attributes
     ----------
     found : bool
-        Whether the pushing force rose through zero after the buckle (`folded_crossing`).
+        Whether the push path ends at the folded equilibrium: a zero of the pushing force beyond
+        which the set-up resists the push, located by the solver (the path's last state, event
+        ``"monitor_zero"``). False if the push reached `EquilibriumSettings.push` first.
     markers12_m, marker3_m : ndarray, shape (3,)
         Absolute displacements (x, y, z) [m] of markers 1-2 (mean) and 3 at the equilibrium.
     unstable_modes : int
-        Unstable modes of the equilibrium under the weight alone: those of the held structure
-        (negative eigenvalues of its tangent) and one more if the pushing force falls through
-        zero as the push grows (where the path turns back; -1 if not found).
+        Unstable modes of the equilibrium under the weight alone: the negative eigenvalues of
+        the tangent with the push held (the set-up resists the push there, so releasing it adds
+        none; -1 if not found).
     push_m, force_N : ndarray
-        The push path, from the gravity equilibrium: marker 3's drop [m] and the pushing force
-        [N] (the driver's force on the weight, positive downwards; negative where it holds the
-        folding set-up back).
+        The push path, from the gravity equilibrium to the folded equilibrium (or to the end of
+        the push): marker 3's drop [m] and the pushing force [N] (the driver's force on the
+        weight, positive downwards; negative where it holds the folding set-up back).
     settings : EquilibriumSettings
     results : tapespring.Results
     wall_s : float
@@ -368,31 +373,6 @@ class EquilibriumResult:
         return "\n".join(lines)
 
 
-def folded_crossing(force: np.ndarray, load: np.ndarray) -> tuple[int, float, int] | None:
-    """Where the pushing force `force` [N] (positive pushing the weight down) of a push path
-    vanishes in the folded structure: ``(k, w, extra)`` for the zero at ``(1 - w)`` state `k`
-    plus `w` state ``k + 1`` (linear in the force), or None if the path has none.
-
-    After the buckle the tapes pull the weight down and the driver holds it back (the force is
-    negative); the folded equilibrium is the first zero after the largest holding force, where
-    the force rises through zero (the reference state 0 is left out: a push too short to buckle
-    the tapes, pushing all along, would take its round-off for the holding force). `load` is the
-    path's load factor, along which the driven displacement grows: where it falls between the
-    two states (an arc-length path turning back), the force falls as the push grows, so the
-    structure without the driver has one unstable mode more than the held one (`extra` = 1).
-    """
-    if force.size < 3:
-        return None
-    hold = 1 + int(np.argmin(force[1:]))
-    rises = np.flatnonzero((force[hold:-1] < 0.0) & (force[hold + 1 :] >= 0.0))
-    if rises.size == 0:
-        return None
-    k = hold + int(rises[0])
-    w = float(force[k] / (force[k] - force[k + 1]))
-    extra = int(load[k + 1] < load[k])
-    return k, w, extra
-
-
 def equilibrium(
     settings: EquilibriumSettings = EquilibriumSettings(), *, progress: bool = False
 ) -> EquilibriumResult:
@@ -412,7 +392,16 @@ def equilibrium(
     built = build_setup(settings.spec, configuration="weight", sense="opposite")
     model, tip = built.model, built.tip_node
     drive(model, tip, "uz", built.down * settings.push, "push")
-    steps = [gravity_step(), buckling_step("push", activate=("push",))]
+    steps = [
+        gravity_step(),
+        buckling_step(
+            "push",
+            activate=("push",),
+            monitor_node=tip,
+            monitor_dof="uz",
+            stop_at_monitor_zero="resisting",
+        ),
+    ]
     outputs = Outputs(reactions=((tip, "uz"),), field_interval=settings.field_interval)
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
     names = results.marker_names
@@ -427,20 +416,15 @@ def equilibrium(
     # The force pushing the weight down: the driver's force on the structure (the reaction
     # f_int - f_ext at the driven DOF), whose downward component is `down` times its z component.
     force = built.down * results.reaction(tip, "uz")[idx]
-    found = False
     m12 = m3 = np.full(3, np.nan)
     unstable = -1
-    crossing = folded_crossing(force, results.t[idx])
-    if crossing is not None:
-        k, w, extra = crossing
+    found = bool(pushed.size) and results.event[pushed[-1]] == "monitor_zero"
+    if found:
         pos = results.marker_positions
-        at = (1.0 - w) * pos[idx[k]] + w * pos[idx[k + 1]]
-        d = np.abs(at - pos[ref])
+        d = np.abs(pos[pushed[-1]] - pos[ref])
         m12 = 0.5 * (d[names.index("marker1")] + d[names.index("marker2")])
         m3 = d[marker3]
-        held = max(results.negative_eigenvalues[idx[k]], results.negative_eigenvalues[idx[k + 1]])
-        unstable = int(held) + extra
-        found = True
+        unstable = int(results.negative_eigenvalues[pushed[-1]])
     out = EquilibriumResult(
         found=found,
         markers12_m=m12,

@@ -1,6 +1,7 @@
 //! Events on arc-length paths: limit points of the load factor and extrema of a monitored
 //! reaction are located between converged states, and stretches of the path along which the
-//! monitored reaction changes much are refined, without changing the path itself.
+//! monitored reaction changes much are refined, without changing the path itself. A zero of the
+//! monitored reaction where the path is to stop ([`super::ZeroStop`]) is located the same way.
 //!
 //! Every extra equilibrium is found on a hyperplane across a chord between two converged states
 //! `z_a`, `z_b` (`z = (q, lambda)`, in the arc-length metric): predictor `z_a + s (z_b - z_a)`,
@@ -11,7 +12,7 @@
 //! resumes exactly as it would have.
 
 use super::statics::{Driver, Increment};
-use super::{Event, StaticPath, StaticStep};
+use super::{Event, StaticPath, StaticStep, ZeroStop};
 use crate::assembly::Assembled;
 use crate::element::shell::ElementStress;
 use crate::error::Result;
@@ -27,7 +28,7 @@ pub(super) struct Point {
     pub monitor: f64,
 }
 
-/// Most evaluations spent on locating one event.
+/// Most evaluations spent on locating one event (a zero: twice as many, see `search_zero`).
 const MAX_EVALUATIONS: usize = 12;
 /// Most sub-segments a converged step is split into when refined.
 const MAX_SPLIT: usize = 16;
@@ -49,6 +50,31 @@ pub(super) struct Found {
     pub state: State,
     pub step: StaticStep,
     monitor: f64,
+}
+
+/// Changes of sign of the monitored reaction along a path, beyond its round-off.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct ZeroWatch {
+    /// The last value that exceeded the noise floor (0 before the first).
+    last: f64,
+    /// Largest magnitude so far.
+    largest: f64,
+}
+
+impl ZeroWatch {
+    /// Takes the monitored reaction `g` of the next state of the path: whether its sign differs
+    /// from that of the last value beyond the floor, `prominence` of the largest magnitude so far,
+    /// both sides beyond it now (the round-off of a reaction that starts at zero is no sign).
+    pub fn crossed(&mut self, g: f64, prominence: f64) -> bool {
+        self.largest = self.largest.max(g.abs());
+        let floor = prominence * self.largest;
+        if g.abs() <= floor {
+            return false;
+        }
+        let crossed = self.last.abs() > floor && self.last.signum() != g.signum();
+        self.last = g;
+        crossed
+    }
 }
 
 impl Driver<'_> {
@@ -181,6 +207,107 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
         path.steps.extend(found.into_iter().map(|f| f.step));
     }
     Ok(())
+}
+
+/// After a converged state whose monitored reaction changed sign (see [`ZeroWatch`]): the zero
+/// where the path is to stop, located between the two states of `history` across which the sign
+/// changed, if `stop` asks for a zero of that kind. `None` if it does not, or if those two states
+/// are not both in the history (the sign changed across a jump). The driver's state is unchanged
+/// on return.
+///
+/// # Errors
+/// A failure of the linear algebra when the driver's factorisation is restored.
+pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop) -> Result<Option<Found>> {
+    let (Some(c), Some(m)) = (history.last(), s.params.monitor) else {
+        return Ok(None);
+    };
+    // Back to the first state of the sign the reaction has now.
+    let mut j = history.len() - 1;
+    while j > 0 && history[j - 1].monitor * c.monitor > 0.0 {
+        j -= 1;
+    }
+    if j == 0 {
+        return Ok(None);
+    }
+    let (a, b) = (&history[j - 1], &history[j]);
+    let wanted = match stop {
+        ZeroStop::Never => false,
+        ZeroStop::Any => true,
+        ZeroStop::Resisting => {
+            // The motion of the monitored DOF from `a` to `b`; beyond the zero the reaction, the
+            // force the constraint exerts, pushes along it.
+            let d = m.dof.index();
+            let du = if d < 3 {
+                b.state.x[m.node][d] - a.state.x[m.node][d]
+            } else {
+                (b.state.q[m.node] * a.state.q[m.node].inverse()).scaled_axis()[d - 3]
+            };
+            b.monitor * du > 0.0
+        }
+    };
+    if !wanted {
+        return Ok(None);
+    }
+    let saved = s.save();
+    let monitor = s.monitor_index();
+    let found = search_zero(s, a, b, monitor);
+    s.restore(saved)?;
+    Ok(found.map(|mut f| {
+        f.step.arc = a.arc + f.s * (b.arc - a.arc);
+        f.step.event = Some(Event::MonitorZero);
+        f
+    }))
+}
+
+/// Searches the zero of the monitored reaction between `a` and `b`, where it has opposite signs,
+/// by regula falsi along the chord (Illinois: the end that stays is halved in value so that the
+/// bracket closes from both sides) until the reaction is within Newton's force tolerance of zero
+/// (the state is then an equilibrium without the constraint as closely as the path's states are
+/// with it), or the bracket is narrower than `event_tolerance` in load factor and a thousand times
+/// narrower than that (a reaction that jumps across the zero has none to find); returns the state
+/// where the reaction is smallest. `None` if Newton fails on the first plane tried.
+fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> Option<Found> {
+    let chord = s.difference(&a.state, &b.state);
+    // Bracket (s, reaction, load factor).
+    let mut l = (0.0, a.monitor, a.state.t);
+    let mut r = (1.0, b.monitor, b.state.t);
+    let target = (s.conv.tol_force * s.reference_force()).max(s.conv.round_off);
+    let tol = 1e-3 * s.params.event_tolerance;
+    let mut best: Option<Found> = None;
+    let mut kept = 0_i8;
+    for _ in 0..2 * MAX_EVALUATIONS {
+        let span = r.0 - l.0;
+        // The secant's zero, kept off the ends (a Newton failure there would end the search).
+        let next = (l.0 - l.1 * span / (r.1 - l.1)).clamp(l.0 + 1e-3 * span, r.0 - 1e-3 * span);
+        let Some(f) = s.on_plane(&a.state, &chord, next, monitor) else {
+            break;
+        };
+        let point = (f.s, f.monitor, f.step.lambda);
+        let zero = f.monitor.abs() <= target;
+        if best
+            .as_ref()
+            .is_none_or(|b| f.monitor.abs() < b.monitor.abs())
+        {
+            best = Some(f);
+        }
+        if point.1 * l.1 > 0.0 {
+            l = point;
+            if kept == 1 {
+                r.1 *= 0.5;
+            }
+            kept = 1;
+        } else {
+            r = point;
+            if kept == -1 {
+                l.1 *= 0.5;
+            }
+            kept = -1;
+        }
+        if zero || (r.2 - l.2).abs() < tol {
+            break;
+        }
+    }
+    best
 }
 
 /// The monitored reaction where the monotonic run (in `sense`) ending at `points`' last point

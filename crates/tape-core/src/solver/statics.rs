@@ -41,10 +41,10 @@
 use std::time::Instant;
 
 use super::control::{GiveUp, StepController};
-use super::events::{after_step, before_jump, first_plane, Point};
+use super::events::{after_step, before_jump, first_plane, zero_to_stop_at, Found, Point, ZeroWatch};
 use super::newton::{Convergence, Stall};
 use super::retrace::PathMemory;
-use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats};
+use super::{Control, Event, Rejection, StaticParams, StaticPath, StaticStep, Stats, ZeroStop};
 
 /// Largest condition number of the tangent, as the load's response shows it, under load
 /// control (see `Driver::load_carried`): above it fewer than 4 significant digits are left.
@@ -738,6 +738,14 @@ struct PathState {
     first_unresolved: Option<(f64, f64)>,
     /// Accepted steps in a row that crawled (see `Walk::crawling`).
     crawl: usize,
+    /// The monitored reaction's changes of sign (with `stop_at_monitor_zero`).
+    zero: ZeroWatch,
+    /// The last state pushed onto the history changed the monitored reaction's sign.
+    zero_crossed: bool,
+    /// The zero of the monitored reaction located after the last state, where the path stops.
+    stop_at: Option<Found>,
+    /// The path stopped at a zero of the monitored reaction (not short of `lambda_end`).
+    stopped_at_zero: bool,
 }
 
 /// What the driver does after a stage of an increment.
@@ -969,6 +977,10 @@ impl<'a, 'b> Walk<'a, 'b> {
                 unresolved: None,
                 first_unresolved: None,
                 crawl: 0,
+                zero: ZeroWatch::default(),
+                zero_crossed: false,
+                stop_at: None,
+                stopped_at_zero: false,
             },
             path: StaticPath::default(),
             progress,
@@ -1421,8 +1433,12 @@ impl<'a, 'b> Walk<'a, 'b> {
         self.s.invalidate();
         if let Ok(out) = self.s.increment(&mut trial, &Increment::Load(end - start)) {
             *state = trial;
-            // The path ends here, whatever the progress callback says.
+            // The path ends here, whatever the progress callback says (at a zero of the
+            // monitored reaction short of it if it is to stop there).
             let _ = self.record_step(state, &out);
+            if let Some(found) = self.p.stop_at.take() {
+                self.stop_at_zero(state, found);
+            }
             return Some(Flow::Stop);
         }
         // The final load step failed: retry the crossing with a shorter arc.
@@ -1447,6 +1463,10 @@ impl<'a, 'b> Walk<'a, 'b> {
         let Some(keep_going) = self.record_step(state, &out) else {
             return Flow::Stop;
         };
+        if let Some(found) = self.p.stop_at.take() {
+            self.stop_at_zero(state, found);
+            return Flow::Stop;
+        }
         // Adapt the increment to the Newton effort.
         self.p.control.accept(out.iterations);
         if let (true, Some(first)) = (restarted, self.p.arc_ds) {
@@ -1547,8 +1567,30 @@ impl<'a, 'b> Walk<'a, 'b> {
                 self.path.error = Some(e);
                 return None;
             }
+            let stop = self.s.params.stop_at_monitor_zero;
+            if std::mem::take(&mut self.p.zero_crossed) && stop != ZeroStop::Never {
+                match zero_to_stop_at(&mut self.s, &self.p.history, stop) {
+                    Ok(found) => self.p.stop_at = found,
+                    Err(e) => {
+                        self.path.error = Some(e);
+                        return None;
+                    }
+                }
+            }
         }
         Some(keep_going)
+    }
+
+    /// Ends the path at the located zero `found` of the monitored reaction: the states recorded
+    /// beyond it (the last converged one, and any located or refined after it) are dropped, and
+    /// the step ends in that zero's state.
+    fn stop_at_zero(&mut self, state: &mut State, found: Found) {
+        let arc = found.step.arc;
+        self.path.steps.retain(|st| st.arc <= arc);
+        self.s.stats.steps += 1;
+        self.path.steps.push(found.step);
+        *state = found.state;
+        self.p.stopped_at_zero = true;
     }
 
     /// Appends `state` (with the monitored reaction of the last assembly) to the history of the
@@ -1557,6 +1599,10 @@ impl<'a, 'b> Walk<'a, 'b> {
         let monitor = self
             .monitor
             .map_or(0.0, |i| self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i]);
+        self.p.zero_crossed = self
+            .p
+            .zero
+            .crossed(monitor, self.s.params.monitor_prominence);
         self.p.history.push(Point {
             state: state.clone(),
             arc: self.p.arc,
@@ -1624,7 +1670,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             (self.arc_control, self.lambda_end, &self.s.params.control)
         {
             let short = (state.t - end).abs() > 1e-9 * end.abs().max(1.0);
-            if self.path.error.is_none() && !self.path.cancelled && short {
+            if self.path.error.is_none() && !self.path.cancelled && short && !self.p.stopped_at_zero {
                 self.path.error = Some(Error::StepLimit {
                     step: None,
                     t: state.t,
