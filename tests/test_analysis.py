@@ -155,6 +155,58 @@ def test_release_step_keeps_the_state_continuous_and_markers_follow_their_node()
     assert list(results.ndof) == [results.ndof[0], results.ndof[0] + 1]
 
 
+@examples(ci=6, long=40)
+@given(force=st.floats(1.0, 30.0), sign=st.sampled_from([-1.0, 1.0]))
+def test_a_push_stops_where_the_strip_carries_its_load_alone(force, sign):
+    # The tip held against a constant load is driven past where the load alone puts it (twice
+    # that deflection, up to 15 % of the length: nonlinear); stop_at_monitor_zero ends the path
+    # where the drive carries no force, which is the equilibrium under the load alone: the
+    # same state as a load-controlled solve without the drive, to Newton's tolerance, which is
+    # the residuals' round-off floor here (above the 1e-10 asked of 1 to 30 N; the 1 N case
+    # stops with 1.7e-7 N on the drive, measured, and 1.7e-7 of its deflection from the free
+    # solve; the others within 5e-10 N and 3e-11): 1e-6 N and 1e-6 of the deflection asserted.
+    model, tip = strip()
+    model.add_load(tip, "uz", sign * force, function=ramp(-1.0, 0.0))
+    free = run(model, [Step.static("free", **TIGHT)], outputs=Outputs(field_interval=1))
+    w = free.displacements[-1, tip, 2]
+    model.prescribe(tip, "uz", 2.0 * w, id="drive")
+    step = Step.static(
+        "drive",
+        control="arc-length",
+        monitor_node=tip,
+        monitor_dof="uz",
+        stop_at_monitor_zero="resisting",
+        **TIGHT,
+    )
+    out = Outputs(reactions=((tip, "uz"),), field_interval=1)
+    result = run(model, [step], outputs=out)
+    assert result.event[-1] == "monitor_zero" and result.t[-1] < 1.0
+    assert abs(result.reaction(tip, "uz")[-1]) <= 1e-6
+    np.testing.assert_allclose(
+        result.displacements[-1], free.displacements[-1], rtol=0, atol=1e-6 * abs(w)
+    )
+    # Without the stop the path runs on to the drive's end, twice as far.
+    full = run(model, [Step.static("drive", control="arc-length", **TIGHT)], outputs=out)
+    assert full.displacements[-1, tip, 2] == pytest.approx(2.0 * w, rel=1e-12)
+    assert "monitor_zero" not in full.event
+
+
+def test_stop_at_monitor_zero_is_checked():
+    model, tip = strip()
+    model.prescribe(tip, "uz", 1e-3)
+    for options, message in [
+        ({"stop_at_monitor_zero": "first"}, "'never', 'any' or 'resisting' \\(got 'first'\\)"),
+        ({"stop_at_monitor_zero": "any"}, "stop_at_monitor_zero = 'any' needs a monitor"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            run(model, [Step.static("s", control="arc-length", **options)])
+    with pytest.raises(
+        ValueError, match=r"\['stop_at_monitor_zero'\] do not apply to control 'load'"
+    ):
+        run(model, [Step.static("s", stop_at_monitor_zero="any")])
+    assert step_options("arc-length")["stop_at_monitor_zero"] == "never"
+
+
 def test_time_functions_ramp_and_table():
     model, tip = strip()
     model.add_load(tip, "uz", 1.0, function=ramp(0.0, 0.5))

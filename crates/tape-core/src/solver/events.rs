@@ -263,16 +263,18 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop)
 /// by regula falsi along the chord (Illinois: the end that stays is halved in value so that the
 /// bracket closes from both sides) until the reaction is within Newton's force tolerance of zero
 /// (the state is then an equilibrium without the constraint as closely as the path's states are
-/// with it), or the bracket is narrower than `event_tolerance` in load factor and a thousand times
-/// narrower than that (a reaction that jumps across the zero has none to find); returns the state
-/// where the reaction is smallest. `None` if Newton fails on the first plane tried.
+/// with it), or the bracket has closed to the load factor's round-off (a reaction that jumps
+/// across the zero has none to find), or after `2 MAX_EVALUATIONS` tries; returns the state where
+/// the reaction is smallest. `None` if Newton fails on the first plane tried.
 fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> Option<Found> {
     let chord = s.difference(&a.state, &b.state);
     // Bracket (s, reaction, load factor).
     let mut l = (0.0, a.monitor, a.state.t);
     let mut r = (1.0, b.monitor, b.state.t);
     let target = (s.conv.tol_force * s.reference_force()).max(s.conv.round_off);
-    let tol = 1e-3 * s.params.event_tolerance;
+    // Not the event tolerance: the reaction would be left at its slope times that, which may
+    // exceed Newton's tolerance.
+    let tol = 1e-12 * a.state.t.abs().max(b.state.t.abs()).max(1.0);
     let mut best: Option<Found> = None;
     let mut kept = 0_i8;
     for _ in 0..2 * MAX_EVALUATIONS {
