@@ -195,7 +195,7 @@ def test_stop_at_monitor_zero_is_checked():
     model, tip = strip()
     model.prescribe(tip, "uz", 1e-3)
     for options, message in [
-        ({"stop_at_monitor_zero": "first"}, "'never', 'any' or 'resisting' \\(got 'first'\\)"),
+        ({"stop_at_monitor_zero": "first"}, "expected one of `never`, `any`, `resisting`"),
         ({"stop_at_monitor_zero": "any"}, "stop_at_monitor_zero = 'any' needs a monitor"),
     ]:
         with pytest.raises(ValueError, match=message):

@@ -392,6 +392,18 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert "the paper's experiment:  110.9 mm" in result.describe()
 
 
+def test_a_path_without_the_equilibrium_says_why() -> None:
+    from tapespring.scenarios.equilibrium import _not_found
+
+    # Pushing all along, or still holding back at the end: the push was too short.
+    assert "push further" in _not_found(np.array([0.0, 1.0, 2.0]))
+    assert "push further" in _not_found(np.array([0.0, 2.0, -1.0, -0.5]))
+    # The force rose through zero after its largest holding force but no zero was located (it
+    # jumped across): pushing further would not help, and the message says so.
+    why = _not_found(np.array([0.0, 2.0, -1.0, -0.5, 0.5]))
+    assert "jumped across" in why and "push further" not in why
+
+
 def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 

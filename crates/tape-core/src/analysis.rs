@@ -257,6 +257,18 @@ fn validate(model: &Model, steps: &[Step], outputs: &Outputs) -> Result<()> {
                  which displacement control does not fix: release them in a load or arc-length step"
             )));
         }
+        if releases
+            && step
+                .static_params()
+                .is_some_and(|p| p.stop_at_monitor_zero != ZeroStop::Never)
+        {
+            // The released reactions would be left partly applied where the path stops.
+            return Err(Error::InvalidParameter(format!(
+                "step {k} '{name}': constraints and loads are released over a step's load-factor range, \
+                 which a path that stops at a zero of its monitored reaction does not reach: release \
+                 them in a step before it"
+            )));
+        }
     }
     outputs.reaction_dofs(model)?;
     Ok(())

@@ -159,12 +159,14 @@ pub struct StaticParams {
     pub refine_change: f64,
     /// See `refine_change` (load factor, > 0).
     pub refine_span: f64,
-    /// With a monitor: whether the path stops at a zero of the monitored reaction, located to
-    /// Newton's force tolerance (the reaction within `tol_force` of the reference force of zero,
-    /// as the residual of every state is) and recorded as the path's last state
-    /// ([`Event::MonitorZero`]); the step then ends there, and the next one starts from it. A
-    /// change of sign counts where the reaction on both sides exceeds `monitor_prominence` of its
-    /// largest magnitude on the path so far (round-off at the path's start is no zero).
+    /// Arc-length with a monitor: whether the path stops at a zero of the monitored reaction,
+    /// located to Newton's force tolerance (the reaction within `tol_force` of the reference
+    /// force, or the round-off floor, of zero, as the residual of every state is; a moment over
+    /// the characteristic length) and recorded as the path's last state ([`Event::MonitorZero`]);
+    /// the step then ends there, and the next one starts from it. A change of sign counts where
+    /// the reaction on both sides exceeds that resolution (round-off at the path's start is no
+    /// zero); one across a jump is not located, nor one across which the reaction jumps (logged;
+    /// the path goes on).
     #[serde(default)]
     pub stop_at_monitor_zero: ZeroStop,
 }
@@ -425,17 +427,7 @@ impl StaticParams {
             p.monitor_prominence = o.take_or("monitor_prominence", d.monitor_prominence)?;
             p.refine_change = o.take_or("refine_change", d.refine_change)?;
             p.refine_span = o.take_or("refine_span", d.refine_span)?;
-            let stop: String = o.take_or("stop_at_monitor_zero", d.stop_at_monitor_zero.name().to_owned())?;
-            p.stop_at_monitor_zero = match stop.as_str() {
-                "never" => ZeroStop::Never,
-                "any" => ZeroStop::Any,
-                "resisting" => ZeroStop::Resisting,
-                other => {
-                    return Err(Error::InvalidParameter(format!(
-                        "stop_at_monitor_zero must be 'never', 'any' or 'resisting' (got '{other}')"
-                    )))
-                }
-            };
+            p.stop_at_monitor_zero = o.take_or("stop_at_monitor_zero", d.stop_at_monitor_zero)?;
         }
         let others: Vec<&str> = LOAD_OPTIONS
             .iter()

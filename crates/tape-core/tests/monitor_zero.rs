@@ -275,5 +275,38 @@ fn stop_at_monitor_zero_is_checked() {
     let err = StaticParams::from_options(tape_core::options::Options::new(o, "static step"))
         .expect_err("unknown value")
         .to_string();
-    assert!(err.contains("'never', 'any' or 'resisting' (got 'first')"), "{err}");
+    assert!(
+        err.contains("stop_at_monitor_zero") && err.contains("expected one of `never`, `any`, `resisting`"),
+        "{err}"
+    );
+}
+
+/// A step that releases constraints or loads cannot stop early: the released reactions are
+/// ramped off over its whole load-factor range and would be left partly applied.
+#[test]
+fn a_releasing_step_cannot_stop_at_a_zero() -> Result<()> {
+    let (mut model, mut steps, _) = buckled_strip(ZeroStop::Any)?;
+    let x0 = model.mesh.node_set("x0")?.to_vec();
+    model.add_constraint(Constraint {
+        id: Some("extra".into()),
+        node: x0[0],
+        dof: Dof::Uz,
+        value: 0.0,
+        function: TimeFunction::Linear,
+        active: true,
+    })?;
+    steps[1].deactivate.push("extra".into());
+    let outputs = Outputs {
+        reactions: vec![],
+        field_interval: 0,
+    };
+    let err = run(&model, &steps, &outputs, &mut |_| true)
+        .err()
+        .expect("refused before running")
+        .to_string();
+    assert!(
+        err.contains("step 1 'drive'") && err.contains("stops at a zero"),
+        "{err}"
+    );
+    Ok(())
 }

@@ -355,7 +355,7 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None) -> Axes:
         )
         title = "static identification: the folded equilibrium, where the push vanishes"
     else:
-        title = "static identification: no folded equilibrium on the push path (push further)"
+        title = "static identification: no folded equilibrium located on the push path"
     handles, _ = ax.get_legend_handles_labels()
     if view.xlim is not None and view.ylim is not None:
         ax.set_xlim(*view.xlim)

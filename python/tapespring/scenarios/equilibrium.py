@@ -211,6 +211,21 @@ def _paper_table6(experiment: bool = False) -> dict[str, float]:
     return {key: getattr(p, key.removesuffix("_m") + suffix) for key, _, _ in TABLE6_ROWS}
 
 
+def _not_found(force_N: np.ndarray) -> str:
+    """Why a push path has no folded equilibrium: too short, or the force rose through zero
+    after its largest holding force without the solver locating the zero (it jumped across)."""
+    f = np.asarray(force_N, dtype=float)
+    if f.size >= 3:
+        hold = 1 + int(np.nanargmin(f[1:]))
+        if f[hold] < 0.0 and np.any((f[hold:-1] < 0.0) & (f[hold + 1 :] >= 0.0)):
+            return (
+                "no folded equilibrium on the push path: the pushing force rose through zero "
+                "without a state in between bringing it to zero (it jumped across: see the "
+                "solver's warning)"
+            )
+    return "no folded equilibrium on the push path (push further)"
+
+
 @dataclass(frozen=True)
 class EquilibriumResult:
     """The folded equilibrium of the static identification configuration.
@@ -294,8 +309,7 @@ class EquilibriumResult:
 
         if not self.found:
             raise ValueError(
-                "the simulation found no folded equilibrium on the push path (push further): "
-                "nothing to compare with"
+                f"the simulation found {_not_found(self.force_N)}: nothing to compare with"
             )
         if isinstance(trial, IdentificationResult):
             measured = trial
@@ -347,7 +361,7 @@ class EquilibriumResult:
             f"{s['newton_iterations']} Newton iterations, wall time {self.wall_s:.1f} s"
         ]
         if not self.found:
-            lines.append("  no folded equilibrium on the push path (push further)")
+            lines.append(f"  {_not_found(self.force_N)}")
             return "\n".join(lines)
         ours, paper, measured, diff = (
             s["marker_displacements_m"],

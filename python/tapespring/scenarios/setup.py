@@ -331,9 +331,10 @@ class SetupSpec:
       :mod:`tapespring.scenarios.equilibrium`), by least squares on the paper's meshes: the
       weight's mass (170 g) and length along x (30 mm) and the markers' height. The four
       displacements come out 25.80 / 78.16 mm (markers 1-2, x / z) and 43.82 / 110.92 mm
-      (marker 3) against 25.7 / 77.9 and 43.7 / 111.6 (within 0.6 %; the pinning was made when
-      the equilibrium was interpolated between the push path's states, which put it up to 0.4 %
-      short: 25.65 / 77.86 and 43.56 / 110.51 mm then, within 1.0 %). These three set the
+      (marker 3) against 25.7 / 77.9 and 43.7 / 111.6 (within 0.6 %). The pinning was made when
+      the equilibrium was interpolated between the push path's states (25.65 / 77.86 and 43.56 /
+      110.51 mm then, within 1.0 %; the same interpolation on the code of 2026-11-27 gave 25.70 /
+      77.94 and 43.64 / 110.61, up to 0.4 % short of the located state). These three set the
       folded geometry: the mass the fold angle (the weight's moment balances the tapes' constant
       folded moment), the length the ratio of marker 3's drop to markers 1-2's, the height the
       ratios dx/dz (0.33 and 0.39; markers in the tapes' plane give about 0.5). Every other

@@ -52,28 +52,35 @@ pub(super) struct Found {
     monitor: f64,
 }
 
-/// Changes of sign of the monitored reaction along a path, beyond its round-off.
+/// Changes of sign of the monitored reaction along a path, beyond its resolution.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct ZeroWatch {
-    /// The last value that exceeded the noise floor (0 before the first).
+    /// The last value beyond the resolution of its state (0 before the first).
     last: f64,
-    /// Largest magnitude so far.
-    largest: f64,
 }
 
 impl ZeroWatch {
-    /// Takes the monitored reaction `g` of the next state of the path: whether its sign differs
-    /// from that of the last value beyond the floor, `prominence` of the largest magnitude so far,
-    /// both sides beyond it now (the round-off of a reaction that starts at zero is no sign).
-    pub fn crossed(&mut self, g: f64, prominence: f64) -> bool {
-        self.largest = self.largest.max(g.abs());
-        let floor = prominence * self.largest;
-        if g.abs() <= floor {
+    /// Takes the monitored reaction `g` of the next state of the path and its resolution
+    /// `floor` there (see [`Driver::zero_floor`]): whether its sign differs from that of the last
+    /// value beyond its own floor. Values within the floor (the round-off of a reaction that
+    /// starts at zero) carry no sign.
+    pub fn crossed(&mut self, g: f64, floor: f64) -> bool {
+        if g.is_nan() || g.abs() <= floor {
             return false;
         }
-        let crossed = self.last.abs() > floor && self.last.signum() != g.signum();
+        let crossed = self.last != 0.0 && self.last.signum() != g.signum();
         self.last = g;
         crossed
+    }
+}
+
+/// Motion of DOF `d` (0-2 translations, 3-5 rotations) of `node` from `a` to `b`: the
+/// translation, or the spatial rotation vector `log(R_b R_a^T)`'s component.
+fn dof_motion(a: &State, b: &State, node: usize, d: usize) -> f64 {
+    if d < 3 {
+        b.x[node][d] - a.x[node][d]
+    } else {
+        (b.q[node] * a.q[node].inverse()).scaled_axis()[d - 3]
     }
 }
 
@@ -109,16 +116,20 @@ impl Driver<'_> {
             .dofs
             .free_dofs
             .iter()
-            .map(|&(node, dof)| {
-                let d = dof.index();
-                if d < 3 {
-                    b.x[node][d] - a.x[node][d]
-                } else {
-                    (b.q[node] * a.q[node].inverse()).scaled_axis()[d - 3]
-                }
-            })
+            .map(|&(node, dof)| dof_motion(a, b, node, dof.index()))
             .collect();
         (dq, b.t - a.t)
+    }
+
+    /// The monitored reaction's resolution at the last assembled state \[N or N m\]: what Newton
+    /// leaves of a residual (`tol_force` of the reference force, or the round-off floor), a moment
+    /// taken times the characteristic length as the force norm weighs rotations.
+    pub(super) fn zero_floor(&self) -> f64 {
+        let floor = (self.conv.tol_force * self.reference_force()).max(self.conv.round_off);
+        match self.params.monitor {
+            Some(m) if m.dof.is_rotation() => floor * self.system.char_length,
+            _ => floor,
+        }
     }
 
     /// The equilibrium on the plane at fraction `s` of the chord from `from` (`None` if Newton
@@ -211,9 +222,10 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
 
 /// After a converged state whose monitored reaction changed sign (see [`ZeroWatch`]): the zero
 /// where the path is to stop, located between the two states of `history` across which the sign
-/// changed, if `stop` asks for a zero of that kind. `None` if it does not, or if those two states
-/// are not both in the history (the sign changed across a jump). The driver's state is unchanged
-/// on return.
+/// changed, if `stop` asks for a zero of that kind. `None` if it does not, if those two states are
+/// not both in the history (the sign changed across a jump), or if no zero is found between them
+/// (the reaction jumps across zero there, or Newton fails: logged, and the path goes on). The
+/// driver's pieces are those of the zero on return if one is found, unchanged otherwise.
 ///
 /// # Errors
 /// A failure of the linear algebra when the driver's factorisation is restored.
@@ -230,69 +242,70 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop)
         return Ok(None);
     }
     let (a, b) = (&history[j - 1], &history[j]);
-    let wanted = match stop {
-        ZeroStop::Never => false,
-        ZeroStop::Any => true,
-        ZeroStop::Resisting => {
-            // The motion of the monitored DOF from `a` to `b`; beyond the zero the reaction, the
-            // force the constraint exerts, pushes along it.
-            let d = m.dof.index();
-            let du = if d < 3 {
-                b.state.x[m.node][d] - a.state.x[m.node][d]
-            } else {
-                (b.state.q[m.node] * a.state.q[m.node].inverse()).scaled_axis()[d - 3]
-            };
-            b.monitor * du > 0.0
-        }
-    };
-    if !wanted {
+    // The motion of the monitored DOF from `a` to `b`: beyond a resisting zero the reaction, the
+    // force the constraint exerts, pushes along it. A DOF that does not move has none.
+    let du = dof_motion(&a.state, &b.state, m.node, m.dof.index());
+    if stop == ZeroStop::Never || (stop == ZeroStop::Resisting && b.monitor * du <= 0.0) {
         return Ok(None);
     }
     let saved = s.save();
     let monitor = s.monitor_index();
-    let found = search_zero(s, a, b, monitor);
+    let found = match search_zero(s, a, b, monitor) {
+        Some(mut f) => {
+            f.step.arc = a.arc + f.s * (b.arc - a.arc);
+            f.step.event = Some(Event::MonitorZero);
+            if s.params.switch_branches {
+                discount_neutral(s, &mut f)?;
+            }
+            Some(f)
+        }
+        None => {
+            log::warn!(
+                "the monitored reaction changed sign between load factors {} and {} ({:.3e} to \
+                 {:.3e}) but no state there brings it within its resolution of zero (it jumps \
+                 across zero, or Newton failed): the path goes on",
+                a.state.t,
+                b.state.t,
+                a.monitor,
+                b.monitor
+            );
+            None
+        }
+    };
     s.restore(saved)?;
-    Ok(found.map(|mut f| {
-        f.step.arc = a.arc + f.s * (b.arc - a.arc);
-        f.step.event = Some(Event::MonitorZero);
-        f
-    }))
+    Ok(found)
 }
 
 /// Searches the zero of the monitored reaction between `a` and `b`, where it has opposite signs,
 /// by regula falsi along the chord (Illinois: the end that stays is halved in value so that the
-/// bracket closes from both sides) until the reaction is within Newton's force tolerance of zero
-/// (the state is then an equilibrium without the constraint as closely as the path's states are
-/// with it), or the bracket has closed to the load factor's round-off (a reaction that jumps
-/// across the zero has none to find), or after `2 MAX_EVALUATIONS` tries; returns the state where
-/// the reaction is smallest. `None` if Newton fails on the first plane tried.
+/// bracket closes from both sides; bisection where Newton fails on the secant's plane), until the
+/// reaction is within its resolution of zero ([`Driver::zero_floor`]: the state is then an
+/// equilibrium without the constraint as closely as the path's states are with it). `None` if the
+/// bracket closes to the load factor's round-off or `2 MAX_EVALUATIONS` planes are tried first (a
+/// reaction that jumps across zero has none to find), or Newton fails on the secant's plane and
+/// the bisection's. Where the reaction crosses zero more than once between `a` and `b` (steps
+/// longer than the reaction's wiggles), the zero found may be any of them.
 fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> Option<Found> {
     let chord = s.difference(&a.state, &b.state);
-    // Bracket (s, reaction, load factor).
+    let floor = s.zero_floor();
+    // Bracket (s, reaction as regula falsi weighs it, load factor): `l` on `a`'s side of the zero.
     let mut l = (0.0, a.monitor, a.state.t);
     let mut r = (1.0, b.monitor, b.state.t);
-    let target = (s.conv.tol_force * s.reference_force()).max(s.conv.round_off);
-    // Not the event tolerance: the reaction would be left at its slope times that, which may
-    // exceed Newton's tolerance.
     let tol = 1e-12 * a.state.t.abs().max(b.state.t.abs()).max(1.0);
-    let mut best: Option<Found> = None;
     let mut kept = 0_i8;
     for _ in 0..2 * MAX_EVALUATIONS {
         let span = r.0 - l.0;
-        // The secant's zero, kept off the ends (a Newton failure there would end the search).
-        let next = (l.0 - l.1 * span / (r.1 - l.1)).clamp(l.0 + 1e-3 * span, r.0 - 1e-3 * span);
-        let Some(f) = s.on_plane(&a.state, &chord, next, monitor) else {
-            break;
-        };
-        let point = (f.s, f.monitor, f.step.lambda);
-        let zero = f.monitor.abs() <= target;
-        if best
-            .as_ref()
-            .is_none_or(|b| f.monitor.abs() < b.monitor.abs())
-        {
-            best = Some(f);
+        // The secant's zero, kept off the ends.
+        let secant = (l.0 - l.1 * span / (r.1 - l.1)).clamp(l.0 + 1e-3 * span, r.0 - 1e-3 * span);
+        let f = s
+            .on_plane(&a.state, &chord, secant, monitor)
+            .or_else(|| s.on_plane(&a.state, &chord, l.0 + 0.5 * span, monitor))?;
+        let g = f.monitor;
+        if g.abs() <= floor {
+            return Some(f);
         }
-        if point.1 * l.1 > 0.0 {
+        let point = (f.s, g, f.step.lambda);
+        if g * a.monitor > 0.0 {
             l = point;
             if kept == 1 {
                 r.1 *= 0.5;
@@ -305,11 +318,11 @@ fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> 
             }
             kept = -1;
         }
-        if zero || (r.2 - l.2).abs() < tol {
-            break;
+        if (r.2 - l.2).abs() < tol {
+            return None;
         }
     }
-    best
+    None
 }
 
 /// The monitored reaction where the monotonic run (in `sense`) ending at `points`' last point

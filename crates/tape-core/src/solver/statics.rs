@@ -742,8 +742,6 @@ struct PathState {
     zero: ZeroWatch,
     /// The last state pushed onto the history changed the monitored reaction's sign.
     zero_crossed: bool,
-    /// The zero of the monitored reaction located after the last state, where the path stops.
-    stop_at: Option<Found>,
     /// The path stopped at a zero of the monitored reaction (not short of `lambda_end`).
     stopped_at_zero: bool,
 }
@@ -979,7 +977,6 @@ impl<'a, 'b> Walk<'a, 'b> {
                 crawl: 0,
                 zero: ZeroWatch::default(),
                 zero_crossed: false,
-                stop_at: None,
                 stopped_at_zero: false,
             },
             path: StaticPath::default(),
@@ -1433,11 +1430,11 @@ impl<'a, 'b> Walk<'a, 'b> {
         self.s.invalidate();
         if let Ok(out) = self.s.increment(&mut trial, &Increment::Load(end - start)) {
             *state = trial;
-            // The path ends here, whatever the progress callback says (at a zero of the
-            // monitored reaction short of it if it is to stop there).
-            let _ = self.record_step(state, &out);
-            if let Some(found) = self.p.stop_at.take() {
-                self.stop_at_zero(state, found);
+            // The path ends here (at a zero of the monitored reaction short of it if it is to
+            // stop there).
+            if self.record_step(state, &out) == Some(false) {
+                // The progress callback's wish stops the analysis, not only this step.
+                self.path.cancelled = true;
             }
             return Some(Flow::Stop);
         }
@@ -1463,8 +1460,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         let Some(keep_going) = self.record_step(state, &out) else {
             return Flow::Stop;
         };
-        if let Some(found) = self.p.stop_at.take() {
-            self.stop_at_zero(state, found);
+        if self.p.stopped_at_zero {
+            // The progress callback's wish stops the analysis, not only this step.
+            self.path.cancelled = !keep_going;
             return Flow::Stop;
         }
         // Adapt the increment to the Newton effort.
@@ -1532,9 +1530,10 @@ impl<'a, 'b> Walk<'a, 'b> {
     }
 
     /// Records the converged `state` reached by the increment `out` (and what is located or
-    /// refined after it); `Some(keep_going)` as the progress callback says, `None` on an error
-    /// (recorded on the path).
-    fn record_step(&mut self, state: &State, out: &Outcome) -> Option<bool> {
+    /// refined after it; at a zero of the monitored reaction where the path is to stop, `state`
+    /// becomes that zero's, see [`Self::stop_at_zero`]); `Some(keep_going)` as the progress
+    /// callback says, `None` on an error (recorded on the path).
+    fn record_step(&mut self, state: &mut State, out: &Outcome) -> Option<bool> {
         self.p.max_load = self.p.max_load.max(self.s.force_norm(&self.s.asm.f_ext));
         self.p.unresolved = self
             .s
@@ -1570,7 +1569,8 @@ impl<'a, 'b> Walk<'a, 'b> {
             let stop = self.s.params.stop_at_monitor_zero;
             if std::mem::take(&mut self.p.zero_crossed) && stop != ZeroStop::Never {
                 match zero_to_stop_at(&mut self.s, &self.p.history, stop) {
-                    Ok(found) => self.p.stop_at = found,
+                    Ok(Some(found)) => self.stop_at_zero(state, found),
+                    Ok(None) => {}
                     Err(e) => {
                         self.path.error = Some(e);
                         return None;
@@ -1587,6 +1587,11 @@ impl<'a, 'b> Walk<'a, 'b> {
     fn stop_at_zero(&mut self, state: &mut State, found: Found) {
         let arc = found.step.arc;
         self.path.steps.retain(|st| st.arc <= arc);
+        // The step's end is judged at the zero, not at the state dropped.
+        let st = &found.step;
+        self.p.unresolved = self
+            .s
+            .unresolved(st.residual, self.p.max_load, st.lambda, st.iterations);
         self.s.stats.steps += 1;
         self.path.steps.push(found.step);
         *state = found.state;
@@ -1599,10 +1604,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         let monitor = self
             .monitor
             .map_or(0.0, |i| self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i]);
-        self.p.zero_crossed = self
-            .p
-            .zero
-            .crossed(monitor, self.s.params.monitor_prominence);
+        if self.s.params.stop_at_monitor_zero != ZeroStop::Never {
+            self.p.zero_crossed = self.p.zero.crossed(monitor, self.s.zero_floor());
+        }
         self.p.history.push(Point {
             state: state.clone(),
             arc: self.p.arc,
