@@ -371,6 +371,7 @@ def test_result_dict_has_every_key_with_consistent_shapes():
         "symbolic_analyses",
         "assembly_s",
         "solve_s",
+        "factorisation_s",
         "wall_s",
     }
     step = r["settings"]["steps"][0]

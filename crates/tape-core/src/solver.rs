@@ -518,6 +518,9 @@ pub struct Stats {
     pub assembly_s: f64,
     /// Time in factorisation and solves \[s\].
     pub solve_s: f64,
+    /// Of `solve_s`, the time in numeric factorisations \[s\].
+    #[serde(default)]
+    pub factorisation_s: f64,
     /// Wall time \[s\].
     pub wall_s: f64,
 }
@@ -534,6 +537,7 @@ impl Stats {
         self.symbolic_analyses += other.symbolic_analyses;
         self.assembly_s += other.assembly_s;
         self.solve_s += other.solve_s;
+        self.factorisation_s += other.factorisation_s;
         self.wall_s += other.wall_s;
     }
 }

@@ -301,8 +301,7 @@ fn a_releasing_step_cannot_stop_at_a_zero() -> Result<()> {
         field_interval: 0,
     };
     let err = run(&model, &steps, &outputs, &mut |_| true)
-        .err()
-        .expect("refused before running")
+        .expect_err("refused before running")
         .to_string();
     assert!(
         err.contains("step 1 'drive'") && err.contains("stops at a zero"),

@@ -852,6 +852,7 @@ impl Integrator<'_> {
                 }
                 self.factor_h = params.reuse_factorisation.then_some(h);
                 self.stats.factorisations += 1;
+                self.stats.factorisation_s += t.elapsed().as_secs_f64();
             }
             previous = res;
             // The next correction is stale unless it comes from a matrix built at this iterate.

@@ -375,6 +375,7 @@ impl Driver<'_> {
                 let t = std::time::Instant::now();
                 self.system.linear.factorize(&k)?;
                 self.stats.factorisations += 1;
+                self.stats.factorisation_s += t.elapsed().as_secs_f64();
                 self.factorised = false;
                 if self.system.linear.negative_eigenvalues().unwrap_or(1) > 0 {
                     // K + C must be positive definite for a descent step.

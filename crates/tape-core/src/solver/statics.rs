@@ -323,7 +323,9 @@ impl Driver<'_> {
             self.system.linear.factorize(&self.asm.k_ff)?;
             self.stats.factorisations += 1;
             self.factorised = true;
-            self.stats.solve_s += t.elapsed().as_secs_f64();
+            let dt = t.elapsed().as_secs_f64();
+            self.stats.solve_s += dt;
+            self.stats.factorisation_s += dt;
         }
         Ok(())
     }
