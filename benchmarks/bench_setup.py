@@ -67,7 +67,10 @@ def line(name: str, result, simulated: float) -> None:
         f"{name:28s} ndof {last_ndof(r):6d}  simulated {simulated:6.3g} s  "
         f"steps {int(dyn.get('steps', 0)):6d} (rejected {int(dyn.get('cutbacks', 0)):5d})  "
         f"iterations {int(stats.get('iterations', 0)):7d}  "
-        f"factorisations {int(stats.get('factorisations', 0)):7d}  wall {result.wall_s:8.1f} s",
+        f"factorisations {int(stats.get('factorisations', 0)):7d}  wall {result.wall_s:8.1f} s "
+        f"(assembly {stats.get('assembly_s', 0.0):.1f} s, factorisations "
+        f"{stats.get('factorisation_s', 0.0):.1f} s, solves "
+        f"{stats.get('solve_s', 0.0) - stats.get('factorisation_s', 0.0):.1f} s)",
         flush=True,
     )
 
