@@ -40,10 +40,16 @@ impl Options {
     /// Removes and converts option `key`; `None` if absent or null.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `key` if its value has the wrong type.
+    /// [`Error::InvalidParameter`] naming `key` if its value has the wrong type. No option is a
+    /// mapping: one is refused as such, since serde would read `{"any": null}` as the name
+    /// `"any"` of an enumerated option (a DOF, `stop_at_monitor_zero`).
     pub fn take<T: DeserializeOwned>(&mut self, key: &str) -> Result<Option<T>> {
         match self.map.remove(key) {
             None | Some(Value::Null) => Ok(None),
+            Some(v @ Value::Object(_)) => Err(Error::InvalidParameter(format!(
+                "{} option {key} = {v}: a mapping, where a number, a string, a bool or a list is expected",
+                self.what
+            ))),
             Some(v) => {
                 let shown = v.to_string();
                 serde_json::from_value(v)
@@ -110,6 +116,16 @@ mod tests {
         let err = o.take::<usize>("b").unwrap_err().to_string();
         assert!(err.contains("option b"), "{err}");
         assert_eq!(o.take_or("missing", 7usize).unwrap(), 7);
+        // An enumerated option's name given as a one-key mapping (serde's form of a unit
+        // variant) is refused, not read as the name.
+        let Value::Object(map) = json!({"dof": {"uz": null}}) else {
+            unreachable!()
+        };
+        let err = Options::new(map, "test")
+            .take::<crate::Dof>("dof")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("option dof = {\"uz\":null}: a mapping"), "{err}");
         let err = o.finish(&["c"], "this control").unwrap_err().to_string();
         assert!(
             err.contains("['c'] do not apply to this control") && err.contains("['d'] are not options"),
