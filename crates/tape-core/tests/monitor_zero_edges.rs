@@ -212,7 +212,7 @@ fn a_reaction_that_starts_at_zero_is_no_zero_to_stop_at() -> Result<()> {
     let h = &r.history;
     assert!(h.reactions[0] == 0.0, "the premise: {} N at the start", h.reactions[0]);
     assert_eq!(zeros(h), 0, "stopped at the start, t = {:?}", h.t);
-    assert!((h.t[h.len() - 1] - 1.0).abs() < 1e-12, "ended at {}", h.t[h.len() - 1]);
+    assert_ends_at(h, 1.0, "the path");
 
     // (b) The loaded strip's free state, then the drive switched on there.
     let held = Held::new(Dof::Uz, P, 0.0)?;
@@ -268,11 +268,7 @@ fn a_reaction_that_starts_at_zero_is_no_zero_to_stop_at() -> Result<()> {
             "first increment {first}: stopped at t = {:?}",
             &h.t[start..]
         );
-        assert!(
-            (h.t[h.len() - 1] - 2.0).abs() < 1e-12,
-            "first increment {first}: ended at {}",
-            h.t[h.len() - 1]
-        );
+        assert_ends_at(h, 2.0, &format!("first increment {first}"));
     }
     // At these sizes the motion's part of the first reaction is of the order of round-off: it
     // must show in one of the two smallest at least, or the case is not tried.
@@ -295,13 +291,15 @@ fn a_reaction_that_starts_at_zero_is_no_zero_to_stop_at() -> Result<()> {
         let start = records(h, 1)[0] - 1;
         assert_eq!(h.event[start], Some(Event::MonitorZero), "the first step's zero");
         assert_eq!(zeros(h), 1, "first increment {first}: t = {:?}", &h.t[start..]);
-        assert!(
-            (h.t[h.len() - 1] - 1.0).abs() < 1e-12,
-            "first increment {first}: ended at {}",
-            h.t[h.len() - 1]
-        );
+        assert_ends_at(h, 1.0, &format!("first increment {first}"));
     }
     Ok(())
+}
+
+/// The history's last record lies at load factor `t` (to round-off).
+fn assert_ends_at(h: &History, t: f64, case: &str) {
+    let last = h.t[h.len() - 1];
+    assert!((last - t).abs() < 1e-12, "{case}: ended at {last}");
 }
 
 /// Case 2. The zero at or just short of `lambda_end`, where the path's last arc step is replaced
@@ -667,11 +665,7 @@ fn a_sign_change_across_a_jump_is_passed_and_a_later_zero_found() -> Result<()> 
     assert!(r.error.is_none(), "resisting on the start: {:?}", r.error);
     assert_eq!(zeros(&r.history), 0, "resisting on a support that does not move");
     let h = &r.history;
-    assert!(
-        (h.t[h.len() - 1] - 2.0).abs() < 1e-12,
-        "resisting on the start: ended at t = {}",
-        h.t[h.len() - 1]
-    );
+    assert_ends_at(h, 2.0, "resisting on the start");
     Ok(())
 }
 
