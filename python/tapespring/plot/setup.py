@@ -274,13 +274,11 @@ def equilibrium_view(push_m: Any, force_N: Any, *, found: bool) -> EquilibriumVi
     force = np.asarray(force_N, dtype=float)
     finite = np.isfinite(push) & np.isfinite(force)
     eq = float(push[-1]) if found and finite.size and finite[-1] else None
-    buckle = None
-    if finite.any():
-        k = int(np.flatnonzero(finite)[np.argmax(force[finite])])
-        if force[k] > 0.0 and np.any(force[k + 1 :][finite[k + 1 :]] < force[k]):
-            buckle = k
     if not finite.any():
-        return EquilibriumView(xlim=None, ylim=None, equilibrium_mm=eq, buckle=buckle)
+        return EquilibriumView(xlim=None, ylim=None, equilibrium_mm=eq, buckle=None)
+    k = int(np.flatnonzero(finite)[np.argmax(force[finite])])
+    falls = force[k] > 0.0 and np.any(force[k + 1 :][finite[k + 1 :]] < force[k])
+    buckle = k if falls else None
     x, y = push[finite], force[finite]
     ylo, yhi = min(float(np.min(y)), 0.0), max(float(np.max(y)), 0.0)
     return EquilibriumView(
@@ -356,7 +354,6 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None) -> Axes:
         title = "static identification: the folded equilibrium, where the push vanishes"
     else:
         title = "static identification: no folded equilibrium located on the push path"
-    handles, _ = ax.get_legend_handles_labels()
     if view.xlim is not None and view.ylim is not None:
         ax.set_xlim(*view.xlim)
         ax.set_ylim(*view.ylim)
@@ -368,7 +365,7 @@ def plot_equilibrium(result: Any, *, ax: Axes | None = None) -> Axes:
     assert fig is not None  # an Axes is always in a figure
     place_legends(
         fig,
-        [(ax, {"handles": handles, "fontsize": 8, "framealpha": 0.9})],
+        [(ax, {"fontsize": 8, "framealpha": 0.9})],
         tight=new,
         ignore=[zero],
     )

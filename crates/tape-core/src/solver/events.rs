@@ -222,14 +222,17 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
 
 /// After a converged state whose monitored reaction changed sign (see [`ZeroWatch`]): the zero
 /// where the path is to stop, located between the two states of `history` across which the sign
-/// changed, if `stop` asks for a zero of that kind. `None` if it does not, if those two states are
-/// not both in the history (the sign changed across a jump), or if no zero is found between them
-/// (the reaction jumps across zero there, or Newton fails: logged, and the path goes on). The
-/// driver's pieces are those of the zero on return if one is found, unchanged otherwise.
+/// changed, if `stop_at_monitor_zero` asks for a zero of that kind. `None` if it does not, if
+/// those two states are not both in the history (the sign changed across a jump), or if no zero
+/// is found between them (the reaction jumps across zero there, or Newton fails: logged, and the
+/// path goes on). The
+/// driver's pieces are those of the zero on return if one is found (the path ends there: they are
+/// not restored, which would factorise the last state's tangent again), unchanged otherwise.
 ///
 /// # Errors
 /// A failure of the linear algebra when the driver's factorisation is restored.
-pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop) -> Result<Option<Found>> {
+pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point]) -> Result<Option<Found>> {
+    let stop = s.params.stop_at_monitor_zero;
     let (Some(c), Some(m)) = (history.last(), s.params.monitor) else {
         return Ok(None);
     };
@@ -250,14 +253,14 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop)
     }
     let saved = s.save();
     let monitor = s.monitor_index();
-    let found = match search_zero(s, a, b, monitor) {
+    match search_zero(s, a, b, monitor) {
         Some(mut f) => {
             f.step.arc = a.arc + f.s * (b.arc - a.arc);
             f.step.event = Some(Event::MonitorZero);
             if s.params.switch_branches {
                 discount_neutral(s, &mut f)?;
             }
-            Some(f)
+            Ok(Some(f))
         }
         None => {
             log::warn!(
@@ -269,11 +272,10 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point], stop: ZeroStop)
                 a.monitor,
                 b.monitor
             );
-            None
+            s.restore(saved)?;
+            Ok(None)
         }
-    };
-    s.restore(saved)?;
-    Ok(found)
+    }
 }
 
 /// Searches the zero of the monitored reaction between `a` and `b`, where it has opposite signs,

@@ -1568,9 +1568,9 @@ impl<'a, 'b> Walk<'a, 'b> {
                 self.path.error = Some(e);
                 return None;
             }
-            let stop = self.s.params.stop_at_monitor_zero;
-            if std::mem::take(&mut self.p.zero_crossed) && stop != ZeroStop::Never {
-                match zero_to_stop_at(&mut self.s, &self.p.history, stop) {
+            // Set only where the path is to stop at a zero (`push_history`).
+            if std::mem::take(&mut self.p.zero_crossed) {
+                match zero_to_stop_at(&mut self.s, &self.p.history) {
                     Ok(Some(found)) => self.stop_at_zero(state, found),
                     Ok(None) => {}
                     Err(e) => {
