@@ -207,6 +207,21 @@ def test_stop_at_monitor_zero_is_checked():
     assert step_options("arc-length")["stop_at_monitor_zero"] == "never"
 
 
+def test_stable_names_the_steps_without_a_count_and_the_static_records_keep_theirs():
+    model, tip = strip(density=RHO)
+    model.add_load(tip, "uz", 1.0)
+    steps = [Step.static("push", increments=2, stability=True), Step.dynamic("free", duration=1e-3)]
+    results = run(model, steps)
+    with pytest.raises(ValueError, match=r"steps 1 \('free', dynamic\).*in_step\(k\)") as info:
+        _ = results.stable
+    n_dynamic = len(results.in_step(1))
+    assert f"at {n_dynamic} of {results.n_records} records" in str(info.value)
+    # The static step's records (and the initial state) have their count: a 1 N load on a
+    # clamped strip leaves the tangent positive definite.
+    assert (results.negative_eigenvalues[results.in_step(0)] == 0).all()
+    assert results.negative_eigenvalues[0] == 0
+
+
 def test_time_functions_ramp_and_table():
     model, tip = strip()
     model.add_load(tip, "uz", 1.0, function=ramp(0.0, 0.5))

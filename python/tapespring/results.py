@@ -238,11 +238,37 @@ class Results:
         ------
         ValueError
             If the eigenvalue count was not computed at every record (it is computed by static
-            steps with ``stability=True`` only, so never for the records of a dynamic step).
+            steps with ``stability=True`` only, so never for the records of a dynamic step). The
+            message names the steps without it; the records of a step that has it are
+            ``negative_eigenvalues[in_step(k)] == 0``.
         """
-        if np.any(self.negative_eigenvalues < 0):
-            raise ValueError("stability was not computed: run the steps with stability=True")
+        missing = self.negative_eigenvalues < 0
+        if np.any(missing):
+            steps = sorted({int(k) for k in self.step[missing]})
+            kinds = self._step_kinds()
+            named = ", ".join(
+                f"{k} ({kinds[k]})" if k < len(kinds) and kinds[k] else str(k) for k in steps
+            )
+            raise ValueError(
+                f"stability was not computed at {int(missing.sum())} of {missing.size} records "
+                f"(steps {named}): static steps count it with stability=True, dynamic steps "
+                "never; for one step's records use negative_eigenvalues[in_step(k)] == 0"
+            )
         return self.negative_eigenvalues == 0
+
+    def _step_kinds(self) -> list[str]:
+        """Each step's name and kind as ``"'name', dynamic"`` (empty where the settings lack it)."""
+        steps = self.settings.get("steps")
+        if not isinstance(steps, list):
+            return []
+        out = []
+        for st in steps:
+            if isinstance(st, Mapping) and isinstance(st.get("name"), str):
+                kind = st.get("kind")
+                out.append(f"{st['name']!r}" + (f", {kind}" if isinstance(kind, str) else ""))
+            else:
+                out.append("")
+        return out
 
     def reaction(self, node: int, dof: str) -> NDArray[np.float64]:
         """History of the recorded force at `dof` of `node` [N or N m], shape (n,).
