@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from functools import partial
 
@@ -159,6 +160,15 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "M* changes by < 1 %%)",
     )
     p.add_argument(
+        "--workers",
+        type=_workers,
+        default=1,
+        metavar="N",
+        help="run the grid's points side by side in N processes ('auto': one per core, here "
+        f"{os.cpu_count() or 1}; default %(default)s: one after the other in this one); the "
+        "results are the same, and on 2 cores 2 processes take about 0.7 of the time",
+    )
+    p.add_argument(
         "--csv",
         type=_output_file,
         help="write one row per (sense, t, E): moments, masses (FE and analytical), ratio",
@@ -171,6 +181,25 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
+
+
+def _workers(text: str) -> int | None:
+    """An argparse type: ``auto`` (None: one process per core) or a number of processes."""
+    from tapespring._pool import check_workers
+
+    if text.strip().lower() == "auto":
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"workers must be an integer or 'auto' (got {text!r})"
+        ) from None
+    try:
+        check_workers(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return value
 
 
 def run(args: argparse.Namespace) -> int:
@@ -241,7 +270,7 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    result = max_mass(settings, progress=shows_progress(args))
+    result = max_mass(settings, progress=shows_progress(args), workers=args.workers)
     if args.csv:
         write_csv(result, args.csv)
     if args.plot:

@@ -387,6 +387,8 @@ class MaxMassResult:
         One line per run that did not reach the final angle.
     cancelled : bool
         True if the progress callback (or Ctrl-C) stopped the study.
+    workers : int
+        Processes that ran it (1: the calling one).
     """
 
     settings: MaxMassSettings
@@ -401,6 +403,7 @@ class MaxMassResult:
     wall_s: float
     errors: tuple[str, ...] = ()
     cancelled: bool = False
+    workers: int = 1
 
     @property
     def lever_arm(self) -> float:
@@ -487,7 +490,8 @@ class MaxMassResult:
             f" > m g l, l = {self.lever_arm * 1e3:.1f} mm, g = {st.gravity:g} m/s^2",
             f"  grid t = {t_mm[0]:.3f}-{t_mm[-1]:.3f} mm ({t_mm.size}) x E = "
             f"{e_gpa[0]:.1f}-{e_gpa[-1]:.1f} GPa ({e_gpa.size}); {st.mesh_size * 1e3:g} mm mesh, "
-            f"{self.ndof} DOFs; {done}/{n_runs} runs in {self.wall_s:.1f} s",
+            f"{self.ndof} DOFs; {done}/{n_runs} runs in {self.wall_s:.1f} s"
+            + (f" ({self.workers} processes)" if self.workers > 1 else ""),
         ]
         for s in self.senses:
             i = self.sense_index(s)
@@ -553,7 +557,7 @@ class MaxMassResult:
         sense) ``residual_moment_Nm`` (one tape, signed), ``residual_moment_analytical_Nm``,
         ``m_max_kg``, ``m_max_analytical_kg``, ``ratio_fe_to_analytical``, ``ratio_min``,
         ``ratio_max``, ``stable``, ``run_wall_s`` and ``m_max_paper_tape_kg`` (None outside the
-        grid); ``tape_weight_equivalent_mass_kg`` (per t), ``wall_s``, ``errors``,
+        grid); ``tape_weight_equivalent_mass_kg`` (per t), ``wall_s``, ``workers``, ``errors``,
         ``cancelled``.
         """
 
@@ -598,14 +602,59 @@ class MaxMassResult:
             **per_sense,
             "tape_weight_equivalent_mass_kg": self.tape_weight_equivalent_mass.tolist(),
             "wall_s": self.wall_s,
+            "workers": self.workers,
             "errors": list(self.errors),
             "cancelled": self.cancelled,
         }
 
 
+@dataclass(frozen=True)
+class _PointRun:
+    """What one grid point's bending run gives the study (picklable, from a worker process)."""
+
+    moment: float | None
+    stable: bool
+    error: str | None
+    wall_s: float
+    ndof: int
+    cancelled: bool
+
+
+def _bend_point(task: tuple[MaxMassSettings, str, float, float]) -> _PointRun:
+    """The bending run of one (sense, t, E) point of `settings`' grid."""
+    from tapespring.scenarios.bending import bend
+
+    settings, sense, thickness, modulus = task
+    setup = settings.bending_setup(sense, thickness, modulus)
+    t0 = time.perf_counter()
+    result = bend(setup)
+    wall = time.perf_counter() - t0
+    reached = result.theta_deg.size > 1 and math.isclose(
+        result.theta_deg[-1], setup.theta_max_deg, abs_tol=1e-9
+    )
+    error = None
+    if result.cancelled:
+        pass
+    elif not reached:
+        last = result.theta_deg[-1] if result.theta_deg.size else 0.0
+        error = f"stopped at {last:+.2f} deg: {result.error}"
+    elif not result.jump.any():
+        error = f"no fold formed (no snap) before {setup.theta_max_deg} deg"
+    ok = reached and error is None and not result.cancelled
+    return _PointRun(
+        moment=float(result.moment[-1]) if ok else None,
+        stable=bool(result.stable[-1]) if ok else False,
+        error=error,
+        wall_s=wall,
+        ndof=int(result.ndof),
+        cancelled=bool(result.cancelled),
+    )
+
+
 def max_mass(
     settings: MaxMassSettings | None = None,
     progress: bool | Callable[[int, int], bool | None] | None = None,
+    workers: int | None = 1,
 ) -> MaxMassResult:
     """Residual moments at ``+-angle_deg`` and maximum masses over a (sense, t, E) grid.
 
@@ -619,6 +668,10 @@ def max_mass(
     progress : bool or callable, optional
         True shows a progress bar on stderr; a callable receives ``(done, total)`` runs after
         each one and may return False to stop (the result is then marked `cancelled`).
+    workers : int or None, optional
+        Runs side by side in that many worker processes (None: one per core; default 1: one
+        after the other in this process). The results are the same; on 2 cores two workers take
+        the grid in about 0.7 of the time, each worker process costing about a second to start.
 
     Returns
     -------
@@ -629,11 +682,16 @@ def max_mass(
     ------
     ValueError
         For invalid settings (the message names the value), before any run.
+    TypeError
+        If `workers` is not an integer or None.
+    RuntimeError
+        If a worker process died during a run (killed, out of memory).
     """
-    from tapespring.scenarios.bending import bend
+    from tapespring._pool import check_workers, processes_for, run_tasks
 
     settings = settings or MaxMassSettings()
     settings.validate()
+    check_workers(workers)
     senses = tuple(settings.senses)
     t_grid = np.array(settings.thicknesses, dtype=float)
     e_grid = np.array(settings.youngs_moduli, dtype=float)
@@ -642,7 +700,7 @@ def max_mass(
     analytical = np.empty(shape)
     stable = np.zeros(shape, dtype=bool)
     run_wall = np.full(shape, np.nan)
-    errors: list[str] = []
+    errors: dict[int, str] = {}
     ndof = 0
     total = int(np.prod(shape))
     points = [(i, j, k) for i in range(shape[0]) for j in range(shape[1]) for k in range(shape[2])]
@@ -652,6 +710,10 @@ def max_mass(
             setup, 1 if senses[i] == "opposite" else -1
         )
 
+    def label(n: int) -> str:
+        i, j, k = points[n]
+        return f"{senses[i]}, t = {t_grid[j] * 1e3:.3f} mm, E = {e_grid[k] / 1e9:.1f} GPa"
+
     bar = None
     if progress is True:
         from tqdm import tqdm
@@ -659,39 +721,33 @@ def max_mass(
         bar = tqdm(total=total, unit=" runs", file=sys.stderr, desc="max-mass", leave=False)
     start = time.perf_counter()
     cancelled = False
+    done = 0
+
+    def record(n: int, run: _PointRun) -> bool:
+        nonlocal ndof, cancelled, done
+        i, j, k = points[n]
+        if run.cancelled:
+            cancelled = True
+            return False
+        done += 1
+        run_wall[i, j, k] = run.wall_s
+        ndof = run.ndof
+        if run.error is not None:
+            errors[n] = f"{label(n)}: {run.error}"
+        elif run.moment is not None:
+            moment[i, j, k] = run.moment
+            stable[i, j, k] = run.stable
+        if bar is not None:
+            bar.set_postfix_str(label(n), refresh=False)
+            bar.update(1)
+        elif callable(progress) and progress(done, total) is False:
+            cancelled = done < total
+            return False
+        return True
+
+    tasks = [(settings, senses[i], float(t_grid[j]), float(e_grid[k])) for i, j, k in points]
     try:
-        for n, (i, j, k) in enumerate(points):
-            label = f"{senses[i]}, t = {t_grid[j] * 1e3:.3f} mm, E = {e_grid[k] / 1e9:.1f} GPa"
-            if bar is not None:
-                bar.set_postfix_str(label, refresh=True)
-            setup = settings.bending_setup(senses[i], t_grid[j], e_grid[k])
-            t0 = time.perf_counter()
-            try:
-                result = bend(setup)
-            except KeyboardInterrupt:
-                cancelled = True
-                break
-            run_wall[i, j, k] = time.perf_counter() - t0
-            ndof = result.ndof
-            reached = result.theta_deg.size > 1 and math.isclose(
-                result.theta_deg[-1], setup.theta_max_deg, abs_tol=1e-9
-            )
-            if result.cancelled:
-                cancelled = True
-                break
-            if not reached:
-                last = result.theta_deg[-1] if result.theta_deg.size else 0.0
-                errors.append(f"{label}: stopped at {last:+.2f} deg: {result.error}")
-            elif not result.jump.any():
-                errors.append(f"{label}: no fold formed (no snap) before {setup.theta_max_deg} deg")
-            else:
-                moment[i, j, k] = result.moment[-1]
-                stable[i, j, k] = bool(result.stable[-1])
-            if bar is not None:
-                bar.update(1)
-            elif callable(progress) and progress(n + 1, total) is False:
-                cancelled = n + 1 < total
-                break
+        stopped = run_tasks(_bend_point, tasks, workers, record)
     finally:
         if bar is not None:
             bar.close()
@@ -706,8 +762,9 @@ def max_mass(
         run_wall_s=run_wall,
         ndof=ndof,
         wall_s=time.perf_counter() - start,
-        errors=tuple(errors),
-        cancelled=cancelled,
+        errors=tuple(errors[n] for n in sorted(errors)),
+        cancelled=cancelled or stopped,
+        workers=processes_for(workers, total),
     )
 
 

@@ -1,0 +1,35 @@
+"""Module-level tasks for `tests/test_pool.py` (a spawned worker imports them by name)."""
+
+from __future__ import annotations
+
+import os
+import time
+
+
+def square_after(task: tuple[int, float]) -> tuple[int, str | None, int]:
+    """``x * x`` after sleeping `delay` seconds, with the worker's core threads and process id."""
+    x, delay = task
+    time.sleep(delay)
+    return x * x, os.environ.get("RAYON_NUM_THREADS"), os.getpid()
+
+
+def fail_on(task: int) -> int:
+    """Raises ValueError for 3, returns the task otherwise."""
+    if task == 3:
+        raise ValueError("task 3 refused")
+    time.sleep(0.05)
+    return task
+
+
+def die_on(task: int) -> int:
+    """Ends its process without a word for 1 (as a kill or the out-of-memory killer would)."""
+    if task == 1:
+        os._exit(9)
+    time.sleep(0.05)
+    return task
+
+
+def sleep_long(task: int) -> int:
+    """Sleeps a minute: a run that Ctrl-C must not wait for."""
+    time.sleep(60.0)
+    return task
