@@ -166,7 +166,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="N",
         help="run the grid's points side by side in N processes ('auto': one per core, here "
         f"{os.cpu_count() or 1}; default %(default)s: one after the other in this one); the "
-        "results are the same, and on 2 cores 2 processes take about 0.7 of the time",
+        "results are the same, and on 2 cores 2 processes take about 0.6 of the time",
     )
     p.add_argument(
         "--csv",
