@@ -185,7 +185,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def _workers(text: str) -> int | None:
     """An argparse type: ``auto`` (None: one process per core) or a number of processes."""
-    from tapespring._pool import check_workers
+    from tapespring.sweep import check_workers
 
     if text.strip().lower() == "auto":
         return None

@@ -688,7 +688,7 @@ def max_mass(
     RuntimeError
         If a worker process died during a run (killed, out of memory).
     """
-    from tapespring._pool import check_workers, processes_for, run_tasks
+    from tapespring.sweep import check_workers, processes_for, run_tasks
 
     settings = settings or MaxMassSettings()
     settings.validate()

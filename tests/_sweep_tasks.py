@@ -1,4 +1,4 @@
-"""Module-level tasks for `tests/test_pool.py` (a spawned worker imports them by name)."""
+"""Module-level tasks for `tests/test_sweep.py` (a spawned worker imports them by name)."""
 
 from __future__ import annotations
 
@@ -32,4 +32,15 @@ def die_on(task: int) -> int:
 def sleep_long(task: int) -> int:
     """Sleeps a minute: a run that Ctrl-C must not wait for."""
     time.sleep(60.0)
+    return task
+
+
+#: Tasks `record_run` has started, in this process (for thread-pool tests).
+RAN: list[int] = []
+
+
+def record_run(task: int) -> int:
+    """Notes `task` in :data:`RAN`, then sleeps 0.05 s."""
+    RAN.append(task)
+    time.sleep(0.05)
     return task

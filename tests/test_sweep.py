@@ -1,6 +1,7 @@
-"""Independent runs in worker processes (`tapespring._pool`): the results of each task reach
-their index whatever the order the workers end them in, a stop or Ctrl-C ends the study without
-waiting for the runs still going, and a failed run or a dead worker is reported, not lost.
+"""Independent runs side by side (`tapespring.sweep`): the results of each task reach their
+index whatever the order the workers end them in, a stop or Ctrl-C ends the study without
+waiting for the runs still going, a failed run or a dead worker is reported, not lost, and an
+executor of the user's (a cluster's) runs them alike.
 
 Each spawned worker is a fresh interpreter (about 0.3 s to start with numpy); the tasks sleep
 rather than compute so that the order in which they end is set by the test.
@@ -14,14 +15,15 @@ import subprocess
 import sys
 import textwrap
 import time
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-from _pool_tasks import die_on, fail_on, square_after
+from _sweep_tasks import RAN, die_on, fail_on, record_run, square_after
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
-from tapespring._pool import MAX_WORKERS, check_workers, processes_for, run_tasks
+from tapespring.sweep import MAX_WORKERS, check_workers, processes_for, run_tasks, sweep
 
 
 def collect(func, tasks, workers):
@@ -91,8 +93,8 @@ def test_ctrl_c_stops_the_study_and_its_workers_at_once(tmp_path: Path):
             f"""
             import sys
             sys.path.insert(0, {str(Path(__file__).parent)!r})
-            from _pool_tasks import sleep_long
-            from tapespring._pool import run_tasks
+            from _sweep_tasks import sleep_long
+            from tapespring.sweep import run_tasks
 
             if __name__ == "__main__":
                 print("started", flush=True)
@@ -135,3 +137,74 @@ def test_workers_of_another_type_are_refused_by_name(value):
         check_workers(value)
     with pytest.raises(TypeError, match="workers must be an integer"):
         run_tasks(square_after, [(1, 0.0)], value, lambda i, r: None)
+
+
+def test_sweep_returns_the_results_in_task_order():
+    tasks = [(x, 0.3 if x == 0 else 0.0) for x in range(4)]
+    for workers in (1, 2):
+        assert [r[0] for r in sweep(square_after, tasks, workers=workers)] == [0, 1, 4, 9]
+    assert sweep(square_after, [], workers=2) == []
+
+
+def test_an_executor_of_the_users_runs_the_tasks_and_stays_open():
+    # Dask's Client.get_executor() is a concurrent.futures.Executor; the standard ones stand in
+    # for it here. The executor is the user's: it is neither shut down nor given a core thread
+    # setting.
+    tasks = [(x, 0.2 if x == 0 else 0.0) for x in range(4)]
+    with ThreadPoolExecutor(2) as threads:
+        order: list[int] = []
+        stopped = run_tasks(square_after, tasks, 1, lambda i, r: order.append(i), executor=threads)
+        assert stopped is False and sorted(order) == [0, 1, 2, 3] and order[-1] == 0
+        assert [r[0] for r in sweep(square_after, tasks, executor=threads)] == [0, 1, 4, 9]
+        assert threads.submit(abs, -3).result() == 3  # still open
+    with ProcessPoolExecutor(2) as processes:
+        results = sweep(square_after, tasks, executor=processes)
+        assert [r[0] for r in results] == [0, 1, 4, 9]
+        assert os.getpid() not in {r[2] for r in results}
+        with pytest.raises(ValueError, match="task 3 refused"):
+            sweep(fail_on, list(range(5)), executor=processes)
+        assert processes.submit(abs, -3).result() == 3
+
+
+def test_a_stop_on_an_executor_cancels_the_tasks_not_started():
+    RAN.clear()
+    with ThreadPoolExecutor(1) as threads:
+        got: list[int] = []
+        stopped = run_tasks(
+            record_run,
+            list(range(6)),
+            on_done=lambda i, r: got.append(i) or False,
+            executor=threads,
+        )
+        assert stopped is True and got == [0]
+    # The pool's one thread ran task 0 and at most the one it had started before the cancel.
+    assert RAN in ([0], [0, 1])
+
+
+def test_an_executor_that_is_no_executor_is_refused_by_name():
+    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+        run_tasks(square_after, [(1, 0.0)], executor="dask")  # type: ignore[arg-type]
+
+
+def test_a_script_without_a_main_guard_is_told_what_it_needs(tmp_path: Path):
+    # Each spawned worker imports the script again; one that starts its study at import would
+    # have each worker start one too. The workers refuse, and the study fails with the remedy.
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        textwrap.dedent(
+            f"""
+            import sys
+            sys.path.insert(0, {str(Path(__file__).parent)!r})
+            from _sweep_tasks import square_after
+            from tapespring.sweep import sweep
+
+            print(sweep(square_after, [(1, 0.0), (2, 0.0)], workers=2))
+            """
+        )
+    )
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("RuntimeError: a worker process died") and "it could not start" in last
+    assert 'if __name__ == "__main__":' in last
+    assert "a worker process started a study while importing its script" in done.stderr

@@ -1,12 +1,23 @@
-"""Independent runs of a study in worker processes (a grid of settings, an ensemble).
+"""Independent runs of a study side by side: a grid of settings, an ensemble, a sensitivity study.
 
 A study's runs share nothing, so they run side by side in processes rather than one after the
 other with the native core's threads: on a 2-core machine two serial runs take about the time of
 one run on both cores (the core's parallel loops scale by about 1.5 on 2 cores, docs/
-performance.md). Each worker is a fresh interpreter (``spawn``: a forked child would inherit the
-parent's thread pool without its threads) with one thread for the core (``RAYON_NUM_THREADS=1``,
-read when the core's pool starts, at its first parallel loop). The results do not depend on the
-number of workers: the core's results do not depend on its number of threads.
+performance.md; the maximum-mass grid: 66 s with two workers against 111 s). Each local worker
+is a fresh interpreter (``spawn``: a forked child would inherit the parent's thread pool without
+its threads) with one thread for the core (``RAYON_NUM_THREADS=1``, read when the core's pool
+starts, at its first parallel loop). The results do not depend on the number of workers: the
+core's results do not depend on its number of threads.
+
+On a cluster, pass an executor instead: any :class:`concurrent.futures.Executor`, e.g. Dask's
+``distributed.Client(address).get_executor()`` (its workers then choose their own threads: set
+``RAYON_NUM_THREADS`` in their environment to share the cores between runs). For example
+(``run_one`` a module-level function of one settings object)::
+
+    from tapespring.sweep import sweep
+
+    results = sweep(run_one, settings_list, workers=None)  # one local process per core
+    results = sweep(run_one, settings_list, executor=client.get_executor())  # Dask
 """
 
 from __future__ import annotations
@@ -18,17 +29,23 @@ import os
 import signal
 import sys
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
-__all__ = ["MAX_WORKERS", "check_workers", "processes_for", "run_tasks"]
+__all__ = ["MAX_WORKERS", "check_workers", "processes_for", "run_tasks", "sweep"]
 
 T = TypeVar("T")
 R = TypeVar("R")
 
 #: The logger of the native core's messages.
 CORE_LOGGER = "tapespring.core"
+
+#: What a script that runs a study in worker processes needs.
+_GUARD = (
+    'a script must start its study under `if __name__ == "__main__":`, since each worker '
+    "process imports it again"
+)
 
 #: Most worker processes a study starts: each is an interpreter with the package and a model in
 #: memory (about 100 MB), and more processes than cores only share them.
@@ -78,14 +95,16 @@ def _start_worker(core_level: int) -> None:
 def run_tasks(
     func: Callable[[T], R],
     tasks: Sequence[T],
-    workers: int | None,
-    on_done: Callable[[int, R], bool | None],
+    workers: int | None = 1,
+    on_done: Callable[[int, R], bool | None] | None = None,
+    *,
+    executor: Executor | None = None,
 ) -> bool:
     """Calls ``func(task)`` for each of `tasks` and ``on_done(index, result)`` as each ends.
 
     With one worker the tasks run in this process, in order; otherwise in `workers` processes
-    (None: one per core), in the order they end. `func` must be a module-level function and the
-    tasks and results picklable.
+    (None: one per core) or on `executor`, in the order they end. `func` must then be a
+    module-level function and the tasks and results picklable.
 
     Parameters
     ----------
@@ -94,10 +113,15 @@ def run_tasks(
     tasks
         Its arguments, one per run.
     workers
-        Processes (1: this one; None: one per core; never more than the tasks).
+        Local processes (1: this one; None: one per core; never more than the tasks). Ignored
+        with `executor`.
     on_done
         Receives the index of each task in `tasks` and its result; returning False stops the
-        study: runs not started are dropped, running ones are stopped.
+        study: runs not started are dropped, running local ones are stopped (on an `executor`,
+        they are cancelled if they have not started, and their results dropped).
+    executor
+        Where to run the tasks instead of local processes: any `concurrent.futures.Executor`
+        (Dask: ``distributed.Client(address).get_executor()``). It is not shut down.
 
     Returns
     -------
@@ -109,10 +133,16 @@ def run_tasks(
     Exception
         The first exception a run raises, after the other runs are stopped.
     RuntimeError
-        If a worker process died (killed, out of memory); the message lists the tasks that had
-        not ended.
+        If a local worker process died (killed, out of memory, or it could not start: a script
+        that starts a study without ``if __name__ == "__main__":`` is imported again by each
+        worker); the message lists the tasks that had not ended.
     """
     check_workers(workers)
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise TypeError(f"executor must be a concurrent.futures.Executor (got {executor!r})")
+    done_with = on_done or (lambda i, r: None)
+    if executor is not None:
+        return _run_on(executor, func, tasks, done_with, own=False)
     n = processes_for(workers, len(tasks))
     if n == 1:
         for i, task in enumerate(tasks):
@@ -120,12 +150,49 @@ def run_tasks(
                 result = func(task)
             except KeyboardInterrupt:
                 return True
-            if on_done(i, result) is False:
+            if done_with(i, result) is False:
                 return i + 1 < len(tasks)
         return False
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        # A spawned worker importing the script that started the study would start its own.
+        raise RuntimeError(f"a worker process started a study while importing its script: {_GUARD}")
     context = multiprocessing.get_context("spawn")
     level = logging.getLogger(CORE_LOGGER).getEffectiveLevel()
     pool = ProcessPoolExecutor(n, mp_context=context, initializer=_start_worker, initargs=(level,))
+    return _run_on(pool, func, tasks, done_with, own=True)
+
+
+def sweep(
+    func: Callable[[T], R],
+    tasks: Sequence[T],
+    *,
+    workers: int | None = 1,
+    executor: Executor | None = None,
+) -> list[R]:
+    """``[func(task) for task in tasks]``, the runs side by side (see :func:`run_tasks`).
+
+    Raises
+    ------
+    Exception
+        The first exception a run raises, after the other runs are stopped.
+    KeyboardInterrupt
+        On Ctrl-C, once the runs are stopped.
+    """
+    results: dict[int, R] = {}
+    if run_tasks(func, tasks, workers, results.__setitem__, executor=executor):
+        raise KeyboardInterrupt
+    return [results[i] for i in range(len(tasks))]
+
+
+def _run_on(
+    pool: Executor,
+    func: Callable[[T], R],
+    tasks: Sequence[T],
+    on_done: Callable[[int, R], bool | None],
+    *,
+    own: bool,
+) -> bool:
+    """:func:`run_tasks` on `pool`, which is shut down if it is `own`."""
     pending: dict[Future[R], int] = {}
     try:
         pending = {pool.submit(func, task): i for i, task in enumerate(tasks)}
@@ -140,8 +207,8 @@ def run_tasks(
                     # known.
                     unfinished = sorted([i, *pending.values()])
                     raise RuntimeError(
-                        "a worker process died (killed, or out of memory) before tasks "
-                        f"{unfinished} of {len(tasks)} ended"
+                        "a worker process died (killed, out of memory, or it could not start: "
+                        f"{_GUARD}) before tasks {unfinished} of {len(tasks)} ended"
                     ) from exc
                 if on_done(i, result) is False:
                     return bool(pending)
@@ -149,11 +216,14 @@ def run_tasks(
     except KeyboardInterrupt:
         return True
     finally:
-        # Normal end: every worker is idle. Otherwise the runs still going are stopped, not
-        # waited for (a run on a fine mesh takes minutes).
-        if pending:
-            _terminate(pool)
-        pool.shutdown(wait=not pending, cancel_futures=True)
+        for future in pending:
+            future.cancel()
+        if own:
+            # Normal end: every worker is idle. Otherwise the runs still going are stopped, not
+            # waited for (a run on a fine mesh takes minutes).
+            if pending and isinstance(pool, ProcessPoolExecutor):
+                _terminate(pool)
+            pool.shutdown(wait=not pending, cancel_futures=True)
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:
