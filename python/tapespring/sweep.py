@@ -1,9 +1,10 @@
 """Independent runs of a study side by side: a grid of settings, an ensemble, a sensitivity study.
 
-A study's runs share nothing, so they run side by side in processes rather than one after the
-other with the native core's threads: on a 2-core machine two serial runs take about the time of
-one run on both cores (the core's parallel loops scale by about 1.5 on 2 cores, docs/
-performance.md; the maximum-mass grid: 66 s with two workers against 111 s). Each local worker
+A study's runs share nothing, so they may run side by side in processes rather than one after
+the other with the native core's threads. That pays where one run uses the cores poorly by
+itself: the maximum-mass grid's single-tape runs, 66 s with two workers against 111 s on 2
+cores; five vibration tests of the set-up on the paper's meshes, whose factorisation already
+splits over both cores, 14.0 s either way (docs/python-api.md, "Studies"). Each local worker
 is a fresh interpreter (``spawn``: a forked child would inherit the parent's thread pool without
 its threads) with one thread for the core (``RAYON_NUM_THREADS=1``, read when the core's pool
 starts, at its first parallel loop). The results do not depend on the number of workers: the

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 from functools import partial
 
@@ -29,7 +28,7 @@ from .bend import (
     warn,
     wrote,
 )
-from .scenario_options import add_json_and_progress_options, shows_progress
+from .scenario_options import add_json_and_progress_options, add_workers_option, shows_progress
 
 __all__ = ["register", "run"]
 
@@ -159,14 +158,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="follow the stable branch where the folded path loses stability (3-4x the cost; "
         "M* changes by < 1 %%)",
     )
-    p.add_argument(
-        "--workers",
-        type=_workers,
-        default=1,
-        metavar="N",
-        help="run the grid's points side by side in N processes ('auto': one per core, here "
-        f"{os.cpu_count() or 1}; default %(default)s: one after the other in this one); the "
-        "results are the same, and on 2 cores 2 processes take about 0.6 of the time",
+    add_workers_option(
+        p, "the grid's points", speed=", and on 2 cores 2 processes take about 0.6 of the time"
     )
     p.add_argument(
         "--csv",
@@ -181,25 +174,6 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
-
-
-def _workers(text: str) -> int | None:
-    """An argparse type: ``auto`` (None: one process per core) or a number of processes."""
-    from tapespring.sweep import check_workers
-
-    if text.strip().lower() == "auto":
-        return None
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"workers must be an integer or 'auto' (got {text!r})"
-        ) from None
-    try:
-        check_workers(value)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return value
 
 
 def run(args: argparse.Namespace) -> int:

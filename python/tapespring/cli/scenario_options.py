@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -321,6 +322,39 @@ def add_output_options(p: argparse.ArgumentParser, csv_what: str, json_what: str
     )
     p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
     add_json_and_progress_options(p, json_what)
+
+
+def add_workers_option(p: argparse._ActionsContainer, runs: str, *, speed: str = "") -> None:
+    """``--workers N|auto``: `runs` side by side in N processes (:mod:`tapespring.sweep`);
+    `speed` is a measured figure for the help."""
+    p.add_argument(
+        "--workers",
+        type=_workers,
+        default=1,
+        metavar="N",
+        help=f"run {runs} side by side in N processes ('auto': one per core, here "
+        f"{os.cpu_count() or 1}; default %(default)s: one after the other in this one); the "
+        f"results are the same{speed}",
+    )
+
+
+def _workers(text: str) -> int | None:
+    """An argparse type: ``auto`` (None: one process per core) or a number of processes."""
+    from tapespring.sweep import check_workers
+
+    if text.strip().lower() == "auto":
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"workers must be an integer or 'auto' (got {text!r})"
+        ) from None
+    try:
+        check_workers(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return value
 
 
 def add_json_and_progress_options(p: argparse.ArgumentParser, json_what: str = "") -> None:
