@@ -657,6 +657,25 @@ fn a_zero_on_a_switching_path_leaves_out_a_neutral_mode() -> Result<()> {
     Ok(())
 }
 
+/// Without refinement (`refine_change` 0, the default) a switching path with a monitor is not
+/// cut back for steps "too coarse" to refine: `Walk::too_coarse` tested the reaction's change
+/// against `0 * magnitude` and rolled back every step longer than `refine_span` until half the
+/// cut-backs were spent (the balanced body's path took 71 records instead of 12). With the
+/// hanging body (nothing neutral, no bifurcation: the same path either way) the switching path
+/// is the plain one, state for state.
+#[test]
+fn a_switching_path_without_refinement_is_not_cut_back_for_it() -> Result<()> {
+    let (mut model, tip, d) = held_cantilever()?;
+    add_pendulum(&mut model, 10.0 * f64::EPSILON * d)?;
+    let plain = path(&model, &[counted(tip, false)], tip, Dof::Uz, "plain")?;
+    let switching = path(&model, &[counted(tip, true)], tip, Dof::Uz, "switching")?;
+    let (p, s) = (&plain.history, &switching.history);
+    assert_eq!(s.t, p.t, "load factors of the switching path against the plain one");
+    assert_eq!(s.reactions, p.reactions);
+    assert_eq!(switching.stats.cutbacks, plain.stats.cutbacks);
+    Ok(())
+}
+
 /// Reproducer of an inconsistency (see case 3): on a path that switches branches, a neutral mode
 /// present from the path's start is counted at every state of the path but left out at the
 /// located zero. `Walk::switch_at_bifurcation` tests a state for a neutral mode (`Driver::leaves`)
