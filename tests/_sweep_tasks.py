@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import time
+from pathlib import Path
 
 
 def square_after(task: tuple[int, float]) -> tuple[int, str | None, int]:
@@ -35,12 +37,28 @@ def sleep_long(task: int) -> int:
     return task
 
 
+def note_pid_and_sleep(task: tuple[str, float]) -> int:
+    """Writes this process's id into the folder `task[0]`, then sleeps `task[1]` seconds."""
+    folder, delay = task
+    (Path(folder) / str(os.getpid())).touch()
+    time.sleep(delay)
+    return os.getpid()
+
+
+def log_from_core(task: int) -> int:
+    """Logs a warning and an info line as the native core would (logger tapespring.core.*)."""
+    logger = logging.getLogger("tapespring.core.test")
+    logger.warning("core warning from task %d", task)
+    logger.info("core info from task %d", task)
+    return task
+
+
 #: Tasks `record_run` has started, in this process (for thread-pool tests).
 RAN: list[int] = []
 
 
 def record_run(task: int) -> int:
-    """Notes `task` in :data:`RAN`, then sleeps 0.05 s."""
+    """Notes `task` in :data:`RAN`, then sleeps 0.3 s."""
     RAN.append(task)
-    time.sleep(0.05)
+    time.sleep(0.3)
     return task

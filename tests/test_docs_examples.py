@@ -86,7 +86,8 @@ def test_docs_examples_run(blocks, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
     prepare(blocks[0].path)
-    namespace = {"__name__": "__docs__"}
+    # As a script runs them: a block's `if __name__ == "__main__":` part runs too.
+    namespace = {"__name__": "__main__"}
     try:
         for block in blocks:
             # Padded so that line numbers in a traceback are the .md file's.

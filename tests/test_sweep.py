@@ -1,14 +1,17 @@
 """Independent runs side by side (`tapespring.sweep`): the results of each task reach their
 index whatever the order the workers end them in, a stop or Ctrl-C ends the study without
-waiting for the runs still going, a failed run or a dead worker is reported, not lost, and an
-executor of the user's (a cluster's) runs them alike.
+waiting for the runs still going and leaves no process behind, a failed run or a dead worker is
+reported, not lost, what the workers cannot receive is refused before any starts, and an
+executor of the user's (a cluster's) runs the tasks alike.
 
-Each spawned worker is a fresh interpreter (about 0.3 s to start with numpy); the tasks sleep
-rather than compute so that the order in which they end is set by the test.
+Each spawned worker is a fresh interpreter (0.1 to 0.3 s to start with numpy); the tasks sleep
+rather than compute so that the order in which they end is set by the test, with margins of
+seconds where a process must start or stop in time.
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import subprocess
@@ -19,11 +22,27 @@ from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-from _sweep_tasks import RAN, die_on, fail_on, record_run, square_after
+from _sweep_tasks import (
+    RAN,
+    die_on,
+    fail_on,
+    log_from_core,
+    record_run,
+    square_after,
+)
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
-from tapespring.sweep import MAX_WORKERS, check_workers, processes_for, run_tasks, sweep
+from tapespring.sweep import (
+    MAX_WORKERS,
+    WorkerDied,
+    check_workers,
+    processes_for,
+    run_tasks,
+    sweep,
+)
+
+TESTS = Path(__file__).parent
 
 
 def collect(func, tasks, workers):
@@ -32,10 +51,32 @@ def collect(func, tasks, workers):
     return stopped, got
 
 
+def alive(pid: int) -> bool:
+    """Whether process `pid` exists and is not a zombie."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return state != "Z"
+
+
+def run_script(tmp_path: Path, body: str) -> subprocess.Popen[str]:
+    """Starts `body` (after the imports of this folder's tasks) as a script in its own session."""
+    script = tmp_path / "study.py"
+    script.write_text(f"import sys\nsys.path.insert(0, {str(TESTS)!r})\n" + textwrap.dedent(body))
+    return subprocess.Popen(
+        [sys.executable, str(script)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+
+
 @pytest.mark.parametrize("workers", [1, 2])
 def test_each_result_reaches_its_task_whatever_order_the_runs_end_in(workers):
-    # The first task sleeps longest: with two workers it ends last.
-    tasks = [(x, 0.4 if x == 0 else 0.02) for x in range(5)]
+    # The first task sleeps longest (1 s, the other four 0.02 s): with two workers it ends last.
+    tasks = [(x, 1.0 if x == 0 else 0.02) for x in range(5)]
     order: list[int] = []
     got: dict[int, tuple[int, str | None, int]] = {}
 
@@ -43,7 +84,7 @@ def test_each_result_reaches_its_task_whatever_order_the_runs_end_in(workers):
         order.append(i)
         got[i] = r
 
-    assert run_tasks(square_after, tasks, workers, on_done) is False
+    assert run_tasks(square_after, iter(tasks), workers, on_done) is False  # any iterable
     assert {i: r[0] for i, r in got.items()} == {x: x * x for x in range(5)}
     if workers == 1:
         # In this process, in order, with the core's threads as the environment sets them.
@@ -58,69 +99,166 @@ def test_each_result_reaches_its_task_whatever_order_the_runs_end_in(workers):
 
 
 @pytest.mark.parametrize("workers", [1, 2])
-def test_on_done_returning_false_stops_the_study(workers):
-    tasks = [(x, 0.05) for x in range(6)]
+def test_on_done_returning_false_stops_the_study_at_once(workers):
+    # Task 0 ends at once, the others would sleep 30 s each: the stop after task 0 returns in
+    # seconds only if the runs still going are ended, not waited for.
+    tasks = [(x, 0.0 if x == 0 else 30.0) for x in range(6)]
     got: list[int] = []
     start = time.perf_counter()
     stopped = run_tasks(square_after, tasks, workers, lambda i, r: got.append(i) or False)
-    assert stopped is True and len(got) == 1
-    # The runs left are dropped, not run: 6 tasks of 0.05 s would take 0.3 s in this process.
-    if workers == 1:
-        assert got == [0]
-        assert time.perf_counter() - start < 0.25
+    assert stopped is True and got == [0]
+    assert time.perf_counter() - start < 10.0
     # Stopping at the last task is no stop.
-    last = run_tasks(square_after, [(1, 0.0)], workers, lambda i, r: False)
-    assert last is False
+    assert run_tasks(square_after, [(1, 0.0)], workers, lambda i, r: False) is False
 
 
 @pytest.mark.parametrize("workers", [1, 2])
-def test_a_failed_run_raises_its_exception(workers):
-    with pytest.raises(ValueError, match="task 3 refused"):
+def test_a_failed_run_raises_its_exception_naming_its_task(workers):
+    with pytest.raises(ValueError, match="task 3 refused") as info:
         collect(fail_on, list(range(6)), workers)
+    assert "(task 3 of 6: 3)" in info.value.__notes__
 
 
 def test_a_dead_worker_is_reported_with_the_tasks_left():
-    with pytest.raises(RuntimeError, match=r"worker process died .* before tasks \[.*1.*\] of 3"):
+    with pytest.raises(WorkerDied, match=r"worker process died .* not reported") as info:
         collect(die_on, [0, 1, 2], 2)
+    assert 1 in info.value.unfinished and isinstance(info.value, RuntimeError)
 
 
-def test_ctrl_c_stops_the_study_and_its_workers_at_once(tmp_path: Path):
-    # A study of minute-long runs in a child interpreter, interrupted as a terminal's Ctrl-C
-    # would: the parent returns "stopped" within seconds, and its workers are gone.
-    script = tmp_path / "study.py"
-    script.write_text(
-        textwrap.dedent(
-            f"""
-            import sys
-            sys.path.insert(0, {str(Path(__file__).parent)!r})
-            from _sweep_tasks import sleep_long
-            from tapespring.sweep import run_tasks
+def test_ctrl_c_stops_the_study_and_ends_its_workers(tmp_path: Path):
+    # A study of minute-long runs, interrupted as a terminal's Ctrl-C would (SIGINT to the whole
+    # process group, workers included): the parent returns "stopped" within seconds, quietly,
+    # and its workers are gone. More tasks than workers: some are still queued at the stop.
+    child = run_script(
+        tmp_path,
+        f"""
+        from pathlib import Path
+        from _sweep_tasks import note_pid_and_sleep
+        from tapespring.sweep import run_tasks
 
-            if __name__ == "__main__":
-                print("started", flush=True)
-                stopped = run_tasks(sleep_long, [0, 1, 2], 2, lambda i, r: None)
-                print("stopped" if stopped else "ended", flush=True)
-            """
-        )
-    )
-    child = subprocess.Popen(
-        [sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        if __name__ == "__main__":
+            print("started", flush=True)
+            tasks = [({str(tmp_path)!r}, 60.0)] * 6
+            stopped = run_tasks(note_pid_and_sleep, tasks, 2, lambda i, r: None)
+            print("stopped" if stopped else "ended", flush=True)
+        """,
     )
     assert child.stdout is not None and child.stdout.readline().strip() == "started"
-    time.sleep(2.0)  # the workers have started their runs
+    deadline = time.time() + 30.0
+    while len([p for p in tmp_path.iterdir() if p.name.isdigit()]) < 2 and time.time() < deadline:
+        time.sleep(0.1)
+    workers = [int(p.name) for p in tmp_path.iterdir() if p.name.isdigit()]
+    assert len(workers) == 2
     start = time.perf_counter()
-    child.send_signal(signal.SIGINT)
+    os.killpg(child.pid, signal.SIGINT)
     out, err = child.communicate(timeout=30)
     assert time.perf_counter() - start < 10.0
     assert out.strip() == "stopped", err
     assert child.returncode == 0, err
-    assert "Traceback" not in err
+    assert "Traceback" not in err and "Exception in thread" not in err, err
+    assert not any(alive(pid) for pid in workers)
 
 
-def test_processes_for_takes_one_per_core_and_never_more_than_the_tasks():
+def test_ctrl_c_while_the_workers_start_reaches_none_of_them(tmp_path: Path):
+    # SIGINT to the group right after the start: the workers, starting with it held back,
+    # print nothing; the parent stops.
+    child = run_script(
+        tmp_path,
+        """
+        from _sweep_tasks import square_after
+        from tapespring.sweep import run_tasks
+
+        if __name__ == "__main__":
+            print("started", flush=True)
+            stopped = run_tasks(square_after, [(x, 5.0) for x in range(6)], 2, lambda i, r: None)
+            print("stopped" if stopped else "ended", flush=True)
+        """,
+    )
+    assert child.stdout is not None and child.stdout.readline().strip() == "started"
+    time.sleep(0.05)
+    os.killpg(child.pid, signal.SIGINT)
+    out, err = child.communicate(timeout=30)
+    assert out.strip() == "stopped", err
+    assert err == "", err
+
+
+def test_workers_of_a_killed_parent_end_too(tmp_path: Path):
+    # A parent killed outright (an IDE's stop button, a kernel restart) cannot end its workers;
+    # they end themselves instead of waiting for tasks forever.
+    child = run_script(
+        tmp_path,
+        f"""
+        from _sweep_tasks import note_pid_and_sleep
+        from tapespring.sweep import run_tasks
+
+        if __name__ == "__main__":
+            run_tasks(note_pid_and_sleep, [({str(tmp_path)!r}, 3.0)] * 2, 2, lambda i, r: None)
+        """,
+    )
+    deadline = time.time() + 30.0
+    while len([p for p in tmp_path.iterdir() if p.name.isdigit()]) < 2 and time.time() < deadline:
+        time.sleep(0.1)
+    workers = [int(p.name) for p in tmp_path.iterdir() if p.name.isdigit()]
+    assert len(workers) == 2
+    child.kill()
+    child.communicate(timeout=10)
+    deadline = time.time() + 10.0  # the workers' runs end after 3 s; their watch at once
+    while any(alive(pid) for pid in workers) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not any(alive(pid) for pid in workers)
+
+
+def test_the_workers_log_into_this_process(caplog):
+    # The solver's messages (logger tapespring.core.*) from the workers reach this process's
+    # handlers, at this process's level, as a run here would send them.
+    core = logging.getLogger("tapespring.core")
+    before = core.level
+    try:
+        core.setLevel(logging.WARNING)
+        with caplog.at_level(logging.WARNING, logger="tapespring.core"):
+            assert sweep(log_from_core, [0, 1], workers=2) == [0, 1]
+        messages = sorted(r.getMessage() for r in caplog.records if r.name.startswith("tapespring"))
+        assert messages == ["core warning from task 0", "core warning from task 1"]
+        caplog.clear()
+        core.setLevel(logging.ERROR)
+        with caplog.at_level(logging.ERROR, logger="tapespring.core"):
+            sweep(log_from_core, [0, 1], workers=2)
+        assert not [r for r in caplog.records if r.name.startswith("tapespring")]
+    finally:
+        core.setLevel(before)
+
+
+def test_what_the_workers_cannot_receive_is_refused_before_any_starts():
+    with pytest.raises(TypeError, match="cannot be sent to worker processes.*not a lambda"):
+        sweep(lambda x: x, [1, 2], workers=2)
+    with pytest.raises(TypeError, match=r"task 1 cannot be sent to worker processes"):
+        sweep(square_after, [(1, 0.0), (lambda: 0, 0.0)], workers=2)
+    # One worker runs here: nothing is sent.
+    assert sweep(lambda x: 2 * x, [1, 2], workers=1) == [2, 4]
+
+
+def test_a_function_of_an_interactive_session_is_refused_with_the_remedy():
+    code = textwrap.dedent(
+        """
+        from tapespring.sweep import sweep
+        def double(x):
+            return 2 * x
+        try:
+            sweep(double, [1, 2], workers=2)
+        except TypeError as e:
+            print(e)
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert "'double' is defined in an interactive session" in done.stdout, done.stderr
+    assert "define it in a module of your own" in done.stdout
+
+
+def test_processes_for_takes_the_cores_this_process_may_use():
     assert processes_for(1, 10) == 1
     assert processes_for(4, 2) == 2
-    assert processes_for(None, 1000) == (os.cpu_count() or 1)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    assert processes_for(None, 1000) == min(cores or 1, MAX_WORKERS)
     assert processes_for(3, 0) == 1
 
 
@@ -140,7 +278,7 @@ def test_workers_of_another_type_are_refused_by_name(value):
 
 
 def test_sweep_returns_the_results_in_task_order():
-    tasks = [(x, 0.3 if x == 0 else 0.0) for x in range(4)]
+    tasks = [(x, 0.5 if x == 0 else 0.0) for x in range(4)]
     for workers in (1, 2):
         assert [r[0] for r in sweep(square_after, tasks, workers=workers)] == [0, 1, 4, 9]
     assert sweep(square_after, [], workers=2) == []
@@ -149,11 +287,11 @@ def test_sweep_returns_the_results_in_task_order():
 def test_an_executor_of_the_users_runs_the_tasks_and_stays_open():
     # Dask's Client.get_executor() is a concurrent.futures.Executor; the standard ones stand in
     # for it here. The executor is the user's: it is neither shut down nor given a core thread
-    # setting.
-    tasks = [(x, 0.2 if x == 0 else 0.0) for x in range(4)]
+    # setting, and `workers` is not used.
+    tasks = [(x, 0.5 if x == 0 else 0.0) for x in range(4)]
     with ThreadPoolExecutor(2) as threads:
         order: list[int] = []
-        stopped = run_tasks(square_after, tasks, 1, lambda i, r: order.append(i), executor=threads)
+        stopped = run_tasks(square_after, tasks, 0, lambda i, r: order.append(i), executor=threads)
         assert stopped is False and sorted(order) == [0, 1, 2, 3] and order[-1] == 0
         assert [r[0] for r in sweep(square_after, tasks, executor=threads)] == [0, 1, 4, 9]
         assert threads.submit(abs, -3).result() == 3  # still open
@@ -170,14 +308,11 @@ def test_a_stop_on_an_executor_cancels_the_tasks_not_started():
     RAN.clear()
     with ThreadPoolExecutor(1) as threads:
         got: list[int] = []
-        stopped = run_tasks(
-            record_run,
-            list(range(6)),
-            on_done=lambda i, r: got.append(i) or False,
-            executor=threads,
-        )
+        stop = lambda i, r: got.append(i) or False  # noqa: E731
+        stopped = run_tasks(record_run, list(range(6)), on_done=stop, executor=threads)
         assert stopped is True and got == [0]
-    # The pool's one thread ran task 0 and at most the one it had started before the cancel.
+    # The pool's one thread ran task 0 (0.3 s) and at most the one it started before the
+    # cancel, which comes within microseconds of task 0's end.
     assert RAN in ([0], [0, 1])
 
 
@@ -189,22 +324,18 @@ def test_an_executor_that_is_no_executor_is_refused_by_name():
 def test_a_script_without_a_main_guard_is_told_what_it_needs(tmp_path: Path):
     # Each spawned worker imports the script again; one that starts its study at import would
     # have each worker start one too. The workers refuse, and the study fails with the remedy.
-    script = tmp_path / "unguarded.py"
-    script.write_text(
-        textwrap.dedent(
-            f"""
-            import sys
-            sys.path.insert(0, {str(Path(__file__).parent)!r})
-            from _sweep_tasks import square_after
-            from tapespring.sweep import sweep
+    child = run_script(
+        tmp_path,
+        """
+        from _sweep_tasks import square_after
+        from tapespring.sweep import sweep
 
-            print(sweep(square_after, [(1, 0.0), (2, 0.0)], workers=2))
-            """
-        )
+        print(sweep(square_after, [(1, 0.0), (2, 0.0)], workers=2))
+        """,
     )
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
-    assert done.returncode == 1
-    last = done.stderr.strip().splitlines()[-1]
-    assert last.startswith("RuntimeError: a worker process died") and "it could not start" in last
-    assert 'if __name__ == "__main__":' in last
-    assert "a worker process started a study while importing its script" in done.stderr
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == 1
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("tapespring.sweep.WorkerDied: a worker process died"), last
+    assert "it could not start" in last and 'if __name__ == "__main__":' in last
+    assert "a worker process started a study while importing its script" in err

@@ -27,6 +27,8 @@ report
     The report of an analysis of trials: CSV tables, PNG figures, text summary, JSON.
 plot
     The paper's figure types for trials (matplotlib).
+sweep
+    A study's independent runs side by side, in worker processes or on a cluster's executor.
 cli
     The ``tapespring`` command.
 
@@ -66,6 +68,7 @@ __all__ = [
     "scenarios",
     "shell",
     "signals",
+    "sweep",
     "trials",
 ]
 

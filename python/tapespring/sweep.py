@@ -23,18 +23,23 @@ On a cluster, pass an executor instead: any :class:`concurrent.futures.Executor`
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import multiprocessing
+import multiprocessing.connection
 import numbers
 import os
+import pickle
 import signal
 import sys
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from logging.handlers import QueueHandler, QueueListener
 from typing import Any, TypeVar
 
-__all__ = ["MAX_WORKERS", "check_workers", "processes_for", "run_tasks", "sweep"]
+__all__ = ["MAX_WORKERS", "WorkerDied", "check_workers", "processes_for", "run_tasks", "sweep"]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -73,29 +78,94 @@ def check_workers(value: object) -> None:
 
 
 def processes_for(workers: int | None, n_tasks: int) -> int:
-    """Processes :func:`run_tasks` runs `n_tasks` in: `workers` (None: one per core), at most one
-    per task, at least one."""
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
+    """Processes :func:`run_tasks` runs `n_tasks` in: `workers` (None: one per core this process
+    may use, as CPU affinity and batch schedulers set it, at most :data:`MAX_WORKERS`), at most
+    one per task, at least one."""
+    if workers is None:
+        try:
+            cores = len(os.sched_getaffinity(0))
+        except (AttributeError, OSError):  # not on every platform
+            cores = os.cpu_count() or 1
+        n = min(cores, MAX_WORKERS)
+    else:
+        n = int(workers)
     return max(1, min(n, n_tasks))
 
 
-def _start_worker(core_level: int) -> None:
-    # One thread for the core per process; Ctrl-C is the parent's to handle (it stops the study),
-    # not each worker's (which would end each with a KeyboardInterrupt traceback).
+class WorkerDied(RuntimeError):
+    """A local worker process died during a study (killed, out of memory, or it could not start).
+
+    Attributes
+    ----------
+    unfinished : list of int
+        Indices of the tasks whose results were not reported.
+    """
+
+    def __init__(self, message: str, unfinished: list[int]) -> None:
+        super().__init__(message)
+        self.unfinished = unfinished
+
+
+def _start_worker(core_level: int, records: Any) -> None:
+    # One thread for the core per process (also set in the environment the parent spawns it
+    # with, before anything the worker imports could start the core's pool).
     os.environ["RAYON_NUM_THREADS"] = "1"
+    # Ctrl-C is the parent's to handle (it stops the study), not each worker's, which would end
+    # each with a KeyboardInterrupt traceback; the parent spawns its workers with SIGINT blocked,
+    # so that a Ctrl-C while they start reaches none of them.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if core_level < logging.WARNING:
-        # The solver's messages the parent shows (the command line's -v), on the shared stderr.
-        core = logging.getLogger(CORE_LOGGER)
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter(f"%(name)s [{os.getpid()}]: %(message)s"))
-        core.addHandler(handler)
-        core.setLevel(core_level)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    # A worker whose parent is gone (killed, a kernel restarted) would wait for tasks forever.
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent.sentinel,), daemon=True).start()
+    # The solver's messages go to the parent's logging, as a run in the parent would send them.
+    core = logging.getLogger(CORE_LOGGER)
+    core.setLevel(core_level)
+    core.addHandler(QueueHandler(records))
+    core.propagate = False
+
+
+def _exit_with(sentinel: int) -> None:
+    multiprocessing.connection.wait([sentinel])
+    os._exit(1)
+
+
+class _Relay(logging.Handler):
+    """Hands each record from a worker to the parent's logger of its name."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        logging.getLogger(record.name).handle(record)
+
+
+def _check_sendable(func: Callable[..., Any], tasks: Sequence[Any]) -> None:
+    """Refuse, before any worker starts, a function or task the workers cannot receive."""
+    main = sys.modules.get("__main__")
+    if getattr(func, "__module__", None) == "__main__" and not hasattr(main, "__file__"):
+        raise TypeError(
+            f"func {getattr(func, '__qualname__', func)!r} is defined in an interactive session "
+            "(a notebook, the REPL, python -c): worker processes cannot import it; define it in "
+            "a module of your own and import it from there, or run with workers=1"
+        )
+    try:
+        pickle.dumps(func)
+    except Exception as exc:
+        raise TypeError(
+            f"func {func!r} cannot be sent to worker processes ({exc}): give a function defined "
+            "at the top level of a module (not a lambda or a nested function), or run with "
+            "workers=1"
+        ) from exc
+    for i, task in enumerate(tasks):
+        try:
+            pickle.dumps(task)
+        except Exception as exc:
+            raise TypeError(f"task {i} cannot be sent to worker processes ({exc})") from exc
 
 
 def run_tasks(
     func: Callable[[T], R],
-    tasks: Sequence[T],
+    tasks: Iterable[T],
     workers: int | None = 1,
     on_done: Callable[[int, R], bool | None] | None = None,
     *,
@@ -104,22 +174,23 @@ def run_tasks(
     """Calls ``func(task)`` for each of `tasks` and ``on_done(index, result)`` as each ends.
 
     With one worker the tasks run in this process, in order; otherwise in `workers` processes
-    (None: one per core) or on `executor`, in the order they end. `func` must then be a
-    module-level function and the tasks and results picklable.
+    (None: one per core) or on `executor`, in the order they end. `func` must then be a function
+    defined at the top level of an importable module, and the tasks and results picklable.
 
     Parameters
     ----------
     func
         The run.
     tasks
-        Its arguments, one per run.
+        Its arguments, one per run (any iterable: it is read once, before the first run).
     workers
-        Local processes (1: this one; None: one per core; never more than the tasks). Ignored
+        Local processes (1: this one; None: one per core; never more than the tasks). Not used
         with `executor`.
     on_done
         Receives the index of each task in `tasks` and its result; returning False stops the
-        study: runs not started are dropped, running local ones are stopped (on an `executor`,
-        they are cancelled if they have not started, and their results dropped).
+        study: runs not started are dropped and local runs still going are ended at once (on an
+        `executor`, runs not started are cancelled; those already running go on there, their
+        results dropped).
     executor
         Where to run the tasks instead of local processes: any `concurrent.futures.Executor`
         (Dask: ``distributed.Client(address).get_executor()``). It is not shut down.
@@ -132,40 +203,60 @@ def run_tasks(
     Raises
     ------
     Exception
-        The first exception a run raises, after the other runs are stopped.
-    RuntimeError
-        If a local worker process died (killed, out of memory, or it could not start: a script
-        that starts a study without ``if __name__ == "__main__":`` is imported again by each
-        worker); the message lists the tasks that had not ended.
+        The first exception a run raises (with a note naming its task), after the other runs
+        are stopped as on a stop.
+    TypeError
+        If `func` or a task cannot be sent to worker processes (a lambda, a function defined in
+        a notebook), before any run; if `executor` is not an executor.
+    WorkerDied
+        A RuntimeError: a local worker process died (killed, out of memory, or it could not
+        start: a script that starts a study without ``if __name__ == "__main__":`` is imported
+        again by each worker); its ``unfinished`` lists the tasks not reported.
     """
-    check_workers(workers)
-    if executor is not None and not callable(getattr(executor, "submit", None)):
-        raise TypeError(f"executor must be a concurrent.futures.Executor (got {executor!r})")
+    tasks = list(tasks)
     done_with = on_done or (lambda i, r: None)
     if executor is not None:
+        if not callable(getattr(executor, "submit", None)):
+            raise TypeError(f"executor must be a concurrent.futures.Executor (got {executor!r})")
         return _run_on(executor, func, tasks, done_with, own=False)
+    check_workers(workers)
     n = processes_for(workers, len(tasks))
     if n == 1:
-        for i, task in enumerate(tasks):
-            try:
-                result = func(task)
-            except KeyboardInterrupt:
-                return True
-            if done_with(i, result) is False:
-                return i + 1 < len(tasks)
+        try:
+            for i, task in enumerate(tasks):
+                try:
+                    result = func(task)
+                except Exception as exc:
+                    exc.add_note(f"(task {i} of {len(tasks)}: {task!r:.200})")
+                    raise
+                if done_with(i, result) is False:
+                    return i + 1 < len(tasks)
+        except KeyboardInterrupt:
+            return True
         return False
     if getattr(multiprocessing.current_process(), "_inheriting", False):
         # A spawned worker importing the script that started the study would start its own.
         raise RuntimeError(f"a worker process started a study while importing its script: {_GUARD}")
+    _check_sendable(func, tasks)
     context = multiprocessing.get_context("spawn")
+    records = context.Queue()
+    listener = QueueListener(records, _Relay())
+    listener.start()
     level = logging.getLogger(CORE_LOGGER).getEffectiveLevel()
-    pool = ProcessPoolExecutor(n, mp_context=context, initializer=_start_worker, initargs=(level,))
-    return _run_on(pool, func, tasks, done_with, own=True)
+    pool = ProcessPoolExecutor(
+        n, mp_context=context, initializer=_start_worker, initargs=(level, records)
+    )
+    try:
+        return _run_on(pool, func, tasks, done_with, own=True)
+    finally:
+        listener.stop()
+        records.close()
+        records.join_thread()
 
 
 def sweep(
     func: Callable[[T], R],
-    tasks: Sequence[T],
+    tasks: Iterable[T],
     *,
     workers: int | None = 1,
     executor: Executor | None = None,
@@ -176,27 +267,56 @@ def sweep(
     ------
     Exception
         The first exception a run raises, after the other runs are stopped.
+    TypeError, WorkerDied
+        As :func:`run_tasks`.
     KeyboardInterrupt
         On Ctrl-C, once the runs are stopped.
     """
+    tasks = list(tasks)
     results: dict[int, R] = {}
     if run_tasks(func, tasks, workers, results.__setitem__, executor=executor):
         raise KeyboardInterrupt
     return [results[i] for i in range(len(tasks))]
 
 
+@contextlib.contextmanager
+def _spawning(own: bool) -> Iterator[None]:
+    """While the pool's workers are spawned: SIGINT held back (a Ctrl-C then reaches this
+    process once they have started, and none of them while they start), and one core thread in
+    the environment they inherit."""
+    if not own:
+        yield
+        return
+    block = hasattr(signal, "pthread_sigmask")
+    before = os.environ.get("RAYON_NUM_THREADS")
+    if block:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    os.environ["RAYON_NUM_THREADS"] = "1"
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop("RAYON_NUM_THREADS", None)
+        else:
+            os.environ["RAYON_NUM_THREADS"] = before
+        if block:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def _run_on(
     pool: Executor,
     func: Callable[[T], R],
-    tasks: Sequence[T],
+    tasks: list[T],
     on_done: Callable[[int, R], bool | None],
     *,
     own: bool,
 ) -> bool:
-    """:func:`run_tasks` on `pool`, which is shut down if it is `own`."""
+    """:func:`run_tasks` on `pool`, which is ended if it is `own`."""
     pending: dict[Future[R], int] = {}
     try:
-        pending = {pool.submit(func, task): i for i, task in enumerate(tasks)}
+        with _spawning(own):
+            for i, task in enumerate(tasks):
+                pending[pool.submit(func, task)] = i
         while pending:
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in sorted(done, key=pending.__getitem__):
@@ -204,27 +324,34 @@ def _run_on(
                 try:
                     result = future.result()
                 except BrokenProcessPool as exc:
-                    # Every unfinished task fails with it: which one the dead worker ran is not
-                    # known.
+                    # Every task not reported fails with it: which one the dead worker ran is
+                    # not known.
                     unfinished = sorted([i, *pending.values()])
-                    raise RuntimeError(
+                    raise WorkerDied(
                         "a worker process died (killed, out of memory, or it could not start: "
-                        f"{_GUARD}) before tasks {unfinished} of {len(tasks)} ended"
+                        f"{_GUARD}) with tasks {unfinished} of {len(tasks)} not reported",
+                        unfinished,
                     ) from exc
+                except Exception as exc:
+                    exc.add_note(f"(task {i} of {len(tasks)}: {tasks[i]!r:.200})")
+                    raise
                 if on_done(i, result) is False:
                     return bool(pending)
         return False
     except KeyboardInterrupt:
         return True
     finally:
-        for future in pending:
-            future.cancel()
-        if own:
-            # Normal end: every worker is idle. Otherwise the runs still going are stopped, not
-            # waited for (a run on a fine mesh takes minutes).
+        if not own:
+            for future in pending:
+                future.cancel()
+        else:
+            # Normal end: every worker is idle. Otherwise the runs still going are ended, not
+            # waited for (a run on a fine mesh takes minutes); the futures are left to the pool,
+            # whose manager fails them once its workers are gone (cancelling them first made it
+            # fail on Python 3.11 with InvalidStateError, leaving its processes unreaped).
             if pending and isinstance(pool, ProcessPoolExecutor):
                 _terminate(pool)
-            pool.shutdown(wait=not pending, cancel_futures=True)
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:

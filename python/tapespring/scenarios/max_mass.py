@@ -523,7 +523,10 @@ class MaxMassResult:
         w = self.tape_weight_equivalent_mass * 1e3
         finite = self.m_max[np.isfinite(self.m_max)]
         if finite.size:
-            share = np.max(self.tape_weight_equivalent_mass / np.nanmin(self.m_max, axis=(0, 2)))
+            # Per thickness, over the senses and moduli run (a stopped study may have none).
+            run = np.isfinite(self.m_max).any(axis=(0, 2))
+            smallest = np.nanmin(self.m_max[:, run, :], axis=(0, 2))
+            share = np.max(self.tape_weight_equivalent_mass[run] / smallest)
             lines.append(
                 f"  tapes' own weight (neglected) = {w.min():.2f}-{w.max():.2f} g at the lever "
                 f"arm, at most {share:.1%} of m_max"
@@ -617,7 +620,6 @@ class _PointRun:
     error: str | None
     wall_s: float
     ndof: int
-    cancelled: bool
 
 
 def _bend_point(task: tuple[MaxMassSettings, str, float, float]) -> _PointRun:
@@ -633,21 +635,19 @@ def _bend_point(task: tuple[MaxMassSettings, str, float, float]) -> _PointRun:
         result.theta_deg[-1], setup.theta_max_deg, abs_tol=1e-9
     )
     error = None
-    if result.cancelled:
-        pass
-    elif not reached:
+    if not reached:
         last = result.theta_deg[-1] if result.theta_deg.size else 0.0
         error = f"stopped at {last:+.2f} deg: {result.error}"
     elif not result.jump.any():
         error = f"no fold formed (no snap) before {setup.theta_max_deg} deg"
-    ok = reached and error is None and not result.cancelled
+    # (No progress callback is passed to the run, so it is never cancelled: a Ctrl-C raises.)
+    ok = reached and error is None
     return _PointRun(
         moment=float(result.moment[-1]) if ok else None,
         stable=bool(result.stable[-1]) if ok else False,
         error=error,
         wall_s=wall,
         ndof=int(result.ndof),
-        cancelled=bool(result.cancelled),
     )
 
 
@@ -672,7 +672,7 @@ def max_mass(
         Runs side by side in that many worker processes (None: one per core; default 1: one
         after the other in this process). The results are the same; on 2 cores two workers take
         the grid in about 0.6 of the time (both senses, 5 x 5: 66 s against 111 s), each worker
-        process costing about a second to start.
+        process costing a fraction of a second to start.
 
     Returns
     -------
@@ -682,13 +682,15 @@ def max_mass(
     Raises
     ------
     ValueError
-        For invalid settings (the message names the value), before any run.
+        For invalid settings (the message names the value) or `workers` out of [1, 256], before
+        any run.
     TypeError
         If `workers` is not an integer or None.
-    RuntimeError
-        If a worker process died during a run (killed, out of memory).
+    tapespring.sweep.WorkerDied
+        A RuntimeError: a worker process died during a run (killed, out of memory); the message
+        names the points not reported.
     """
-    from tapespring.sweep import check_workers, processes_for, run_tasks
+    from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
 
     settings = settings or MaxMassSettings()
     settings.validate()
@@ -727,9 +729,6 @@ def max_mass(
     def record(n: int, run: _PointRun) -> bool:
         nonlocal ndof, cancelled, done
         i, j, k = points[n]
-        if run.cancelled:
-            cancelled = True
-            return False
         done += 1
         run_wall[i, j, k] = run.wall_s
         ndof = run.ndof
@@ -749,6 +748,9 @@ def max_mass(
     tasks = [(settings, senses[i], float(t_grid[j]), float(e_grid[k])) for i, j, k in points]
     try:
         stopped = run_tasks(_bend_point, tasks, workers, record)
+    except WorkerDied as exc:
+        lost = "; ".join(label(n) for n in exc.unfinished)
+        raise WorkerDied(f"{exc} (points: {lost})", exc.unfinished) from exc
     finally:
         if bar is not None:
             bar.close()
