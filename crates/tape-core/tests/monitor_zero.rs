@@ -23,39 +23,21 @@
 
 mod common;
 
+use common::zero::{pushed_strip, L};
+
 use nalgebra::Vector3;
-use tape_core::mesh::generate::flat_plate;
 use tape_core::model::{Constraint, Load};
 use tape_core::solver::{Control, Event, Monitor, NewtonParams, StaticParams, ZeroStop};
 use tape_core::{run, Dof, Model, Outputs, Result, RunResult, Step, TimeFunction};
 
-const L: f64 = 0.2;
 /// End shortening [m].
 const PUSH_IN: f64 = 1e-4;
 
 /// The strip buckled up (step 0), the nodes tied to the driven middle, and the step that drives the
 /// middle 8 mm down (about 5 times the buckle's height) with `stop`.
 fn buckled_strip(stop: ZeroStop) -> Result<(Model, Vec<Step>, usize)> {
-    let mesh = flat_plate(L, 0.02, 16, 2)?;
-    let mut model = Model::try_new(mesh, common::section(2e-3, 2e11, 0.3))?;
-    let x0 = model.mesh.node_set("x0")?.to_vec();
-    let x1 = model.mesh.node_set("x1")?.to_vec();
-    let middle: Vec<usize> = (0..model.mesh.nodes.len())
-        .filter(|&i| (model.mesh.nodes[i].x - 0.5 * L).abs() < 1e-9)
-        .collect();
-    assert_eq!(middle.len(), 3, "the middle section's nodes");
-    model.fix(&x0, &Dof::ALL)?;
-    let end = model.add_node(Vector3::new(L, 0.01, 0.0))?;
-    model.tie(&x1, end)?;
-    model.fix(&[end], &[Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz])?;
-    model.add_constraint(Constraint {
-        id: None,
-        node: end,
-        dof: Dof::Ux,
-        value: -PUSH_IN,
-        function: TimeFunction::Ramp { start: 0.0, end: 1.0 },
-        active: true,
-    })?;
+    let held = [Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz];
+    let (mut model, _, middle) = pushed_strip(0.3, PUSH_IN, &held)?;
     let mid = model.add_node(Vector3::new(0.5 * L, 0.01, 0.0))?;
     model.tie(&middle, mid)?;
     model.add_load_with(Load {

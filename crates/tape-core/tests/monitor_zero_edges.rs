@@ -32,33 +32,16 @@
 
 mod common;
 
+use common::zero::{arc, driven, outputs, tight, L};
+
 use nalgebra::Vector3;
 use tape_core::mesh::generate::flat_plate;
 use tape_core::model::{Constraint, Load};
-use tape_core::solver::{Control, DynamicParams, Event, Monitor, NewtonParams, StaticParams, ZeroStop};
-use tape_core::{run, Dof, History, Model, Outputs, Result, RunResult, Step, System, TimeFunction};
+use tape_core::solver::{Control, DynamicParams, Event, NewtonParams, StaticParams, ZeroStop};
+use tape_core::{run, Dof, History, Model, Result, RunResult, Step, System, TimeFunction};
 
-/// Length of the strip \[m\].
-const L: f64 = 0.2;
 /// Tip load of the translation cases \[N\]: 10 mm of deflection (5 % of the length).
 const P: f64 = 10.0;
-
-fn tight() -> NewtonParams {
-    NewtonParams {
-        tol_force: 1e-10,
-        ..NewtonParams::default()
-    }
-}
-
-fn arc(lambda_end: f64, initial_increment: f64) -> Control {
-    Control::ArcLength {
-        lambda_end,
-        initial_increment,
-        max_increment_factor: 10.0,
-        max_steps: 500,
-        direction: 1.0,
-    }
-}
 
 /// Arc-length control whose arcs may grow to a tenth of a unit range whatever the first.
 fn growing(lambda_end: f64, initial_increment: f64) -> Control {
@@ -68,24 +51,6 @@ fn growing(lambda_end: f64, initial_increment: f64) -> Control {
         max_increment_factor: 0.1 / initial_increment,
         max_steps: 500,
         direction: 1.0,
-    }
-}
-
-/// An arc-length step over the motions' range with the reaction of `dof` at `node` monitored.
-fn driven(node: usize, dof: Dof, stop: ZeroStop, control: Control) -> StaticParams {
-    StaticParams {
-        control,
-        newton: tight(),
-        monitor: Some(Monitor { node, dof }),
-        stop_at_monitor_zero: stop,
-        ..StaticParams::default()
-    }
-}
-
-fn outputs(reactions: Vec<(usize, Dof)>) -> Outputs {
-    Outputs {
-        reactions,
-        field_interval: 1,
     }
 }
 

@@ -43,6 +43,8 @@
 
 mod common;
 
+use common::zero::{arc, driven, outputs, pushed_strip, tight, L};
+
 use std::sync::{Mutex, Once};
 use std::thread::{self, ThreadId};
 
@@ -51,48 +53,11 @@ use tape_core::assembly::Assembled;
 use tape_core::mesh::generate::flat_plate;
 use tape_core::model::{Constraint, Gravity, Load, RigidBody};
 use tape_core::output::Fields;
-use tape_core::solver::{Control, Event, Monitor, NewtonParams, StaticParams, ZeroStop};
-use tape_core::{run, Dof, History, Model, Outputs, Result, RunResult, Step, System, TimeFunction};
+use tape_core::solver::{Control, Event, NewtonParams, StaticParams, ZeroStop};
+use tape_core::{run, Dof, History, Model, Result, RunResult, Step, System, TimeFunction};
 
-/// Length of the strip \[m\].
-const L: f64 = 0.2;
 /// The cantilever's tip stiffness `3 EI / L^3` \[N/m\] (see the header).
 const K_TIP: f64 = 1e3;
-
-fn tight() -> NewtonParams {
-    NewtonParams {
-        tol_force: 1e-10,
-        ..NewtonParams::default()
-    }
-}
-
-fn arc(lambda_end: f64, initial_increment: f64) -> Control {
-    Control::ArcLength {
-        lambda_end,
-        initial_increment,
-        max_increment_factor: 10.0,
-        max_steps: 500,
-        direction: 1.0,
-    }
-}
-
-/// An arc-length step with the reaction of `dof` at `node` monitored.
-fn driven(node: usize, dof: Dof, stop: ZeroStop, control: Control) -> StaticParams {
-    StaticParams {
-        control,
-        newton: tight(),
-        monitor: Some(Monitor { node, dof }),
-        stop_at_monitor_zero: stop,
-        ..StaticParams::default()
-    }
-}
-
-fn outputs(reactions: Vec<(usize, Dof)>) -> Outputs {
-    Outputs {
-        reactions,
-        field_interval: 1,
-    }
-}
 
 /// Runs `steps` on `model` recording the reaction of `(node, dof)`; an error of the path fails.
 fn path(model: &Model, steps: &[Step], node: usize, dof: Dof, case: &str) -> Result<RunResult> {
@@ -718,26 +683,7 @@ const TURN: f64 = -0.12;
 /// along +z that vanishes by its end chooses the side), then its end's rotation driven by
 /// `TURN` (step 1, arc-length, the end's moment monitored, stopping as `stop` says).
 fn pinned_strip(stop: ZeroStop) -> Result<(Model, Vec<Step>, usize)> {
-    let mesh = flat_plate(L, 0.02, 16, 2)?;
-    let mut model = Model::try_new(mesh, common::section(2e-3, 2e11, 0.0))?;
-    let x0 = model.mesh.node_set("x0")?.to_vec();
-    let x1 = model.mesh.node_set("x1")?.to_vec();
-    let middle: Vec<usize> = (0..model.mesh.nodes.len())
-        .filter(|&i| (model.mesh.nodes[i].x - 0.5 * L).abs() < 1e-9)
-        .collect();
-    assert_eq!(middle.len(), 3, "the middle section's nodes");
-    model.fix(&x0, &Dof::ALL)?;
-    let end = model.add_node(Vector3::new(L, 0.01, 0.0))?;
-    model.tie(&x1, end)?;
-    model.fix(&[end], &[Dof::Uy, Dof::Uz, Dof::Rx, Dof::Rz])?;
-    model.add_constraint(Constraint {
-        id: None,
-        node: end,
-        dof: Dof::Ux,
-        value: -PUSH_IN,
-        function: TimeFunction::Ramp { start: 0.0, end: 1.0 },
-        active: true,
-    })?;
+    let (mut model, end, middle) = pushed_strip(0.0, PUSH_IN, &[Dof::Uy, Dof::Uz, Dof::Rx, Dof::Rz])?;
     for &n in &middle {
         model.add_load_with(Load {
             id: None,

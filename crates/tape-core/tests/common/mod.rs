@@ -309,6 +309,8 @@ pub fn value_at_load(lambdas: &[f64], values: &[f64], level: f64, first: bool) -
 ///   hinged ====v==== hinged      straight edges (phi = +-theta) hinged, curved edges free
 ///          /         \
 /// ```
+pub mod zero;
+
 pub mod hinged_roof {
     use std::sync::OnceLock;
 

@@ -1,0 +1,77 @@
+//! Builders shared by the tests of `stop_at_monitor_zero` (`monitor_zero*.rs`): arc-length steps
+//! with a monitored reaction, and the steel strip clamped at one end and pushed in at the other.
+
+use nalgebra::Vector3;
+use tape_core::mesh::generate::flat_plate;
+use tape_core::model::Constraint;
+use tape_core::solver::{Control, Monitor, NewtonParams, StaticParams, ZeroStop};
+use tape_core::{Dof, Model, Outputs, Result, TimeFunction};
+
+/// Length of the strips \[m\].
+pub const L: f64 = 0.2;
+
+/// Newton to 1e-10 of the reference force: the zeros are then located to the round-off floor.
+pub fn tight() -> NewtonParams {
+    NewtonParams {
+        tol_force: 1e-10,
+        ..NewtonParams::default()
+    }
+}
+
+/// Arc-length control to `lambda_end`, arcs growing to ten times the first.
+pub fn arc(lambda_end: f64, initial_increment: f64) -> Control {
+    Control::ArcLength {
+        lambda_end,
+        initial_increment,
+        max_increment_factor: 10.0,
+        max_steps: 500,
+        direction: 1.0,
+    }
+}
+
+/// A step under `control` with the reaction of `dof` at `node` monitored, stopping as `stop` says.
+pub fn driven(node: usize, dof: Dof, stop: ZeroStop, control: Control) -> StaticParams {
+    StaticParams {
+        control,
+        newton: tight(),
+        monitor: Some(Monitor { node, dof }),
+        stop_at_monitor_zero: stop,
+        ..StaticParams::default()
+    }
+}
+
+/// Records the reactions at `reactions` and the fields of every state.
+pub fn outputs(reactions: Vec<(usize, Dof)>) -> Outputs {
+    Outputs {
+        reactions,
+        field_interval: 1,
+    }
+}
+
+/// A steel strip `L` x 20 x 2 mm (16 x 2 elements, Poisson's ratio `poisson`) clamped at x = 0,
+/// its end section tied to the node `end`, which is held on `held` and pushed in along x by
+/// `push_in` \[m\] over t in [0, 1]. Returns the model, `end` and the nodes of the middle
+/// section.
+pub fn pushed_strip(poisson: f64, push_in: f64, held: &[Dof]) -> Result<(Model, usize, Vec<usize>)> {
+    let mesh = flat_plate(L, 0.02, 16, 2)?;
+    let mut model = Model::try_new(mesh, super::section(2e-3, 2e11, poisson))?;
+    let x0 = model.mesh.node_set("x0")?.to_vec();
+    let x1 = model.mesh.node_set("x1")?.to_vec();
+    let middle: Vec<usize> = (0..model.mesh.nodes.len())
+        .filter(|&i| (model.mesh.nodes[i].x - 0.5 * L).abs() < 1e-9)
+        .collect();
+    assert_eq!(middle.len(), 3, "the middle section's nodes");
+    model.fix(&x0, &Dof::ALL)?;
+    let end = model.add_node(Vector3::new(L, 0.01, 0.0))?;
+    model.tie(&x1, end)?;
+    model.fix(&[end], held)?;
+    model.add_constraint(Constraint {
+        id: None,
+        node: end,
+        dof: Dof::Ux,
+        value: -push_in,
+        function: TimeFunction::Ramp { start: 0.0, end: 1.0 },
+        active: true,
+    })?;
+    Ok((model, end, middle))
+}
