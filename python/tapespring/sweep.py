@@ -73,7 +73,7 @@ def check_workers(value: object) -> None:
         return
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"workers must be an integer number of processes or None (got {value!r})")
-    if not 1 <= value <= MAX_WORKERS:
+    if not 1 <= int(value) <= MAX_WORKERS:
         raise ValueError(f"workers must be between 1 and {MAX_WORKERS} (got {value})")
 
 
