@@ -245,6 +245,15 @@ pub(crate) fn static_option_names() -> Vec<&'static str> {
 }
 
 impl StaticParams {
+    /// Whether a converged step over `dl` in load factor, along which the monitored reaction went
+    /// from `m0` to `m1`, is to be refined (`refine_change` > 0, the step longer than
+    /// `refine_span`, the reaction changed by more than `refine_change` of its magnitude).
+    pub(crate) fn wants_refinement(&self, dl: f64, m0: f64, m1: f64) -> bool {
+        self.refine_change > 0.0
+            && dl.abs() > self.refine_span
+            && (m1 - m0).abs() > self.refine_change * m0.abs().max(m1.abs())
+    }
+
     /// Checks every setting.
     ///
     /// # Errors

@@ -474,10 +474,8 @@ fn search(
 /// Whether the step from `b` to `c` is longer than `refine_span` in load factor while the
 /// monitored reaction changes by more than `refine_change` of its magnitude.
 fn needs_refinement(s: &Driver, b: &Point, c: &Point) -> bool {
-    let (span, change) = (s.params.refine_span, s.params.refine_change);
-    let dl = (c.state.t - b.state.t).abs();
-    let dm = (c.monitor - b.monitor).abs();
-    change > 0.0 && dl > span && dm > change * b.monitor.abs().max(c.monitor.abs())
+    s.params
+        .wants_refinement(c.state.t - b.state.t, b.monitor, c.monitor)
 }
 
 /// Recounts the negative eigenvalues of a state found with one, leaving out a neutral mode (see

@@ -1215,10 +1215,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         let m = self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i];
         let dm = (m - last.monitor).abs();
         let scale = m.abs().max(last.monitor.abs());
-        // No refinement asked (`refine_change` 0): no step is too coarse for it either.
-        if params.refine_change <= 0.0
-            || (state.t - saved.t).abs() <= params.refine_span
-            || dm <= params.refine_change * scale
+        // A step too coarse is one that needs refinement, and more (none without `refine_change`).
+        if !params.wants_refinement(state.t - saved.t, last.monitor, m)
             || self.p.control.cutbacks >= params.max_cutbacks / 2
         {
             return false;
