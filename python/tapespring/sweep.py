@@ -280,13 +280,10 @@ def sweep(
 
 
 @contextlib.contextmanager
-def _spawning(own: bool) -> Iterator[None]:
+def _spawning() -> Iterator[None]:
     """While the pool's workers are spawned: SIGINT held back (a Ctrl-C then reaches this
     process once they have started, and none of them while they start), and one core thread in
     the environment they inherit."""
-    if not own:
-        yield
-        return
     block = hasattr(signal, "pthread_sigmask")
     before = os.environ.get("RAYON_NUM_THREADS")
     if block:
@@ -314,7 +311,7 @@ def _run_on(
     """:func:`run_tasks` on `pool`, which is ended if it is `own`."""
     pending: dict[Future[R], int] = {}
     try:
-        with _spawning(own):
+        with _spawning() if own else contextlib.nullcontext():
             for i, task in enumerate(tasks):
                 pending[pool.submit(func, task)] = i
         while pending:

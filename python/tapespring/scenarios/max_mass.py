@@ -723,11 +723,10 @@ def max_mass(
 
         bar = tqdm(total=total, unit=" runs", file=sys.stderr, desc="max-mass", leave=False)
     start = time.perf_counter()
-    cancelled = False
     done = 0
 
     def record(n: int, run: _PointRun) -> bool:
-        nonlocal ndof, cancelled, done
+        nonlocal ndof, done
         i, j, k = points[n]
         done += 1
         run_wall[i, j, k] = run.wall_s
@@ -740,10 +739,7 @@ def max_mass(
         if bar is not None:
             bar.set_postfix_str(label(n), refresh=False)
             bar.update(1)
-        elif callable(progress) and progress(done, total) is False:
-            cancelled = done < total
-            return False
-        return True
+        return not (callable(progress) and progress(done, total) is False)
 
     tasks = [(settings, senses[i], float(t_grid[j]), float(e_grid[k])) for i, j, k in points]
     try:
@@ -766,7 +762,8 @@ def max_mass(
         ndof=ndof,
         wall_s=time.perf_counter() - start,
         errors=tuple(errors[n] for n in sorted(errors)),
-        cancelled=cancelled or stopped,
+        # (run_tasks: a stop at the last run is no stop, the study ended.)
+        cancelled=stopped,
         workers=processes_for(workers, total),
     )
 
