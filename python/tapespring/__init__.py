@@ -27,6 +27,9 @@ report
     The report of an analysis of trials: CSV tables, PNG figures, text summary, JSON.
 plot
     The paper's figure types for trials (matplotlib).
+identify
+    The model's uncertain parameters from the identification tests: the tapes' thickness and
+    Young's modulus (Sec. 5.1), the Kelvin-Voigt viscosity (Sec. 5.2).
 sweep
     A study's independent runs side by side, in worker processes or on a cluster's executor.
 cli
@@ -59,6 +62,7 @@ __all__ = [
     "__version__",
     "analysis",
     "cli",
+    "identify",
     "modes",
     "plot",
     "protocols",

@@ -15,6 +15,10 @@ deploy, pull, vibrate, equilibrium
     The paper's set-up: deployment (Sec. 4.1, 6.1), quasi-static pull (Sec. 4.2, 6.2),
     small-amplitude vibrations (Sec. 5.2) and the static identification configuration
     (Sec. 5.1); see :mod:`tapespring.scenarios`.
+identify static, identify damping
+    The tapes' thickness and Young's modulus from the static identification test (Sec. 5.1),
+    and their Kelvin-Voigt viscosity from a damping ratio (Sec. 5.2); see
+    :mod:`tapespring.cli.identify`.
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -104,7 +108,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, deploy, equilibrium, max_mass, pull, release, trials, vibrate
+    from . import bend, deploy, equilibrium, identify, max_mass, pull, release, trials, vibrate
     from .parser import ArgumentParser
 
     parser = ArgumentParser(
@@ -122,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
     equilibrium.register(sub)
     vibrate.register(sub)
     max_mass.register(sub)
+    identify.register(sub)
     trials.register(sub)
     for command, depth in _command_parsers(parser):
         # -v after the command too (`tapespring deploy -v`), counted with those before it: a

@@ -59,11 +59,18 @@ D = TypeVar("D", bound="DataclassInstance")
 
 
 def add_spec_options(
-    p: argparse.ArgumentParser, *, mesh_tape: float, mesh_plates: float, eta: bool = True
+    p: argparse.ArgumentParser,
+    *,
+    mesh_tape: float,
+    mesh_plates: float,
+    eta: bool = True,
+    material: bool = True,
 ) -> None:
-    """Add the set-up's options (mesh sizes, tape material and, with `eta`, the tapes'
-    viscosity) with the given mesh defaults. A static scenario (pull, equilibrium) has no rates
-    for a viscosity to act on: it leaves ``--eta`` out."""
+    """Add the set-up's options (mesh sizes, with `material` the tapes' thickness and Young's
+    modulus, with `eta` their viscosity) with the given mesh defaults. A static scenario (pull,
+    equilibrium) has no rates for a viscosity to act on: it leaves ``--eta`` out; an
+    identification leaves out what it identifies (its ``--spec`` assignments of those fields
+    are refused by `spec_from_args`)."""
     from tapespring.scenarios.setup import PAPER_SETUP
 
     s = PAPER_SETUP
@@ -81,15 +88,18 @@ def add_spec_options(
         help="element size of the rod and appendix [m] (paper: 3e-3 m; default %(default)g m)",
     )
     spec = "the set-up spec's {}, "
-    add_thickness_option(
-        g, s.tape.thickness, name="tape.thickness", source=spec.format("tape.thickness")
-    )
-    add_youngs_modulus_option(
-        g,
-        s.tape.youngs_modulus,
-        name="tape.youngs_modulus",
-        source=spec.format("tape.youngs_modulus"),
-    )
+    if material:
+        add_thickness_option(
+            g, s.tape.thickness, name="tape.thickness", source=spec.format("tape.thickness")
+        )
+        add_youngs_modulus_option(
+            g,
+            s.tape.youngs_modulus,
+            name="tape.youngs_modulus",
+            source=spec.format("tape.youngs_modulus"),
+        )
+    else:
+        p.set_defaults(identified=IDENTIFIED_MATERIAL)
     if eta:
         add_eta_option(g, s.eta, source=spec.format("eta"))
     else:
@@ -267,6 +277,10 @@ def add_energy_tolerance_option(p: argparse._ActionsContainer, default: float) -
 STATIC_IGNORED = ("eta", "support_eta")
 
 
+#: The spec's fields an identification of the tapes' material finds (``--spec`` refuses them).
+IDENTIFIED_MATERIAL = ("tape.thickness", "tape.youngs_modulus")
+
+
 def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
     """The :class:`SetupSpec` of the parsed options: the dedicated ones and `fields` (a
     command's own options, such as deploy's ``support``), then ``--spec``'s assignments."""
@@ -283,7 +297,17 @@ def spec_from_args(args: argparse.Namespace, **fields: Any) -> Any:
                     f"--spec {name}: this test is static (a path without rates), so a viscosity "
                     "acts on nothing; leave it out"
                 )
-    tape = replace(PAPER_SETUP.tape, thickness=args.thickness, youngs_modulus=args.youngs_modulus)
+    for name, _ in getattr(args, "spec", []):
+        if name in getattr(args, "identified", ()):
+            raise ValueError(
+                f"--spec {name}: this command identifies {name}, so a value given for it would "
+                "be replaced; leave it out"
+            )
+    tape = replace(
+        PAPER_SETUP.tape,
+        thickness=getattr(args, "thickness", PAPER_SETUP.tape.thickness),
+        youngs_modulus=getattr(args, "youngs_modulus", PAPER_SETUP.tape.youngs_modulus),
+    )
     spec = replace(
         PAPER_SETUP,
         tape=tape,

@@ -16,6 +16,10 @@ bending
 release
     The free motion of a released tape spring: end angle and energy balance (returns a Figure).
 
+identify
+    The identifications of Sec. 5: the search for t and E, and eta against the damping ratio
+    (return a Figure).
+
 setup, max_mass, numerical_damping, support, snapshots
     The paper's tests on the set-up (deployment, pull, vibration, Figs. 27-34; the push path to
     the folded equilibrium, Sec. 5.1), the maximum mass (Fig. 7), the numerical damping study
@@ -30,6 +34,7 @@ from tapespring._lazy import lazy_exports
 if TYPE_CHECKING:
     # What the lazy __getattr__ below returns, for the type checker (not imported at run time).
     from .bending import plot_bending
+    from .identify import plot_damping_identification, plot_static_identification
     from .max_mass import plot_max_mass
     from .numerical_damping import plot_numerical_damping
     from .release import plot_release
@@ -52,6 +57,7 @@ __all__ = [
     "plot_angle_histories",
     "plot_bending",
     "plot_clamp_forces",
+    "plot_damping_identification",
     "plot_damping_series",
     "plot_deployment",
     "plot_equilibrium",
@@ -65,6 +71,7 @@ __all__ = [
     "plot_release",
     "plot_series_comparison",
     "plot_snapshots",
+    "plot_static_identification",
     "plot_tip_trajectory",
     "plot_variation_coefficients",
     "plot_vibration",
@@ -86,6 +93,7 @@ __getattr__, __dir__ = lazy_exports(
             "plot_variation_coefficients",
         ],
         "bending": ["plot_bending"],
+        "identify": ["plot_damping_identification", "plot_static_identification"],
         "release": ["plot_release"],
         "setup": ["plot_deployment", "plot_equilibrium", "plot_pull", "plot_vibration"],
         "max_mass": ["plot_max_mass"],

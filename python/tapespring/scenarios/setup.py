@@ -257,6 +257,22 @@ class IdentificationBounds:
     youngs_modulus_min: float = 100e9
     youngs_modulus_max: float = 220e9
 
+    def validate(self) -> None:
+        """Raise ValueError naming a bound that is not a thickness or a Young's modulus, or a
+        range that is empty (each minimum must lie below its maximum)."""
+        for name in ("thickness_min", "thickness_max"):
+            check_thickness(getattr(self, name), name)
+        for name in ("youngs_modulus_min", "youngs_modulus_max"):
+            check_youngs_modulus(getattr(self, name), name)
+        for low, high in (
+            ("thickness_min", "thickness_max"),
+            ("youngs_modulus_min", "youngs_modulus_max"),
+        ):
+            if not getattr(self, low) < getattr(self, high):
+                raise ValueError(
+                    f"{low} = {getattr(self, low)!r} must be below {high} = {getattr(self, high)!r}"
+                )
+
 
 #: Table 4: the (t, E) range of the identification, also the range of the design study (Fig. 7).
 PAPER_BOUNDS = IdentificationBounds()

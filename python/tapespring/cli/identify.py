@@ -1,0 +1,332 @@
+"""Command line: ``tapespring identify static`` (the tapes' thickness and Young's modulus, paper
+Sec. 5.1) and ``tapespring identify damping`` (the Kelvin-Voigt viscosity, Sec. 5.2)."""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+from typing import TYPE_CHECKING, Any
+
+from .bend import _checked, _field, _input_file, print_warnings, refuse_shared_paths
+from .scenario_options import (
+    add_output_options,
+    add_rho_inf_option,
+    add_spec_options,
+    add_workers_option,
+    analyze_experiment,
+    finish,
+    shows_progress,
+    spec_from_args,
+)
+
+if TYPE_CHECKING:
+    from tapespring.identify.damping import DampingIdentification
+    from tapespring.identify.static import StaticIdentification
+
+__all__ = ["register", "run_damping", "run_static"]
+
+
+def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``identify`` command, with its ``static`` and ``damping`` sub-commands, to a CLI
+    (`sub` from ``add_subparsers``)."""
+    p = sub.add_parser(
+        "identify",
+        help="identify the tapes' t and E (static test) or eta (free decay), as Sec. 5 does",
+        description=(
+            "Identify the model's uncertain parameters from the paper's identification tests: "
+            "'static' the tapes' thickness and Young's modulus from the folded equilibrium "
+            "with the additional weight (Sec. 5.1), 'damping' the Kelvin-Voigt viscosity from "
+            "the damping ratio of small free vibrations (Sec. 5.2)."
+        ),
+    )
+    commands = p.add_subparsers(dest="identify_command", required=True)
+    _register_static(commands)
+    _register_damping(commands)
+    return p
+
+
+def _experiment_option(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument(
+        "--experiment",
+        dest="experiments",
+        type=_input_file,
+        action="append",
+        default=[],
+        metavar="FILE",
+        help=f"a recorded trial (C3D or CSV, markers M0-M3 as in 'tapespring trials'): {what}; "
+        "repeatable (the mean over the recordings is matched)",
+    )
+
+
+def _refuse_shared_paths(args: argparse.Namespace) -> None:
+    """`refuse_shared_paths` for each recording read."""
+    for path in args.experiments or [None]:
+        refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}))
+
+
+def _analyzed(args: argparse.Namespace, analyze: Any, test: str) -> list[Any]:
+    return [analyze_experiment(path, analyze, test=test) for path in args.experiments]
+
+
+def _register_static(sub: argparse._SubParsersAction) -> None:
+    from tapespring.identify.static import MAX_EVALUATIONS
+    from tapespring.scenarios.equilibrium import EquilibriumSettings, check_push
+
+    p = sub.add_parser(
+        "static",
+        help="the tapes' thickness and Young's modulus from the folded equilibrium (Table 3)",
+        description=(
+            "Find the tapes' thickness t and Young's modulus E (within Table 4's bounds) whose "
+            "folded equilibrium of the set-up with the additional weight ('tapespring "
+            "equilibrium') matches the measured displacements of markers 1-2 and 3 along x and "
+            "z best, by the paper's objective (eq. (4): the sum of the relative differences), "
+            "from several starting points (Nelder-Mead in ln t, ln E). Then two more runs give "
+            "the sensitivity: the combination E t^a the data fix best, and how far t and E may "
+            "move together along the valley. Default: Table 3's displacements."
+        ),
+    )
+    _experiment_option(
+        p,
+        "a static identification test recorded from the unfolded equilibrium at rest to the "
+        "folded one at rest, analysed as 'tapespring trials analyze --kind identification' "
+        "does; its displacements replace Table 3's",
+    )
+    p.add_argument(
+        "--target-m",
+        type=float,
+        nargs=4,
+        metavar=("X12", "Z12", "X3", "Z3"),
+        help="the measured absolute displacements [m] of markers 1-2 (mean) and 3 along x and "
+        "z instead of Table 3's (0.0247 0.0779 0.0418 0.1109); not with --experiment",
+    )
+    p.add_argument(
+        "--starts",
+        type=_checked("starts", _check_starts),
+        default=4,
+        help="starting points, spread over the bounds (default %(default)s)",
+    )
+    p.add_argument(
+        "--max-evaluations",
+        type=_checked("max_evaluations", _check_evaluations),
+        default=MAX_EVALUATIONS,
+        help="equilibrium runs per start at most (default %(default)s)",
+    )
+    p.add_argument(
+        "--no-sensitivity",
+        action="store_true",
+        help="skip the two runs about the optimum that measure the sensitivity",
+    )
+    p.add_argument(
+        "--push",
+        type=_checked("push", check_push),
+        default=EquilibriumSettings.push,
+        help="largest push of the weight's tip [m] in each run (default %(default)g m)",
+    )
+    add_workers_option(p, "the starts")
+    add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False, material=False)
+    add_output_options(
+        p, "every equilibrium run (start, t, E, objective, displacements)", "every run too"
+    )
+    p.set_defaults(func=run_static, parser=p)
+
+
+def _check_starts(value: float) -> None:
+    if value != int(value) or value < 1:
+        raise ValueError(f"starts must be an integer >= 1 (got {value!r})")
+
+
+def _check_evaluations(value: float) -> None:
+    if value != int(value) or value < 3:
+        raise ValueError(f"max_evaluations must be an integer >= 3 (got {value!r})")
+
+
+def run_static(args: argparse.Namespace) -> int:
+    """Handler of ``tapespring identify static``; returns the exit code (0; 1 nothing
+    identified, or an experiment file that cannot be read; 2 bad input or a recording the
+    analysis refuses)."""
+    from tapespring.identify.static import TARGET_KEYS, identify_static
+    from tapespring.scenarios.equilibrium import EquilibriumSettings
+
+    from .bend import refuse
+
+    _refuse_shared_paths(args)
+    if args.target_m is not None and args.experiments:
+        refuse(args, "--target-m and --experiment both give the measured displacements")
+    measured: Any = None
+    if args.experiments:
+        from tapespring.protocols.identification import analyze_identification
+
+        measured = _analyzed(args, analyze_identification, "a static identification test")
+    elif args.target_m is not None:
+        measured = dict(zip(TARGET_KEYS, args.target_m, strict=True))
+    found: list[bool] = []
+
+    def simulate() -> StaticIdentification:
+        settings = EquilibriumSettings(spec=spec_from_args(args), push=args.push)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = identify_static(
+                measured,
+                settings,
+                starts=int(args.starts),
+                max_evaluations=int(args.max_evaluations),
+                sensitivity=not args.no_sensitivity,
+                workers=args.workers,
+                progress=shows_progress(args),
+            )
+        print_warnings(caught)
+        found.append(result.found)
+        return result
+
+    def plot(result: StaticIdentification, path: str) -> None:
+        from tapespring.plot.identify import plot_static_identification
+        from tapespring.report import save_figure
+
+        save_figure(plot_static_identification(result), path)
+
+    def columns(result: StaticIdentification) -> dict:
+        runs = result.evaluations
+        table: dict[str, list[float]] = {
+            "start": [e.start for e in runs],
+            "thickness_m": [e.thickness_m for e in runs],
+            "youngs_modulus_Pa": [e.youngs_modulus_Pa for e in runs],
+            "objective": [e.objective for e in runs],
+            "unstable_modes": [e.unstable_modes for e in runs],
+        }
+        for key in TARGET_KEYS:
+            table[key] = [
+                float("nan") if e.displacements_m is None else e.displacements_m[key] for e in runs
+            ]
+        table["wall_s"] = [e.wall_s for e in runs]
+        return table
+
+    code = finish(args, simulate, columns, plot)
+    return 1 if code == 0 and found == [False] else code
+
+
+def _register_damping(sub: argparse._SubParsersAction) -> None:
+    from tapespring.scenarios.setup import PAPER_MODEL
+    from tapespring.scenarios.vibration import VibrationSettings, check_initial_displacement
+
+    d = VibrationSettings()
+    p = sub.add_parser(
+        "damping",
+        help="the tapes' Kelvin-Voigt viscosity eta from a measured damping ratio (Table 7)",
+        description=(
+            "Find the viscosity eta [s] of the tapes' Kelvin-Voigt material for which the "
+            "small-vibration test ('tapespring vibrate'), its free decay fitted as the "
+            "recordings are (peaks within 0.4-4 mm), has the measured damping ratio: a first "
+            "guess from eta omega / 2, then secant steps (the ratio is nearly affine in eta, "
+            "the scheme's numerical damping its offset). Default: Table 7's 0.509 %%."
+        ),
+    )
+    _experiment_option(
+        p,
+        "a free decay of marker M3 on the additional weight, analysed as 'tapespring trials "
+        "analyze --kind vibration' does; its damping ratio replaces Table 7's and its period "
+        "is set beside the simulation's",
+    )
+    p.add_argument(
+        "--damping-ratio",
+        type=_field("damping_ratio"),
+        default=None,
+        help=f"the measured damping ratio [-] (default Table 7's {PAPER_MODEL.damping_ratio_exp:g}"
+        "); not with --experiment",
+    )
+    p.add_argument(
+        "--rel-tolerance",
+        type=_field("rel_tolerance"),
+        default=0.005,
+        help="stop when the fitted ratio is within this fraction of the target (default "
+        "%(default)g)",
+    )
+    p.add_argument(
+        "--max-runs",
+        type=_checked("max_runs", _check_runs),
+        default=6,
+        help="vibration runs at most (default %(default)s)",
+    )
+    p.add_argument(
+        "--duration",
+        type=_field("duration"),
+        default=d.duration,
+        help="free decay of each run [s] (default %(default)g s)",
+    )
+    p.add_argument(
+        "--initial-displacement",
+        type=_checked("initial_displacement", check_initial_displacement),
+        default=d.initial_displacement,
+        help="push before the release [m] (default %(default)g m; paper: about 8e-3 m)",
+    )
+    add_rho_inf_option(p, d.rho_inf)
+    add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3, eta=False)
+    add_output_options(p, "every run (eta, damping ratio, period)")
+    p.set_defaults(func=run_damping, parser=p)
+
+
+def _check_runs(value: float) -> None:
+    if value != int(value) or value < 2:
+        raise ValueError(f"max_runs must be an integer >= 2 (got {value!r})")
+
+
+def run_damping(args: argparse.Namespace) -> int:
+    """Handler of ``tapespring identify damping``; returns the exit code (0; 1 the tolerance
+    not met, a run stopped early, or an experiment file that cannot be read; 2 bad input or a
+    recording the analysis refuses)."""
+    from tapespring.identify.damping import identify_damping
+    from tapespring.scenarios.setup import PAPER_MODEL
+    from tapespring.scenarios.vibration import VibrationSettings
+
+    from .bend import refuse
+
+    _refuse_shared_paths(args)
+    if args.damping_ratio is not None and args.experiments:
+        refuse(args, "--damping-ratio and --experiment both give the measured damping ratio")
+    measured: Any = PAPER_MODEL.damping_ratio_exp
+    if args.experiments:
+        from tapespring.protocols.vibration import analyze_vibration
+
+        measured = _analyzed(args, analyze_vibration, "a free decay (a vibration test)")
+    elif args.damping_ratio is not None:
+        measured = args.damping_ratio
+    converged: list[bool] = []
+
+    def simulate() -> DampingIdentification:
+        settings = VibrationSettings(
+            spec=spec_from_args(args),
+            duration=args.duration,
+            initial_displacement=args.initial_displacement,
+            rho_inf=args.rho_inf,
+        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = identify_damping(
+                measured,
+                settings,
+                rel_tolerance=args.rel_tolerance,
+                max_runs=int(args.max_runs),
+                progress=shows_progress(args),
+            )
+        print_warnings(caught)
+        converged.append(result.converged)
+        return result
+
+    def plot(result: DampingIdentification, path: str) -> None:
+        from tapespring.plot.identify import plot_damping_identification
+        from tapespring.report import save_figure
+
+        save_figure(plot_damping_identification(result), path)
+
+    def columns(result: DampingIdentification) -> dict:
+        nan = float("nan")
+        return {
+            "eta_s": [r.eta_s for r in result.runs],
+            "damping_ratio": [
+                nan if r.damping_ratio is None else r.damping_ratio for r in result.runs
+            ],
+            "period_s": [nan if r.period_s is None else r.period_s for r in result.runs],
+            "wall_s": [r.wall_s for r in result.runs],
+        }
+
+    code = finish(args, simulate, columns, plot)
+    return 1 if code == 0 and converged == [False] else code

@@ -1,0 +1,887 @@
+"""Identification of the tapes' equivalent thickness and Young's modulus from the static
+identification test (paper Sec. 5.1, eq. (4), Tables 3 to 6).
+
+The tapes are multilayered; the paper models each as a homogeneous shell whose thickness ``t``
+and Young's modulus ``E`` make the set-up's folded equilibrium under the additional weight
+(:func:`tapespring.scenarios.equilibrium.equilibrium`) reproduce the measured displacements of
+markers 1-2 and 3 along x and z (Table 3). Its objective, eq. (4), is the sum of the absolute
+differences, each divided by the measured value::
+
+    f(E, t) = sum_k |d_k(E, t) - m_k| / m_k      (k: markers 1-2 and 3, along x and z)
+
+minimised within Table 4's bounds from several starting points (the paper used MATLAB's
+``fmincon`` and found E = 151.76 GPa, t = 0.138 mm, Table 5).
+
+Here each start runs a bounded Nelder-Mead search (scipy), which needs no derivatives: the
+objective has kinks (absolute values) and each evaluation is a path through the tapes' snap whose
+adaptive steps make it slightly rough. The search moves in the logarithms of ``t`` and ``E``,
+scaled to [0, 1] over the bounds, where the valley of the objective is nearly straight: the folded
+equilibrium depends mostly on the tapes' bending stiffness ``E t^3`` (the fold's moment), and
+only weakly on the other combination. The starts are independent runs, so they go side by side
+with ``workers`` (:mod:`tapespring.sweep`).
+
+A run without a folded equilibrium (tapes too stiff for the weight to hold a fold, or a path the
+solver could not follow) or whose equilibrium is unstable under the weight (not one a recording
+can hold at rest) scores :data:`NO_EQUILIBRIUM_OBJECTIVE`, the objective of markers that do not
+move at all: the search then turns away from it. A start whose first simplex (its own point and
+one step along each axis) has no folded equilibrium at all sees a flat objective and is
+abandoned after those three runs; the other starts carry the search.
+
+At the optimum, :class:`Sensitivity` (two more runs) says how well the data fix each
+combination of ``t`` and ``E``: the derivatives of the relative displacements with respect to
+``ln t`` and ``ln E``, and the combination ``E t^a`` they determine best.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+import warnings
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import asdict, dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
+from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, IdentificationBounds
+
+if TYPE_CHECKING:
+    from tapespring.protocols.identification import IdentificationResult
+
+__all__ = [
+    "NO_EQUILIBRIUM_OBJECTIVE",
+    "TARGET_KEYS",
+    "LocalSearch",
+    "Sensitivity",
+    "StaticEvaluation",
+    "StaticIdentification",
+    "identify_static",
+    "objective",
+    "paper_target",
+    "target_from",
+]
+
+#: The displacements eq. (4) compares [m]: markers 1-2 and 3, along x and z (Table 6's rows).
+TARGET_KEYS = tuple(key for key, _, _ in TABLE6_ROWS)
+
+#: Objective of a run without a stable folded equilibrium: that of markers that do not move (each
+#: of the four relative differences is 1). The set-up's runs within Table 4's bounds score 0.1
+#: to 2 (5 mm tapes, against Table 3), so the search turns away from such points.
+NO_EQUILIBRIUM_OBJECTIVE = float(len(TARGET_KEYS))
+
+#: Relative step in t and in E of the forward differences of :class:`Sensitivity`: 1 %, large
+#: against the runs' roughness (their displacements repeat to about 1e-6 relative) and small
+#: against the curvature of the folded equilibrium's dependence on them.
+SENSITIVITY_STEP = 0.01
+
+#: Rise of eq. (4) that :meth:`Sensitivity.spread` converts into ranges of t and E: 0.01, a
+#: change of 1 % spread over the four displacements (about 0.4 mm on Table 3's, the markers'
+#: precision of 0.05 mm to 0.3 mm and the tapes' spread between trials being larger still).
+SPREAD_RISE = 0.01
+
+#: Default budget of Nelder-Mead evaluations per start (each one an equilibrium run).
+MAX_EVALUATIONS = 40
+
+
+def paper_target() -> dict[str, float]:
+    """The paper's measured displacements (Table 3, markers 1-2 averaged, absolute values) [m],
+    keyed as :data:`TARGET_KEYS`."""
+    return {
+        key: float(getattr(PAPER_MODEL, key.removesuffix("_m") + "_exp")) for key in TARGET_KEYS
+    }
+
+
+def target_from(
+    measured: Mapping[str, float] | IdentificationResult | Iterable[IdentificationResult] | None,
+) -> dict[str, float]:
+    """The four displacements to match [m], keyed as :data:`TARGET_KEYS`.
+
+    Parameters
+    ----------
+    measured : mapping, IdentificationResult, iterable of them, or None
+        The displacements themselves (a mapping with at least :data:`TARGET_KEYS`, each a
+        positive finite number [m]); the analysis of a recorded static identification test
+        (:func:`tapespring.protocols.identification.analyze_identification`); several of them
+        (the mean of each displacement, as the paper's "mean experimental results"); or None
+        for the paper's (Table 3).
+
+    Raises
+    ------
+    ValueError
+        Naming a missing, non-finite or non-positive displacement, or an empty set of trials.
+    TypeError
+        For anything else.
+    """
+    from tapespring.protocols.identification import IdentificationResult
+
+    if measured is None:
+        return paper_target()
+    if isinstance(measured, IdentificationResult):
+        measured = [measured]
+    if isinstance(measured, Mapping):
+        values = {}
+        for key in TARGET_KEYS:
+            if key not in measured:
+                raise ValueError(
+                    f"the measured displacements lack {key!r} (give {', '.join(TARGET_KEYS)} [m])"
+                )
+            values[key] = measured[key]
+    elif isinstance(measured, Iterable) and not isinstance(measured, str | bytes):
+        trials = list(measured)
+        if not trials:
+            raise ValueError("no identification trials given: nothing to identify from")
+        for trial in trials:
+            if not isinstance(trial, IdentificationResult):
+                raise TypeError(
+                    "measured must be a mapping of displacements [m], an IdentificationResult "
+                    f"or an iterable of them (got an item {trial!r})"
+                )
+        figures = [trial.figures() for trial in trials]
+        values = {key: float(np.mean([f[key] for f in figures])) for key in TARGET_KEYS}
+    else:
+        raise TypeError(
+            "measured must be a mapping of displacements [m], an IdentificationResult or an "
+            f"iterable of them (got {measured!r})"
+        )
+    out: dict[str, float] = {}
+    for key, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, int | float | np.floating):
+            raise ValueError(f"the measured {key} must be a number [m] (got {value!r})")
+        if not (math.isfinite(value) and value > 0.0):
+            # eq. (4) divides by each: a zero or negative displacement has no relative difference.
+            raise ValueError(f"the measured {key} must be positive and finite [m] (got {value!r})")
+        out[key] = float(value)
+    return out
+
+
+def objective(displacements: Mapping[str, float], target: Mapping[str, float]) -> float:
+    """Eq. (4): the sum over :data:`TARGET_KEYS` of ``|d - m| / m`` [-], `displacements` ``d``
+    and `target` ``m`` in metres."""
+    return float(sum(abs(displacements[k] - target[k]) / target[k] for k in TARGET_KEYS))
+
+
+@dataclass(frozen=True)
+class StaticEvaluation:
+    """One equilibrium run of the search.
+
+    Attributes
+    ----------
+    thickness_m, youngs_modulus_Pa : float
+        The tapes' thickness [m] and Young's modulus [Pa].
+    objective : float
+        Eq. (4) [-], or :data:`NO_EQUILIBRIUM_OBJECTIVE` without a stable folded equilibrium.
+    displacements_m : dict of str -> float, or None
+        The folded equilibrium's displacements [m] (:data:`TARGET_KEYS`); None if none was found.
+    found : bool
+        Whether the push path found the folded equilibrium.
+    unstable_modes : int
+        Unstable modes of that equilibrium under the weight (-1 if not found).
+    error : str or None
+        Why the run stopped early, if it did.
+    wall_s : float
+        Wall time of the run [s].
+    start : int
+        The start whose search made it (-1 for the sensitivity's runs).
+    """
+
+    thickness_m: float
+    youngs_modulus_Pa: float
+    objective: float
+    displacements_m: dict[str, float] | None
+    found: bool
+    unstable_modes: int
+    error: str | None
+    wall_s: float
+    start: int
+
+    @property
+    def counted(self) -> bool:
+        """Whether eq. (4) was computed (a stable folded equilibrium was found)."""
+        return self.displacements_m is not None and self.unstable_modes == 0
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready fields (units in the keys)."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class LocalSearch:
+    """One start's Nelder-Mead search.
+
+    Attributes
+    ----------
+    start_thickness_m, start_youngs_modulus_Pa : float
+        Where it started [m], [Pa].
+    thickness_m, youngs_modulus_Pa, objective : float
+        Where it ended: its best evaluation [m], [Pa], [-].
+    evaluations : int
+        Equilibrium runs it made.
+    converged : bool
+        Whether the simplex shrank below the tolerances (False: the budget ran out, or stopped).
+    message : str
+        scipy's message, or why the search stopped.
+    """
+
+    start_thickness_m: float
+    start_youngs_modulus_Pa: float
+    thickness_m: float
+    youngs_modulus_Pa: float
+    objective: float
+    evaluations: int
+    converged: bool
+    message: str
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    """How the displacements change about the optimum.
+
+    Attributes
+    ----------
+    jacobian : ndarray, shape (4, 2)
+        Derivatives of each displacement relative to its measured value (rows: :data:`TARGET_KEYS`)
+        with respect to ``ln t`` and ``ln E`` (columns) [-], by forward differences of
+        :data:`SENSITIVITY_STEP`.
+    singular_values : ndarray, shape (2,)
+        Of the Jacobian, largest first [-]: a change of ``ln t`` and ``ln E`` along the first
+        right singular vector by ``delta`` moves the relative displacements by about
+        ``singular_values[0] * delta`` (2-norm).
+    best_exponent : float
+        The data fix best the combination ``E t^best_exponent`` (the first right singular
+        vector, scaled so that E's exponent is 1); about 3 when the fold's bending stiffness
+        ``E t^3`` governs.
+    condition : float
+        ``singular_values[0] / singular_values[1]``: how much better determined that
+        combination is than the other one.
+    """
+
+    jacobian: np.ndarray
+    singular_values: np.ndarray
+    best_exponent: float
+    condition: float
+
+    @property
+    def weak_direction(self) -> np.ndarray:
+        """The change of (``ln t``, ``ln E``) the displacements see least (the last right
+        singular vector, unit length, t's component >= 0) [-]."""
+        _, _, vt = np.linalg.svd(self.jacobian)
+        v = vt[-1]
+        return -v if v[0] < 0.0 else v
+
+    def spread(self, rise: float = SPREAD_RISE) -> tuple[float, float]:
+        """How far t and E may move together along :attr:`weak_direction` before eq. (4) rises
+        by `rise` [-], to first order: relative changes of t and of E [-] (``|J v|_1`` per unit
+        step bounds the objective's rise). A first-order estimate about the optimum: where the
+        valley bends, the objective rises later."""
+        v = self.weak_direction
+        slope = float(np.sum(np.abs(self.jacobian @ v)))
+        step = rise / slope if slope > 0.0 else math.inf
+        return abs(step * float(v[0])), abs(step * float(v[1]))
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready: ``jacobian`` (rows :data:`TARGET_KEYS`, columns ``ln t``, ``ln E``),
+        ``singular_values``, ``best_exponent``, ``condition``, ``weak_direction`` and the
+        :meth:`spread` for :data:`SPREAD_RISE` (``spread_thickness_relative``,
+        ``spread_youngs_modulus_relative``, ``spread_objective_rise``)."""
+        spread_t, spread_e = self.spread()
+        return {
+            "jacobian": self.jacobian.tolist(),
+            "jacobian_rows": list(TARGET_KEYS),
+            "jacobian_columns": ["ln_thickness", "ln_youngs_modulus"],
+            "singular_values": self.singular_values.tolist(),
+            "best_exponent": self.best_exponent,
+            "condition": self.condition,
+            "weak_direction": self.weak_direction.tolist(),
+            "spread_objective_rise": SPREAD_RISE,
+            "spread_thickness_relative": spread_t,
+            "spread_youngs_modulus_relative": spread_e,
+        }
+
+
+@dataclass(frozen=True)
+class StaticIdentification:
+    """The identified thickness and Young's modulus, and how they were found.
+
+    Attributes
+    ----------
+    thickness_m, youngs_modulus_Pa : float
+        The best evaluation over all starts [m], [Pa] (Table 5's kind).
+    objective : float
+        Eq. (4) there [-].
+    displacements_m : dict of str -> float, or None
+        Its folded equilibrium's displacements [m] (None if no start found one).
+    target_m : dict of str -> float
+        The measured displacements matched [m].
+    searches : tuple of LocalSearch
+        One per start.
+    evaluations : tuple of StaticEvaluation
+        Every run, the sensitivity's included, in the order of the starts.
+    sensitivity : Sensitivity or None
+        About the optimum (None if not asked for, not found, or a neighbour's run failed: see
+        `sensitivity_error`).
+    sensitivity_error : str or None
+        Why there is no sensitivity when one was asked for.
+    bounds : IdentificationBounds
+    settings : EquilibriumSettings
+        The equilibrium runs' settings; its tape's t and E are the search's.
+    max_evaluations : int
+        Budget per start.
+    workers : int
+        Processes the starts ran in.
+    cancelled : bool
+        Whether a progress callback stopped the search.
+    wall_s : float
+    """
+
+    thickness_m: float
+    youngs_modulus_Pa: float
+    objective: float
+    displacements_m: dict[str, float] | None
+    target_m: dict[str, float]
+    searches: tuple[LocalSearch, ...]
+    evaluations: tuple[StaticEvaluation, ...]
+    sensitivity: Sensitivity | None
+    sensitivity_error: str | None
+    bounds: IdentificationBounds
+    settings: EquilibriumSettings
+    max_evaluations: int
+    workers: int
+    cancelled: bool
+    wall_s: float
+
+    @property
+    def found(self) -> bool:
+        """Whether any run found a stable folded equilibrium."""
+        return self.displacements_m is not None
+
+    def differences_relative(self) -> dict[str, float] | None:
+        """Identified minus measured, divided by the measured (Table 6's Delta) [-], keyed as
+        :data:`TARGET_KEYS` without ``_m`` plus ``_relative``."""
+        if self.displacements_m is None:
+            return None
+        return {
+            key.removesuffix("_m") + "_relative": self.displacements_m[key] / self.target_m[key]
+            - 1.0
+            for key in TARGET_KEYS
+        }
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready figures [m, Pa, s]: ``thickness_m``, ``youngs_modulus_Pa``, ``objective``,
+        ``displacements_m``, ``target_m``, ``difference_relative`` (Table 6's Delta),
+        ``bending_stiffness_Nm`` (the tapes' ``E t^3 / (12 (1 - nu^2))``), the paper's Table 5
+        (``paper_thickness_m``, ``paper_youngs_modulus_Pa``), ``searches``, ``evaluations``,
+        ``sensitivity``, ``bounds``, ``settings``, ``max_evaluations``, ``workers``,
+        ``cancelled``, ``wall_s``."""
+        nu = self.settings.spec.tape.poisson
+        return {
+            "found": self.found,
+            "thickness_m": self.thickness_m,
+            "youngs_modulus_Pa": self.youngs_modulus_Pa,
+            "objective": self.objective,
+            "displacements_m": self.displacements_m,
+            "target_m": self.target_m,
+            "difference_relative": self.differences_relative(),
+            "bending_stiffness_Nm": self.youngs_modulus_Pa
+            * self.thickness_m**3
+            / (12.0 * (1.0 - nu**2)),
+            "paper_thickness_m": PAPER_TAPE_THICKNESS,
+            "paper_youngs_modulus_Pa": PAPER_TAPE_MODULUS,
+            "searches": [asdict(s) for s in self.searches],
+            "evaluations": [e.summary() for e in self.evaluations],
+            "sensitivity": None if self.sensitivity is None else self.sensitivity.summary(),
+            "sensitivity_error": self.sensitivity_error,
+            "bounds": asdict(self.bounds),
+            "settings": asdict(self.settings),
+            "max_evaluations": self.max_evaluations,
+            "workers": self.workers,
+            "cancelled": self.cancelled,
+            "wall_s": self.wall_s,
+        }
+
+    def table(self) -> str:
+        """Table 6's layout: measured (Exp.), identified (Num.) and Delta [%]."""
+        lines = [f"  {'':12}{'Exp. [mm]':>11}{'Num. [mm]':>11}{'Delta [%]':>11}"]
+        diff = self.differences_relative()
+        for key, marker, axis in TABLE6_ROWS:
+            num = "-" if self.displacements_m is None else f"{self.displacements_m[key] * 1e3:.1f}"
+            delta = (
+                "-" if diff is None else f"{100 * diff[key.removesuffix('_m') + '_relative']:+.1f}"
+            )
+            lines.append(
+                f"  {marker:8}{axis:4}{self.target_m[key] * 1e3:11.1f}{num:>11}{delta:>11}"
+            )
+        return "\n".join(lines)
+
+    def describe(self) -> str:
+        """A few lines for a person."""
+        runs = len(self.evaluations)
+        lines = [
+            f"identification of t and E (Sec. 5.1, eq. (4)): {len(self.searches)} start(s), "
+            f"{runs} equilibrium runs"
+            + (f" ({self.workers} processes)" if self.workers > 1 else "")
+            + f", wall time {self.wall_s:.1f} s"
+            + (" (stopped)" if self.cancelled else "")
+        ]
+        if not self.found:
+            lines.append("  no run found a stable folded equilibrium: nothing identified")
+            return "\n".join(lines)
+        lines.append(
+            f"  t = {self.thickness_m * 1e3:.4f} mm, E = {self.youngs_modulus_Pa / 1e9:.2f} GPa "
+            f"(objective {self.objective:.4f}; the paper, Table 5: t = "
+            f"{PAPER_TAPE_THICKNESS * 1e3:.3f} mm, E = {PAPER_TAPE_MODULUS / 1e9:.2f} GPa)"
+        )
+        lines.append(self.table())
+        for n, s in enumerate(self.searches):
+            lines.append(
+                f"  start {n}: from t = {s.start_thickness_m * 1e3:.4f} mm, E = "
+                f"{s.start_youngs_modulus_Pa / 1e9:.1f} GPa to t = {s.thickness_m * 1e3:.4f} mm, "
+                f"E = {s.youngs_modulus_Pa / 1e9:.2f} GPa, objective {s.objective:.4f} in "
+                f"{s.evaluations} runs" + ("" if s.converged else f" ({s.message})")
+            )
+        if self.sensitivity is not None:
+            sens = self.sensitivity
+            spread_t, spread_e = sens.spread()
+            lines.append(
+                f"  the displacements fix E t^{sens.best_exponent:.2f} best, "
+                f"{sens.condition:.1f} times better than the other combination of t and E: "
+                f"t by {spread_t:.1%} and E by {spread_e:.1%} together along the valley raise "
+                f"the objective by only {SPREAD_RISE} (first order)"
+            )
+        elif self.sensitivity_error:
+            lines.append(f"  no sensitivity: {self.sensitivity_error}")
+        return "\n".join(lines)
+
+
+# The paper's identified values (Table 5), through the set-up's tape: their one home is there.
+def _paper_tape() -> tuple[float, float]:
+    from tapespring.scenarios.setup import PAPER_TAPE
+
+    return PAPER_TAPE.thickness, PAPER_TAPE.youngs_modulus
+
+
+PAPER_TAPE_THICKNESS, PAPER_TAPE_MODULUS = _paper_tape()
+
+
+@dataclass(frozen=True)
+class _Scale:
+    """The map between (t, E) and the search's unit square (the logarithms over the bounds)."""
+
+    bounds: IdentificationBounds
+
+    def to_unit(self, thickness: float, modulus: float) -> np.ndarray:
+        b = self.bounds
+        return np.array(
+            [
+                math.log(thickness / b.thickness_min) / math.log(b.thickness_max / b.thickness_min),
+                math.log(modulus / b.youngs_modulus_min)
+                / math.log(b.youngs_modulus_max / b.youngs_modulus_min),
+            ]
+        )
+
+    def from_unit(self, x: np.ndarray) -> tuple[float, float]:
+        b = self.bounds
+        u = np.clip(np.asarray(x, dtype=float), 0.0, 1.0)
+        return (
+            float(b.thickness_min * (b.thickness_max / b.thickness_min) ** u[0]),
+            float(b.youngs_modulus_min * (b.youngs_modulus_max / b.youngs_modulus_min) ** u[1]),
+        )
+
+
+def _evaluate(
+    settings: EquilibriumSettings,
+    target: Mapping[str, float],
+    thickness: float,
+    modulus: float,
+    start: int,
+) -> StaticEvaluation:
+    """One equilibrium run with the tapes' `thickness` [m] and `modulus` [Pa]."""
+    from tapespring.analysis import ConvergenceError
+    from tapespring.scenarios.equilibrium import equilibrium
+
+    tape = replace(settings.spec.tape, thickness=thickness, youngs_modulus=modulus)
+    run_settings = replace(settings, spec=replace(settings.spec, tape=tape))
+    t0 = time.perf_counter()
+    error = None
+    try:
+        result = equilibrium(run_settings)
+    except ConvergenceError as exc:
+        # A path the solver could not follow to its end: scored as no equilibrium, its message
+        # kept, so that one hard point does not end the search.
+        result, error = exc.result, str(exc)
+    wall = time.perf_counter() - t0
+    displacements = None
+    unstable = -1
+    if result is not None and result.found:
+        figures = result.summary()["marker_displacements_m"]
+        displacements = {key: float(figures[key]) for key in TARGET_KEYS}
+        unstable = int(result.unstable_modes)
+    counted = displacements is not None and unstable == 0
+    return StaticEvaluation(
+        thickness_m=thickness,
+        youngs_modulus_Pa=modulus,
+        objective=objective(displacements, target)  # type: ignore[arg-type]
+        if counted
+        else NO_EQUILIBRIUM_OBJECTIVE,
+        displacements_m=displacements,
+        found=displacements is not None,
+        unstable_modes=unstable,
+        error=error,
+        wall_s=wall,
+        start=start,
+    )
+
+
+@dataclass(frozen=True)
+class _SearchTask:
+    """What one start's search needs (picklable, for a worker process)."""
+
+    settings: EquilibriumSettings
+    target: dict[str, float]
+    bounds: IdentificationBounds
+    start: int
+    x0: tuple[float, float]
+    max_evaluations: int
+    xatol: float
+    fatol: float
+
+
+@dataclass(frozen=True)
+class _SearchOutcome:
+    search: LocalSearch
+    evaluations: tuple[StaticEvaluation, ...]
+    stopped: bool
+
+
+class _Stop(Exception):
+    """Raised inside the objective when the progress callback asks to stop."""
+
+
+class _Flat(Exception):
+    """Raised inside the objective when no vertex of the first simplex found a folded
+    equilibrium: the objective is flat there, and Nelder-Mead would shrink its simplex to the
+    tolerance (about 40 runs) before stopping where it started."""
+
+
+#: Edge of the first simplex in the unit square: a tenth of each range (5 % in t, 8 % in E over
+#: Table 4's), wide enough to see the valley from any start, small enough to stay in one basin.
+SIMPLEX_EDGE = 0.1
+
+
+def _first_simplex(x0: np.ndarray) -> np.ndarray:
+    """x0 and one vertex along each axis, stepping inwards at the square's edges."""
+    vertices = [x0]
+    for axis in range(2):
+        v = x0.copy()
+        v[axis] += SIMPLEX_EDGE if x0[axis] + SIMPLEX_EDGE <= 1.0 else -SIMPLEX_EDGE
+        vertices.append(v)
+    return np.array(vertices)
+
+
+def _search(
+    task: _SearchTask, on_evaluation: Callable[[StaticEvaluation], bool] | None = None
+) -> _SearchOutcome:
+    """One start's bounded Nelder-Mead search; `on_evaluation` (in this process only) sees each
+    run and returns False to stop."""
+    from scipy.optimize import minimize
+
+    scale = _Scale(task.bounds)
+    done: list[StaticEvaluation] = []
+
+    def f(x: np.ndarray) -> float:
+        thickness, modulus = scale.from_unit(x)
+        evaluation = _evaluate(task.settings, task.target, thickness, modulus, task.start)
+        done.append(evaluation)
+        if on_evaluation is not None and on_evaluation(evaluation) is False:
+            raise _Stop
+        if len(done) == 3 and not any(e.counted for e in done):
+            raise _Flat
+        return evaluation.objective
+
+    x0 = np.array(task.x0, dtype=float)
+    stopped = False
+    converged = False
+    try:
+        res = minimize(
+            f,
+            x0,
+            method="Nelder-Mead",
+            bounds=[(0.0, 1.0), (0.0, 1.0)],
+            options={
+                "initial_simplex": _first_simplex(x0),
+                "maxfev": task.max_evaluations,
+                "xatol": task.xatol,
+                "fatol": task.fatol,
+            },
+        )
+        message, converged = str(res.message), bool(res.success)
+    except _Stop:
+        message, stopped = "stopped", True
+    except _Flat:
+        message = "no stable folded equilibrium at the first simplex's vertices: start abandoned"
+    t0, e0 = scale.from_unit(x0)
+    best = min(done, key=lambda e: e.objective) if done else None
+    search = LocalSearch(
+        start_thickness_m=t0,
+        start_youngs_modulus_Pa=e0,
+        thickness_m=best.thickness_m if best else t0,
+        youngs_modulus_Pa=best.youngs_modulus_Pa if best else e0,
+        objective=best.objective if best else math.nan,
+        evaluations=len(done),
+        converged=converged,
+        message=message,
+    )
+    return _SearchOutcome(search=search, evaluations=tuple(done), stopped=stopped)
+
+
+def _halton(n: int) -> list[tuple[float, float]]:
+    """The first `n` points of the (2, 3) Halton sequence after its origin: spread over the unit
+    square, the same on every run."""
+
+    def radical_inverse(i: int, base: int) -> float:
+        value, weight = 0.0, 1.0 / base
+        while i:
+            i, digit = divmod(i, base)
+            value += digit * weight
+            weight /= base
+        return value
+
+    return [(radical_inverse(i, 2), radical_inverse(i, 3)) for i in range(1, n + 1)]
+
+
+def _check_starts(
+    starts: int | Sequence[tuple[float, float]], bounds: IdentificationBounds
+) -> list[tuple[float, float]]:
+    """The starts in the unit square, from a count or from (t [m], E [Pa]) pairs."""
+    scale = _Scale(bounds)
+    if isinstance(starts, bool):
+        raise ValueError(f"starts must be a count >= 1 or (t, E) pairs (got {starts!r})")
+    if isinstance(starts, int):
+        if starts < 1:
+            raise ValueError(f"starts must be a count >= 1 or (t, E) pairs (got {starts!r})")
+        return _halton(starts)
+    points = list(starts)
+    if not points:
+        raise ValueError("starts is empty: give a count >= 1 or (t, E) pairs")
+    out = []
+    for point in points:
+        try:
+            thickness, modulus = (float(v) for v in point)
+        except (TypeError, ValueError):
+            raise ValueError(f"a start must be a (t [m], E [Pa]) pair (got {point!r})") from None
+        b = bounds
+        if not (
+            b.thickness_min <= thickness <= b.thickness_max
+            and b.youngs_modulus_min <= modulus <= b.youngs_modulus_max
+        ):
+            raise ValueError(
+                f"the start (t = {thickness!r} m, E = {modulus!r} Pa) lies outside the bounds "
+                f"(t in [{b.thickness_min}, {b.thickness_max}] m, E in "
+                f"[{b.youngs_modulus_min}, {b.youngs_modulus_max}] Pa)"
+            )
+        x = scale.to_unit(thickness, modulus)
+        out.append((float(x[0]), float(x[1])))
+    return out
+
+
+def _sensitivity(
+    settings: EquilibriumSettings, target: Mapping[str, float], best: StaticEvaluation
+) -> tuple[Sensitivity | None, str | None, list[StaticEvaluation]]:
+    """Forward differences in ln t and ln E about `best` (two more runs)."""
+    assert best.displacements_m is not None
+    base = np.array([best.displacements_m[k] / target[k] for k in TARGET_KEYS])
+    factor = math.exp(SENSITIVITY_STEP)
+    runs = [
+        _evaluate(settings, target, best.thickness_m * factor, best.youngs_modulus_Pa, -1),
+        _evaluate(settings, target, best.thickness_m, best.youngs_modulus_Pa * factor, -1),
+    ]
+    columns = []
+    for run, name in zip(runs, ("t", "E"), strict=True):
+        if not run.counted or run.displacements_m is None:
+            return (
+                None,
+                f"the run with {name} raised by {SENSITIVITY_STEP:.0%} found no stable folded "
+                "equilibrium: the optimum lies at the edge of the folded states",
+                runs,
+            )
+        columns.append(
+            (np.array([run.displacements_m[k] / target[k] for k in TARGET_KEYS]) - base)
+            / SENSITIVITY_STEP
+        )
+    jacobian = np.column_stack(columns)
+    _, singular, vt = np.linalg.svd(jacobian)
+    v_t, v_e = vt[0]
+    exponent = float(v_t / v_e) if v_e != 0.0 else math.inf
+    condition = float(singular[0] / singular[1]) if singular[1] > 0.0 else math.inf
+    return Sensitivity(jacobian, singular, exponent, condition), None, runs
+
+
+def identify_static(
+    measured: Mapping[str, float]
+    | IdentificationResult
+    | Iterable[IdentificationResult]
+    | None = None,
+    settings: EquilibriumSettings | None = None,
+    *,
+    bounds: IdentificationBounds = PAPER_BOUNDS,
+    starts: int | Sequence[tuple[float, float]] = 4,
+    max_evaluations: int = MAX_EVALUATIONS,
+    xatol: float = 2e-3,
+    fatol: float = 1e-3,
+    sensitivity: bool = True,
+    workers: int | None = 1,
+    progress: bool | Callable[[StaticEvaluation], bool | None] | None = None,
+) -> StaticIdentification:
+    """Identify the tapes' thickness and Young's modulus from the static identification test.
+
+    Parameters
+    ----------
+    measured : mapping, IdentificationResult, iterable of them, or None
+        The displacements to match (:func:`target_from`); None: the paper's (Table 3).
+    settings : EquilibriumSettings, optional
+        The equilibrium runs: the set-up (its tape's ``thickness`` and ``youngs_modulus`` are
+        replaced by the search's), its meshes, the push. Default: the paper's meshes.
+    bounds : IdentificationBounds
+        The search's box (Table 4 by default).
+    starts : int or sequence of (t [m], E [Pa])
+        The number of starting points (spread over the box by a Halton sequence, the same on
+        every call), or the points themselves. The paper started from several (Sec. 5.1).
+    max_evaluations : int
+        Budget of equilibrium runs per start (>= 3).
+    xatol, fatol : float
+        Nelder-Mead's tolerances: the simplex's size in the unit square of ``ln t`` and ``ln E``
+        over the bounds (2e-3: 0.1 % of t, 0.16 % of E over Table 4's) and the spread of its
+        objectives [-].
+    sensitivity : bool
+        Run the two neighbours of the optimum for :class:`Sensitivity`.
+    workers : int or None
+        The starts side by side in that many worker processes (None: one per core; default 1:
+        one after the other, in this process).
+    progress : bool or callable, optional
+        True: one line per run on stderr. A callable receives each :class:`StaticEvaluation` as
+        it ends (at the end of its start's search with ``workers`` > 1) and may return False to
+        stop (the result is then marked ``cancelled``).
+
+    Returns
+    -------
+    StaticIdentification
+
+    Raises
+    ------
+    ValueError
+        For bad settings, bounds, starts, tolerances or measured displacements, before any run.
+    TypeError
+        For a `measured` or `workers` of the wrong type.
+    tapespring.sweep.WorkerDied
+        If a worker process died (killed, out of memory).
+    """
+    from tapespring.scenarios.setup import check_count, check_number
+    from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
+
+    target = target_from(measured)
+    settings = EquilibriumSettings() if settings is None else settings
+    if not isinstance(settings, EquilibriumSettings):
+        raise ValueError(f"settings must be an EquilibriumSettings (got {settings!r})")
+    settings.validate()
+    if not isinstance(bounds, IdentificationBounds):
+        raise ValueError(f"bounds must be an IdentificationBounds (got {bounds!r})")
+    bounds.validate()
+    for thickness, modulus in (
+        (bounds.thickness_min, bounds.youngs_modulus_min),
+        (bounds.thickness_max, bounds.youngs_modulus_max),
+    ):
+        # The set-up's own checks (a tape thick against its radius) at the box's corners, so
+        # that no run of the search fails on them.
+        tape = replace(settings.spec.tape, thickness=thickness, youngs_modulus=modulus)
+        replace(settings.spec, tape=tape).validate()
+    unit_starts = _check_starts(starts, bounds)
+    check_count("max_evaluations", max_evaluations, minimum=3)
+    check_number("xatol", xatol, positive=True)
+    check_number("fatol", fatol, positive=True)
+    check_workers(workers)
+
+    show = progress is True
+    callback = progress if callable(progress) else None
+    stopped = False
+
+    def report(evaluation: StaticEvaluation) -> bool:
+        if show:
+            shown = (
+                f"objective {evaluation.objective:.4f}"
+                if evaluation.counted
+                else (
+                    "no stable folded equilibrium"
+                    if evaluation.error is None
+                    else f"stopped: {evaluation.error}"
+                )
+            )
+            print(
+                f"identify: start {evaluation.start}: t = {evaluation.thickness_m * 1e3:.4f} mm, "
+                f"E = {evaluation.youngs_modulus_Pa / 1e9:.2f} GPa: {shown} "
+                f"({evaluation.wall_s:.1f} s)",
+                file=sys.stderr,
+                flush=True,
+            )
+        return not (callback is not None and callback(evaluation) is False)
+
+    start_time = time.perf_counter()
+    tasks = [
+        _SearchTask(settings, target, bounds, n, x0, max_evaluations, xatol, fatol)
+        for n, x0 in enumerate(unit_starts)
+    ]
+    outcomes: dict[int, _SearchOutcome] = {}
+    serial = processes_for(workers, len(tasks)) == 1
+    if serial:
+        for task in tasks:
+            outcome = _search(task, report)
+            outcomes[task.start] = outcome
+            if outcome.stopped:
+                stopped = True
+                break
+    else:
+
+        def record(n: int, outcome: _SearchOutcome) -> bool:
+            outcomes[n] = outcome
+            return all(report(e) for e in outcome.evaluations)
+
+        try:
+            stopped = run_tasks(_search, tasks, workers, record)
+        except WorkerDied as exc:
+            lost = ", ".join(str(n) for n in exc.unfinished)
+            raise WorkerDied(f"{exc} (starts: {lost})", exc.unfinished) from exc
+
+    ordered = [outcomes[n] for n in sorted(outcomes)]
+    evaluations = [e for o in ordered for e in o.evaluations]
+    counted = [e for e in evaluations if e.counted]
+    best = min(counted, key=lambda e: e.objective) if counted else None
+    sens = sens_error = None
+    if best is not None and sensitivity and not stopped:
+        sens, sens_error, extra = _sensitivity(settings, target, best)
+        evaluations += extra
+        for e in extra:
+            report(e)
+    if best is None:
+        warnings.warn(
+            "no run found a stable folded equilibrium: nothing identified (widen the bounds or "
+            "check the set-up's weight)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return StaticIdentification(
+        thickness_m=best.thickness_m if best else math.nan,
+        youngs_modulus_Pa=best.youngs_modulus_Pa if best else math.nan,
+        objective=best.objective if best else math.nan,
+        displacements_m=None if best is None else best.displacements_m,
+        target_m=target,
+        searches=tuple(o.search for o in ordered),
+        evaluations=tuple(evaluations),
+        sensitivity=sens,
+        sensitivity_error=sens_error,
+        bounds=bounds,
+        settings=settings,
+        max_evaluations=max_evaluations,
+        workers=processes_for(workers, len(tasks)),
+        cancelled=stopped,
+        wall_s=time.perf_counter() - start_time,
+    )
