@@ -387,5 +387,7 @@ def test_every_command_refuses_through_its_own_parser():
     # (it kept a branch for a Namespace made by hand, which no command passes any more).
     commands = _subcommands(build_parser())
     commands["trials"] = _subcommands(commands["trials"])["analyze"]
+    identify = _subcommands(commands.pop("identify"))
+    commands.update({f"identify {name}": parser for name, parser in identify.items()})
     for name, parser in commands.items():
         assert parser.get_default("parser") is parser, name

@@ -1,0 +1,101 @@
+"""``tapespring identify static`` and ``tapespring identify damping``: a short real run of each
+on coarse meshes, the recordings they read, and their refusals."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+from _cli import refused
+from _identification import identification_trial
+from tapespring.cli import main
+from tapespring.identify.static import TARGET_KEYS
+from tapespring.trials.csv import write_csv
+
+STATIC = [
+    "identify",
+    "static",
+    "--mesh-tape=5e-3",
+    "--mesh-plates=10e-3",
+    "--starts=1",
+    "--max-evaluations=3",
+    "--no-sensitivity",
+    "--no-progress",
+]
+
+
+def test_static_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    table = tmp_path / "runs.csv"
+    assert main([*STATIC, "--json", f"--csv={table}", f"--plot={tmp_path / 'id.png'}"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["found"] and len(data["evaluations"]) == 3
+    assert data["target_m"]["marker3_dz_m"] == pytest.approx(0.1109)  # Table 3
+    assert data["settings"]["spec"]["mesh_tape"] == 5e-3
+    assert data["sensitivity"] is None and data["max_evaluations"] == 3
+    best = min(e["objective"] for e in data["evaluations"])
+    assert data["objective"] == best
+    with table.open() as fh:
+        assert fh.readline().startswith("# tapespring identify: ")
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 3
+    assert [float(r["objective"]) for r in rows] == [e["objective"] for e in data["evaluations"]]
+    assert set(TARGET_KEYS) <= set(rows[0])
+    assert (tmp_path / "id.png").stat().st_size > 10_000
+
+
+def test_static_matches_the_given_or_recorded_displacements(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    target = ["0.02", "0.07", "0.04", "0.1"]
+    assert main([*STATIC, "--json", "--target-m", *target]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert list(data["target_m"].values()) == [float(v) for v in target]
+    # Two recordings: their mean is matched (markers 1 and 2 averaged in each).
+    moved = {"M0": (0.0, 0.0, 0.0), "M1": (-0.02, 0.0, -0.07), "M2": (-0.022, 0.0, -0.072),
+             "M3": (-0.04, 0.0, -0.1)}  # fmt: skip
+    first = write_csv(identification_trial(displacements=moved, noise=False), tmp_path / "a.csv")
+    larger = {k: tuple(1.1 * x for x in v) for k, v in moved.items()}
+    second = write_csv(
+        identification_trial(displacements=larger, noise=False, name="b"), tmp_path / "b.csv"
+    )
+    assert main([*STATIC, "--json", f"--experiment={first}", f"--experiment={second}"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["target_m"]["markers12_dx_m"] == pytest.approx(0.021 * 1.05, rel=1e-6)
+    assert data["target_m"]["marker3_dz_m"] == pytest.approx(0.1 * 1.05, rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("args", "match", "by_parser"),
+    [
+        (["--starts=0"], "starts must be an integer >= 1", True),
+        (["--starts=1.5"], "starts must be an integer >= 1", True),
+        (["--max-evaluations=2"], "max_evaluations must be an integer >= 3", True),
+        (["--thickness=1e-4"], "unrecognized arguments: --thickness", True),
+        (["--spec", "tape.youngs_modulus=2e11"], "this command identifies tape.youngs_mod", False),
+        (["--target-m", "0.02", "0.07", "0.04", "0"], "marker3_dz_m must be positive", False),
+        (["--target-m", "0.02", "0.07", "0.04", "nan"], "marker3_dz_m must be positive", False),
+        (["--target-m", "1", "1", "1", "1", "--experiment=x.csv"], "--target-m and --exper", True),
+        (["--workers=0"], "workers", True),
+    ],
+)
+def test_static_refusals(
+    args: list[str], match: str, by_parser: bool, tmp_path: Path, capsys: pytest.CaptureFixture,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    if "--experiment=x.csv" in args:
+        write_csv(identification_trial(), tmp_path / "x.csv")
+    assert match in refused([*STATIC, *args], capsys, by_parser=by_parser)
+
+
+def test_static_refuses_a_recording_of_another_test(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    # A record without a fold (marker 3 moves by 5 mm): the analysis refuses it, exit code 2.
+    still = {"M0": (0.0, 0.0, 0.0), "M1": (0.0, 0.0, -0.002), "M2": (0.0, 0.0, -0.002),
+             "M3": (0.0, 0.0, -0.005)}  # fmt: skip
+    path = write_csv(identification_trial(displacements=still, noise=False), tmp_path / "s.csv")
+    line = refused([*STATIC, f"--experiment={path}"], capsys, by_parser=False)
+    assert str(path) in line and "a static identification test" in line
