@@ -215,8 +215,8 @@ def test_runs_without_a_folded_equilibrium_are_avoided(
     fake_runs: list[tuple[float, float]],
 ) -> None:
     """A start whose first simplex lies where no run finds a folded equilibrium sees a flat
-    objective and is abandoned after those three runs; a start across the border turns away from it; the best of the
-    starts is the result."""
+    objective and is abandoned after those three runs; a start across the border turns away
+    from it; the best of the starts is the result."""
     corner, border = (0.19e-3, 210e9), (0.16e-3, 140e9)
     result = identify_static(closed_form(TRUE_T, TRUE_E), starts=[corner, border],
                              max_evaluations=300, xatol=1e-4, fatol=1e-6)  # fmt: skip
