@@ -37,7 +37,7 @@ def test_static_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.Capture
     best = min(e["objective"] for e in data["evaluations"])
     assert data["objective"] == best
     with table.open() as fh:
-        assert fh.readline().startswith("# tapespring identify: ")
+        assert fh.readline().startswith("# tapespring identify static: ")
         rows = list(csv.DictReader(fh))
     assert len(rows) == 3
     assert [float(r["objective"]) for r in rows] == [e["objective"] for e in data["evaluations"]]
@@ -99,3 +99,51 @@ def test_static_refuses_a_recording_of_another_test(
     path = write_csv(identification_trial(displacements=still, noise=False), tmp_path / "s.csv")
     line = refused([*STATIC, f"--experiment={path}"], capsys, by_parser=False)
     assert str(path) in line and "a static identification test" in line
+
+
+DAMPING = [
+    "identify",
+    "damping",
+    "--mesh-tape=5e-3",
+    "--mesh-plates=10e-3",
+    "--duration=3",
+    "--rel-tolerance=0.02",
+    "--no-progress",
+]
+
+
+def test_damping_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    table = tmp_path / "runs.csv"
+    assert main([*DAMPING, "--json", f"--csv={table}", f"--plot={tmp_path / 'eta.png'}"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["converged"] and data["target_damping_ratio"] == 0.00509  # Table 7
+    assert abs(data["damping_ratio"] / 0.00509 - 1.0) <= 0.02
+    # On these meshes eta omega / 2 with the modal period 0.108 s: about 1.75e-4 s.
+    assert data["eta_s"] == pytest.approx(1.75e-4, rel=0.05)
+    with table.open() as fh:
+        assert fh.readline().startswith("# tapespring identify damping: ")
+        rows = list(csv.DictReader(fh))
+    assert [float(r["eta_s"]) for r in rows] == [r["eta_s"] for r in data["runs"]]
+    assert (tmp_path / "eta.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    ("args", "match", "by_parser"),
+    [
+        (["--damping-ratio=0"], "damping_ratio must be", True),
+        (["--damping-ratio=0.7"], "damping_ratio", False),
+        (["--max-runs=1"], "max_runs must be an integer >= 2", True),
+        (["--rel-tolerance=-1"], "rel_tolerance must be", True),
+        (["--eta=1e-4"], "unrecognized arguments: --eta", True),
+        (["--spec", "eta=1e-4"], "this command identifies eta", False),
+        (["--damping-ratio=0.005", "--experiment=x.csv"], "--damping-ratio and --experiment", True),
+    ],
+)
+def test_damping_refusals(
+    args: list[str], match: str, by_parser: bool, tmp_path: Path, capsys: pytest.CaptureFixture,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    if "--experiment=x.csv" in args:
+        write_csv(identification_trial(), tmp_path / "x.csv")
+    assert match in refused([*DAMPING, *args], capsys, by_parser=by_parser)

@@ -127,7 +127,8 @@ def _register_static(sub: argparse._SubParsersAction) -> None:
     add_output_options(
         p, "every equilibrium run (start, t, E, objective, displacements)", "every run too"
     )
-    p.set_defaults(func=run_static, parser=p)
+    # The command's full name for the settings line of --csv ("tapespring identify static: ...").
+    p.set_defaults(func=run_static, parser=p, command="identify static")
 
 
 def _check_starts(value: float) -> None:
@@ -260,8 +261,11 @@ def _register_damping(sub: argparse._SubParsersAction) -> None:
     )
     add_rho_inf_option(p, d.rho_inf)
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3, eta=False)
+    # Without --eta, as a static command, but because eta is what it finds: its --spec refuses
+    # eta with that reason.
+    p.set_defaults(static_spec=False, identified=("eta",))
     add_output_options(p, "every run (eta, damping ratio, period)")
-    p.set_defaults(func=run_damping, parser=p)
+    p.set_defaults(func=run_damping, parser=p, command="identify damping")
 
 
 def _check_runs(value: float) -> None:

@@ -110,8 +110,9 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
 
 def plot_damping_identification(result: Any, *, paper: bool = True) -> Any:
     """The runs of :func:`tapespring.identify.identify_damping`: the fitted damping ratio against
-    the viscosity eta, the target ratio, the identified eta and (with `paper`) the paper's model
-    (Table 8: eta = 1.73e-4 s, 0.505 %). Returns the figure."""
+    the viscosity eta, the least-squares line through them, the target ratio and its tolerance
+    band, the identified eta and (with `paper`) the paper's model (Table 8: eta = 1.73e-4 s,
+    0.505 %). Returns the figure."""
     import matplotlib.pyplot as plt
 
     from tapespring.scenarios.setup import PAPER_MODEL
@@ -123,13 +124,23 @@ def plot_damping_identification(result: Any, *, paper: bool = True) -> Any:
         eps = np.array([r.damping_ratio for r in runs])
         order = np.argsort(eta)
         ax.plot(eta[order] * 1e4, 100 * eps[order], "o-", color="C3", label="simulated decays")
-    ax.axhline(
-        100 * result.target_damping_ratio,
-        color="0.3",
-        lw=0.8,
-        ls="--",
-        label=f"target {result.target_damping_ratio:.3%}",
+    target = result.target_damping_ratio
+    ax.axhline(100 * target, color="0.3", lw=0.8, ls="--", label=f"target {target:.3%}")
+    ax.axhspan(
+        100 * target * (1.0 - result.rel_tolerance),
+        100 * target * (1.0 + result.rel_tolerance),
+        color="0.85",
+        zorder=0,
+        label=f"tolerance ±{result.rel_tolerance:.1%}",
     )
+    model = result.affine_model
+    if model is not None and runs:
+        offset, slope = model
+        low, high = ax.get_xlim()
+        line = np.linspace(low, high, 2) * 1e-4
+        ax.plot(line * 1e4, 100 * (offset + slope * line), ":", color="C3", lw=1.0,
+                label="line through the runs")  # fmt: skip
+        ax.set_xlim(low, high)
     if result.damping_ratio is not None:
         ax.plot(
             [result.eta_s * 1e4],
@@ -138,7 +149,7 @@ def plot_damping_identification(result: Any, *, paper: bool = True) -> Any:
             color="C1",
             ms=14,
             mec="k",
-            label=f"identified: eta = {result.eta_s:.3g} s",
+            label=f"identified: eta = {result.eta_s:.3e} s",
         )
     if paper:
         ax.plot(
