@@ -132,7 +132,8 @@ def test_damping_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.Captur
     [
         (["--damping-ratio=0"], "damping_ratio must be", True),
         (["--damping-ratio=0.7"], "damping_ratio", False),
-        (["--max-runs=1"], "max_runs must be an integer >= 2", True),
+        (["--max-runs=0"], "max_runs must be an integer >= 1", True),
+        (["--max-runs=2.5"], "max_runs must be an integer >= 1", True),
         (["--rel-tolerance=-1"], "rel_tolerance must be", True),
         (["--eta=1e-4"], "unrecognized arguments: --eta", True),
         (["--spec", "eta=1e-4"], "this command identifies eta", False),

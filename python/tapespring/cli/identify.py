@@ -269,8 +269,8 @@ def _register_damping(sub: argparse._SubParsersAction) -> None:
 
 
 def _check_runs(value: float) -> None:
-    if value != int(value) or value < 2:
-        raise ValueError(f"max_runs must be an integer >= 2 (got {value!r})")
+    if value != int(value) or value < 1:
+        raise ValueError(f"max_runs must be an integer >= 1 (got {value!r})")
 
 
 def run_damping(args: argparse.Namespace) -> int:
