@@ -29,7 +29,17 @@ abandoned after those three runs; the other starts carry the search.
 
 At the optimum, :class:`Sensitivity` (two more runs) says how well the data fix each
 combination of ``t`` and ``E``: the derivatives of the relative displacements with respect to
-``ln t`` and ``ln E``, and the combination ``E t^a`` they determine best.
+``ln t`` and ``ln E``, and the combination ``E t^a`` they determine best. On the paper's set-up
+that is nearly the fold's bending stiffness ``E t^3``: the folded equilibrium alone fixes t and E
+together along a valley, not apart (docs/scenarios.md).
+
+Beyond the paper: with the measured period of the small free vibrations (``period``, Table 7:
+0.100 s), each evaluation also computes the set-up's first modal period about its loaded
+unfolded equilibrium (:func:`tapespring.scenarios.vibration.loaded_periods`, a fraction of the
+equilibrium run's cost), and ``|T - T_measured| / T_measured`` joins eq. (4)'s sum as a fifth
+term. The period depends on another combination of t and E (the straight tapes' bending
+stiffness, through their curved section) and splits the valley. The modal period stands in for
+the decay's fitted one, which is 0.4 % longer on the paper's meshes.
 """
 
 from __future__ import annotations
@@ -49,9 +59,11 @@ from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, Identification
 
 if TYPE_CHECKING:
     from tapespring.protocols.identification import IdentificationResult
+    from tapespring.protocols.vibration import VibrationResult
 
 __all__ = [
     "NO_EQUILIBRIUM_OBJECTIVE",
+    "PERIOD_KEY",
     "TARGET_KEYS",
     "LocalSearch",
     "Sensitivity",
@@ -60,15 +72,20 @@ __all__ = [
     "identify_static",
     "objective",
     "paper_target",
+    "period_from",
     "target_from",
 ]
 
 #: The displacements eq. (4) compares [m]: markers 1-2 and 3, along x and z (Table 6's rows).
 TARGET_KEYS = tuple(key for key, _, _ in TABLE6_ROWS)
 
+#: Key of the measured period [s] in a target, when the search matches it too.
+PERIOD_KEY = "period_s"
+
 #: Objective of a run without a stable folded equilibrium: that of markers that do not move (each
-#: of the four relative differences is 1). The set-up's runs within Table 4's bounds score 0.1
-#: to 2 (5 mm tapes, against Table 3), so the search turns away from such points.
+#: of the four relative differences is 1; with the period, one more for it: 5). The set-up's runs
+#: within Table 4's bounds score 0.1 to 2 (5 mm tapes, against Table 3), so the search turns away
+#: from such points.
 NO_EQUILIBRIUM_OBJECTIVE = float(len(TARGET_KEYS))
 
 #: Relative step in t and in E of the forward differences of :class:`Sensitivity`: 1 %, large
@@ -156,10 +173,56 @@ def target_from(
     return out
 
 
-def objective(displacements: Mapping[str, float], target: Mapping[str, float]) -> float:
-    """Eq. (4): the sum over :data:`TARGET_KEYS` of ``|d - m| / m`` [-], `displacements` ``d``
-    and `target` ``m`` in metres."""
-    return float(sum(abs(displacements[k] - target[k]) / target[k] for k in TARGET_KEYS))
+def objective(values: Mapping[str, float], target: Mapping[str, float]) -> float:
+    """Eq. (4): the sum over the keys of `target` (:data:`TARGET_KEYS`, and :data:`PERIOD_KEY`
+    if it has one) of ``|v - m| / m`` [-], `values` ``v`` and `target` ``m`` in metres (the
+    period in seconds)."""
+    return float(sum(abs(values[k] - target[k]) / target[k] for k in target))
+
+
+def _penalty(target: Mapping[str, float]) -> float:
+    """The objective of a run without a stable folded equilibrium: 1 per term."""
+    return NO_EQUILIBRIUM_OBJECTIVE + (1.0 if PERIOD_KEY in target else 0.0)
+
+
+def period_from(measured: object) -> float | None:
+    """The measured period to match [s]: a positive finite number, the analysis of a recorded
+    free decay (:class:`tapespring.protocols.vibration.VibrationResult`: its fitted period), or
+    several (their mean); None for None.
+
+    Raises
+    ------
+    ValueError
+        For a non-positive or non-finite period, or an empty set of decays.
+    TypeError
+        For anything else.
+    """
+    from tapespring.protocols.vibration import VibrationResult
+
+    if measured is None:
+        return None
+    if isinstance(measured, VibrationResult):
+        measured = [measured]
+    if isinstance(measured, bool) or isinstance(measured, str | bytes):
+        raise TypeError(f"period must be a number [s] or recorded decays (got {measured!r})")
+    if isinstance(measured, int | float | np.floating | np.integer):
+        value = float(measured)
+    elif isinstance(measured, Iterable):
+        decays = list(measured)
+        if not decays:
+            raise ValueError("no recorded decays given for the period")
+        for decay in decays:
+            if not isinstance(decay, VibrationResult):
+                raise TypeError(
+                    "period must be a number [s], a VibrationResult or an iterable of them (got "
+                    f"an item {decay!r})"
+                )
+        value = float(np.mean([decay.fit.period for decay in decays]))
+    else:
+        raise TypeError(f"period must be a number [s] or recorded decays (got {measured!r})")
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"the measured period must be positive and finite [s] (got {value!r})")
+    return value
 
 
 @dataclass(frozen=True)
@@ -171,9 +234,14 @@ class StaticEvaluation:
     thickness_m, youngs_modulus_Pa : float
         The tapes' thickness [m] and Young's modulus [Pa].
     objective : float
-        Eq. (4) [-], or :data:`NO_EQUILIBRIUM_OBJECTIVE` without a stable folded equilibrium.
+        Eq. (4) [-] (with the period's term if one was matched), or 1 per term (the four
+        displacements', :data:`NO_EQUILIBRIUM_OBJECTIVE`, and the period's) without a stable
+        folded equilibrium.
     displacements_m : dict of str -> float, or None
         The folded equilibrium's displacements [m] (:data:`TARGET_KEYS`); None if none was found.
+    period_s : float or None
+        First modal period about the loaded unfolded equilibrium [s], when a period is matched
+        (None otherwise, or if the modal run failed).
     found : bool
         Whether the push path found the folded equilibrium.
     unstable_modes : int
@@ -195,11 +263,20 @@ class StaticEvaluation:
     error: str | None
     wall_s: float
     start: int
+    period_s: float | None = None
 
     @property
     def counted(self) -> bool:
-        """Whether eq. (4) was computed (a stable folded equilibrium was found)."""
-        return self.displacements_m is not None and self.unstable_modes == 0
+        """Whether eq. (4) was computed: a stable folded equilibrium was found, and the period
+        if one was asked for (no `error`)."""
+        return self.displacements_m is not None and self.unstable_modes == 0 and self.error is None
+
+    def values(self) -> dict[str, float]:
+        """The compared figures: the displacements [m], and the period [s] if computed."""
+        out = dict(self.displacements_m or {})
+        if self.period_s is not None:
+            out[PERIOD_KEY] = self.period_s
+        return out
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready fields (units in the keys)."""
@@ -241,9 +318,9 @@ class Sensitivity:
     Attributes
     ----------
     jacobian : ndarray, shape (4, 2)
-        Derivatives of each displacement relative to its measured value (rows: :data:`TARGET_KEYS`)
-        with respect to ``ln t`` and ``ln E`` (columns) [-], by forward differences of
-        :data:`SENSITIVITY_STEP`.
+        Derivatives of each displacement (and the period, if matched) relative to its measured
+        value (rows: `rows`) with respect to ``ln t`` and ``ln E`` (columns) [-], by forward
+        differences of :data:`SENSITIVITY_STEP`.
     singular_values : ndarray, shape (2,)
         Of the Jacobian, largest first [-]: a change of ``ln t`` and ``ln E`` along the first
         right singular vector by ``delta`` moves the relative displacements by about
@@ -255,12 +332,15 @@ class Sensitivity:
     condition : float
         ``singular_values[0] / singular_values[1]``: how much better determined that
         combination is than the other one.
+    rows : tuple of str
+        The Jacobian's rows: :data:`TARGET_KEYS`, then :data:`PERIOD_KEY` if matched.
     """
 
     jacobian: np.ndarray
     singular_values: np.ndarray
     best_exponent: float
     condition: float
+    rows: tuple[str, ...] = TARGET_KEYS
 
     @property
     def weak_direction(self) -> np.ndarray:
@@ -281,14 +361,14 @@ class Sensitivity:
         return abs(step * float(v[0])), abs(step * float(v[1]))
 
     def summary(self) -> dict[str, Any]:
-        """JSON-ready: ``jacobian`` (rows :data:`TARGET_KEYS`, columns ``ln t``, ``ln E``),
+        """JSON-ready: ``jacobian`` (rows `rows`, columns ``ln t``, ``ln E``),
         ``singular_values``, ``best_exponent``, ``condition``, ``weak_direction`` and the
         :meth:`spread` for :data:`SPREAD_RISE` (``spread_thickness_relative``,
         ``spread_youngs_modulus_relative``, ``spread_objective_rise``)."""
         spread_t, spread_e = self.spread()
         return {
             "jacobian": self.jacobian.tolist(),
-            "jacobian_rows": list(TARGET_KEYS),
+            "jacobian_rows": list(self.rows),
             "jacobian_columns": ["ln_thickness", "ln_youngs_modulus"],
             "singular_values": self.singular_values.tolist(),
             "best_exponent": self.best_exponent,
@@ -314,6 +394,11 @@ class StaticIdentification:
         Its folded equilibrium's displacements [m] (None if no start found one).
     target_m : dict of str -> float
         The measured displacements matched [m].
+    target_period_s : float or None
+        The measured period matched [s] (None: the displacements alone, as the paper).
+    period_s : float or None
+        The best evaluation's first modal period about the loaded equilibrium [s] (when a
+        period was matched).
     searches : tuple of LocalSearch
         One per start.
     evaluations : tuple of StaticEvaluation
@@ -350,6 +435,8 @@ class StaticIdentification:
     workers: int
     cancelled: bool
     wall_s: float
+    target_period_s: float | None = None
+    period_s: float | None = None
 
     @property
     def found(self) -> bool:
@@ -369,7 +456,8 @@ class StaticIdentification:
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures [m, Pa, s]: ``thickness_m``, ``youngs_modulus_Pa``, ``objective``,
-        ``displacements_m``, ``target_m``, ``difference_relative`` (Table 6's Delta),
+        ``displacements_m``, ``target_m``, ``difference_relative`` (Table 6's Delta; with a
+        period, ``period_s``, ``target_period_s`` and ``period_difference_relative``),
         ``bending_stiffness_Nm`` (the tapes' ``E t^3 / (12 (1 - nu^2))``), the paper's Table 5
         (``paper_thickness_m``, ``paper_youngs_modulus_Pa``), ``searches``, ``evaluations``,
         ``sensitivity``, ``bounds``, ``settings``, ``max_evaluations``, ``workers``,
@@ -383,6 +471,11 @@ class StaticIdentification:
             "displacements_m": self.displacements_m,
             "target_m": self.target_m,
             "difference_relative": self.differences_relative(),
+            "period_s": self.period_s,
+            "target_period_s": self.target_period_s,
+            "period_difference_relative": None
+            if self.period_s is None or self.target_period_s is None
+            else self.period_s / self.target_period_s - 1.0,
             "bending_stiffness_Nm": self.youngs_modulus_Pa
             * self.thickness_m**3
             / (12.0 * (1.0 - nu**2)),
@@ -412,13 +505,23 @@ class StaticIdentification:
             lines.append(
                 f"  {marker:8}{axis:4}{self.target_m[key] * 1e3:11.1f}{num:>11}{delta:>11}"
             )
+        if self.target_period_s is not None:
+            exp = f"{self.target_period_s:.4f} s"
+            if self.period_s is None:
+                num, delta = "-", "-"
+            else:
+                num = f"{self.period_s:.4f} s"
+                delta = f"{100 * (self.period_s / self.target_period_s - 1.0):+.1f}"
+            lines.append(f"  {'period':12}{exp:>11}{num:>11}{delta:>11}")
         return "\n".join(lines)
 
     def describe(self) -> str:
         """A few lines for a person."""
         runs = len(self.evaluations)
         lines = [
-            f"identification of t and E (Sec. 5.1, eq. (4)): {len(self.searches)} start(s), "
+            "identification of t and E (Sec. 5.1, eq. (4)"
+            + (", with the vibration period" if self.target_period_s is not None else "")
+            + f"): {len(self.searches)} start(s), "
             f"{runs} equilibrium runs"
             + (f" ({self.workers} processes)" if self.workers > 1 else "")
             + f", wall time {self.wall_s:.1f} s"
@@ -444,7 +547,8 @@ class StaticIdentification:
             sens = self.sensitivity
             spread_t, spread_e = sens.spread()
             lines.append(
-                f"  the displacements fix E t^{sens.best_exponent:.2f} best, "
+                f"  the {'figures' if self.target_period_s is not None else 'displacements'} fix "
+                f"E t^{sens.best_exponent:.2f} best, "
                 f"{sens.condition:.1f} times better than the other combination of t and E: "
                 f"t by {spread_t:.1%} and E by {spread_e:.1%} together along the valley raise "
                 f"the objective by only {SPREAD_RISE} (first order)"
@@ -496,9 +600,11 @@ def _evaluate(
     modulus: float,
     start: int,
 ) -> StaticEvaluation:
-    """One equilibrium run with the tapes' `thickness` [m] and `modulus` [Pa]."""
+    """One equilibrium run with the tapes' `thickness` [m] and `modulus` [Pa], and the modal run
+    for the period if `target` has one."""
     from tapespring.analysis import ConvergenceError
     from tapespring.scenarios.equilibrium import equilibrium
+    from tapespring.scenarios.vibration import loaded_periods
 
     tape = replace(settings.spec.tape, thickness=thickness, youngs_modulus=modulus)
     run_settings = replace(settings, spec=replace(settings.spec, tape=tape))
@@ -510,27 +616,34 @@ def _evaluate(
         # A path the solver could not follow to its end: scored as no equilibrium, its message
         # kept, so that one hard point does not end the search.
         result, error = exc.result, str(exc)
-    wall = time.perf_counter() - t0
     displacements = None
     unstable = -1
     if result is not None and result.found:
         figures = result.summary()["marker_displacements_m"]
         displacements = {key: float(figures[key]) for key in TARGET_KEYS}
         unstable = int(result.unstable_modes)
-    counted = displacements is not None and unstable == 0
-    return StaticEvaluation(
+    counted = displacements is not None and unstable == 0 and error is None
+    period = None
+    if counted and PERIOD_KEY in target:
+        try:
+            period = float(loaded_periods(run_settings.spec)[0])
+        except ConvergenceError as exc:
+            counted, error = False, f"no modal period: {exc}"
+    evaluation = StaticEvaluation(
         thickness_m=thickness,
         youngs_modulus_Pa=modulus,
-        objective=objective(displacements, target)  # type: ignore[arg-type]
-        if counted
-        else NO_EQUILIBRIUM_OBJECTIVE,
+        objective=_penalty(target),
         displacements_m=displacements,
         found=displacements is not None,
         unstable_modes=unstable,
         error=error,
-        wall_s=wall,
+        wall_s=time.perf_counter() - t0,
         start=start,
+        period_s=period,
     )
+    if counted:
+        evaluation = replace(evaluation, objective=objective(evaluation.values(), target))
+    return evaluation
 
 
 @dataclass(frozen=True)
@@ -689,8 +802,8 @@ def _sensitivity(
     settings: EquilibriumSettings, target: Mapping[str, float], best: StaticEvaluation
 ) -> tuple[Sensitivity | None, str | None, list[StaticEvaluation]]:
     """Forward differences in ln t and ln E about `best` (two more runs)."""
-    assert best.displacements_m is not None
-    base = np.array([best.displacements_m[k] / target[k] for k in TARGET_KEYS])
+    rows = tuple(target)
+    base = np.array([best.values()[k] / target[k] for k in rows])
     factor = math.exp(SENSITIVITY_STEP)
     runs = [
         _evaluate(settings, target, best.thickness_m * factor, best.youngs_modulus_Pa, -1),
@@ -698,23 +811,23 @@ def _sensitivity(
     ]
     columns = []
     for run, name in zip(runs, ("t", "E"), strict=True):
-        if not run.counted or run.displacements_m is None:
+        if not run.counted:
+            why = run.error or "found no stable folded equilibrium"
             return (
                 None,
-                f"the run with {name} raised by {SENSITIVITY_STEP:.0%} found no stable folded "
-                "equilibrium: the optimum lies at the edge of the folded states",
+                f"the run with {name} raised by {SENSITIVITY_STEP:.0%} {why}: the optimum lies "
+                "at the edge of the folded states",
                 runs,
             )
         columns.append(
-            (np.array([run.displacements_m[k] / target[k] for k in TARGET_KEYS]) - base)
-            / SENSITIVITY_STEP
+            (np.array([run.values()[k] / target[k] for k in rows]) - base) / SENSITIVITY_STEP
         )
     jacobian = np.column_stack(columns)
     _, singular, vt = np.linalg.svd(jacobian)
     v_t, v_e = vt[0]
     exponent = float(v_t / v_e) if v_e != 0.0 else math.inf
     condition = float(singular[0] / singular[1]) if singular[1] > 0.0 else math.inf
-    return Sensitivity(jacobian, singular, exponent, condition), None, runs
+    return Sensitivity(jacobian, singular, exponent, condition, rows), None, runs
 
 
 def identify_static(
@@ -724,6 +837,7 @@ def identify_static(
     | None = None,
     settings: EquilibriumSettings | None = None,
     *,
+    period: float | VibrationResult | Iterable[VibrationResult] | None = None,
     bounds: IdentificationBounds = PAPER_BOUNDS,
     starts: int | Sequence[tuple[float, float]] = 4,
     max_evaluations: int = MAX_EVALUATIONS,
@@ -742,6 +856,10 @@ def identify_static(
     settings : EquilibriumSettings, optional
         The equilibrium runs: the set-up (its tape's ``thickness`` and ``youngs_modulus`` are
         replaced by the search's), its meshes, the push. Default: the paper's meshes.
+    period : float, VibrationResult, iterable of them, or None
+        The measured period of the small free vibrations [s] (:func:`period_from`; Table 7:
+        0.100 s), matched too: its relative difference joins eq. (4)'s sum (module docs). None:
+        the displacements alone, as the paper.
     bounds : IdentificationBounds
         The search's box (Table 4 by default).
     starts : int or sequence of (t [m], E [Pa])
@@ -780,6 +898,9 @@ def identify_static(
     from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
 
     target = target_from(measured)
+    period_s = period_from(period)
+    if period_s is not None:
+        target[PERIOD_KEY] = period_s
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
         raise ValueError(f"settings must be an EquilibriumSettings (got {settings!r})")
@@ -873,7 +994,7 @@ def identify_static(
         youngs_modulus_Pa=best.youngs_modulus_Pa if best else math.nan,
         objective=best.objective if best else math.nan,
         displacements_m=None if best is None else best.displacements_m,
-        target_m=target,
+        target_m={key: target[key] for key in TARGET_KEYS},
         searches=tuple(o.search for o in ordered),
         evaluations=tuple(evaluations),
         sensitivity=sens,
@@ -884,4 +1005,6 @@ def identify_static(
         workers=processes_for(workers, len(tasks)),
         cancelled=stopped,
         wall_s=time.perf_counter() - start_time,
+        target_period_s=period_s,
+        period_s=None if best is None else best.period_s,
     )

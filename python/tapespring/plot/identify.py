@@ -101,7 +101,8 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
         ylabel="Young's modulus E [GPa]",
         xlim=(b.thickness_min * 1e3, b.thickness_max * 1e3),
         ylim=(b.youngs_modulus_min / 1e9, b.youngs_modulus_max / 1e9),
-        title="identification of t and E (Sec. 5.1)",
+        title="identification of t and E (Sec. 5.1"
+        + (", with the period)" if result.target_period_s is not None else ")"),
     )
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7, loc="upper right")
