@@ -22,6 +22,7 @@ from property_settings import examples
 from tapespring.analysis import ConvergenceError
 from tapespring.identify import damping
 from tapespring.identify.damping import DampingIdentification, DampingRun, identify_damping
+from tapespring.identify.notes import IdentificationWarning
 from tapespring.protocols.vibration import analyze_vibration
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.scenarios.vibration import VibrationSettings, VibrationSimulation, vibrate
@@ -136,7 +137,7 @@ def test_a_target_below_the_integrators_own_damping_is_reported() -> None:
     measured). A target of 0.2 %: the Kelvin-Voigt step from the first guess goes below eta = 0,
     the run at 0 confirms, and the search stops there (2 runs, about 4 s)."""
     settings = replace(SETTINGS, rho_inf=0.0, time_step=5e-3, duration=2.0)
-    with pytest.warns(RuntimeWarning, match="integrator alone"):
+    with pytest.warns(IdentificationWarning, match="integrator alone"):
         out = identify_damping(0.002, settings, max_runs=4)
     assert not out.converged
     assert out.eta_s == 0.0
@@ -151,7 +152,7 @@ def test_a_decay_too_short_for_the_window_says_so() -> None:
     no fit, eta is raised until one fits, and the line through it puts the target where the fit
     failed, so the search stops asking for a longer decay (about 2.6 s)."""
     settings = replace(SETTINGS, duration=1.5)
-    with pytest.warns(RuntimeWarning, match="lengthen the duration"):
+    with pytest.warns(IdentificationWarning, match="lengthen the duration"):
         out = identify_damping(0.00509, settings)
     assert not out.converged
     assert out.runs[0].damping_ratio is None and out.runs[0].fit_error
@@ -381,7 +382,7 @@ def test_the_run_budget_spent_returns_the_nearest_run_with_a_warning(
 ) -> None:
     fake = _AffineVibrate(offset=0.0, slope=1.2 * math.pi / 0.108)
     monkeypatch.setattr(damping, "vibrate", fake)
-    with pytest.warns(RuntimeWarning, match="max_runs"):
+    with pytest.warns(IdentificationWarning, match="max_runs"):
         out = identify_damping(0.005, SETTINGS, max_runs=1)
     assert not out.converged and len(out.runs) == 1 == len(fake.etas)
     assert out.eta_s == out.runs[0].eta_s and out.damping_ratio == out.runs[0].damping_ratio

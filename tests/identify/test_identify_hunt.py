@@ -1,8 +1,8 @@
 """A bug hunt in the identifications of Sec. 5 (`tapespring.identify`, `tapespring identify`).
 
-Each real defect found is a test marked ``xfail(strict=True)`` whose reason names it: it fails
-today and passes once the defect is fixed. The other tests pin down behaviour that was checked
-and found sound. Every test runs on stand-ins (`static._evaluate` replaced by a closed form,
+Each real defect found was a test marked ``xfail(strict=True)``; all are fixed, and each test's
+comment says what the defect was. The other tests pin down behaviour that was checked and found
+sound. Every test runs on stand-ins (`static._evaluate` replaced by a closed form,
 `damping.vibrate` by an affine fit), so that the file runs in a few seconds; the threads of a
 `concurrent.futures.ThreadPoolExecutor` stand in for the worker processes of ``workers=2`` (the
 same `tapespring.sweep.run_tasks` logic, on which a stand-in of this process is seen).
@@ -32,6 +32,7 @@ from tapespring.analysis import ConvergenceError
 from tapespring.cli import main
 from tapespring.identify import damping, static
 from tapespring.identify.damping import DampingIdentification, identify_damping
+from tapespring.identify.notes import IdentificationWarning
 from tapespring.identify.static import (
     NO_EQUILIBRIUM_OBJECTIVE,
     PERIOD_KEY,
@@ -194,34 +195,28 @@ def _recorded_decay(period: float = 0.100) -> Any:
 
 
 # =============================================================================================
-# Defects (xfail, strict): each fails today and passes once fixed
+# Defects found by the hunt, now fixed: each test fails on the code before the fix
 # =============================================================================================
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="DampingIdentification.describe() formats period_difference_relative (None) with "
-    "'+.1%' when the target came from recordings (measured_period_s set) and no run was fitted: "
-    "TypeError",
-)
+# Fixed (was a defect): DampingIdentification.describe() formats period_difference_relative (None)
+# with '+.1%' when the target came from recordings (measured_period_s set) and no run was fitted:
+# TypeError
 def test_describe_of_an_unfitted_identification_from_recordings(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(damping, "vibrate", FakeVibrate(floor=1.0))  # no run is ever fitted
-    with pytest.warns(RuntimeWarning, match="max_runs"):
+    with pytest.warns(IdentificationWarning, match="max_runs"):
         out = identify_damping(_recorded_decay(), VIBRATION, max_runs=2)
     assert out.damping_ratio is None and out.measured_period_s is not None
     text = out.describe()
     assert "0.1000 s" in text  # the measured period, beside no fitted one
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="'tapespring identify damping --experiment DECAY' crashes with a TypeError "
-    "traceback (DampingIdentification.describe) after its runs when none could be fitted: the "
-    "outputs are lost instead of exit code 1",
-)
-@pytest.mark.filterwarnings("ignore:damping identification:RuntimeWarning")
+# Fixed (was a defect): 'tapespring identify damping --experiment DECAY' crashes with a TypeError
+# traceback (DampingIdentification.describe) after its runs when none could be fitted: the outputs
+# are lost instead of exit code 1
+@pytest.mark.filterwarnings("ignore:damping identification:UserWarning")
 def test_cli_damping_from_a_recording_without_a_fitted_run_exits_1(
     tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -236,12 +231,9 @@ def test_cli_damping_from_a_recording_without_a_fitted_run_exits_1(
     assert "NOT CONVERGED" in out and "Traceback" not in err
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the CLI's integer checks (_check_starts, _check_evaluations, _check_runs) call "
-    "int(value) unguarded: 'inf' escapes argparse as an OverflowError traceback (exit 1), 'nan' "
-    "is refused as 'cannot convert float NaN to integer' instead of the option's rule",
-)
+# Fixed (was a defect): the CLI's integer checks (_check_starts, _check_evaluations, _check_runs)
+# call int(value) unguarded: 'inf' escapes argparse as an OverflowError traceback (exit 1), 'nan'
+# is refused as 'cannot convert float NaN to integer' instead of the option's rule
 @pytest.mark.parametrize(
     ("argv", "rule"),
     [
@@ -261,14 +253,11 @@ def test_cli_counts_refuse_inf_and_nan_by_their_rule(
     assert rule in refused(argv, capsys)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the identifications' notes for the user ('nothing identified', 'max_runs spent', "
-    "'the integrator alone damps more') are RuntimeWarnings, which the CLI's print_warnings "
-    "re-issues as Python warnings (a file path and a source line on stderr; under -W error a "
-    "traceback that loses the outputs) instead of 'warning: ...' lines (UserWarning, as "
-    "numerical_damping and TrialWarning do)",
-)
+# Fixed (was a defect): the identifications' notes for the user ('nothing identified', 'max_runs
+# spent', 'the integrator alone damps more') are RuntimeWarnings, which the CLI's print_warnings
+# re-issues as Python warnings (a file path and a source line on stderr; under -W error a
+# traceback that loses the outputs) instead of 'warning: ...' lines (UserWarning, as
+# numerical_damping and TrialWarning do)
 @pytest.mark.parametrize("command", ["static", "damping"])
 def test_cli_prints_the_identifications_notes_as_warning_lines(
     command: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
@@ -281,12 +270,9 @@ def test_cli_prints_the_identifications_notes_as_warning_lines(
     assert err.startswith("warning: ") and "RuntimeWarning" not in err
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="with workers > 1, a progress callback that returns False on the last start to end "
-    "is ignored (run_tasks reports no stop when nothing is pending): cancelled is False and "
-    "the two sensitivity runs are made after the stop, unlike workers=1",
-)
+# Fixed (was a defect): with workers > 1, a progress callback that returns False on the last start
+# to end is ignored (run_tasks reports no stop when nothing is pending): cancelled is False and
+# the two sensitivity runs are made after the stop, unlike workers=1
 def test_a_stop_on_the_last_start_with_workers_is_a_stop(
     fake: FakeEvaluate, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -303,11 +289,8 @@ def test_a_stop_on_the_last_start_with_workers_is_a_stop(
     assert all(e.start >= 0 for e in result.evaluations)  # no run after the stop
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a progress callback's False on the sensitivity's first run is ignored (report()'s "
-    "answer is dropped there): the second run is made and cancelled stays False",
-)
+# Fixed (was a defect): a progress callback's False on the sensitivity's first run is ignored
+# (report()'s answer is dropped there): the second run is made and cancelled stays False
 def test_a_stop_during_the_sensitivity_is_a_stop(fake: FakeEvaluate) -> None:
     def stop_at_the_sensitivity(evaluation: StaticEvaluation) -> bool:
         return evaluation.start >= 0
@@ -317,12 +300,9 @@ def test_a_stop_during_the_sensitivity_is_a_stop(fake: FakeEvaluate) -> None:
     assert [e.start for e in result.evaluations].count(-1) == 1
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="with workers=1 identify_static runs its own loop, not run_tasks: a Ctrl-C "
-    "(KeyboardInterrupt) loses every run made so far, where workers > 1 (run_tasks) and "
-    "max_mass return them marked cancelled",
-)
+# Fixed (was a defect): with workers=1 identify_static runs its own loop, not run_tasks: a Ctrl-C
+# (KeyboardInterrupt) loses every run made so far, where workers > 1 (run_tasks) and max_mass
+# return them marked cancelled
 def test_ctrl_c_with_one_worker_keeps_the_runs_so_far(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(static, "_evaluate", FakeEvaluate(interrupt_at=5))
     result: Any = None
@@ -336,11 +316,8 @@ def test_ctrl_c_with_one_worker_keeps_the_runs_so_far(monkeypatch: pytest.Monkey
     assert len(result.evaluations) == 4
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="identify_damping keeps nothing on a Ctrl-C: the KeyboardInterrupt of a run "
-    "propagates without the runs so far (a ConvergenceError carries them in 'result')",
-)
+# Fixed (was a defect): identify_damping keeps nothing on a Ctrl-C: the KeyboardInterrupt of a run
+# propagates without the runs so far (a ConvergenceError carries them in 'result')
 def test_ctrl_c_in_the_damping_search_keeps_the_runs_so_far(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -359,12 +336,9 @@ class _HaltonHang(Exception):
     pass
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a huge count of starts is accepted and the Halton points are all built before any "
-    "other check (10**6 starts: 7 s; 10**12: a hang or MemoryError), e.g. before "
-    "max_evaluations=2 is refused",
-)
+# Fixed (was a defect): a huge count of starts is accepted and the Halton points are all built
+# before any other check (10**6 starts: 7 s; 10**12: a hang or MemoryError), e.g. before
+# max_evaluations=2 is refused
 def test_a_huge_count_of_starts_is_refused_at_once(
     fake: FakeEvaluate, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -383,33 +357,24 @@ def test_a_huge_count_of_starts_is_refused_at_once(
     assert fake.calls == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="_check_starts: a numpy integer count (np.int64(2), as workers accepts) falls "
-    "through to list(starts): TypeError \"'numpy.int64' object is not iterable\"",
-)
+# Fixed (was a defect): _check_starts: a numpy integer count (np.int64(2), as workers accepts)
+# falls through to list(starts): TypeError "'numpy.int64' object is not iterable"
 def test_a_numpy_integer_count_of_starts_is_a_count(fake: FakeEvaluate) -> None:
     result = identify_static(BASE, starts=np.int64(2), max_evaluations=4, sensitivity=False)
     assert len(result.searches) == 2
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="_check_starts: a float count (starts=2.0) is refused with TypeError \"'float' "
-    'object is not iterable", which does not name starts',
-)
+# Fixed (was a defect): _check_starts: a float count (starts=2.0) is refused with TypeError
+# "'float' object is not iterable", which does not name starts
 def test_a_float_count_of_starts_is_refused_by_name(fake: FakeEvaluate) -> None:
     with pytest.raises((ValueError, TypeError), match="starts"):
         identify_static(BASE, starts=2.0)  # type: ignore[arg-type]
     assert fake.calls == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="check_count refuses numpy integers with a self-contradicting message "
-    "('max_evaluations must be an integer >= 3 (got np.int64(5))'; identify_damping's max_runs "
-    "alike) while workers=np.int64(2) is accepted",
-)
+# Fixed (was a defect): check_count refuses numpy integers with a self-contradicting message
+# ('max_evaluations must be an integer >= 3 (got np.int64(5))'; identify_damping's max_runs alike)
+# while workers=np.int64(2) is accepted
 @pytest.mark.parametrize("which", ["static", "damping"])
 def test_numpy_integer_budgets_are_accepted(
     which: str, fake: FakeEvaluate, monkeypatch: pytest.MonkeyPatch
@@ -423,21 +388,15 @@ def test_numpy_integer_budgets_are_accepted(
         assert out.converged
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="target_from: an int displacement beyond the floats (10**400) raises OverflowError "
-    "from math.isfinite, not a ValueError naming it (check_number handles this case)",
-)
+# Fixed (was a defect): target_from: an int displacement beyond the floats (10**400) raises
+# OverflowError from math.isfinite, not a ValueError naming it (check_number handles this case)
 def test_a_displacement_beyond_the_floats_is_refused_by_name() -> None:
     with pytest.raises(ValueError, match="marker3_dz_m"):
         target_from({**BASE, "marker3_dz_m": 10**400})
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a measured mapping holding PERIOD_KEY ('period_s', the key of the period in a "
-    "target) has it silently dropped: the period is not matched and nothing says so",
-)
+# Fixed (was a defect): a measured mapping holding PERIOD_KEY ('period_s', the key of the period
+# in a target) has it silently dropped: the period is not matched and nothing says so
 def test_a_period_in_the_measured_mapping_is_not_silently_dropped(fake: FakeEvaluate) -> None:
     try:
         result = identify_static({**BASE, PERIOD_KEY: 0.1}, starts=1, max_evaluations=3,
@@ -448,11 +407,8 @@ def test_a_period_in_the_measured_mapping_is_not_silently_dropped(fake: FakeEval
         assert result.target_period_s == 0.1
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="identify_static does not check `progress`: a value neither bool, None nor callable "
-    "('yes') is silently ignored",
-)
+# Fixed (was a defect): identify_static does not check `progress`: a value neither bool, None nor
+# callable ('yes') is silently ignored
 def test_a_bad_progress_is_refused_by_identify_static(fake: FakeEvaluate) -> None:
     with pytest.raises(TypeError, match="progress"):
         identify_static(BASE, starts=1, max_evaluations=3, progress="yes")  # type: ignore[arg-type]
@@ -467,12 +423,9 @@ def _no_run(settings: VibrationSettings, *, progress: bool = False) -> Any:
     raise _NoRun("a vibration run was started before the input was refused")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="identify_damping does not check `progress` before the runs: 'yes' reaches vibrate, "
-    "refused by analysis.run only after the set-up is built (0.9 s on 5 mm meshes, more on the "
-    "paper's)",
-)
+# Fixed (was a defect): identify_damping does not check `progress` before the runs: 'yes' reaches
+# vibrate, refused by analysis.run only after the set-up is built (0.9 s on 5 mm meshes, more on
+# the paper's)
 def test_a_bad_progress_is_refused_before_any_vibration_run(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -481,27 +434,21 @@ def test_a_bad_progress_is_refused_before_any_vibration_run(
         identify_damping(0.005, VIBRATION, progress="yes")  # type: ignore[arg-type]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="StaticIdentification.summary() (documented JSON-ready) holds NaN when nothing was "
-    "found (thickness_m, youngs_modulus_Pa, objective, bending_stiffness_Nm): not JSON; "
-    "DampingIdentification.summary() maps such values to None",
-)
+# Fixed (was a defect): StaticIdentification.summary() (documented JSON-ready) holds NaN when
+# nothing was found (thickness_m, youngs_modulus_Pa, objective, bending_stiffness_Nm): not JSON;
+# DampingIdentification.summary() maps such values to None
 def test_the_static_summary_is_strict_json_when_nothing_is_found(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(static, "_evaluate", _no_equilibrium)
-    with pytest.warns(RuntimeWarning, match="nothing identified"):
+    with pytest.warns(IdentificationWarning, match="nothing identified"):
         result = identify_static(BASE, starts=1, max_evaluations=3)
     _strict_json(json.dumps(result.summary()))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="'tapespring identify static' exits 0 when the search was stopped (cancelled: a "
-    "Ctrl-C with --workers > 1, run_tasks returning True), where finish() exits 1 for a run "
-    "that stopped early",
-)
+# Fixed (was a defect): 'tapespring identify static' exits 0 when the search was stopped
+# (cancelled: a Ctrl-C with --workers > 1, run_tasks returning True), where finish() exits 1 for a
+# run that stopped early
 def test_cli_a_stopped_static_identification_exits_1(
     fake: FakeEvaluate, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
 ) -> None:
@@ -518,12 +465,9 @@ def test_cli_a_stopped_static_identification_exits_1(
     assert code == 1
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a search run again at a (t, E) it has run already (Nelder-Mead's steps clipped to "
-    "the bounds land on the same point): an equilibrium run repeated for nothing (13 of 74 "
-    "runs when the optimum lies at a corner); a cache in the objective would spare them",
-)
+# Fixed (was a defect): a search run again at a (t, E) it has run already (Nelder-Mead's steps
+# clipped to the bounds land on the same point): an equilibrium run repeated for nothing (13 of 74
+# runs when the optimum lies at a corner); a cache in the objective would spare them
 def test_no_equilibrium_run_is_repeated_within_a_search(monkeypatch: pytest.MonkeyPatch) -> None:
     def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
         # The truth below the box's thickness: the optimum at the box's edge.
@@ -541,13 +485,10 @@ def test_no_equilibrium_run_is_repeated_within_a_search(monkeypatch: pytest.Monk
         assert max(points.values()) == 1, f"start {n}: {points.most_common(1)}"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the sensitivity's neighbours (t and E times exp(0.01)) leave the bounds when the "
-    "optimum lies on an upper bound; where that bound is the set-up's own limit (E at "
-    "MAX_YOUNGS_MODULUS, t at radius / 2) the run's ValueError escapes identify_static after the "
-    "whole search, losing it",
-)
+# Fixed (was a defect): the sensitivity's neighbours (t and E times exp(0.01)) leave the bounds
+# when the optimum lies on an upper bound; where that bound is the set-up's own limit (E at
+# MAX_YOUNGS_MODULUS, t at radius / 2) the run's ValueError escapes identify_static after the
+# whole search, losing it
 def test_the_sensitivity_at_an_upper_bound_does_not_lose_the_search(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -569,12 +510,9 @@ def test_the_sensitivity_at_an_upper_bound_does_not_lose_the_search(
     assert result.sensitivity is not None or result.sensitivity_error
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="identify_damping's _target checks the recordings' damping ratios but not their "
-    "periods: a fit with a NaN period gives measured_period_s = NaN silently (static's "
-    "period_from refuses it)",
-)
+# Fixed (was a defect): identify_damping's _target checks the recordings' damping ratios but not
+# their periods: a fit with a NaN period gives measured_period_s = NaN silently (static's
+# period_from refuses it)
 def test_a_recording_with_a_nan_period_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(damping, "vibrate", _no_run)
     recorded = _recorded_decay()
@@ -583,11 +521,8 @@ def test_a_recording_with_a_nan_period_is_refused(monkeypatch: pytest.MonkeyPatc
         identify_damping(broken, VIBRATION)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a 0-d numpy array (np.asarray(0.1)) as period or damping_ratio falls through to "
-    "list(): TypeError 'iteration over a 0-d array', which names neither",
-)
+# Fixed (was a defect): a 0-d numpy array (np.asarray(0.1)) as period or damping_ratio falls
+# through to list(): TypeError 'iteration over a 0-d array', which names neither
 @pytest.mark.parametrize("which", ["period", "damping_ratio"])
 def test_a_0d_array_is_taken_or_refused_by_name(which: str) -> None:
     try:
@@ -599,11 +534,8 @@ def test_a_0d_array_is_taken_or_refused_by_name(which: str) -> None:
         assert which in str(exc)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="'tapespring identify damping --help' shows 'Table 7's 0.509 %%.': argparse does not "
-    "%-format a description, so the doubled % is printed as is",
-)
+# Fixed (was a defect): 'tapespring identify damping --help' shows 'Table 7's 0.509 %%.': argparse
+# does not %-format a description, so the doubled % is printed as is
 def test_the_damping_help_shows_one_percent_sign(capsys: pytest.CaptureFixture) -> None:
     with pytest.raises(SystemExit):
         main(["identify", "damping", "--help"])
@@ -611,12 +543,9 @@ def test_the_damping_help_shows_one_percent_sign(capsys: pytest.CaptureFixture) 
     assert "%%" not in text and "0.509 %" in text
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="StaticIdentification.settings (and the CSV's '#' settings line, the JSON's "
-    "'settings') carry the set-up's default tape t = 0.138 mm, E = 151.76 GPa, which no run "
-    "used, where DampingIdentification.settings is the identified run's",
-)
+# Fixed (was a defect): StaticIdentification.settings (and the CSV's '#' settings line, the JSON's
+# 'settings') carry the set-up's default tape t = 0.138 mm, E = 151.76 GPa, which no run used,
+# where DampingIdentification.settings is the identified run's
 def test_the_static_settings_carry_the_identified_tape(fake: FakeEvaluate) -> None:
     result = identify_static(closed_form(TRUE_T, TRUE_E), starts=1, max_evaluations=20,
                              sensitivity=False)  # fmt: skip
@@ -717,7 +646,8 @@ def test_runs_are_attributed_and_the_best_is_the_least_counted(
     for n, search in enumerate(result.searches):
         own = [e for e in result.evaluations if e.start == n]
         assert search.evaluations == len(own) <= budget
-        assert search.objective == min(e.objective for e in own)
+        # A start's end is its best counted run (a penalty run only if none counted).
+        assert search.objective == min(e.objective for e in ([e for e in own if e.counted] or own))
     counted = [e for e in result.evaluations if e.counted and e.start >= 0]
     if not counted:
         assert not result.found and math.isnan(result.objective)
@@ -727,12 +657,15 @@ def test_runs_are_attributed_and_the_best_is_the_least_counted(
     assert (result.thickness_m, result.youngs_modulus_Pa, result.objective) == (
         best.thickness_m, best.youngs_modulus_Pa, best.objective)  # fmt: skip
     extra = [e for e in result.evaluations if e.start == -1]
-    assert len(extra) == 2 and result.evaluations[-2:] == tuple(extra)
+    # Two runs, or one when the first neighbour has no folded equilibrium (no Jacobian then).
+    assert 1 <= len(extra) <= 2 and result.evaluations[-len(extra) :] == tuple(extra)
+    assert len(extra) == 2 or result.sensitivity is None
     factor = math.exp(static.SENSITIVITY_STEP)
     assert (extra[0].thickness_m, extra[0].youngs_modulus_Pa) == pytest.approx(
         (best.thickness_m * factor, best.youngs_modulus_Pa))  # fmt: skip
-    assert (extra[1].thickness_m, extra[1].youngs_modulus_Pa) == pytest.approx(
-        (best.thickness_m, best.youngs_modulus_Pa * factor))  # fmt: skip
+    if len(extra) == 2:
+        assert (extra[1].thickness_m, extra[1].youngs_modulus_Pa) == pytest.approx(
+            (best.thickness_m, best.youngs_modulus_Pa * factor))  # fmt: skip
 
 
 def test_the_sensitivity_is_the_log_derivative_at_the_optimum(fake: FakeEvaluate) -> None:
@@ -760,18 +693,18 @@ def test_a_stop_at_the_third_run_of_a_flat_start_is_a_stop(
         seen.append(evaluation)
         return len(seen) < 3
 
-    with pytest.warns(RuntimeWarning, match="nothing identified"):
+    with pytest.warns(IdentificationWarning, match="nothing identified"):
         result = identify_static(BASE, starts=2, progress=stop_at_three)
     assert result.cancelled and len(result.evaluations) == 3 == len(seen)
     assert [s.message for s in result.searches] == ["stopped"]
     # Without the stop, the flat start is abandoned after its three runs and the next goes on.
-    with pytest.warns(RuntimeWarning, match="nothing identified"):
+    with pytest.warns(IdentificationWarning, match="nothing identified"):
         result = identify_static(BASE, starts=2)
     assert not result.cancelled and [s.evaluations for s in result.searches] == [3, 3]
     assert all("start abandoned" in s.message and not s.converged for s in result.searches)
 
 
-@pytest.mark.filterwarnings("ignore:no run found:RuntimeWarning")
+@pytest.mark.filterwarnings("ignore:no run found:UserWarning")
 def test_cli_nothing_identified_exits_1_with_strict_json_csv_and_plot(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
@@ -821,7 +754,7 @@ def test_cli_damping_stopped_run_exits_1_with_strict_json(
     assert figure.stat().st_size > 5_000
 
 
-@pytest.mark.filterwarnings("ignore:damping identification:RuntimeWarning")
+@pytest.mark.filterwarnings("ignore:damping identification:UserWarning")
 def test_cli_damping_not_converged_exits_1(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
 ) -> None:
@@ -867,7 +800,7 @@ def test_cli_a_missing_recording_exits_1_before_any_run(
     assert str(missing) in line
 
 
-@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@pytest.mark.filterwarnings("ignore::UserWarning")
 def test_damping_plot_and_summary_without_a_fitted_run(monkeypatch: pytest.MonkeyPatch) -> None:
     import matplotlib.pyplot as plt
     from tapespring.plot.identify import plot_damping_identification

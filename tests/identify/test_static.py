@@ -14,6 +14,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
 from tapespring.identify import static
+from tapespring.identify.notes import IdentificationWarning
 from tapespring.identify.static import (
     NO_EQUILIBRIUM_OBJECTIVE,
     TARGET_KEYS,
@@ -129,7 +130,8 @@ def test_bad_measurements_are_refused(measured: object, error: type, match: str)
         ({"bounds": (0.1, 0.2)}, "must be an IdentificationBounds"),
         # A tape as thick as its radius (the set-up's own check, at the box's corner).
         ({"bounds": IdentificationBounds(thickness_max=9e-3)}, "not thin"),
-        ({"starts": 0}, "starts must be a count >= 1"),
+        ({"starts": 0}, r"starts must be a count in \[1, 1000\]"),
+        ({"starts": 1001}, r"starts must be a count in \[1, 1000\]"),
         ({"starts": True}, "starts must be a count"),
         ({"starts": []}, "starts is empty"),
         ({"starts": [(0.1e-3, 150e9)]}, "outside the bounds"),
@@ -202,8 +204,10 @@ def test_sensitivity_sees_the_bending_stiffness(monkeypatch: pytest.MonkeyPatch)
 
         monkeypatch.setattr(static, "_evaluate", evaluate)
         best = evaluate(None, BASE, TRUE_T, TRUE_E, 0)
-        sens, error, runs = static._sensitivity(EquilibriumSettings(), BASE, best)
-        assert error is None and sens is not None and len(runs) == 2
+        sens, error, runs, stopped = static._sensitivity(
+            EquilibriumSettings(), BASE, best, PAPER_BOUNDS, lambda e: True
+        )
+        assert error is None and sens is not None and len(runs) == 2 and not stopped
         # Forward differences of a power law: (exp(-a h/2) - 1) / (exp(-h/2) - 1) = a to 1 %.
         assert sens.best_exponent == pytest.approx(exponent, rel=0.01)
         assert sens.condition > 1e6
@@ -237,7 +241,7 @@ def test_nothing_found_is_said(monkeypatch: pytest.MonkeyPatch) -> None:
                                 "the push stopped", 0.0, start)  # fmt: skip
 
     monkeypatch.setattr(static, "_evaluate", evaluate)
-    with pytest.warns(RuntimeWarning, match="no run found a stable folded equilibrium"):
+    with pytest.warns(IdentificationWarning, match="no run found a stable folded equilibrium"):
         result = identify_static(None, starts=1, max_evaluations=5)
     assert not result.found and math.isnan(result.thickness_m)
     assert result.sensitivity is None

@@ -4,6 +4,7 @@ Sec. 5.1) and ``tapespring identify damping`` (the Kelvin-Voigt viscosity, Sec. 
 from __future__ import annotations
 
 import argparse
+import math
 import warnings
 from typing import TYPE_CHECKING, Any
 
@@ -140,13 +141,20 @@ def _register_static(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run_static, parser=p, command="identify static")
 
 
+def _whole(value: float) -> bool:
+    """Whether `value` is a finite whole number (int() of inf overflows, of NaN fails)."""
+    return math.isfinite(value) and value == int(value)
+
+
 def _check_starts(value: float) -> None:
-    if value != int(value) or value < 1:
-        raise ValueError(f"starts must be an integer >= 1 (got {value!r})")
+    from tapespring.identify.static import MAX_STARTS
+
+    if not _whole(value) or not 1 <= value <= MAX_STARTS:
+        raise ValueError(f"starts must be an integer >= 1, at most {MAX_STARTS} (got {value!r})")
 
 
 def _check_evaluations(value: float) -> None:
-    if value != int(value) or value < 3:
+    if not _whole(value) or value < 3:
         raise ValueError(f"max_evaluations must be an integer >= 3 (got {value!r})")
 
 
@@ -169,7 +177,7 @@ def run_static(args: argparse.Namespace) -> int:
         measured = _analyzed(args, analyze_identification, "a static identification test")
     elif args.target_m is not None:
         measured = dict(zip(TARGET_KEYS, args.target_m, strict=True))
-    found: list[bool] = []
+    ended: list[bool] = []
 
     def simulate() -> StaticIdentification:
         settings = EquilibriumSettings(spec=spec_from_args(args), push=args.push)
@@ -186,7 +194,9 @@ def run_static(args: argparse.Namespace) -> int:
                 progress=shows_progress(args),
             )
         print_warnings(caught)
-        found.append(result.found)
+        # Asked for t and E, the command fails when nothing was identified or the search was
+        # stopped (a Ctrl-C), as a run that stopped early does; the outputs are still written.
+        ended.append(result.found and not result.cancelled)
         return result
 
     def plot(result: StaticIdentification, path: str) -> None:
@@ -202,6 +212,7 @@ def run_static(args: argparse.Namespace) -> int:
             "thickness_m": [e.thickness_m for e in runs],
             "youngs_modulus_Pa": [e.youngs_modulus_Pa for e in runs],
             "objective": [e.objective for e in runs],
+            "counted": [int(e.counted) for e in runs],
             "unstable_modes": [e.unstable_modes for e in runs],
         }
         for key in TARGET_KEYS:
@@ -214,7 +225,7 @@ def run_static(args: argparse.Namespace) -> int:
         return table
 
     code = finish(args, simulate, columns, plot)
-    return 1 if code == 0 and found == [False] else code
+    return 1 if code == 0 and ended == [False] else code
 
 
 def _register_damping(sub: argparse._SubParsersAction) -> None:
@@ -230,7 +241,7 @@ def _register_damping(sub: argparse._SubParsersAction) -> None:
             "small-vibration test ('tapespring vibrate'), its free decay fitted as the "
             "recordings are (peaks within 0.4-4 mm), has the measured damping ratio: a first "
             "guess from eta omega / 2, then secant steps (the ratio is nearly affine in eta, "
-            "the scheme's numerical damping its offset). Default: Table 7's 0.509 %%."
+            "the scheme's numerical damping its offset). Default: Table 7's 0.509 %."
         ),
     )
     _experiment_option(
@@ -281,7 +292,7 @@ def _register_damping(sub: argparse._SubParsersAction) -> None:
 
 
 def _check_runs(value: float) -> None:
-    if value != int(value) or value < 1:
+    if not _whole(value) or value < 1:
         raise ValueError(f"max_runs must be an integer >= 1 (got {value!r})")
 
 

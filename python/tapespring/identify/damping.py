@@ -66,6 +66,8 @@ from tapespring.scenarios.setup import (
 )
 from tapespring.scenarios.vibration import VibrationSettings, VibrationSimulation, vibrate
 
+from .notes import IdentificationWarning
+
 if TYPE_CHECKING:
     from tapespring.protocols.vibration import VibrationResult
 
@@ -256,8 +258,12 @@ class DampingIdentification:
         measured = (
             ""
             if self.measured_period_s is None
-            else f"; measured {self.measured_period_s:.4f} s "
-            f"({self.period_difference_relative:+.1%})"
+            else f"; measured {self.measured_period_s:.4f} s"
+            + (
+                ""
+                if self.period_difference_relative is None
+                else f" ({self.period_difference_relative:+.1%})"
+            )
         )
         lines.append(
             f"  period {period} (modal {self.modal_period_s:.4f} s){measured}; "
@@ -310,7 +316,8 @@ def identify_damping(
     Returns
     -------
     DampingIdentification
-        `converged` False (with a RuntimeWarning giving the `message`) when the target was not
+        `converged` False (with an :class:`~tapespring.identify.notes.IdentificationWarning`
+        giving the `message`) when the target was not
         met: `max_runs` spent (the nearest run is returned), a target below the integrator's own
         damping (eta = 0), or a damping ratio whose decay these settings cannot fit.
 
@@ -326,6 +333,9 @@ def identify_damping(
         that ended (the stopped run listed last, without a fit; `converged` False); the
         run's own error, with its partial `VibrationSimulation` as ``result``, is the
         exception's ``__cause__``.
+    KeyboardInterrupt
+        On Ctrl-C during a run, with the :class:`DampingIdentification` of the runs that ended
+        in its ``result`` attribute (as :func:`tapespring.analysis.run`).
     """
     from tapespring.analysis import ConvergenceError
 
@@ -343,6 +353,8 @@ def identify_damping(
     ):
         raise ValueError(f"rel_tolerance must be a number in (0, 1) (got {rel_tolerance!r})")
     check_count("max_runs", max_runs, minimum=1)
+    if not isinstance(progress, bool):
+        raise TypeError(f"progress must be True or False (got {progress!r})")
     if on_run is not None and not callable(on_run):
         raise TypeError(f"on_run must be callable or None (got {on_run!r})")
 
@@ -358,6 +370,14 @@ def identify_damping(
         t0 = time.perf_counter()
         try:
             sim = vibrate(_with_eta(settings, eta), progress=progress)
+        except KeyboardInterrupt as exc:
+            # As `tapespring.analysis.run`: the interrupt goes on, with what was found so far.
+            exc.result = search.result(  # type: ignore[attr-defined]
+                f"interrupted during run {len(search.runs) + 1} (eta = {eta:.4g} s)",
+                measured_period,
+                time.perf_counter() - start,
+            )
+            raise
         except ConvergenceError as exc:
             stopped = DampingRun(
                 eta_s=eta,
@@ -394,13 +414,18 @@ def identify_damping(
         eta, message = search.next_eta()
     else:
         if eta is not None:
+            kept = (
+                "the nearest run is returned"
+                if any(r.damping_ratio is not None for r in search.runs)
+                else "no run could be fitted; the last one is returned"
+            )
             message = (
                 f"max_runs = {max_runs} runs spent without meeting rel_tolerance = "
-                f"{search.rel_tolerance:g}: the nearest run is returned"
+                f"{search.rel_tolerance:g}: {kept}"
             )
     out = search.result(message, measured_period, time.perf_counter() - start)
     if not out.converged:
-        warnings.warn(f"damping identification: {message}", RuntimeWarning, stacklevel=2)
+        warnings.warn(f"damping identification: {message}", IdentificationWarning, stacklevel=2)
     return out
 
 
@@ -414,6 +439,8 @@ def _target(value: object) -> tuple[float, float | None]:
             "damping_ratio must be a number, a VibrationResult or an iterable of them "
             f"(got {value!r})"
         )
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()  # a 0-d array is its number
     if isinstance(value, numbers.Real):
         _check_ratio("damping_ratio", value)
         return float(value), None
@@ -434,6 +461,11 @@ def _target(value: object) -> tuple[float, float | None]:
                 f"an item {trial!r} at position {k})"
             )
         _check_ratio(f"damping_ratio (the fit of {trial.name!r})", trial.fit.damping_ratio)
+        if not (math.isfinite(trial.fit.period) and trial.fit.period > 0.0):
+            raise ValueError(
+                f"damping_ratio: the fitted period of {trial.name!r} must be positive and finite "
+                f"[s] (got {trial.fit.period!r})"
+            )
     eps = float(np.mean([t.fit.damping_ratio for t in trials]))
     period = float(np.mean([t.fit.period for t in trials]))
     return eps, period

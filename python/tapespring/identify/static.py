@@ -45,6 +45,7 @@ the decay's fitted one, which is 0.4 % longer on the paper's meshes.
 from __future__ import annotations
 
 import math
+import numbers
 import sys
 import time
 import warnings
@@ -56,6 +57,8 @@ import numpy as np
 
 from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
 from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, IdentificationBounds
+
+from .notes import IdentificationWarning
 
 if TYPE_CHECKING:
     from tapespring.protocols.identification import IdentificationResult
@@ -98,6 +101,10 @@ SENSITIVITY_STEP = 0.01
 #: precision of 0.05 mm to 0.3 mm and the tapes' spread between trials being larger still).
 SPREAD_RISE = 0.01
 
+#: Most starts of one identification: 1000, each at least three equilibrium runs (hours on the
+#: paper's meshes); a count of 10**12 built its starting points for ever before any refusal.
+MAX_STARTS = 1000
+
 #: Default budget of Nelder-Mead evaluations per start (each one an equilibrium run).
 MAX_EVALUATIONS = 40
 
@@ -138,6 +145,11 @@ def target_from(
     if isinstance(measured, IdentificationResult):
         measured = [measured]
     if isinstance(measured, Mapping):
+        if PERIOD_KEY in measured:
+            raise ValueError(
+                f"the measured displacements hold {PERIOD_KEY!r}: give the period as "
+                "identify_static's period= (it is matched only when asked for)"
+            )
         values = {}
         for key in TARGET_KEYS:
             if key not in measured:
@@ -166,7 +178,11 @@ def target_from(
     for key, value in values.items():
         if isinstance(value, bool) or not isinstance(value, int | float | np.floating):
             raise ValueError(f"the measured {key} must be a number [m] (got {value!r})")
-        if not (math.isfinite(value) and value > 0.0):
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # an int beyond the floats (10**400)
+            finite = False
+        if not (finite and value > 0.0):
             # eq. (4) divides by each: a zero or negative displacement has no relative difference.
             raise ValueError(f"the measured {key} must be positive and finite [m] (got {value!r})")
         out[key] = float(value)
@@ -201,12 +217,17 @@ def period_from(measured: object) -> float | None:
 
     if measured is None:
         return None
+    if isinstance(measured, np.ndarray) and measured.ndim == 0:
+        measured = measured.item()  # a 0-d array is its number
     if isinstance(measured, VibrationResult):
         measured = [measured]
     if isinstance(measured, bool) or isinstance(measured, str | bytes):
         raise TypeError(f"period must be a number [s] or recorded decays (got {measured!r})")
     if isinstance(measured, int | float | np.floating | np.integer):
-        value = float(measured)
+        try:
+            value = float(measured)
+        except OverflowError:  # an int beyond the floats (10**400)
+            value = math.inf
     elif isinstance(measured, Iterable):
         decays = list(measured)
         if not decays:
@@ -317,7 +338,7 @@ class Sensitivity:
 
     Attributes
     ----------
-    jacobian : ndarray, shape (4, 2)
+    jacobian : ndarray, shape (4, 2), or (5, 2) with the period
         Derivatives of each displacement (and the period, if matched) relative to its measured
         value (rows: `rows`) with respect to ``ln t`` and ``ln E`` (columns) [-], by forward
         differences of :data:`SENSITIVITY_STEP`.
@@ -410,7 +431,8 @@ class StaticIdentification:
         Why there is no sensitivity when one was asked for.
     bounds : IdentificationBounds
     settings : EquilibriumSettings
-        The equilibrium runs' settings; its tape's t and E are the search's.
+        The identified run's settings: the search's, with the tape's t and E found (as given
+        when nothing was found).
     max_evaluations : int
         Budget per start.
     workers : int
@@ -455,15 +477,18 @@ class StaticIdentification:
         }
 
     def summary(self) -> dict[str, Any]:
-        """JSON-ready figures [m, Pa, s]: ``thickness_m``, ``youngs_modulus_Pa``, ``objective``,
-        ``displacements_m``, ``target_m``, ``difference_relative`` (Table 6's Delta; with a
-        period, ``period_s``, ``target_period_s`` and ``period_difference_relative``),
-        ``bending_stiffness_Nm`` (the tapes' ``E t^3 / (12 (1 - nu^2))``), the paper's Table 5
-        (``paper_thickness_m``, ``paper_youngs_modulus_Pa``), ``searches``, ``evaluations``,
-        ``sensitivity``, ``bounds``, ``settings``, ``max_evaluations``, ``workers``,
-        ``cancelled``, ``wall_s``."""
+        """JSON-ready figures [m, Pa, s], NaN and infinities as None: ``thickness_m``,
+        ``youngs_modulus_Pa``, ``objective``, ``displacements_m``, ``target_m``,
+        ``difference_relative`` (Table 6's Delta), ``period_s``, ``target_period_s`` and
+        ``period_difference_relative`` (None without a period), ``bending_stiffness_Nm`` (the
+        tapes' ``E t^3 / (12 (1 - nu^2))``), the paper's Table 5 (``paper_thickness_m``,
+        ``paper_youngs_modulus_Pa``), ``searches``, ``evaluations``, ``sensitivity``,
+        ``bounds``, ``settings``, ``max_evaluations``, ``workers``, ``cancelled``,
+        ``wall_s``."""
+        from tapespring.report import jsonable_tree
+
         nu = self.settings.spec.tape.poisson
-        return {
+        out = {
             "found": self.found,
             "thickness_m": self.thickness_m,
             "youngs_modulus_Pa": self.youngs_modulus_Pa,
@@ -492,6 +517,8 @@ class StaticIdentification:
             "cancelled": self.cancelled,
             "wall_s": self.wall_s,
         }
+        # Strict JSON: NaN (nothing found) and infinities (a degenerate Jacobian) become None.
+        return dict(jsonable_tree(out))  # type: ignore[call-overload]
 
     def table(self) -> str:
         """Table 6's layout: measured (Exp.), identified (Num.) and Delta [%]."""
@@ -701,10 +728,16 @@ def _search(
 
     scale = _Scale(task.bounds)
     done: list[StaticEvaluation] = []
+    # Nelder-Mead's steps clipped to the bounds land on points already run (13 of 74 runs with
+    # the optimum at a corner): each point is run once.
+    seen: dict[tuple[float, float], float] = {}
 
     def f(x: np.ndarray) -> float:
         thickness, modulus = scale.from_unit(x)
+        if (thickness, modulus) in seen:
+            return seen[thickness, modulus]
         evaluation = _evaluate(task.settings, task.target, thickness, modulus, task.start)
+        seen[thickness, modulus] = evaluation.objective
         done.append(evaluation)
         if on_evaluation is not None and on_evaluation(evaluation) is False:
             raise _Stop
@@ -731,10 +764,15 @@ def _search(
         message, converged = str(res.message), bool(res.success)
     except _Stop:
         message, stopped = "stopped", True
+    except KeyboardInterrupt:
+        # In this process only (worker processes ignore SIGINT): the runs so far are kept, and
+        # the search ends as a stopped one.
+        message, stopped = "interrupted (Ctrl-C)", True
     except _Flat:
         message = "no stable folded equilibrium at the first simplex's vertices: start abandoned"
     t0, e0 = scale.from_unit(x0)
-    best = min(done, key=lambda e: e.objective) if done else None
+    counted = [e for e in done if e.counted]
+    best = min(counted or done, key=lambda e: e.objective) if done else None
     search = LocalSearch(
         start_thickness_m=t0,
         start_youngs_modulus_Pa=e0,
@@ -768,13 +806,25 @@ def _check_starts(
 ) -> list[tuple[float, float]]:
     """The starts in the unit square, from a count or from (t [m], E [Pa]) pairs."""
     scale = _Scale(bounds)
-    if isinstance(starts, bool):
+    if isinstance(starts, np.ndarray) and starts.ndim == 0:
+        starts = starts.item()
+    if isinstance(starts, bool | float | np.floating | str | bytes):
         raise ValueError(f"starts must be a count >= 1 or (t, E) pairs (got {starts!r})")
-    if isinstance(starts, int):
-        if starts < 1:
-            raise ValueError(f"starts must be a count >= 1 or (t, E) pairs (got {starts!r})")
-        return _halton(starts)
+    if isinstance(starts, numbers.Integral):
+        count = int(starts)
+        if not 1 <= count <= MAX_STARTS:
+            raise ValueError(
+                f"starts must be a count in [1, {MAX_STARTS}] or (t, E) pairs (got {starts!r}; "
+                "see MAX_STARTS)"
+            )
+        return _halton(count)
+    if not isinstance(starts, Iterable):
+        raise ValueError(f"starts must be a count >= 1 or (t, E) pairs (got {starts!r})")
     points = list(starts)
+    if len(points) > MAX_STARTS:
+        raise ValueError(
+            f"starts gives {len(points)} points: at most {MAX_STARTS} (see MAX_STARTS)"
+        )
     if not points:
         raise ValueError("starts is empty: give a count >= 1 or (t, E) pairs")
     out = []
@@ -799,35 +849,56 @@ def _check_starts(
 
 
 def _sensitivity(
-    settings: EquilibriumSettings, target: Mapping[str, float], best: StaticEvaluation
-) -> tuple[Sensitivity | None, str | None, list[StaticEvaluation]]:
-    """Forward differences in ln t and ln E about `best` (two more runs)."""
+    settings: EquilibriumSettings,
+    target: Mapping[str, float],
+    best: StaticEvaluation,
+    bounds: IdentificationBounds,
+    report: Callable[[StaticEvaluation], bool],
+) -> tuple[Sensitivity | None, str | None, list[StaticEvaluation], bool]:
+    """One-sided differences in ln t and ln E about `best` (two more runs, each reported):
+    forwards, or backwards where the forward point would leave `bounds` (an optimum on an upper
+    bound). Returns the sensitivity or why there is none, the runs, and whether `report` asked
+    to stop."""
     rows = tuple(target)
     base = np.array([best.values()[k] / target[k] for k in rows])
-    factor = math.exp(SENSITIVITY_STEP)
-    runs = [
-        _evaluate(settings, target, best.thickness_m * factor, best.youngs_modulus_Pa, -1),
-        _evaluate(settings, target, best.thickness_m, best.youngs_modulus_Pa * factor, -1),
-    ]
+    steps = (
+        SENSITIVITY_STEP
+        if best.thickness_m * math.exp(SENSITIVITY_STEP) <= bounds.thickness_max
+        else -SENSITIVITY_STEP,
+        SENSITIVITY_STEP
+        if best.youngs_modulus_Pa * math.exp(SENSITIVITY_STEP) <= bounds.youngs_modulus_max
+        else -SENSITIVITY_STEP,
+    )
+    points = (
+        (best.thickness_m * math.exp(steps[0]), best.youngs_modulus_Pa),
+        (best.thickness_m, best.youngs_modulus_Pa * math.exp(steps[1])),
+    )
+    runs: list[StaticEvaluation] = []
     columns = []
-    for run, name in zip(runs, ("t", "E"), strict=True):
+    for (thickness, modulus), step, name in zip(points, steps, ("t", "E"), strict=True):
+        moved = f"the run with {name} {'raised' if step > 0 else 'lowered'} by {abs(step):.0%}"
+        try:
+            run = _evaluate(settings, target, thickness, modulus, -1)
+        except ValueError as exc:  # the set-up refuses the point (beyond its own limits)
+            return None, f"{moved} was refused: {exc}", runs, False
+        runs.append(run)
+        if not report(run):
+            return None, "stopped", runs, True
         if not run.counted:
             why = run.error or "found no stable folded equilibrium"
             return (
                 None,
-                f"the run with {name} raised by {SENSITIVITY_STEP:.0%} {why}: the optimum lies "
-                "at the edge of the folded states",
+                f"{moved} {why}: the optimum lies at the edge of the folded states",
                 runs,
+                False,
             )
-        columns.append(
-            (np.array([run.values()[k] / target[k] for k in rows]) - base) / SENSITIVITY_STEP
-        )
+        columns.append((np.array([run.values()[k] / target[k] for k in rows]) - base) / step)
     jacobian = np.column_stack(columns)
     _, singular, vt = np.linalg.svd(jacobian)
     v_t, v_e = vt[0]
     exponent = float(v_t / v_e) if v_e != 0.0 else math.inf
     condition = float(singular[0] / singular[1]) if singular[1] > 0.0 else math.inf
-    return Sensitivity(jacobian, singular, exponent, condition, rows), None, runs
+    return Sensitivity(jacobian, singular, exponent, condition, rows), None, runs, False
 
 
 def identify_static(
@@ -901,6 +972,15 @@ def identify_static(
     period_s = period_from(period)
     if period_s is not None:
         target[PERIOD_KEY] = period_s
+    # The scalar options first: a bad one is named before any start is built.
+    check_count("max_evaluations", max_evaluations, minimum=3)
+    check_number("xatol", xatol, positive=True)
+    check_number("fatol", fatol, positive=True)
+    check_workers(workers)
+    if not isinstance(sensitivity, bool):
+        raise TypeError(f"sensitivity must be True or False (got {sensitivity!r})")
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(f"progress must be True, False, None or a callable (got {progress!r})")
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
         raise ValueError(f"settings must be an EquilibriumSettings (got {settings!r})")
@@ -917,10 +997,6 @@ def identify_static(
         tape = replace(settings.spec.tape, thickness=thickness, youngs_modulus=modulus)
         replace(settings.spec, tape=tape).validate()
     unit_starts = _check_starts(starts, bounds)
-    check_count("max_evaluations", max_evaluations, minimum=3)
-    check_number("xatol", xatol, positive=True)
-    check_number("fatol", fatol, positive=True)
-    check_workers(workers)
 
     show = progress is True
     callback = progress if callable(progress) else None
@@ -948,7 +1024,7 @@ def identify_static(
 
     start_time = time.perf_counter()
     tasks = [
-        _SearchTask(settings, target, bounds, n, x0, max_evaluations, xatol, fatol)
+        _SearchTask(settings, target, bounds, n, x0, int(max_evaluations), xatol, fatol)
         for n, x0 in enumerate(unit_starts)
     ]
     outcomes: dict[int, _SearchOutcome] = {}
@@ -961,13 +1037,18 @@ def identify_static(
                 stopped = True
                 break
     else:
+        asked_stop = False
 
         def record(n: int, outcome: _SearchOutcome) -> bool:
+            nonlocal asked_stop
             outcomes[n] = outcome
-            return all(report(e) for e in outcome.evaluations)
+            if not all(report(e) for e in outcome.evaluations):
+                # Kept here: run_tasks reports no stop when it comes with the last start.
+                asked_stop = True
+            return not asked_stop
 
         try:
-            stopped = run_tasks(_search, tasks, workers, record)
+            stopped = run_tasks(_search, tasks, workers, record) or asked_stop
         except WorkerDied as exc:
             lost = ", ".join(str(n) for n in exc.unfinished)
             raise WorkerDied(f"{exc} (starts: {lost})", exc.unfinished) from exc
@@ -978,17 +1059,24 @@ def identify_static(
     best = min(counted, key=lambda e: e.objective) if counted else None
     sens = sens_error = None
     if best is not None and sensitivity and not stopped:
-        sens, sens_error, extra = _sensitivity(settings, target, best)
+        try:
+            sens, sens_error, extra, stopped = _sensitivity(settings, target, best, bounds, report)
+        except KeyboardInterrupt:
+            sens, sens_error, extra, stopped = None, "interrupted (Ctrl-C)", [], True
         evaluations += extra
-        for e in extra:
-            report(e)
     if best is None:
         warnings.warn(
             "no run found a stable folded equilibrium: nothing identified (widen the bounds or "
             "check the set-up's weight)",
-            RuntimeWarning,
+            IdentificationWarning,
             stacklevel=2,
         )
+    if best is not None:
+        # The settings of the identified run (as the damping identification's), so that the
+        # results' settings reproduce it.
+        tape = replace(settings.spec.tape, thickness=best.thickness_m,
+                       youngs_modulus=best.youngs_modulus_Pa)  # fmt: skip
+        settings = replace(settings, spec=replace(settings.spec, tape=tape))
     return StaticIdentification(
         thickness_m=best.thickness_m if best else math.nan,
         youngs_modulus_Pa=best.youngs_modulus_Pa if best else math.nan,
@@ -1001,7 +1089,7 @@ def identify_static(
         sensitivity_error=sens_error,
         bounds=bounds,
         settings=settings,
-        max_evaluations=max_evaluations,
+        max_evaluations=int(max_evaluations),
         workers=processes_for(workers, len(tasks)),
         cancelled=stopped,
         wall_s=time.perf_counter() - start_time,

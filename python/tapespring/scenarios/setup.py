@@ -9,6 +9,7 @@ fixed a priori at 0.3). SI units; angles in degrees only in names ending ``_deg`
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -1087,8 +1088,9 @@ def check_spec(value: object) -> None:
 
 
 def check_count(name: str, value: object, *, minimum: int) -> None:
-    """Raise ValueError naming `name` unless `value` is an integer >= `minimum`."""
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+    """Raise ValueError naming `name` unless `value` is an integer >= `minimum` (a Python or
+    numpy integer; not a bool, nor a float even if whole)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum} (got {value!r})")
 
 
