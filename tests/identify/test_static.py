@@ -373,3 +373,15 @@ def test_the_period_is_the_loaded_set_ups_first_mode() -> None:
     assert run.objective == pytest.approx(
         objective(run.displacements_m, paper_target()) + abs(run.period_s / 0.100 - 1.0)
     )
+
+
+def test_starts_in_worker_processes() -> None:
+    """Two starts in two worker processes: each start's runs are its own, and a run is the same
+    to the bit in a worker as in this process (the core's results do not depend on threads)."""
+    result = identify_static(None, COARSE, starts=2, max_evaluations=3, sensitivity=False,
+                             workers=2)  # fmt: skip
+    assert result.workers == 2 and [s.evaluations for s in result.searches] == [3, 3]
+    assert [e.start for e in result.evaluations] == [0, 0, 0, 1, 1, 1]
+    again = static._evaluate(COARSE, paper_target(), result.thickness_m,
+                             result.youngs_modulus_Pa, 0)  # fmt: skip
+    assert again.displacements_m == result.displacements_m
