@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import pytest
+from _vibrate_stand_in import Fit, NoRun, Simulation, no_run
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
@@ -183,7 +184,7 @@ def test_a_decay_too_short_for_the_window_says_so() -> None:
 def test_a_bad_damping_ratio_is_refused_by_name_before_any_run(
     value: Any, error: type[Exception], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     with pytest.raises(error, match="damping_ratio"):
         identify_damping(value, SETTINGS)
 
@@ -194,9 +195,9 @@ def test_a_damping_ratio_is_accepted_or_refused_by_name(value: float) -> None:
     """Any float outside (0, 0.5) is a ValueError naming `damping_ratio`; one inside goes on to
     the runs (here a stand-in that stops at once)."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(damping, "vibrate", _no_run)
+        patch.setattr(damping, "vibrate", no_run)
         if math.isfinite(value) and 0.0 < value < 0.5:
-            with pytest.raises(_NoRun):
+            with pytest.raises(NoRun):
                 identify_damping(value, SETTINGS)
         else:
             with pytest.raises(ValueError, match="damping_ratio"):
@@ -219,7 +220,7 @@ def test_a_damping_ratio_is_accepted_or_refused_by_name(value: float) -> None:
 def test_bad_options_are_refused_by_name_before_any_run(
     options: dict[str, Any], name: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     with pytest.raises((ValueError, TypeError), match=name):
         identify_damping(0.005, **options)
 
@@ -273,31 +274,6 @@ def test_a_recorded_decay_with_no_damping_is_refused(twin: VibrationSimulation) 
 # ---------------------------------------------------------------------------------------------
 
 
-class _NoRun(Exception):
-    pass
-
-
-def _no_run(settings: VibrationSettings, *, progress: bool = False) -> VibrationSimulation:
-    raise _NoRun("identify_damping ran a vibration before refusing its input")
-
-
-@dataclass(frozen=True)
-class _Fit:
-    damping_ratio: float
-    period: float
-
-
-@dataclass(frozen=True)
-class _Simulation:
-    fit: _Fit | None
-    fit_error: str | None
-    modal_periods_s: np.ndarray
-    time_s: np.ndarray
-    displacement_m: np.ndarray
-    settings: VibrationSettings
-    wall_s: float
-
-
 class _AffineVibrate:
     """A stand-in for `vibrate`: eps_fit = offset + slope eta; no fit below `floor` (the decay
     ends above the window) or above `ceiling` (it crosses the window too fast); a
@@ -326,13 +302,13 @@ class _AffineVibrate:
             raise exc
         eps = self.offset + self.slope * eta
         t = np.linspace(0.0, settings.duration, 200)
-        fit: _Fit | None = _Fit(eps, self.period * 1.005)
+        fit: Fit | None = Fit(eps, self.period * 1.005)
         error = None
         if eps < self.floor or eps > self.ceiling:
             fit, error = None, "only 0 peak(s) with |z| in the window (a stand-in)"
         # Still swinging at 5 mm at the end when too little damped, at rest when too much.
         amplitude = 5e-3 if eps < self.floor else (0.0 if eps > self.ceiling else 1e-3)
-        return _Simulation(
+        return Simulation(
             fit=fit,
             fit_error=error,
             modal_periods_s=np.array([self.period]),

@@ -18,12 +18,13 @@ import time
 import warnings
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from _vibrate_stand_in import Fit, Simulation, no_run
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
@@ -133,23 +134,6 @@ def _threaded(workers: int = 1):  # noqa: ANN202
 # ---------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class _Fit:
-    damping_ratio: float
-    period: float
-
-
-@dataclass(frozen=True)
-class _Simulation:
-    fit: _Fit | None
-    fit_error: str | None
-    modal_periods_s: np.ndarray
-    time_s: np.ndarray
-    displacement_m: np.ndarray
-    settings: VibrationSettings
-    wall_s: float
-
-
 class FakeVibrate:
     """eps_fit = slope eta; no fit below `floor` (the decay still above the window at the end);
     a ConvergenceError at run `stop_at`, a KeyboardInterrupt at run `interrupt_at` (1-based)."""
@@ -177,12 +161,12 @@ class FakeVibrate:
             raise exc
         eps = self.slope * eta
         t = np.linspace(0.0, settings.duration, 200)
-        fit: _Fit | None = _Fit(eps, 0.1085)
+        fit: Fit | None = Fit(eps, 0.1085)
         error = None
         if eps < self.floor:
             fit, error = None, "only 0 peak(s) with |z| in the window (a stand-in)"
         amplitude = 5e-3 if fit is None else 1e-3
-        return _Simulation(fit=fit, fit_error=error, modal_periods_s=np.array([0.108]), time_s=t,
+        return Simulation(fit=fit, fit_error=error, modal_periods_s=np.array([0.108]), time_s=t,
                            displacement_m=amplitude * np.cos(2 * np.pi * t / 0.108),
                            settings=settings, wall_s=0.0)  # fmt: skip
 
@@ -415,21 +399,13 @@ def test_a_bad_progress_is_refused_by_identify_static(fake: FakeEvaluate) -> Non
     assert fake.calls == []
 
 
-class _NoRun(Exception):
-    pass
-
-
-def _no_run(settings: VibrationSettings, *, progress: bool = False) -> Any:
-    raise _NoRun("a vibration run was started before the input was refused")
-
-
 # Fixed (was a defect): identify_damping does not check `progress` before the runs: 'yes' reaches
 # vibrate, refused by analysis.run only after the set-up is built (0.9 s on 5 mm meshes, more on
 # the paper's)
 def test_a_bad_progress_is_refused_before_any_vibration_run(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     with pytest.raises(TypeError, match="progress"):
         identify_damping(0.005, VIBRATION, progress="yes")  # type: ignore[arg-type]
 
@@ -514,7 +490,7 @@ def test_the_sensitivity_at_an_upper_bound_does_not_lose_the_search(
 # their periods: a fit with a NaN period gives measured_period_s = NaN silently (static's
 # period_from refuses it)
 def test_a_recording_with_a_nan_period_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     recorded = _recorded_decay()
     broken = replace(recorded, fit=replace(recorded.fit, period=math.nan))
     with pytest.raises(ValueError, match="period"):
@@ -781,7 +757,7 @@ def test_cli_refuses_a_recording_of_the_other_test_before_any_run(
     from tapespring.trials.samples import make_vibration_trial
 
     monkeypatch.setattr(static, "_evaluate", _no_equilibrium)
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     trial = make_vibration_trial(seed=0) if kind == "vibration" else identification_trial()
     path = write_csv(trial, tmp_path / f"{kind}.csv")
     line = refused(["identify", command, f"--experiment={path}"], capsys, by_parser=False)
@@ -793,7 +769,7 @@ def test_cli_a_missing_recording_exits_1_before_any_run(
 ) -> None:
     from _cli import refused
 
-    monkeypatch.setattr(damping, "vibrate", _no_run)
+    monkeypatch.setattr(damping, "vibrate", no_run)
     missing = tmp_path / "missing.csv"
     line = refused(["identify", "damping", f"--experiment={missing}"], capsys, by_parser=False,
                    code=1)  # fmt: skip
