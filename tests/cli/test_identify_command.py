@@ -153,3 +153,30 @@ def test_damping_refusals(
     if "--experiment=x.csv" in args:
         write_csv(identification_trial(), tmp_path / "x.csv")
     assert match in refused([*DAMPING, *args], capsys, by_parser=by_parser)
+
+
+def test_static_reads_the_period_from_recorded_decays(
+    tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from dataclasses import replace
+
+    from tapespring.identify import static
+    from tapespring.identify.static import StaticEvaluation, objective
+    from tapespring.trials.samples import make_vibration_trial
+
+    def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
+        d = {key: 0.05 for key in TARGET_KEYS}  # a stand-in: no solver run
+        e = StaticEvaluation(thickness, modulus, 0.0, d, True, 0, None, 0.0, start, 0.1)
+        return replace(e, objective=objective(e.values(), target))
+
+    monkeypatch.setattr(static, "_evaluate", evaluate)
+    paths = [
+        write_csv(make_vibration_trial(period=p, seed=n), tmp_path / f"decay{n}.csv")
+        for n, p in enumerate((0.100, 0.104))
+    ]
+    argv = [*STATIC, "--json", *(f"--period-experiment={p}" for p in paths)]
+    assert main(argv) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["target_period_s"] == pytest.approx(0.102, rel=2e-3)  # the mean of the fits
+    line = refused([*STATIC, "--period=0.1", f"--period-experiment={paths[0]}"], capsys)
+    assert "--period and --period-experiment" in line

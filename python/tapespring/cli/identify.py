@@ -110,6 +110,17 @@ def _register_static(sub: argparse._SubParsersAction) -> None:
         "alone)",
     )
     p.add_argument(
+        "--period-experiment",
+        dest="period_experiments",
+        type=_input_file,
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a recorded free decay (C3D or CSV, marker M3 on the additional weight), analysed as "
+        "'tapespring trials analyze --kind vibration' does: its fitted period is matched as "
+        "--period's; repeatable (the mean is matched); not with --period",
+    )
+    p.add_argument(
         "--starts",
         type=_checked("starts", _check_starts),
         default=4,
@@ -170,6 +181,10 @@ def run_static(args: argparse.Namespace) -> int:
     _refuse_shared_paths(args)
     if args.target_m is not None and args.experiments:
         refuse(args, "--target-m and --experiment both give the measured displacements")
+    if args.period is not None and args.period_experiments:
+        refuse(args, "--period and --period-experiment both give the measured period")
+    for path in args.period_experiments:
+        refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}))
     measured: Any = None
     if args.experiments:
         from tapespring.protocols.identification import analyze_identification
@@ -177,6 +192,14 @@ def run_static(args: argparse.Namespace) -> int:
         measured = _analyzed(args, analyze_identification, "a static identification test")
     elif args.target_m is not None:
         measured = dict(zip(TARGET_KEYS, args.target_m, strict=True))
+    period: Any = args.period
+    if args.period_experiments:
+        from tapespring.protocols.vibration import analyze_vibration
+
+        period = [
+            analyze_experiment(path, analyze_vibration, test="a free decay (a vibration test)")
+            for path in args.period_experiments
+        ]
     ended: list[bool] = []
 
     def simulate() -> StaticIdentification:
@@ -186,7 +209,7 @@ def run_static(args: argparse.Namespace) -> int:
             result = identify_static(
                 measured,
                 settings,
-                period=args.period,
+                period=period,
                 starts=int(args.starts),
                 max_evaluations=int(args.max_evaluations),
                 sensitivity=not args.no_sensitivity,
