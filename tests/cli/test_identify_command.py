@@ -166,7 +166,7 @@ def test_static_reads_the_period_from_recorded_decays(
 
     def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
         d = {key: 0.05 for key in TARGET_KEYS}  # a stand-in: no solver run
-        e = StaticEvaluation(thickness, modulus, 0.0, d, True, 0, None, 0.0, start, 0.1)
+        e = StaticEvaluation(thickness, modulus, 0.0, d, 0, None, 0.0, start, 0.1)
         return replace(e, objective=objective(e.values(), target))
 
     monkeypatch.setattr(static, "_evaluate", evaluate)

@@ -98,10 +98,10 @@ class FakeEvaluate:
             raise KeyboardInterrupt
         stiff = modulus * thickness**3 / (TRUE_E * TRUE_T**3)
         if stiff > self.stiff_limit:
-            return StaticEvaluation(thickness, modulus, static._penalty(target), None, False, -1,
+            return StaticEvaluation(thickness, modulus, static._penalty(target), None, -1,
                                     None, 0.0, start)  # fmt: skip
         d = closed_form(thickness, modulus)
-        return StaticEvaluation(thickness, modulus, objective(d, target), d, True, 0, None, 0.0,
+        return StaticEvaluation(thickness, modulus, objective(d, target), d, 0, None, 0.0,
                                 start)  # fmt: skip
 
 
@@ -113,7 +113,7 @@ def fake(monkeypatch: pytest.MonkeyPatch) -> FakeEvaluate:
 
 
 def _no_equilibrium(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
-    return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, False, -1, None,
+    return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, -1, None,
                             0.0, start)  # fmt: skip
 
 
@@ -449,7 +449,7 @@ def test_no_equilibrium_run_is_repeated_within_a_search(monkeypatch: pytest.Monk
         # The truth below the box's thickness: the optimum at the box's edge.
         stiff = (modulus * thickness**3) / (TRUE_E * 0.10e-3**3)
         d = {k: v * stiff**-0.5 for k, v in BASE.items()}
-        return StaticEvaluation(thickness, modulus, objective(d, target), d, True, 0, None, 0.0,
+        return StaticEvaluation(thickness, modulus, objective(d, target), d, 0, None, 0.0,
                                 start)  # fmt: skip
 
     monkeypatch.setattr(static, "_evaluate", evaluate)
@@ -476,7 +476,7 @@ def test_the_sensitivity_at_an_upper_bound_does_not_lose_the_search(
         if modulus > top:  # the real run: refused by the set-up's validate() before any build
             return real(settings, target, thickness, modulus, start)
         d = closed_form(thickness, modulus, true_e=2.0 * top)  # the truth beyond the box
-        return StaticEvaluation(thickness, modulus, objective(d, target), d, True, 0, None, 0.0,
+        return StaticEvaluation(thickness, modulus, objective(d, target), d, 0, None, 0.0,
                                 start)  # fmt: skip
 
     monkeypatch.setattr(static, "_evaluate", evaluate)
@@ -705,7 +705,7 @@ def test_cli_static_with_the_period_writes_strict_json(
 ) -> None:
     def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
         d = closed_form(thickness, modulus)
-        e = StaticEvaluation(thickness, modulus, 0.0, d, True, 0, None, 0.0, start, 0.1)
+        e = StaticEvaluation(thickness, modulus, 0.0, d, 0, None, 0.0, start, 0.1)
         return replace(e, objective=objective(e.values(), target))
 
     monkeypatch.setattr(static, "_evaluate", evaluate)

@@ -57,10 +57,10 @@ def fake_runs(monkeypatch: pytest.MonkeyPatch) -> list[tuple[float, float]]:
         calls.append((thickness, modulus))
         stiff = modulus * thickness**3 / (TRUE_E * TRUE_T**3)
         if stiff > 1.6:
-            return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, False,
-                                    -1, None, 0.0, start)  # fmt: skip
+            return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, -1,
+                                    None, 0.0, start)  # fmt: skip
         d = closed_form(thickness, modulus)
-        return StaticEvaluation(thickness, modulus, objective(d, target), d, True, 0, None, 0.0,
+        return StaticEvaluation(thickness, modulus, objective(d, target), d, 0, None, 0.0,
                                 start)  # fmt: skip
 
     monkeypatch.setattr(static, "_evaluate", evaluate)
@@ -199,7 +199,7 @@ def test_sensitivity_sees_the_bending_stiffness(monkeypatch: pytest.MonkeyPatch)
         def evaluate(settings, target, thickness, modulus, start, a=exponent):  # noqa: ANN001, ANN202
             stiff = modulus * thickness**a / (TRUE_E * TRUE_T**a)
             d = {k: v * stiff**-0.5 for k, v in BASE.items()}
-            return StaticEvaluation(thickness, modulus, objective(d, target), d, True, 0, None,
+            return StaticEvaluation(thickness, modulus, objective(d, target), d, 0, None,
                                     0.0, start)  # fmt: skip
 
         monkeypatch.setattr(static, "_evaluate", evaluate)
@@ -237,7 +237,7 @@ def test_runs_without_a_folded_equilibrium_are_avoided(
 
 def test_nothing_found_is_said(monkeypatch: pytest.MonkeyPatch) -> None:
     def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
-        return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, False, -1,
+        return StaticEvaluation(thickness, modulus, NO_EQUILIBRIUM_OBJECTIVE, None, -1,
                                 "the push stopped", 0.0, start)  # fmt: skip
 
     monkeypatch.setattr(static, "_evaluate", evaluate)
@@ -304,7 +304,7 @@ def fake_runs_with_period(monkeypatch: pytest.MonkeyPatch) -> list[tuple[float, 
         stiff = modulus * thickness**3 / (TRUE_E * TRUE_T**3)
         d = {k: v * stiff**-0.5 for k, v in BASE.items()}
         period = closed_form_period(thickness, modulus) if static.PERIOD_KEY in target else None
-        e = StaticEvaluation(thickness, modulus, 0.0, d, True, 0, None, 0.0, start, period)
+        e = StaticEvaluation(thickness, modulus, 0.0, d, 0, None, 0.0, start, period)
         return replace(e, objective=objective(e.values(), target))
 
     monkeypatch.setattr(static, "_evaluate", evaluate)

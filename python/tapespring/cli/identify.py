@@ -59,14 +59,21 @@ def _experiment_option(p: argparse.ArgumentParser, what: str) -> None:
     )
 
 
-def _refuse_shared_paths(args: argparse.Namespace) -> None:
-    """`refuse_shared_paths` for each recording read."""
-    for path in args.experiments or [None]:
+#: What the commands' free-decay recordings are, for the hint of a recording refused.
+_DECAY = "a free decay (a vibration test)"
+
+
+def _refuse_shared_paths(args: argparse.Namespace, recordings: list[str]) -> None:
+    """`refuse_shared_paths` for each of the `recordings` read (the outputs among themselves
+    without any)."""
+    paths: list[str | None] = [*recordings] or [None]
+    for path in paths:
         refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}))
 
 
-def _analyzed(args: argparse.Namespace, analyze: Any, test: str) -> list[Any]:
-    return [analyze_experiment(path, analyze, test=test) for path in args.experiments]
+def _analyzed(paths: list[str], analyze: Any, test: str) -> list[Any]:
+    """Each recording of `paths` read and analysed (`analyze_experiment`)."""
+    return [analyze_experiment(path, analyze, test=test) for path in paths]
 
 
 def _register_static(sub: argparse._SubParsersAction) -> None:
@@ -178,28 +185,25 @@ def run_static(args: argparse.Namespace) -> int:
 
     from .bend import refuse
 
-    _refuse_shared_paths(args)
+    _refuse_shared_paths(args, args.experiments + args.period_experiments)
     if args.target_m is not None and args.experiments:
         refuse(args, "--target-m and --experiment both give the measured displacements")
     if args.period is not None and args.period_experiments:
         refuse(args, "--period and --period-experiment both give the measured period")
-    for path in args.period_experiments:
-        refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}))
     measured: Any = None
     if args.experiments:
         from tapespring.protocols.identification import analyze_identification
 
-        measured = _analyzed(args, analyze_identification, "a static identification test")
+        measured = _analyzed(
+            args.experiments, analyze_identification, "a static identification test"
+        )
     elif args.target_m is not None:
         measured = dict(zip(TARGET_KEYS, args.target_m, strict=True))
     period: Any = args.period
     if args.period_experiments:
         from tapespring.protocols.vibration import analyze_vibration
 
-        period = [
-            analyze_experiment(path, analyze_vibration, test="a free decay (a vibration test)")
-            for path in args.period_experiments
-        ]
+        period = _analyzed(args.period_experiments, analyze_vibration, _DECAY)
     ended: list[bool] = []
 
     def simulate() -> StaticIdentification:
@@ -329,14 +333,14 @@ def run_damping(args: argparse.Namespace) -> int:
 
     from .bend import refuse
 
-    _refuse_shared_paths(args)
+    _refuse_shared_paths(args, args.experiments)
     if args.damping_ratio is not None and args.experiments:
         refuse(args, "--damping-ratio and --experiment both give the measured damping ratio")
     measured: Any = PAPER_MODEL.damping_ratio_exp
     if args.experiments:
         from tapespring.protocols.vibration import analyze_vibration
 
-        measured = _analyzed(args, analyze_vibration, "a free decay (a vibration test)")
+        measured = _analyzed(args.experiments, analyze_vibration, _DECAY)
     elif args.damping_ratio is not None:
         measured = args.damping_ratio
     converged: list[bool] = []

@@ -189,12 +189,7 @@ class DampingIdentification:
         the fitted runs ([-], [1/s]); None with fewer than two distinct fitted viscosities.
         ``eps_0`` estimates the integrator's own damping, ``slope`` the Kelvin-Voigt
         ``omega_1 / 2``."""
-        eta, eps = self.run_eta_s, self.run_damping_ratio
-        ok = np.isfinite(eps)
-        if np.unique(eta[ok]).size < 2:
-            return None
-        slope, offset = np.polyfit(eta[ok], eps[ok], 1)
-        return float(offset), float(slope)
+        return _fitted_line(self.runs)
 
     @property
     def period_difference_relative(self) -> float | None:
@@ -212,21 +207,21 @@ class DampingIdentification:
         ``paper_model_eta_s``, ``paper_model_damping_ratio``, ``paper_model_period_s``,
         ``paper_experiment_damping_ratio``, ``paper_experiment_period_s``, ``wall_s`` and
         ``settings``."""
+        from tapespring.report import jsonable_tree
+
         affine = self.affine_model
-        return {
+        out = {
             "eta_s": self.eta_s,
             "damping_ratio": self.damping_ratio,
             "target_damping_ratio": self.target_damping_ratio,
             "rel_tolerance": self.rel_tolerance,
             "period_s": self.period_s,
-            "modal_period_s": _finite_or_none(self.modal_period_s),
+            "modal_period_s": self.modal_period_s,
             "measured_period_s": self.measured_period_s,
             "period_difference_relative": self.period_difference_relative,
             "affine_offset": None if affine is None else affine[0],
             "affine_slope_per_s": None if affine is None else affine[1],
-            "runs": [
-                {key: _finite_or_none(value) for key, value in asdict(r).items()} for r in self.runs
-            ],
+            "runs": [asdict(r) for r in self.runs],
             "converged": self.converged,
             "message": self.message,
             "paper_model_eta_s": PAPER_MODEL.eta,
@@ -237,6 +232,8 @@ class DampingIdentification:
             "wall_s": self.wall_s,
             "settings": asdict(self.settings),
         }
+        # JSON has no NaN: a run stopped before its modal step has no period.
+        return dict(jsonable_tree(out))  # type: ignore[call-overload]
 
     def describe(self) -> str:
         """A few lines for a person."""
@@ -575,13 +572,11 @@ class _Search:
         else:
             near = fitted[0]
             slope = kelvin_voigt
-            etas = np.array([r.eta_s for r in fitted])
-            if np.unique(etas).size >= 2:
-                # The slope of all fitted runs, not only of the last two: the fits are rough on
-                # the scale of close runs (module docs).
-                line = float(np.polyfit(etas, [_eps(r) for r in fitted], 1)[0])
-                if SLOPE_RANGE[0] * kelvin_voigt < line < SLOPE_RANGE[1] * kelvin_voigt:
-                    slope = line
+            # The slope of all fitted runs, not only of the last two: the fits are rough on the
+            # scale of close runs (module docs).
+            line = _fitted_line(fitted)
+            if line is not None and SLOPE_RANGE[0] < line[1] / kelvin_voigt < SLOPE_RANGE[1]:
+                slope = line[1]
             eta = near.eta_s - (_eps(near) - self.target) / slope
             if eta <= 0.0:
                 at_zero = [r for r in fitted if r.eta_s == 0.0]
@@ -665,10 +660,15 @@ class _Search:
         return None
 
 
-def _finite_or_none(value: Any) -> Any:
-    """`value`, or None for a float that is not finite (JSON has no NaN: a run stopped before
-    its modal step has no period)."""
-    return None if isinstance(value, float) and not math.isfinite(value) else value
+def _fitted_line(runs: Iterable[DampingRun]) -> tuple[float, float] | None:
+    """``(eps_0, slope)`` of the least-squares line through the fitted runs' (eta, eps) ([-],
+    [1/s]); None with fewer than two distinct fitted viscosities."""
+    fitted = [r for r in runs if r.damping_ratio is not None]
+    eta = np.array([r.eta_s for r in fitted], dtype=float)
+    if np.unique(eta).size < 2:
+        return None
+    slope, offset = np.polyfit(eta, [_eps(r) for r in fitted], 1)
+    return float(offset), float(slope)
 
 
 def _eps(run: DampingRun) -> float:

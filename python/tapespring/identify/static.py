@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
-from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, IdentificationBounds
+from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, PAPER_TAPE, IdentificationBounds
 
 from .notes import IdentificationWarning
 
@@ -264,7 +264,8 @@ class StaticEvaluation:
         First modal period about the loaded unfolded equilibrium [s], when a period is matched
         (None otherwise, or if the modal run failed).
     found : bool
-        Whether the push path found the folded equilibrium.
+        Whether the push path found the folded equilibrium (a property: `displacements_m` is
+        not None).
     unstable_modes : int
         Unstable modes of that equilibrium under the weight (-1 if not found).
     error : str or None
@@ -279,12 +280,16 @@ class StaticEvaluation:
     youngs_modulus_Pa: float
     objective: float
     displacements_m: dict[str, float] | None
-    found: bool
     unstable_modes: int
     error: str | None
     wall_s: float
     start: int
     period_s: float | None = None
+
+    @property
+    def found(self) -> bool:
+        """Whether the push path found the folded equilibrium."""
+        return self.displacements_m is not None
 
     @property
     def counted(self) -> bool:
@@ -300,8 +305,8 @@ class StaticEvaluation:
         return out
 
     def summary(self) -> dict[str, Any]:
-        """JSON-ready fields (units in the keys)."""
-        return asdict(self)
+        """JSON-ready fields (units in the keys), `found` among them."""
+        return {**asdict(self), "found": self.found}
 
 
 @dataclass(frozen=True)
@@ -487,7 +492,6 @@ class StaticIdentification:
         ``wall_s``."""
         from tapespring.report import jsonable_tree
 
-        nu = self.settings.spec.tape.poisson
         out = {
             "found": self.found,
             "thickness_m": self.thickness_m,
@@ -501,11 +505,12 @@ class StaticIdentification:
             "period_difference_relative": None
             if self.period_s is None or self.target_period_s is None
             else self.period_s / self.target_period_s - 1.0,
-            "bending_stiffness_Nm": self.youngs_modulus_Pa
-            * self.thickness_m**3
-            / (12.0 * (1.0 - nu**2)),
-            "paper_thickness_m": PAPER_TAPE_THICKNESS,
-            "paper_youngs_modulus_Pa": PAPER_TAPE_MODULUS,
+            # The settings carry the identified tape when one was found.
+            "bending_stiffness_Nm": self.settings.spec.tape.flexural_rigidity
+            if self.found
+            else None,
+            "paper_thickness_m": PAPER_TAPE.thickness,
+            "paper_youngs_modulus_Pa": PAPER_TAPE.youngs_modulus,
             "searches": [asdict(s) for s in self.searches],
             "evaluations": [e.summary() for e in self.evaluations],
             "sensitivity": None if self.sensitivity is None else self.sensitivity.summary(),
@@ -560,7 +565,7 @@ class StaticIdentification:
         lines.append(
             f"  t = {self.thickness_m * 1e3:.4f} mm, E = {self.youngs_modulus_Pa / 1e9:.2f} GPa "
             f"(objective {self.objective:.4f}; the paper, Table 5: t = "
-            f"{PAPER_TAPE_THICKNESS * 1e3:.3f} mm, E = {PAPER_TAPE_MODULUS / 1e9:.2f} GPa)"
+            f"{PAPER_TAPE.thickness * 1e3:.3f} mm, E = {PAPER_TAPE.youngs_modulus / 1e9:.2f} GPa)"
         )
         lines.append(self.table())
         for n, s in enumerate(self.searches):
@@ -583,16 +588,6 @@ class StaticIdentification:
         elif self.sensitivity_error:
             lines.append(f"  no sensitivity: {self.sensitivity_error}")
         return "\n".join(lines)
-
-
-# The paper's identified values (Table 5), through the set-up's tape: their one home is there.
-def _paper_tape() -> tuple[float, float]:
-    from tapespring.scenarios.setup import PAPER_TAPE
-
-    return PAPER_TAPE.thickness, PAPER_TAPE.youngs_modulus
-
-
-PAPER_TAPE_THICKNESS, PAPER_TAPE_MODULUS = _paper_tape()
 
 
 @dataclass(frozen=True)
@@ -649,28 +644,24 @@ def _evaluate(
         figures = result.summary()["marker_displacements_m"]
         displacements = {key: float(figures[key]) for key in TARGET_KEYS}
         unstable = int(result.unstable_modes)
-    counted = displacements is not None and unstable == 0 and error is None
-    period = None
-    if counted and PERIOD_KEY in target:
-        try:
-            period = float(loaded_periods(run_settings.spec)[0])
-        except ConvergenceError as exc:
-            counted, error = False, f"no modal period: {exc}"
     evaluation = StaticEvaluation(
         thickness_m=thickness,
         youngs_modulus_Pa=modulus,
         objective=_penalty(target),
         displacements_m=displacements,
-        found=displacements is not None,
         unstable_modes=unstable,
         error=error,
-        wall_s=time.perf_counter() - t0,
+        wall_s=0.0,
         start=start,
-        period_s=period,
     )
-    if counted:
+    if evaluation.counted and PERIOD_KEY in target:
+        try:
+            evaluation = replace(evaluation, period_s=float(loaded_periods(run_settings.spec)[0]))
+        except ConvergenceError as exc:
+            evaluation = replace(evaluation, error=f"no modal period: {exc}")
+    if evaluation.counted:
         evaluation = replace(evaluation, objective=objective(evaluation.values(), target))
-    return evaluation
+    return replace(evaluation, wall_s=time.perf_counter() - t0)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
 
-    from tapespring.identify.static import PAPER_TAPE_MODULUS, PAPER_TAPE_THICKNESS
+    from tapespring.scenarios.setup import PAPER_TAPE
 
     fig, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
     runs = [e for e in result.evaluations if e.start >= 0]
@@ -88,8 +88,8 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
         )
     if paper:
         ax.plot(
-            [PAPER_TAPE_THICKNESS * 1e3],
-            [PAPER_TAPE_MODULUS / 1e9],
+            [PAPER_TAPE.thickness * 1e3],
+            [PAPER_TAPE.youngs_modulus / 1e9],
             "s",
             color="C0",
             mec="k",
