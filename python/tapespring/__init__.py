@@ -32,6 +32,8 @@ identify
     Young's modulus (Sec. 5.1), the Kelvin-Voigt viscosity (Sec. 5.2).
 sweep
     A study's independent runs side by side, in worker processes or on a cluster's executor.
+study
+    Ensembles over the settings' uncertainty and local sensitivities of a scenario's figures.
 cli
     The ``tapespring`` command.
 

@@ -1,0 +1,246 @@
+"""One run of a study: a scenario with some of its settings replaced, reduced to its figures and
+its history in the process that ran it (a worker sends back numbers, not the whole results)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .figures import History, ScenarioKind, kind_of, scenario_named
+from .paths import assign, check_settings
+
+__all__ = ["Runner", "StudyRun", "StudyWarning", "print_run", "run_all", "runner_for"]
+
+
+class StudyWarning(UserWarning):
+    """A study's runs did not all give their figures (settings out of range, a solver stop). A
+    `UserWarning`, so that the command line prints it as a ``warning: ...`` line; the study's
+    result keeps every run, the failed ones with their message."""
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """One run of a study.
+
+    Attributes
+    ----------
+    index : int
+        Its place in the study.
+    values : dict of str to float
+        The settings it replaced (name: value, SI units).
+    figures : dict of str to float
+        The scenario's figures (NaN: not produced); empty if it failed before running.
+    history : (ndarray, ndarray) or None
+        Its history (abscissa, ordinate), None if not recorded.
+    error : str or None
+        Why it gave no figures: settings out of range (refused before running) or the solver
+        stopped (the figures so far are kept but not used by the study's statistics).
+    wall_s : float
+        Its wall time [s].
+    """
+
+    index: int
+    values: dict[str, float]
+    figures: dict[str, float] = field(default_factory=dict)
+    history: History | None = None
+    error: str | None = None
+    wall_s: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        """True if the run ended with its figures."""
+        return self.error is None
+
+
+@dataclass(frozen=True)
+class Runner:
+    """A study's scenario and what is kept of each run (picklable: sent to worker processes).
+
+    Attributes
+    ----------
+    name : str
+        The scenario's name (its command's, or the function's for another one).
+    scenario : callable
+        ``scenario(settings)`` runs it.
+    figures : callable
+        Its result to its figures.
+    history : callable or None
+        Its result to its history; None: none kept.
+    history_labels : (str, str)
+        The history's axes.
+    """
+
+    name: str
+    scenario: Callable[[Any], Any]
+    figures: Callable[[Any], Mapping[str, float]]
+    history: Callable[[Any], History] | None
+    history_labels: tuple[str, str] = ("", "")
+
+
+def runner_for(
+    scenario: str | Callable[[Any], Any],
+    settings: Any,
+    figures: Callable[[Any], Mapping[str, float]] | None,
+    history: Callable[[Any], History] | bool | None,
+) -> tuple[Runner, Any]:
+    """The `Runner` of a study, and its base settings (the scenario's defaults if None).
+
+    Raises
+    ------
+    TypeError
+        If `scenario` is neither a ready-made scenario's name or function nor callable, or a
+        scenario of your own comes without its settings or its figures.
+    ValueError
+        For an unknown scenario name, or settings its own check refuses.
+    """
+    kind: ScenarioKind | None
+    if isinstance(scenario, str):
+        kind = scenario_named(scenario)
+        run = kind.run()
+    elif callable(scenario):
+        kind, run = kind_of(scenario), scenario
+    else:
+        raise TypeError(
+            f"scenario must be a scenario's name (such as 'deploy') or a function of the settings "
+            f"(got {scenario!r})"
+        )
+    if not (figures is None or callable(figures)):
+        raise TypeError(f"figures must be a function of a run's result or None (got {figures!r})")
+    if not (history is None or isinstance(history, bool) or callable(history)):
+        raise TypeError(f"history must be a function, True, False or None (got {history!r})")
+    name = kind.name if kind is not None else getattr(run, "__qualname__", repr(run))
+    if kind is None and (settings is None or figures is None):
+        raise TypeError(
+            f"a scenario of your own ({name}) needs its settings and its figures (a function of "
+            f"its result returning name: number); the ready-made ones are {', '.join(_names())}"
+        )
+    if settings is None:
+        settings = kind.default_settings()  # type: ignore[union-attr]
+    check_settings(settings)
+    keep: Callable[[Any], History] | None
+    if callable(history):
+        keep, labels = history, ("", "")
+    elif history is False or kind is None:
+        keep, labels = None, ("", "")
+    else:
+        keep, labels = kind.history, kind.history_labels
+    return (
+        Runner(name, run, figures or kind.figures, keep, labels),  # type: ignore[union-attr]
+        settings,
+    )
+
+
+def _names() -> list[str]:
+    from .figures import SCENARIOS
+
+    return list(SCENARIOS)
+
+
+@dataclass(frozen=True)
+class _Task:
+    runner: Runner
+    index: int
+    values: dict[str, float]
+    settings: Any
+
+
+def _run(task: _Task) -> StudyRun:
+    """One run in this process (a worker's entry point)."""
+    from tapespring.analysis import TapeError
+
+    t0 = time.perf_counter()
+    error = None
+    try:
+        result = task.runner.scenario(task.settings)
+    except TapeError as exc:
+        # A solver stop (ConvergenceError) or the core refusing the model: this run's answer,
+        # not the study's end. Scenarios raise ConvergenceError with their partial result.
+        result = getattr(exc, "result", None)
+        error = f"{type(exc).__name__}: {exc}"
+    error = error or getattr(result, "error", None)  # a curve that stopped early (bend)
+    figures: dict[str, float] = {}
+    history = None
+    if result is not None:
+        try:
+            figures = {str(k): float(v) for k, v in task.runner.figures(result).items()}
+            if task.runner.history is not None:
+                x, y = task.runner.history(result)
+                history = (np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        except Exception:
+            if error is None:
+                raise
+            # A partial result may lack what the figures read: the stop is the message.
+    return StudyRun(
+        index=task.index,
+        values=task.values,
+        figures=figures,
+        history=history,
+        error=None if error is None else str(error),
+        wall_s=time.perf_counter() - t0,
+    )
+
+
+def run_all(
+    runner: Runner,
+    settings: Any,
+    values: Sequence[dict[str, float]],
+    *,
+    workers: int | None,
+    executor: Any,
+    report: Callable[[StudyRun], bool],
+) -> tuple[list[StudyRun], bool]:
+    """Run `settings` with each of `values` replaced; the runs refused by the settings' check
+    are recorded with their message, not run. ``report`` receives each run as it ends and may
+    return False to stop.
+
+    Returns
+    -------
+    (list of StudyRun, bool)
+        The runs that ended, in the study's order, and whether the study was stopped (by
+        `report` or Ctrl-C) before all ended.
+    """
+    from tapespring.sweep import WorkerDied, run_tasks
+
+    runs: dict[int, StudyRun] = {}
+    tasks: list[_Task] = []
+    stopped = False
+    for i, v in enumerate(values):
+        try:
+            s = assign(settings, v)
+            check_settings(s)
+        except (TypeError, ValueError) as exc:
+            runs[i] = StudyRun(index=i, values=v, error=f"settings refused: {exc}")
+            if not report(runs[i]):
+                return [runs[k] for k in sorted(runs)], True
+            continue
+        tasks.append(_Task(runner, i, v, s))
+
+    def done(n: int, run: StudyRun) -> bool:
+        nonlocal stopped
+        runs[run.index] = run
+        if not report(run):
+            stopped = True
+        return not stopped
+
+    try:
+        stopped = run_tasks(_run, tasks, workers, done, executor=executor) or stopped
+    except WorkerDied as exc:
+        lost = ", ".join(str(tasks[n].index) for n in exc.unfinished)
+        raise WorkerDied(f"{exc} (runs: {lost})", exc.unfinished) from exc
+    return [runs[k] for k in sorted(runs)], stopped
+
+
+def print_run(prefix: str, total: int, run: StudyRun) -> None:
+    """One line on stderr for a run that ended: its values and its outcome."""
+    values = ", ".join(f"{k} = {v:.6g}" for k, v in run.values.items()) or "nominal settings"
+    outcome = "ok" if run.ok else f"failed: {run.error}"
+    print(
+        f"{prefix}: run {run.index + 1} of {total} ({values}): {outcome} ({run.wall_s:.1f} s)",
+        file=sys.stderr,
+        flush=True,
+    )

@@ -1,0 +1,388 @@
+"""Local sensitivities: how each figure of a scenario moves with each setting about the nominal
+settings, by central differences.
+
+The result gives each figure's derivative with respect to each setting and its elasticity
+``(df / f) / (dp / p)``: the percentage change of the figure per percent of the setting (1 for a
+force proportional to Young's modulus, 3 for a bending moment of a plate against its thickness).
+A tape spring's figures are not all smooth in its settings: a peak's time jumps where a fold
+appears one swing later, a phase may not be detected. Each pair of one-sided differences is
+compared, and a figure whose two sides disagree is flagged as not smooth there: its central
+difference is then no derivative.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import numbers
+import sys
+import time
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .ensemble import _settings_tree, check_progress
+from .paths import number_at, resolve
+from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
+
+__all__ = ["NONSMOOTH", "REL_STEP", "SensitivityStudy", "sensitivity"]
+
+#: Default step: 1 % of each setting. Small enough that a smooth figure's central difference is
+#: within about 1e-4 of its derivative (the error is h^2 f''' / 6), large enough that the solver's
+#: tolerances (1e-4 of the forces, the time steps' error control) stay below the change.
+REL_STEP = 0.01
+
+#: A figure is flagged as not smooth in a setting when its two one-sided changes differ by more
+#: than this share of the larger: `|df+ + df-| > NONSMOOTH max(|df+|, |df-|)` (0 for a straight
+#: line, h f'' / f' for a smooth curve: 0.02 for a figure going as p^3 at a 1 % step).
+NONSMOOTH = 0.25
+
+#: A change below this share of the figure is taken as no change (the solver's round-off).
+NO_CHANGE = 1e-9
+
+
+@dataclass(frozen=True)
+class SensitivityStudy:
+    """The runs of a sensitivity study and the derivatives they give.
+
+    Attributes
+    ----------
+    scenario : str
+        The scenario's name.
+    parameters : tuple of str
+        The settings, as given.
+    nominal : ndarray, shape (parameters,)
+        Their nominal values.
+    steps : ndarray, shape (parameters,)
+        The step of each (absolute, SI units).
+    runs : tuple of StudyRun
+        The runs that ended: the nominal one first (index 0), then for each setting its step up
+        (index ``2 j + 1``) and down (``2 j + 2``).
+    settings : object
+        The nominal settings.
+    workers : int
+        Processes the runs ran in (0: on an executor).
+    cancelled : bool
+        True if stopped before every run ended.
+    wall_s : float
+        Wall time [s].
+    """
+
+    scenario: str
+    parameters: tuple[str, ...]
+    nominal: NDArray[np.float64]
+    steps: NDArray[np.float64]
+    runs: tuple[StudyRun, ...]
+    settings: Any
+    workers: int
+    cancelled: bool
+    wall_s: float
+
+    @property
+    def figure_names(self) -> tuple[str, ...]:
+        """The figures of the nominal run (of the first run that gave any if it failed)."""
+        for run in self.runs:
+            if run.ok and run.figures:
+                return tuple(run.figures)
+        return ()
+
+    def _figures(self, index: int) -> NDArray[np.float64]:
+        for run in self.runs:
+            if run.index == index and run.ok:
+                return np.array([run.figures.get(k, math.nan) for k in self.figure_names])
+        return np.full(len(self.figure_names), math.nan)
+
+    @property
+    def base(self) -> NDArray[np.float64]:
+        """The nominal run's figures, shape (figures,) (NaN if it failed)."""
+        return self._figures(0)
+
+    @property
+    def changes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The figures' changes from the nominal run at each setting's step up and down, each of
+        shape (figures, parameters) (NaN where a run failed)."""
+        up = np.column_stack([self._figures(2 * j + 1) for j in range(len(self.parameters))])
+        down = np.column_stack([self._figures(2 * j + 2) for j in range(len(self.parameters))])
+        base = self.base[:, None]
+        return up - base, down - base
+
+    @property
+    def derivatives(self) -> NDArray[np.float64]:
+        """d figure / d setting, shape (figures, parameters), in the figure's unit per the
+        setting's: central differences, one-sided where one side failed (NaN where both did)."""
+        up, down = self.changes
+        h = self.steps[None, :]
+        central = (up - down) / (2.0 * h)
+        return np.where(np.isfinite(central), central, np.where(np.isfinite(up), up / h, -down / h))
+
+    @property
+    def elasticities(self) -> NDArray[np.float64]:
+        """``(d f / f) / (d p / p)``, shape (figures, parameters): the figure's relative change
+        per relative change of the setting (NaN where the figure is 0)."""
+        base = self.base[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = self.derivatives * self.nominal[None, :] / base
+        return np.where(base != 0.0, out, math.nan)
+
+    @property
+    def nonsmooth(self) -> NDArray[np.bool_]:
+        """True where a figure's two one-sided changes disagree (:data:`NONSMOOTH`): a jump or
+        kink within the steps, where the derivative means little. Shape (figures, parameters)."""
+        up, down = self.changes
+        larger = np.maximum(np.abs(up), np.abs(down))
+        floor = NO_CHANGE * np.abs(self.base)[:, None]
+        with np.errstate(invalid="ignore"):
+            return (np.abs(up + down) > NONSMOOTH * larger) & (larger > floor)
+
+    @property
+    def failed(self) -> tuple[StudyRun, ...]:
+        """The runs that gave no figures."""
+        return tuple(run for run in self.runs if not run.ok)
+
+    def summary(self) -> dict[str, Any]:
+        """The study as JSON-ready values: per figure its nominal value, and per setting its
+        derivative, elasticity and smoothness; the runs; the settings."""
+        from tapespring.report import jsonable_tree
+
+        d, e, rough = self.derivatives, self.elasticities, self.nonsmooth
+        up, down = self.changes
+        figures = {
+            name: {
+                "nominal": float(self.base[i]),
+                "parameters": {
+                    p: {
+                        "derivative": float(d[i, j]),
+                        "elasticity": float(e[i, j]),
+                        "change_up": float(up[i, j]),
+                        "change_down": float(down[i, j]),
+                        "smooth": not bool(rough[i, j]),
+                    }
+                    for j, p in enumerate(self.parameters)
+                },
+            }
+            for i, name in enumerate(self.figure_names)
+        }
+        return jsonable_tree(  # type: ignore[return-value]
+            {
+                "scenario": self.scenario,
+                "parameters": {
+                    p: {"nominal": float(self.nominal[j]), "step": float(self.steps[j])}
+                    for j, p in enumerate(self.parameters)
+                },
+                "figures": figures,
+                "runs": [
+                    {"index": r.index, "values": r.values, "figures": r.figures,
+                     "error": r.error, "wall_s": r.wall_s}
+                    for r in self.runs
+                ],
+                "cancelled": self.cancelled,
+                "workers": self.workers,
+                "wall_s": self.wall_s,
+                "settings": _settings_tree(self.settings),
+            }
+        )  # fmt: skip
+
+    def table(self) -> str:
+        """The elasticities as a text table (figures as rows, settings as columns); ``*`` marks
+        a figure not smooth in that setting."""
+        e, rough = self.elasticities, self.nonsmooth
+        header = ("figure", "nominal", *self.parameters)
+        rows = [header]
+        for i, name in enumerate(self.figure_names):
+            cells = [
+                ("nan" if not math.isfinite(e[i, j]) else f"{e[i, j]:+.3f}")
+                + ("*" if rough[i, j] else " ")
+                for j in range(len(self.parameters))
+            ]
+            rows.append((name, f"{self.base[i]:.5g}", *cells))
+        widths = [max(len(r[k]) for r in rows) for k in range(len(header))]
+        return "\n".join(
+            "  ".join(
+                c.ljust(w) if k == 0 else c.rjust(w)
+                for k, (c, w) in enumerate(zip(r, widths, strict=True))
+            )
+            for r in rows
+        )
+
+    def describe(self) -> str:
+        """A few lines for a person: the steps, the outcome and the elasticities."""
+        steps = "; ".join(
+            f"{p} = {self.nominal[j]:.6g} +/- {self.steps[j]:.3g}"
+            for j, p in enumerate(self.parameters)
+        )
+        lines = [
+            f"sensitivity of {self.scenario}: {len(self.runs)} of {2 * len(self.parameters) + 1} "
+            f"runs ended ({len(self.failed)} failed){', stopped early' if self.cancelled else ''}"
+            f", wall time {self.wall_s:.1f} s",
+            f"  about {steps}",
+        ]
+        for run in self.failed[:3]:
+            lines.append(f"  run {run.index} failed: {run.error}")
+        if self.figure_names:
+            lines += [
+                "",
+                "elasticities (d f / f) / (d p / p); * not smooth: the two sides differ",
+                self.table(),
+            ]
+        return "\n".join(lines)
+
+    def write_csv(self, path: str | Path) -> None:
+        """One row per figure and setting: nominal value, derivative, elasticity, the two
+        one-sided changes and whether they agree."""
+        d, e, rough = self.derivatives, self.elasticities, self.nonsmooth
+        up, down = self.changes
+        with open(path, "w", newline="", encoding="utf-8") as f:
+            w = csv.writer(f)
+            w.writerow(
+                ["figure", "parameter", "nominal_figure", "nominal_parameter", "step",
+                 "derivative", "elasticity", "change_up", "change_down", "smooth"]
+            )  # fmt: skip
+            for i, name in enumerate(self.figure_names):
+                for j, p in enumerate(self.parameters):
+                    w.writerow(
+                        [name, p, repr(float(self.base[i])), repr(float(self.nominal[j])),
+                         repr(float(self.steps[j])), repr(float(d[i, j])), repr(float(e[i, j])),
+                         repr(float(up[i, j])), repr(float(down[i, j])), not rough[i, j]]
+                    )  # fmt: skip
+
+    def write_json(self, path: str | Path) -> None:
+        """:meth:`summary` as a JSON file (NaN written as null)."""
+        Path(path).write_text(json.dumps(self.summary(), indent=1), encoding="utf-8")
+
+
+def _steps(
+    settings: Any, parameters: Sequence[str] | Mapping[str, float], rel_step: float
+) -> tuple[tuple[str, ...], NDArray[np.float64], NDArray[np.float64]]:
+    if isinstance(parameters, str) or not isinstance(parameters, Sequence | Mapping):
+        raise TypeError(
+            "parameters must be a sequence of setting names, or a mapping of names to absolute "
+            f"steps (got {parameters!r})"
+        )
+    names = tuple(parameters)
+    if not names:
+        raise ValueError("parameters must name at least one setting")
+    if len({resolve(settings, n) for n in names}) != len(names):
+        raise ValueError(f"a setting is named twice in {list(names)}")
+    nominal = np.array([number_at(settings, n) for n in names])
+    steps = np.empty(len(names))
+    for j, name in enumerate(names):
+        if isinstance(parameters, Mapping):
+            step = parameters[name]
+            if isinstance(step, bool) or not isinstance(step, numbers.Real):
+                raise TypeError(f"the step of {name!r} must be a number (got {step!r})")
+            if not (math.isfinite(step) and step > 0.0):
+                raise ValueError(f"the step of {name!r} must be positive and finite (got {step})")
+            steps[j] = float(step)
+        elif nominal[j] == 0.0:
+            raise ValueError(
+                f"{name!r} is 0: a relative step moves it nowhere; give its absolute step "
+                f"(parameters={{{name!r}: step}})"
+            )
+        else:
+            steps[j] = rel_step * abs(nominal[j])
+    return names, nominal, steps
+
+
+def sensitivity(
+    scenario: str | Callable[[Any], Any],
+    parameters: Sequence[str] | Mapping[str, float],
+    settings: Any = None,
+    *,
+    rel_step: float = REL_STEP,
+    figures: Callable[[Any], Mapping[str, float]] | None = None,
+    workers: int | None = 1,
+    executor: Any = None,
+    progress: bool | Callable[[StudyRun], bool | None] | None = None,
+) -> SensitivityStudy:
+    """The derivatives of a scenario's figures with respect to some of its settings, by central
+    differences about `settings` (``2 P + 1`` runs for ``P`` settings).
+
+    Parameters
+    ----------
+    scenario : str or callable
+        As :func:`tapespring.study.ensemble`.
+    parameters : sequence of str, or mapping of str to float
+        The settings (names as :mod:`tapespring.study.paths`): each stepped by `rel_step` of
+        its nominal value, or by the absolute step a mapping gives (needed for a setting that
+        is 0, such as ``eta`` in the release).
+    settings : object, optional
+        The nominal settings; the scenario's defaults if None.
+    rel_step : float
+        The relative step, in (0, 0.5] (default :data:`REL_STEP`, 1 %).
+    figures : callable, optional
+        A run's result to its figures; the scenario's defaults if None.
+    workers, executor, progress
+        As :func:`tapespring.study.ensemble`.
+
+    Returns
+    -------
+    SensitivityStudy
+
+    Raises
+    ------
+    TypeError, ValueError
+        For bad arguments (an unknown or non-numeric setting, a setting at 0 without its step,
+        a step out of range), before any run.
+    tapespring.sweep.WorkerDied
+        If a worker process died.
+
+    Warns
+    -----
+    StudyWarning
+        If some runs failed (a step outside a setting's range is refused by the settings' check:
+        that setting's derivative is then one-sided).
+    """
+    from tapespring.scenarios.setup import check_number
+    from tapespring.sweep import check_workers, processes_for
+
+    rel = check_number("rel_step", rel_step, positive=True)
+    if rel > 0.5:
+        raise ValueError(f"rel_step must be at most 0.5 (got {rel_step})")
+    check_workers(workers)
+    check_progress(progress)
+    runner, settings = runner_for(scenario, settings, figures, False)
+    names, nominal, steps = _steps(settings, parameters, rel)
+    values: list[dict[str, float]] = [{}]
+    for j, name in enumerate(names):
+        values.append({name: float(nominal[j] + steps[j])})
+        values.append({name: float(nominal[j] - steps[j])})
+
+    callback = progress if callable(progress) else None
+
+    def report(run: StudyRun) -> bool:
+        if progress is True:
+            print_run(f"sensitivity of {runner.name}", len(values), run)
+        return not (callback is not None and callback(run) is False)
+
+    t0 = time.perf_counter()
+    ended, stopped = run_all(
+        runner, settings, values, workers=workers, executor=executor, report=report
+    )
+    result = SensitivityStudy(
+        scenario=runner.name,
+        parameters=names,
+        nominal=nominal,
+        steps=steps,
+        runs=tuple(ended),
+        settings=settings,
+        workers=0 if executor is not None else processes_for(workers, len(values)),
+        cancelled=stopped,
+        wall_s=time.perf_counter() - t0,
+    )
+    if result.failed:
+        first = result.failed[0]
+        warnings.warn(
+            f"{len(result.failed)} of {len(ended)} runs failed (run {first.index}: {first.error})",
+            StudyWarning,
+            stacklevel=2,
+        )
+    if progress is True:
+        print(f"sensitivity of {runner.name}: {len(ended)} runs in {result.wall_s:.1f} s",
+              file=sys.stderr)  # fmt: skip
+    return result
