@@ -125,6 +125,27 @@ def test_a_dead_worker_is_reported_with_the_tasks_left():
     assert 1 in info.value.unfinished and isinstance(info.value, RuntimeError)
 
 
+def test_a_study_run_from_a_script_read_on_standard_input_gets_its_workers():
+    # `python - < study.py`: __main__'s file name is "<stdin>", no file a worker could import;
+    # the workers died at their start before the main script was left out of their preparation.
+    script = textwrap.dedent(
+        f"""
+        import sys
+        sys.path.insert(0, {str(TESTS)!r})
+        from _sweep_tasks import square_after
+        from tapespring.sweep import sweep
+
+        print([r[0] for r in sweep(square_after, [(x, 0.0) for x in range(4)], workers=2)])
+        print(sys.modules["__main__"].__file__)
+        """
+    )
+    done = subprocess.run(
+        [sys.executable, "-"], input=script, capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:2] == ["[0, 1, 4, 9]", "<stdin>"], done.stdout
+
+
 def test_ctrl_c_stops_the_study_and_ends_its_workers(tmp_path: Path):
     # A study of minute-long runs, interrupted as a terminal's Ctrl-C would (SIGINT to the whole
     # process group, workers included): the parent returns "stopped" within seconds, quietly,

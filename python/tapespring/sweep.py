@@ -286,12 +286,22 @@ def _spawning() -> Iterator[None]:
     the environment they inherit."""
     block = hasattr(signal, "pthread_sigmask")
     before = os.environ.get("RAYON_NUM_THREADS")
+    # A script read from standard input (``python - < study.py``) is `__main__` with a file name
+    # that is no file: a spawned worker would fail to import it and die. Its functions cannot be
+    # sent anyway (`_check_sendable`), so the workers are spawned without it.
+    main = sys.modules.get("__main__")
+    script = getattr(main, "__file__", None)
+    hidden = isinstance(script, str) and not os.path.isfile(script)
+    if hidden:
+        del main.__file__  # type: ignore[union-attr]
     if block:
         signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     os.environ["RAYON_NUM_THREADS"] = "1"
     try:
         yield
     finally:
+        if hidden:
+            main.__file__ = script  # type: ignore[union-attr]
         if before is None:
             os.environ.pop("RAYON_NUM_THREADS", None)
         else:
