@@ -140,3 +140,24 @@ def test_an_ensemble_of_deployments_in_two_workers_matches_each_run_alone():
     assert math.isfinite(run.figures["min_1_deg"]) and run.figures["min_1_deg"] < 0.0
     time_s, angle = run.history  # type: ignore[misc]
     assert np.array_equal(angle, alone.angle_deg) and np.array_equal(time_s, alone.time_s)
+
+
+def test_the_pull_scales_with_every_modulus_and_gravity_together():
+    # The pull is static under gravity and a driven displacement: with every modulus and g times
+    # lambda, the same displacements balance forces times lambda. So the maximum force's
+    # elasticities to the tapes' E, the plates' E and g sum to 1, and its displacement's to 0.
+    # Measured on 5 mm / 10 mm meshes: 1 + 1e-8 (the force, E's share 1.057, g's -0.057) and
+    # 1.1e-4 (the displacement: its location on the flat top of the force moves by about 1e-7 m,
+    # 1e-3 of an elasticity at a 1 % step, against E's share of 0.038).
+    from tapespring.scenarios.pull import PullSettings
+    from tapespring.scenarios.setup import PAPER_SETUP
+
+    settings = PullSettings(spec=replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3))
+    s = sensitivity("pull", ["tape.youngs_modulus", "plate_youngs_modulus", "gravity"], settings)
+    force, displacement = (
+        s.figure_names.index(k) for k in ("max_force_N", "max_force_displacement_m")
+    )
+    assert s.elasticities[force].sum() == pytest.approx(1.0, abs=1e-6)
+    assert s.elasticities[force, 2] < -0.01  # gravity's share is there: the sum is no accident
+    assert abs(s.elasticities[displacement].sum()) < 5e-3
+    assert abs(s.elasticities[displacement, 0]) > 0.02

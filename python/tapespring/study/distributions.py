@@ -46,7 +46,8 @@ def check_distribution(name: str, distribution: object) -> None:
 
 
 def describe_distribution(distribution: Any) -> str:
-    """``norm(loc=0.000138, scale=2e-06)``: SciPy's name and arguments, for tables and JSON."""
+    """``norm(0.000138, 2e-06), mean 0.000138, std 2e-06``: SciPy's name and arguments, and the
+    mean and standard deviation, for tables and JSON."""
     dist = getattr(distribution, "dist", None)
     name = getattr(dist, "name", type(distribution).__name__)
     args = [
@@ -56,7 +57,14 @@ def describe_distribution(distribution: Any) -> str:
         f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v!r}"
         for k, v in getattr(distribution, "kwds", {}).items()
     ]
-    return f"{name}({', '.join(args + kwds)})"
+    text = f"{name}({', '.join(args + kwds)})"
+    try:
+        mean, std = float(distribution.mean()), float(distribution.std())
+    except (AttributeError, TypeError, ValueError):
+        return text
+    # SciPy's arguments are its own (a uniform's are its low end and width): the moments say it
+    # plainly.
+    return f"{text}, mean {mean:.6g}, std {std:.3g}"
 
 
 def _number(text: str, what: str, form: str) -> float:

@@ -7,7 +7,9 @@ force proportional to Young's modulus, 3 for a bending moment of a plate against
 A tape spring's figures are not all smooth in its settings: a peak's time jumps where a fold
 appears one swing later, a phase may not be detected. Each pair of one-sided differences is
 compared, and a figure whose two sides disagree is flagged as not smooth there: its central
-difference is then no derivative.
+difference is then no derivative. A flag on a tiny elasticity (0.001) is usually the figure's own
+noise rather than a kink: a located extremum's position moves by the solver's tolerance (the
+pull's displacement at its maximum force, on the flat top of the curve, by about 1e-7 m).
 """
 
 from __future__ import annotations
@@ -227,7 +229,8 @@ class SensitivityStudy:
         if self.figure_names:
             lines += [
                 "",
-                "elasticities (d f / f) / (d p / p); * not smooth: the two sides differ",
+                "elasticities (d f / f) / (d p / p); *: the two sides differ (a kink or jump "
+                "within the steps, or, on a tiny elasticity, the figure's own noise)",
                 self.table(),
             ]
         return "\n".join(lines)
