@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import sys
 import time
+import traceback
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -149,19 +151,38 @@ class _Task:
     settings: Any
 
 
+def _failure(exc: Exception, what: str = "") -> str:
+    """The message of a run's failure: the exception, and where it was raised unless the solver
+    raised it (its message says what stopped)."""
+    from tapespring.analysis import TapeError
+
+    message = f"{what}{type(exc).__name__}: {exc}"
+    if isinstance(exc, TapeError):
+        return message
+    frames = traceback.extract_tb(exc.__traceback__)
+    if frames:
+        message += f" (raised at {Path(frames[-1].filename).name}:{frames[-1].lineno})"
+    return message
+
+
 def _run(task: _Task) -> StudyRun:
-    """One run in this process (a worker's entry point)."""
+    """One run in this process (a worker's entry point). Whatever the scenario or the figures
+    raise (an Exception, not Ctrl-C) is this run's failure, not the study's end: a long study
+    keeps its other runs."""
     from tapespring.analysis import TapeError
 
     t0 = time.perf_counter()
     error = None
+    result = None
     try:
         result = task.runner.scenario(task.settings)
     except TapeError as exc:
-        # A solver stop (ConvergenceError) or the core refusing the model: this run's answer,
-        # not the study's end. Scenarios raise ConvergenceError with their partial result.
+        # A solver stop (ConvergenceError) or the core refusing the model. Scenarios raise
+        # ConvergenceError with their partial result.
         result = getattr(exc, "result", None)
-        error = f"{type(exc).__name__}: {exc}"
+        error = _failure(exc)
+    except Exception as exc:
+        error = _failure(exc)
     error = error or getattr(result, "error", None)  # a curve that stopped early (bend)
     figures: dict[str, float] = {}
     history = None
@@ -171,10 +192,9 @@ def _run(task: _Task) -> StudyRun:
             if task.runner.history is not None:
                 x, y = task.runner.history(result)
                 history = (np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        except Exception:
-            if error is None:
-                raise
-            # A partial result may lack what the figures read: the stop is the message.
+        except Exception as exc:
+            # A partial result may lack what the figures read: a stop is then the message.
+            error = error or _failure(exc, "figures: ")
     return StudyRun(
         index=task.index,
         values=task.values,
