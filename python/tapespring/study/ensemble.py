@@ -303,8 +303,8 @@ class Ensemble:
         lines = [
             f"ensemble of {self.scenario}: {len(self.runs)} of {self.samples.shape[0]} runs ended "
             f"({len(self.failed)} failed){', stopped early' if self.cancelled else ''}, "
-            f"{self.sampling} draws from seed {self.seed}, {self.workers} worker"
-            f"{'s' if self.workers != 1 else ''}, wall time {self.wall_s:.1f} s",
+            f"{self.sampling} draws from seed {self.seed}, {_where(self.workers)}, "
+            f"wall time {self.wall_s:.1f} s",
             f"  varied: {varied}",
         ]
         for run in self.failed[:3]:
@@ -339,6 +339,13 @@ class Ensemble:
     def write_json(self, path: str | Path) -> None:
         """:meth:`summary` as a JSON file (strict JSON: NaN written as null)."""
         Path(path).write_text(json.dumps(self.summary(), indent=1), encoding="utf-8")
+
+
+def _where(workers: int) -> str:
+    """Where a study's runs ran, for a person."""
+    if workers == 0:
+        return "on an executor"
+    return "in this process" if workers == 1 else f"in {workers} worker processes"
 
 
 def draws(distributions: list[Any], runs: int, *, seed: int, sampling: str) -> NDArray[np.float64]:

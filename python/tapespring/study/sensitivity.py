@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .ensemble import _settings_tree, check_progress
+from .ensemble import _settings_tree, _where, check_progress
 from .paths import number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
@@ -221,7 +221,7 @@ class SensitivityStudy:
         lines = [
             f"sensitivity of {self.scenario}: {len(self.runs)} of {2 * len(self.parameters) + 1} "
             f"runs ended ({len(self.failed)} failed){', stopped early' if self.cancelled else ''}"
-            f", wall time {self.wall_s:.1f} s",
+            f" {_where(self.workers)}, wall time {self.wall_s:.1f} s",
             f"  about {steps}",
         ]
         for run in self.failed[:3]:
