@@ -20,6 +20,11 @@ identify
     The identifications of Sec. 5: the search for t and E, and eta against the damping ratio
     (return a Figure).
 
+study
+    The studies of :mod:`tapespring.study`: an ensemble's histories, band and scatter of its
+    figures against their driving settings; a sensitivity study's elasticities as a tornado
+    chart (return a Figure).
+
 setup, max_mass, numerical_damping, support, snapshots
     The paper's tests on the set-up (deployment, pull, vibration, Figs. 27-34; the push path to
     the folded equilibrium, Sec. 5.1), the maximum mass (Fig. 7), the numerical damping study
@@ -40,6 +45,7 @@ if TYPE_CHECKING:
     from .release import plot_release
     from .setup import plot_deployment, plot_equilibrium, plot_pull, plot_vibration
     from .snapshots import plot_snapshots
+    from .study import plot_ensemble, plot_sensitivity
     from .support import plot_clamp_forces
     from .trials import (
         plot_angle_histories,
@@ -60,6 +66,7 @@ __all__ = [
     "plot_damping_identification",
     "plot_damping_series",
     "plot_deployment",
+    "plot_ensemble",
     "plot_equilibrium",
     "plot_force_and_angle",
     "plot_free_decay",
@@ -69,6 +76,7 @@ __all__ = [
     "plot_pull",
     "plot_pull_test",
     "plot_release",
+    "plot_sensitivity",
     "plot_series_comparison",
     "plot_snapshots",
     "plot_static_identification",
@@ -100,5 +108,6 @@ __getattr__, __dir__ = lazy_exports(
         "numerical_damping": ["plot_numerical_damping"],
         "support": ["plot_clamp_forces"],
         "snapshots": ["plot_snapshots"],
+        "study": ["plot_ensemble", "plot_sensitivity"],
     },
 )
