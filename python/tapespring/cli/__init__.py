@@ -19,6 +19,10 @@ identify static, identify damping
     The tapes' thickness and Young's modulus from the static identification test (Sec. 5.1),
     and their Kelvin-Voigt viscosity from a damping ratio (Sec. 5.2); see
     :mod:`tapespring.cli.identify`.
+study ensemble, study sensitivity
+    A scenario run over settings drawn from distributions (each figure's statistics and rank
+    correlations), or its figures' elasticities to settings by central differences; see
+    :mod:`tapespring.cli.study`.
 trials analyze
     Statistics and figures of experimental trials (see :mod:`tapespring.cli.trials`).
 
@@ -108,7 +112,18 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``tapespring`` argument parser with all sub-commands."""
     # Imported here, not at the top, so that ``python -m tapespring.cli.trials`` does not find its
     # own module already imported by the package.
-    from . import bend, deploy, equilibrium, identify, max_mass, pull, release, trials, vibrate
+    from . import (
+        bend,
+        deploy,
+        equilibrium,
+        identify,
+        max_mass,
+        pull,
+        release,
+        study,
+        trials,
+        vibrate,
+    )
     from .parser import ArgumentParser
 
     parser = ArgumentParser(
@@ -127,6 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
     vibrate.register(sub)
     max_mass.register(sub)
     identify.register(sub)
+    study.register(sub)
     trials.register(sub)
     for command, depth in _command_parsers(parser):
         # -v after the command too (`tapespring deploy -v`), counted with those before it: a
