@@ -127,7 +127,6 @@ def test_bad_measurements_are_refused(measured: object, error: type, match: str)
     [
         ({"bounds": IdentificationBounds(thickness_min=0.3e-3)}, "must be below thickness_max"),
         ({"bounds": IdentificationBounds(youngs_modulus_min=-1.0)}, "youngs_modulus_min"),
-        ({"bounds": (0.1, 0.2)}, "must be an IdentificationBounds"),
         # A tape as thick as its radius (the set-up's own check, at the box's corner).
         ({"bounds": IdentificationBounds(thickness_max=9e-3)}, "not thin"),
         ({"starts": 0}, r"starts must be a count in \[1, 1000\]"),
@@ -139,7 +138,6 @@ def test_bad_measurements_are_refused(measured: object, error: type, match: str)
         ({"max_evaluations": 2}, "max_evaluations must be an integer >= 3"),
         ({"xatol": 0.0}, "xatol must be"),
         ({"fatol": math.nan}, "fatol must be"),
-        ({"settings": PAPER_SETUP}, "settings must be an EquilibriumSettings"),
         ({"workers": 0}, "workers"),
     ],
 )
@@ -147,6 +145,22 @@ def test_bad_settings_are_refused_before_any_run(
     fake_runs: list[tuple[float, float]], kwargs: dict, match: str
 ) -> None:
     with pytest.raises(ValueError, match=match):
+        identify_static(None, **kwargs)
+    assert fake_runs == []
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"bounds": (0.1, 0.2)}, "bounds must be an IdentificationBounds"),
+        ({"settings": PAPER_SETUP}, "settings must be an EquilibriumSettings"),
+    ],
+)
+def test_settings_of_the_wrong_type_are_type_errors(
+    fake_runs: list[tuple[float, float]], kwargs: dict, match: str
+) -> None:
+    """As identify_damping's: a wrong type is a TypeError, a value out of range a ValueError."""
+    with pytest.raises(TypeError, match=match):
         identify_static(None, **kwargs)
     assert fake_runs == []
 

@@ -950,9 +950,11 @@ def identify_static(
     Raises
     ------
     ValueError
-        For bad settings, bounds, starts, tolerances or measured displacements, before any run.
+        For settings, bounds, starts, tolerances or measured displacements out of their
+        ranges, before any run.
     TypeError
-        For a `measured` or `workers` of the wrong type.
+        For a `measured`, `period`, `settings`, `bounds`, `workers`, `sensitivity` or
+        `progress` of the wrong type, before any run.
     tapespring.sweep.WorkerDied
         If a worker process died (killed, out of memory).
     """
@@ -974,10 +976,10 @@ def identify_static(
         raise TypeError(f"progress must be True, False, None or a callable (got {progress!r})")
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
-        raise ValueError(f"settings must be an EquilibriumSettings (got {settings!r})")
+        raise TypeError(f"settings must be an EquilibriumSettings (got {settings!r})")
     settings.validate()
     if not isinstance(bounds, IdentificationBounds):
-        raise ValueError(f"bounds must be an IdentificationBounds (got {bounds!r})")
+        raise TypeError(f"bounds must be an IdentificationBounds (got {bounds!r})")
     bounds.validate()
     for thickness, modulus in (
         (bounds.thickness_min, bounds.youngs_modulus_min),
