@@ -48,7 +48,8 @@ def _deployment_figures(result: Any) -> dict[str, float]:
     out["phase_ii_start_s"] = _number(s["phases"]["phase_ii_start_s"])
     out["phase_iii_start_s"] = _number(s["phases"]["phase_iii_start_s"])
     out["max_clamp_force_N"] = _number(s["max_clamp_force_N"])
-    out["max_lateral_tip_displacement_m"] = _number(s["max_lateral_tip_displacement_m"])
+    # Not the lateral excursion: the model is symmetric about the x-z plane, so it is round-off
+    # (1e-13 m) and its scatter and derivatives are noise.
     out["final_angle_deg"] = _number(s["final_angle_deg"])
     return out
 
