@@ -10,8 +10,9 @@ from pathlib import Path
 import pytest
 from _cli import refused
 from _identification import identification_trial
-from tapespring.cli import main
-from tapespring.identify.static import TARGET_KEYS
+from tapespring.cli import build_parser, main
+from tapespring.identify import damping, static
+from tapespring.identify.static import TARGET_KEYS, StaticEvaluation
 from tapespring.trials.csv import write_csv
 
 STATIC = [
@@ -180,3 +181,50 @@ def test_static_reads_the_period_from_recorded_decays(
     assert data["target_period_s"] == pytest.approx(0.102, rel=2e-3)  # the mean of the fits
     line = refused([*STATIC, "--period=0.1", f"--period-experiment={paths[0]}"], capsys)
     assert "--period and --period-experiment" in line
+
+
+@pytest.mark.parametrize(
+    ("command", "shown"),
+    [("static", "a line per equilibrium run"), ("damping", "a progress bar per vibration run")],
+)
+def test_progress_help_says_what_is_shown(command: str, shown: str) -> None:
+    parser = build_parser()
+    sub = parser.parse_args(["identify", command]).parser
+    helps = {a.option_strings[0]: a.help for a in sub._actions if a.option_strings}
+    assert helps["--progress"].startswith(f"show {shown} on stderr")
+    assert helps["--no-progress"] == f"never show {shown}"
+
+
+def test_static_progress_is_a_line_per_run(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """What the help says: one line per equilibrium run on stderr (stand-in runs), no bar."""
+
+    def evaluate(settings, target, thickness, modulus, start):  # noqa: ANN001, ANN202
+        return StaticEvaluation(thickness, modulus, 0.5, dict(target), 0, None, 0.0, start)
+
+    monkeypatch.setattr(static, "_evaluate", evaluate)
+    argv = [arg for arg in STATIC if arg != "--no-progress"]
+    assert main([*argv, "--progress", "--json"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert len(lines) == len(json.loads(captured.out)["evaluations"]) == 3
+    assert all(line.startswith("identify: start 0: t = ") for line in lines)
+    assert "\r" not in captured.err
+
+
+def test_damping_progress_is_handed_to_each_vibration_run(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """What the help says: each vibration run draws its own progress bar."""
+    seen: list[bool] = []
+
+    def vibrate(settings, *, progress=False):  # noqa: ANN001, ANN202
+        seen.append(progress)
+        raise ValueError("a stand-in run")
+
+    monkeypatch.setattr(damping, "vibrate", vibrate)
+    argv = [arg for arg in DAMPING if arg != "--no-progress"]
+    assert main([*argv, "--progress"]) == 2
+    assert seen == [True]
+    assert "a stand-in run" in capsys.readouterr().err

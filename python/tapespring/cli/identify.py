@@ -153,7 +153,10 @@ def _register_static(sub: argparse._SubParsersAction) -> None:
     add_workers_option(p, "the starts")
     add_spec_options(p, mesh_tape=3e-3, mesh_plates=3e-3, eta=False, material=False)
     add_output_options(
-        p, "every equilibrium run (start, t, E, objective, displacements)", "every run too"
+        p,
+        "every equilibrium run (start, t, E, objective, displacements)",
+        "every run too",
+        progress="a line per equilibrium run",
     )
     # The command's full name for the settings line of --csv ("tapespring identify static: ...").
     p.set_defaults(func=run_static, parser=p, command="identify static")
@@ -314,7 +317,9 @@ def _register_damping(sub: argparse._SubParsersAction) -> None:
     # Without --eta, as a static command, but because eta is what it finds: its --spec refuses
     # eta with that reason.
     p.set_defaults(static_spec=False, identified=("eta",))
-    add_output_options(p, "every run (eta, damping ratio, period)")
+    add_output_options(
+        p, "every run (eta, damping ratio, period)", progress="a progress bar per vibration run"
+    )
     p.set_defaults(func=run_damping, parser=p, command="identify damping")
 
 

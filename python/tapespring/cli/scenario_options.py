@@ -335,17 +335,24 @@ def add_sample_rate_option(p: argparse.ArgumentParser, *, recorded: str, default
     )
 
 
-def add_output_options(p: argparse.ArgumentParser, csv_what: str, json_what: str = "") -> None:
+#: What ``--progress`` shows by default: the scenario runs' tqdm bar (a command that writes
+#: something else, a line per run, names it: `add_progress_options`).
+BAR = "the progress bar"
+
+
+def add_output_options(
+    p: argparse.ArgumentParser, csv_what: str, json_what: str = "", *, progress: str = BAR
+) -> None:
     """Add ``--csv``, ``--plot``, ``--json`` and the progress options; `csv_what` says what the
     table holds, `json_what` (if the JSON's histories are not the table's rows) what the JSON
-    object's histories hold."""
+    object's histories hold, `progress` what ``--progress`` shows (`add_progress_options`)."""
     p.add_argument(
         "--csv",
         type=_output_file,
         help=f"write {csv_what} to this CSV file, after a '#' line of the settings as JSON",
     )
     p.add_argument("--plot", type=_image_file, help="write the figure to this PNG file")
-    add_json_and_progress_options(p, json_what)
+    add_json_and_progress_options(p, json_what, progress=progress)
 
 
 def add_workers_option(p: argparse._ActionsContainer, runs: str, *, speed: str = "") -> None:
@@ -381,28 +388,31 @@ def _workers(text: str) -> int | None:
     return value
 
 
-def add_json_and_progress_options(p: argparse.ArgumentParser, json_what: str = "") -> None:
+def add_json_and_progress_options(
+    p: argparse.ArgumentParser, json_what: str = "", *, progress: str = BAR
+) -> None:
     """Add ``--json``, ``--progress`` and ``--no-progress``, which every scenario command takes
-    (the commands with their own ``--csv`` and ``--plot`` add these alone); `json_what` as in
-    `add_output_options`; read by `shows_progress`."""
+    (the commands with their own ``--csv`` and ``--plot`` add these alone); `json_what` and
+    `progress` as in `add_output_options`; read by `shows_progress`."""
     what = f" ({json_what})" if json_what else ""
     p.add_argument("--json", action="store_true", help=f"print one JSON object on stdout{what}")
-    add_progress_options(p, "the progress bar", json_hides=True)
+    add_progress_options(p, progress, json_hides=True)
 
 
 def add_progress_options(p: argparse.ArgumentParser, bar: str, *, json_hides: bool) -> None:
-    """Add ``--progress`` and ``--no-progress`` (exclusive), read by `shows_progress`: `bar` is
-    drawn on stderr when stderr is a terminal (and, with `json_hides`, without ``--json``);
-    ``--progress`` draws it anyway, ``--no-progress`` never."""
+    """Add ``--progress`` and ``--no-progress`` (exclusive), read by `shows_progress`: `bar`
+    (what the command writes: :data:`BAR`, "a line per run as it ends") is shown on stderr when
+    stderr is a terminal (and, with `json_hides`, without ``--json``); ``--progress`` shows it
+    anyway, ``--no-progress`` never."""
     unless = ", and not with --json" if json_hides else ""
     g = p.add_mutually_exclusive_group()
     g.add_argument(
         "--progress",
         action="store_true",
-        help=f"draw {bar} on stderr even if stderr is no terminal (default: only on a "
+        help=f"show {bar} on stderr even if stderr is no terminal (default: only on a "
         f"terminal{unless})",
     )
-    g.add_argument("--no-progress", action="store_true", help=f"never draw {bar}")
+    g.add_argument("--no-progress", action="store_true", help=f"never show {bar}")
     p.set_defaults(progress_with_json=not json_hides)
 
 
