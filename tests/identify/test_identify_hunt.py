@@ -560,10 +560,10 @@ def test_starts_from_a_generator_an_array_or_tuples_agree(fake: FakeEvaluate) ->
 @pytest.mark.parametrize(
     ("kwargs", "error", "match"),
     [
-        ({"measured": {**BASE, "marker3_dz_m": -0.0}}, ValueError, "marker3_dz_m must be posit"),
+        ({"measured": {**BASE, "marker3_dz_m": -0.0}}, ValueError, "marker3_dz_m must be > 0"),
         ({"measured": {**BASE, "marker3_dx_m": True}}, ValueError, "must be a number"),
-        ({"period": -0.0}, ValueError, "period must be positive"),
-        ({"period": math.nan}, ValueError, "period must be positive"),
+        ({"period": -0.0}, ValueError, "period must be > 0"),
+        ({"period": math.nan}, ValueError, "period must be finite"),
         ({"starts": [(0.15e-3, math.nan)]}, ValueError, "outside the bounds"),
         ({"starts": (0.15e-3, 150e9)}, ValueError, "a start must be a"),
         ({"starts": [(0.15e-3, 150e9, 0.3)]}, ValueError, "a start must be a"),

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -25,7 +26,13 @@ from tapespring.identify.static import (
     target_from,
 )
 from tapespring.scenarios.equilibrium import EquilibriumSettings
-from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, PAPER_SETUP, IdentificationBounds
+from tapespring.scenarios.setup import (
+    PAPER_BOUNDS,
+    PAPER_MODEL,
+    PAPER_SETUP,
+    IdentificationBounds,
+    check_number,
+)
 
 COARSE = EquilibriumSettings(spec=replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3))
 
@@ -108,8 +115,8 @@ def test_trials_are_averaged() -> None:
     ("measured", "error", "match"),
     [
         ({"markers12_dx_m": 0.02}, ValueError, "lack 'markers12_dz_m'"),
-        ({**paper_target(), "marker3_dx_m": 0.0}, ValueError, "marker3_dx_m must be positive"),
-        ({**paper_target(), "marker3_dz_m": math.nan}, ValueError, "marker3_dz_m must be posit"),
+        ({**paper_target(), "marker3_dx_m": 0.0}, ValueError, "marker3_dx_m must be > 0"),
+        ({**paper_target(), "marker3_dz_m": math.nan}, ValueError, "marker3_dz_m must be finite"),
         ({**paper_target(), "marker3_dz_m": "0.1"}, ValueError, "must be a number"),
         ([], ValueError, "no identification trials"),
         ([1.0], TypeError, "an item 1.0"),
@@ -120,6 +127,46 @@ def test_trials_are_averaged() -> None:
 def test_bad_measurements_are_refused(measured: object, error: type, match: str) -> None:
     with pytest.raises(error, match=match):
         target_from(measured)  # type: ignore[arg-type]
+
+
+def _message(check: Callable[[object], object], value: object) -> str:
+    with pytest.raises(ValueError) as exc:
+        check(value)
+    return str(exc.value)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        0.0,
+        -0.0,
+        -24e-3,
+        math.nan,
+        -math.inf,
+        pytest.param(10**400, id="int-beyond-floats"),
+        pytest.param(np.float32(0.0), id="float32"),
+        pytest.param(np.array(-1.0), id="0-d-array"),
+    ],
+)
+def test_bad_numbers_are_refused_in_the_settings_words(value: object) -> None:
+    """target_from and period_from refuse a number as check_number does (the settings' and
+    the command line's words), naming the displacement or the period."""
+    key = "marker3_dx_m"
+    number = value.item() if isinstance(value, np.generic | np.ndarray) else value
+    expected = _message(lambda v: check_number(f"the measured {key}", v, positive=True), number)
+    assert _message(lambda v: target_from({**paper_target(), key: v}), value) == expected
+    expected = _message(lambda v: check_number("period", v, positive=True), number)
+    assert _message(static.period_from, value) == expected
+    assert key in _message(lambda v: target_from({**paper_target(), key: v}), value)
+
+
+def test_numpy_numbers_are_measured_numbers() -> None:
+    measured = {**paper_target(), "marker3_dx_m": np.float32(0.04), "marker3_dz_m": np.int64(1)}
+    target = target_from(measured)
+    assert target["marker3_dx_m"] == pytest.approx(0.04) and target["marker3_dz_m"] == 1.0
+    assert all(type(v) is float for v in target.values())
+    assert static.period_from(np.float32(0.1)) == pytest.approx(0.1)
+    assert static.period_from(np.int64(1)) == 1.0
 
 
 @pytest.mark.parametrize(

@@ -56,7 +56,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
-from tapespring.scenarios.setup import PAPER_BOUNDS, PAPER_MODEL, PAPER_TAPE, IdentificationBounds
+from tapespring.scenarios.setup import (
+    PAPER_BOUNDS,
+    PAPER_MODEL,
+    PAPER_TAPE,
+    IdentificationBounds,
+    check_number,
+)
 
 from .notes import IdentificationWarning
 
@@ -176,17 +182,18 @@ def target_from(
         )
     out: dict[str, float] = {}
     for key, value in values.items():
-        if isinstance(value, bool) or not isinstance(value, int | float | np.floating):
-            raise ValueError(f"the measured {key} must be a number [m] (got {value!r})")
-        try:
-            finite = math.isfinite(value)
-        except OverflowError:  # an int beyond the floats (10**400)
-            finite = False
-        if not (finite and value > 0.0):
-            # eq. (4) divides by each: a zero or negative displacement has no relative difference.
-            raise ValueError(f"the measured {key} must be positive and finite [m] (got {value!r})")
-        out[key] = float(value)
+        # eq. (4) divides by each: a zero or negative displacement has no relative difference.
+        number = check_number(f"the measured {key}", _python_number(value), positive=True)
+        out[key] = float(number)
     return out
+
+
+def _python_number(value: object) -> object:
+    """A numpy scalar or 0-d array as the Python number it holds (for :func:`check_number`,
+    which takes Python numbers); anything else unchanged."""
+    if isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0:
+        return value.item()
+    return value
 
 
 def objective(values: Mapping[str, float], target: Mapping[str, float]) -> float:
@@ -217,17 +224,14 @@ def period_from(measured: object) -> float | None:
 
     if measured is None:
         return None
-    if isinstance(measured, np.ndarray) and measured.ndim == 0:
-        measured = measured.item()  # a 0-d array is its number
+    measured = _python_number(measured)
     if isinstance(measured, VibrationResult):
         measured = [measured]
     if isinstance(measured, bool) or isinstance(measured, str | bytes):
         raise TypeError(f"period must be a number [s] or recorded decays (got {measured!r})")
-    if isinstance(measured, int | float | np.floating | np.integer):
-        try:
-            value = float(measured)
-        except OverflowError:  # an int beyond the floats (10**400)
-            value = math.inf
+    value: object
+    if isinstance(measured, int | float):
+        value = measured
     elif isinstance(measured, Iterable):
         decays = list(measured)
         if not decays:
@@ -241,9 +245,8 @@ def period_from(measured: object) -> float | None:
         value = float(np.mean([decay.fit.period for decay in decays]))
     else:
         raise TypeError(f"period must be a number [s] or recorded decays (got {measured!r})")
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"the measured period must be positive and finite [s] (got {value!r})")
-    return value
+    # The command line's --period is refused with the same message.
+    return float(check_number("period", value, positive=True))
 
 
 @dataclass(frozen=True)
@@ -958,7 +961,7 @@ def identify_static(
     tapespring.sweep.WorkerDied
         If a worker process died (killed, out of memory).
     """
-    from tapespring.scenarios.setup import check_count, check_number
+    from tapespring.scenarios.setup import check_count
     from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
 
     target = target_from(measured)
