@@ -319,6 +319,25 @@ class _AffineVibrate:
         )
 
 
+def test_the_plot_draws_into_the_given_axes(monkeypatch: pytest.MonkeyPatch) -> None:
+    """As the other one-axes plots: into `ax` if given (no figure of its own), else a new one."""
+    import matplotlib.pyplot as plt
+    from tapespring.plot import plot_damping_identification
+
+    monkeypatch.setattr(damping, "vibrate", _AffineVibrate(offset=0.001, slope=math.pi / 0.108))
+    result = identify_damping(0.005, SETTINGS, rel_tolerance=1e-6)
+    fig, (left, right) = plt.subplots(1, 2)
+    figures = plt.get_fignums()
+    assert plot_damping_identification(result, ax=right) is right
+    assert plt.get_fignums() == figures
+    assert len(right.lines) >= 3 and "viscosity" in right.get_xlabel()
+    assert not left.lines and not left.collections
+    plt.close(fig)
+    own = plot_damping_identification(result)
+    assert own.figure is not fig and "viscosity" in own.get_xlabel()
+    plt.close(own.figure)
+
+
 def test_an_affine_fit_is_met_in_two_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     """The Kelvin-Voigt step from the first guess, with the offset of the integrator's damping:
     exact when the slope is Kelvin-Voigt's (pi / T)."""

@@ -786,7 +786,7 @@ def test_damping_plot_and_summary_without_a_fitted_run(monkeypatch: pytest.Monke
     assert out.damping_ratio is None and not out.converged and out.affine_model is None
     _strict_json(json.dumps(out.summary()))
     assert "no fit" in out.describe()
-    plt.close(plot_damping_identification(out))
+    plt.close(plot_damping_identification(out).figure)
 
 
 def test_damping_flags_follow_the_returned_run(monkeypatch: pytest.MonkeyPatch) -> None:

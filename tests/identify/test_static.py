@@ -446,3 +446,22 @@ def test_starts_in_worker_processes() -> None:
     again = static._evaluate(COARSE, paper_target(), result.thickness_m,
                              result.youngs_modulus_Pa, 0)  # fmt: skip
     assert again.displacements_m == result.displacements_m
+
+
+def test_the_plot_draws_into_the_given_axes(fake_runs: list[tuple[float, float]]) -> None:
+    """As the other one-axes plots: into `ax` if given (no figure of its own), else a new one."""
+    import matplotlib.pyplot as plt
+    from tapespring.plot import plot_static_identification
+
+    result = identify_static(closed_form(TRUE_T, TRUE_E), starts=2, max_evaluations=12)
+    fig, (left, right) = plt.subplots(1, 2)
+    figures = plt.get_fignums()
+    assert plot_static_identification(result, ax=right) is right
+    assert plt.get_fignums() == figures
+    assert right.collections and right.get_xlabel() == "thickness t [mm]"
+    assert not left.lines and not left.collections
+    assert len(fig.axes) == 3  # the two, and the objective's colour bar beside the right one
+    plt.close(fig)
+    own = plot_static_identification(result)
+    assert own.figure is not fig and own.get_xlabel() == "thickness t [mm]"
+    plt.close(own.figure)

@@ -233,7 +233,7 @@ def run_static(args: argparse.Namespace) -> int:
         from tapespring.plot.identify import plot_static_identification
         from tapespring.report import save_figure
 
-        save_figure(plot_static_identification(result), path)
+        save_figure(plot_static_identification(result).figure, path)
 
     def columns(result: StaticIdentification) -> dict:
         runs = result.evaluations
@@ -374,7 +374,7 @@ def run_damping(args: argparse.Namespace) -> int:
         from tapespring.plot.identify import plot_damping_identification
         from tapespring.report import save_figure
 
-        save_figure(plot_damping_identification(result), path)
+        save_figure(plot_damping_identification(result).figure, path)
 
     def columns(result: DampingIdentification) -> dict:
         nan = float("nan")

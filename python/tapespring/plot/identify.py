@@ -3,25 +3,44 @@ eta matched to a damping ratio."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["plot_damping_identification", "plot_static_identification"]
 
 
-def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
+def plot_static_identification(result: Any, *, paper: bool = True, ax: Axes | None = None) -> Axes:
     """The search of :func:`tapespring.identify.identify_static` in the (t, E) plane: every run
     coloured by its objective (eq. (4), logarithmic scale; crosses where no stable folded
     equilibrium was found), each start's path, the optimum, the curve ``E t^a`` = const through
     it along which the data fix t and E least (``a`` from the sensitivity, else 3), and the
-    paper's Table 5. Returns the figure."""
+    paper's Table 5.
+
+    Parameters
+    ----------
+    result : tapespring.identify.StaticIdentification
+        The identification.
+    paper : bool
+        Mark the paper's t and E (Table 5).
+    ax : matplotlib Axes, optional
+        Where to draw (the objective's colour bar is taken from it); a new figure is made if
+        None.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
 
     from tapespring.scenarios.setup import PAPER_TAPE
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
     runs = [e for e in result.evaluations if e.start >= 0]
     counted = [e for e in runs if e.counted]
     failed = [e for e in runs if not e.counted]
@@ -38,7 +57,7 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
             s=18,
             zorder=3,
         )
-        fig.colorbar(points, ax=ax, label="objective, eq. (4) [-]")
+        ax.figure.colorbar(points, ax=ax, label="objective, eq. (4) [-]")
     if failed:
         ax.plot(
             [e.thickness_m * 1e3 for e in failed],
@@ -106,19 +125,34 @@ def plot_static_identification(result: Any, *, paper: bool = True) -> Any:
     )
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7, loc="upper right")
-    return fig
+    return ax
 
 
-def plot_damping_identification(result: Any, *, paper: bool = True) -> Any:
+def plot_damping_identification(result: Any, *, paper: bool = True, ax: Axes | None = None) -> Axes:
     """The runs of :func:`tapespring.identify.identify_damping`: the fitted damping ratio against
     the viscosity eta, the least-squares line through them, the target ratio and its tolerance
     band, the identified eta and (with `paper`) the paper's model (Table 8: eta = 1.73e-4 s,
-    0.505 %). Returns the figure."""
+    0.505 %).
+
+    Parameters
+    ----------
+    result : tapespring.identify.DampingIdentification
+        The identification.
+    paper : bool
+        Mark the paper's model (Table 8).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure is made if None.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
     import matplotlib.pyplot as plt
 
     from tapespring.scenarios.setup import PAPER_MODEL
 
-    fig, ax = plt.subplots(figsize=(6.0, 4.0), constrained_layout=True)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.0, 4.0), constrained_layout=True)
     runs = [r for r in result.runs if r.damping_ratio is not None]
     if runs:
         eta = np.array([r.eta_s for r in runs])
@@ -168,4 +202,4 @@ def plot_damping_identification(result: Any, *, paper: bool = True) -> Any:
     )
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=8)
-    return fig
+    return ax
