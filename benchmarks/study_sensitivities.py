@@ -57,7 +57,7 @@ def settings_for(test: str, mesh_tape: float, mesh_plates: float) -> object:
 def main(argv: list[str] | None = None) -> int:
     from tapespring.scenarios.setup import PAPER_SETUP
     from tapespring.study import sensitivity
-    from tapespring.study.sensitivity import REL_STEP
+    from tapespring.study.sensitivities import REL_STEP
 
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tests", nargs="+", choices=list(PARAMETERS), default=list(PARAMETERS))

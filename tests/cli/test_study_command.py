@@ -165,9 +165,8 @@ def test_set_converts_each_value_to_its_settings_type(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
 ) -> None:
     # Flags, integers, texts, tuples and numbers, given to the scenarios' settings as they are
-    # typed; the study is not run (its function stood in for). The module from sys.modules:
-    # `import tapespring.study.sensitivity as m` gives the package's function of that name.
-    module = importlib.import_module("tapespring.study.sensitivity")
+    # typed; the study is not run (its function stood in for).
+    module = importlib.import_module("tapespring.study.sensitivities")
 
     given = {}
 

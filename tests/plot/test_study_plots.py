@@ -1,11 +1,6 @@
 """The studies' figures (plot.study): an ensemble's histories, band and scatter panels, and a
 sensitivity study's tornado chart, drawn from results built from synthetic runs (no solver run,
 except one small ensemble of bending curves).
-
-The study's classes are imported inside the helpers, not at the top: importing
-``tapespring.study.ensemble`` (the module) before ``tapespring.study.ensemble`` (the function)
-has been looked up binds the package's name ``ensemble`` to the module, and the test modules
-collected after this one (``from tapespring.study import ensemble``) would get the module.
 """
 
 from __future__ import annotations
@@ -29,8 +24,8 @@ from tapespring.plot.study import (
 from tapespring.report import save_figure
 
 if TYPE_CHECKING:
-    from tapespring.study.ensemble import Ensemble
-    from tapespring.study.sensitivity import SensitivityStudy
+    from tapespring.study.ensembles import Ensemble
+    from tapespring.study.sensitivities import SensitivityStudy
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -46,7 +41,7 @@ def _ensemble(
     of `figures` is a function ``f(t, E)`` of a run's draws. Each run's history is a moment
     ``E / E0 sin(3 theta)`` over 0-30 deg (`increasing`), a pull path that turns back at its
     maximum (`turning`), or none (`none`). The runs of `failed` end with an error."""
-    from tapespring.study.ensemble import Ensemble
+    from tapespring.study.ensembles import Ensemble
     from tapespring.study.runs import StudyRun
 
     rng = np.random.default_rng(7)
@@ -109,7 +104,7 @@ def _sensitivity(
     1 % steps; `kink` (figure, setting) gets a one-sided change three times the other; the runs
     of `failed` (indices) end with an error."""
     from tapespring.study.runs import StudyRun
-    from tapespring.study.sensitivity import SensitivityStudy
+    from tapespring.study.sensitivities import SensitivityStudy
 
     parameters = ("youngs_modulus", "thickness", "poisson")
     nominal = np.array([1.5176e11, 1.38e-4, 0.3])
@@ -258,7 +253,7 @@ def test_sensitivity_has_a_bar_per_figure_and_setting_hatched_where_not_smooth()
         kink=("theta_snap_deg", "thickness"),
     )  # fmt: skip
     assert study.nonsmooth.sum() == 1
-    fig = plot_sensitivity(study)
+    fig = plot_sensitivity(study).figure
     try:
         ax = fig.axes[0]
         bars = _bars(ax)
@@ -286,7 +281,7 @@ def test_sensitivity_marks_what_it_could_not_compute():
     study = _sensitivity({"m_max_Nm": (1.0, 1.9, -0.3), "m_star_Nm": (1.0, 2.85, 0.0)},
                          failed=(5, 6))  # fmt: skip
     assert np.isnan(study.elasticities[:, 2]).all()
-    fig = plot_sensitivity(study)
+    fig = plot_sensitivity(study).figure
     try:
         ax = fig.axes[0]
         assert len(_bars(ax)) == 2 * 2
@@ -300,7 +295,7 @@ def test_sensitivity_marks_what_it_could_not_compute():
 def test_sensitivity_draws_on_the_axes_given():
     fig, ax = plt.subplots()
     try:
-        assert plot_sensitivity(_sensitivity({"m_max_Nm": (1.0, 2.0, 0.0)}), ax=ax) is fig
+        assert plot_sensitivity(_sensitivity({"m_max_Nm": (1.0, 2.0, 0.0)}), ax=ax) is ax
         assert len(_bars(ax)) == 3 and ax.get_legend() is not None
     finally:
         plt.close(fig)
@@ -313,7 +308,7 @@ def test_the_figures_save_as_png(which, tmp_path: Path):
     else:
         fig = plot_sensitivity(
             _sensitivity({"m_max_Nm": (1.0, 1.9, -0.3)}, kink=("m_max_Nm", "poisson"))
-        )
+        ).figure
     path = save_figure(fig, tmp_path / f"{which}.png")
     assert path.read_bytes()[:8] == PNG_SIGNATURE and path.stat().st_size > 10_000
 
@@ -323,7 +318,7 @@ def test_an_ensemble_of_bending_curves():
     # on this mesh), so the curves are lines without a band; the peak moment's driver is E.
     from scipy import stats
     from tapespring.scenarios.bending import BendingSetup
-    from tapespring.study.ensemble import ensemble
+    from tapespring.study.ensembles import ensemble
 
     result = ensemble(
         "bend",

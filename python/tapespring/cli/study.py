@@ -9,7 +9,7 @@ changes any setting of the scenario first. Settings are named by their dotted pa
 scenario's settings (:mod:`tapespring.study.paths`: ``tape.thickness``, ``eta``, ``duration``,
 ``mesh_size``), their values in SI units.
 
-Building the parser imports ``tapespring.study.figures`` and ``tapespring.study.sensitivity``
+Building the parser imports ``tapespring.study.figures`` and ``tapespring.study.sensitivities``
 for the scenarios' names and the default step (numpy; no scipy, matplotlib or native extension);
 the distributions (scipy) are parsed when ``--vary`` is given, the scenario runs and matplotlib
 are imported by the handlers.
@@ -31,8 +31,8 @@ from .bend import warn as warn_line
 from .scenario_options import add_progress_options, add_workers_option, shows_progress
 
 if TYPE_CHECKING:
-    from tapespring.study.ensemble import Ensemble
-    from tapespring.study.sensitivity import SensitivityStudy
+    from tapespring.study.ensembles import Ensemble
+    from tapespring.study.sensitivities import SensitivityStudy
 
 __all__ = ["register", "run_ensemble", "run_sensitivity"]
 
@@ -43,19 +43,11 @@ _WIDTH = 78
 
 def _study_names() -> tuple[tuple[str, ...], float, str, tuple[str, ...]]:
     """The scenarios' names, the default relative step, the distributions' forms and the
-    samplings, from :mod:`tapespring.study`.
-
-    The package's lazy names ``ensemble`` and ``sensitivity`` (the functions) are looked up
-    before the modules of the same names are imported: importing a module of a package binds
-    its name in the package, so that a later ``from tapespring.study import ensemble`` (a
-    script or test importing after a parser was built) gave the module, not the function."""
-    import tapespring.study as study
-
-    study.ensemble, study.sensitivity  # noqa: B018 (looked up for their side effect)
+    samplings, from :mod:`tapespring.study`."""
     from tapespring.study.distributions import FORMS
-    from tapespring.study.ensemble import SAMPLINGS
+    from tapespring.study.ensembles import SAMPLINGS
     from tapespring.study.figures import SCENARIOS
-    from tapespring.study.sensitivity import REL_STEP
+    from tapespring.study.sensitivities import REL_STEP
 
     return tuple(SCENARIOS), REL_STEP, "; ".join(FORMS.values()), SAMPLINGS
 
@@ -290,7 +282,7 @@ def _whole(value: float) -> bool:
 
 
 def _check_runs(value: float) -> None:
-    from tapespring.study.ensemble import MAX_RUNS
+    from tapespring.study.ensembles import MAX_RUNS
 
     if not _whole(value) or not 1 <= value <= MAX_RUNS:
         raise ValueError(f"runs must be an integer from 1 to {MAX_RUNS} (got {value:g})")
@@ -472,7 +464,7 @@ def _exit_code(result: Any, *, nominal_failed: bool = False) -> int:
 def run_ensemble(args: argparse.Namespace) -> int:
     """Handler of ``tapespring study ensemble``; returns the exit code (0; 1 stopped, every run
     failed or a worker died; 2 bad input)."""
-    from tapespring.study.ensemble import ensemble
+    from tapespring.study.ensembles import ensemble
     from tapespring.study.paths import resolve
 
     refuse_shared_paths(args)
@@ -516,7 +508,7 @@ def run_sensitivity(args: argparse.Namespace) -> int:
     """Handler of ``tapespring study sensitivity``; returns the exit code (0; 1 stopped, the
     nominal run or every run failed, or a worker died; 2 bad input)."""
     from tapespring.study.paths import number_at
-    from tapespring.study.sensitivity import sensitivity
+    from tapespring.study.sensitivities import sensitivity
 
     refuse_shared_paths(args)
     settings = _settings(args)
@@ -555,7 +547,7 @@ def run_sensitivity(args: argparse.Namespace) -> int:
     def plot(r: SensitivityStudy) -> Any:
         from tapespring.plot.study import plot_sensitivity
 
-        return plot_sensitivity(r)
+        return plot_sensitivity(r).figure
 
     _outputs(args, result, result.summary(), ["scenario", "parameters", "settings"], plot)
     nominal = next((r for r in result.runs if r.index == 0), None)

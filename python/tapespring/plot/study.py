@@ -13,8 +13,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from tapespring.study.ensemble import Ensemble
-    from tapespring.study.sensitivity import SensitivityStudy
+    from tapespring.study.ensembles import Ensemble
+    from tapespring.study.sensitivities import SensitivityStudy
 
 __all__ = ["MAX_SCATTER_PANELS", "plot_ensemble", "plot_sensitivity"]
 
@@ -120,7 +120,7 @@ def _scatter_figures(result: Ensemble) -> list[tuple[str, str | None, float, flo
 def _plot_histories(ax: Axes, result: Ensemble) -> bool:
     """The runs' histories as thin lines, with the band of their quantiles and their median when
     the abscissae increase; returns whether the band was drawn."""
-    from tapespring.study.ensemble import QUANTILES
+    from tapespring.study.ensembles import QUANTILES
 
     histories = result.histories()
     for k, (x, y) in enumerate(histories):
@@ -276,7 +276,7 @@ def plot_ensemble(result: Ensemble) -> Figure:
     return fig
 
 
-def plot_sensitivity(result: SensitivityStudy, *, ax: Axes | None = None) -> Figure:
+def plot_sensitivity(result: SensitivityStudy, *, ax: Axes | None = None) -> Axes:
     """A sensitivity study's elasticities (:func:`tapespring.study.sensitivity`) as a tornado
     chart: one group of horizontal bars per figure, one bar per setting (coloured by setting,
     its value at its end), the figures with the largest elasticity at the top. A bar whose two
@@ -293,8 +293,8 @@ def plot_sensitivity(result: SensitivityStudy, *, ax: Axes | None = None) -> Fig
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure drawn on (that of `ax` if given).
+    matplotlib.axes.Axes
+        The axes drawn on (`ax` if given), as the other one-axes plots; its ``.figure`` to save.
     """
     import matplotlib.pyplot as plt
     from matplotlib.patches import Patch
@@ -385,4 +385,4 @@ def plot_sensitivity(result: SensitivityStudy, *, ax: Axes | None = None) -> Fig
                    fontsize=8, frameon=False)  # fmt: skip
     else:
         ax.legend(handles=handles, fontsize=8)
-    return fig
+    return ax

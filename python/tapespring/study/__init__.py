@@ -3,10 +3,10 @@ uncertainty and local sensitivities of the figures to the settings.
 
 Modules
 -------
-ensemble
+ensembles
     `ensemble`: a scenario over settings drawn from their distributions; each figure's
     statistics, its rank correlation with each setting, a band of the histories.
-sensitivity
+sensitivities
     `sensitivity`: derivatives and elasticities of the figures by central differences, with a
     flag where a figure is not smooth.
 paths
@@ -24,9 +24,9 @@ from typing import TYPE_CHECKING
 from tapespring._lazy import lazy_exports
 
 if TYPE_CHECKING:
-    from .ensemble import Ensemble, ensemble
+    from .ensembles import Ensemble, ensemble
     from .runs import StudyRun, StudyWarning
-    from .sensitivity import SensitivityStudy, sensitivity
+    from .sensitivities import SensitivityStudy, sensitivity
 
 __all__ = [
     "Ensemble",
@@ -41,8 +41,8 @@ __getattr__, __dir__ = lazy_exports(
     __name__,
     __all__,
     {
-        "ensemble": ["Ensemble", "ensemble"],
-        "sensitivity": ["SensitivityStudy", "sensitivity"],
+        "ensembles": ["Ensemble", "ensemble"],
+        "sensitivities": ["SensitivityStudy", "sensitivity"],
         "runs": ["StudyRun", "StudyWarning"],
     },
 )

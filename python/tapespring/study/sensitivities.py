@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .ensemble import _settings_tree, _where, check_progress
+from .ensembles import _settings_tree, _where, check_progress
 from .paths import number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
