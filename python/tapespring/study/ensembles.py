@@ -35,13 +35,16 @@ from .figures import History
 from .paths import number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
-__all__ = ["MAX_RUNS", "QUANTILES", "SAMPLINGS", "Ensemble", "ensemble"]
+__all__ = ["MAX_RUNS", "QUANTILES", "SAMPLINGS", "SAVE_FORMAT", "Ensemble", "ensemble"]
 
 #: Most runs an ensemble takes in one call (a study of more is several calls, or a cluster's).
 MAX_RUNS = 100_000
 
 #: How the draws are spread: ``lhs`` a Latin hypercube, ``random`` independent draws.
 SAMPLINGS = ("lhs", "random")
+
+#: The kind and version of :meth:`Ensemble.save`'s files.
+SAVE_FORMAT = "tapespring.study.ensemble/1"
 
 #: The quantiles of the histories' band and of the figures' statistics: 5 %, median, 95 %.
 QUANTILES = (0.05, 0.5, 0.95)
@@ -339,6 +342,84 @@ class Ensemble:
     def write_json(self, path: str | Path) -> None:
         """:meth:`summary` as a JSON file (strict JSON: NaN written as null)."""
         Path(path).write_text(json.dumps(self.summary(), indent=1), encoding="utf-8")
+
+    def save(self, path: str | Path) -> None:
+        """Everything of the ensemble, its runs' histories included, as a JSON file that
+        :meth:`load` reads back (to plot or tabulate a long study again without running it).
+        The settings are kept as their JSON tree."""
+        from tapespring.report import jsonable_tree
+
+        data = self.summary() | {
+            "format": SAVE_FORMAT,
+            "distributions": list(self.distributions),
+            "varied": list(self.parameters),
+            "samples": jsonable_tree(self.samples.tolist()),
+            "history_labels": list(self.history_labels),
+            "histories": [
+                None if run.history is None else [run.history[0].tolist(), run.history[1].tolist()]
+                for run in self.runs
+            ],
+        }
+        Path(path).write_text(json.dumps(jsonable_tree(data)), encoding="utf-8")
+
+    @classmethod
+    def load(cls, path: str | Path) -> Ensemble:
+        """An ensemble written by :meth:`save`; its ``settings`` are their JSON tree.
+
+        Raises
+        ------
+        OSError
+            If the file cannot be read.
+        ValueError
+            If it is not an ensemble saved by :meth:`save` (not JSON, another format, a field
+            missing or of the wrong kind), naming the file.
+        """
+        try:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+            if not isinstance(data, dict) or data.get("format") != SAVE_FORMAT:
+                raise ValueError(f"not a saved ensemble (format {SAVE_FORMAT!r})")
+
+            def number(x: Any) -> float:
+                return math.nan if x is None else float(x)
+
+            runs = []
+            for run, history in zip(data["runs"], data["histories"], strict=True):
+                runs.append(
+                    StudyRun(
+                        index=int(run["index"]),
+                        values={k: float(v) for k, v in run["values"].items()},
+                        figures={k: number(v) for k, v in run["figures"].items()},
+                        history=None
+                        if history is None
+                        else (
+                            np.asarray(history[0], dtype=float),
+                            np.asarray(history[1], dtype=float),
+                        ),
+                        error=run["error"],
+                        wall_s=float(run["wall_s"]),
+                    )
+                )
+            samples = np.array(
+                [[number(x) for x in row] for row in data["samples"]], dtype=float
+            ).reshape(len(data["samples"]), len(data["varied"]))
+            return cls(
+                scenario=str(data["scenario"]),
+                parameters=tuple(str(p) for p in data["varied"]),
+                distributions=tuple(str(d) for d in data["distributions"]),
+                samples=samples,
+                runs=tuple(runs),
+                settings=data["settings"],
+                sampling=str(data["sampling"]),
+                seed=int(data["seed"]),
+                workers=int(data["workers"]),
+                cancelled=bool(data["cancelled"]),
+                wall_s=float(data["wall_s"]),
+                history_labels=(str(data["history_labels"][0]), str(data["history_labels"][1])),
+            )
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise ValueError(
+                f"{path}: cannot read an ensemble ({type(exc).__name__}: {exc})"
+            ) from exc
 
 
 def _where(workers: int) -> str:
