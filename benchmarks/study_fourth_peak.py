@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--modulus", default="normal:151.76e9:3%", help="E's distribution [Pa]")
     p.add_argument("--mesh-tape", type=float, default=PAPER_SETUP.mesh_tape)
     p.add_argument("--mesh-plates", type=float, default=PAPER_SETUP.mesh_plates)
-    p.add_argument("--json", help="write the ensemble's summary to this file")
+    p.add_argument("--json", help="save the ensemble (Ensemble.save: runs, histories) to this file")
     p.add_argument("--plot", help="write the ensemble's figure (PNG) to this file")
     args = p.parse_args(argv)
 
@@ -89,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
         if have.any():
             print(f"  {label}: eta from {eta[have].min():.3e} to {eta[have].max():.3e} s")
     if args.json:
-        result.write_json(args.json)
+        result.save(args.json)
     if args.plot:
         from tapespring.plot.study import plot_ensemble
 
