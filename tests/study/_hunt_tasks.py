@@ -154,3 +154,8 @@ def history_empty_above_3(r: Result) -> tuple[np.ndarray, np.ndarray]:
     if r.x[-1] > 3.0:
         return np.empty(0), np.empty(0)
     return r.x, r.y
+
+
+def kinked_figures(r: Result) -> dict[str, float]:
+    """``k = |a - 2|`` (a kink at the nominal ``a = 2``) and the smooth ``f``."""
+    return {"k": abs(r.x[-1] - 2.0), "f": r.f}
