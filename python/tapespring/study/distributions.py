@@ -94,8 +94,22 @@ def parse_distribution(text: str) -> Any:
     ------
     ValueError
         For an unknown kind, a wrong number of arguments, or arguments out of range (a
-        non-positive standard deviation, bounds in the wrong order), naming the form expected.
+        non-positive standard deviation, bounds in the wrong order, a spread beyond the
+        floating-point range), naming the form expected.
     """
+    import numpy as np
+
+    distribution, form = _parsed(text)
+    with np.errstate(all="ignore"):
+        quantiles = np.asarray(distribution.ppf([0.05, 0.5, 0.95]), dtype=float)
+        std = float(distribution.std())
+    if not (np.isfinite(quantiles).all() and math.isfinite(std) and std > 0.0):
+        raise ValueError(f"{text!r}: its spread is beyond the floating-point range ({form})")
+    return distribution
+
+
+def _parsed(text: str) -> tuple[Any, str]:
+    """:func:`parse_distribution`'s distribution and its form, before its spread is checked."""
     from scipy import stats
 
     kind, *args = (part.strip() for part in str(text).split(":"))
@@ -110,27 +124,27 @@ def parse_distribution(text: str) -> Any:
         raise ValueError(f"{text!r}: expected {form}")
     if kind == "normal":
         mean = _number(args[0], "MEAN", form)
-        return stats.norm(mean, _std(args[1], mean, form))
+        return stats.norm(mean, _std(args[1], mean, form)), form
     if kind == "truncnormal":
         mean = _number(args[0], "MEAN", form)
         std = _std(args[1], mean, form)
         low, high = (_number(a, w, form) for a, w in ((args[2], "LOW"), (args[3], "HIGH")))
         if not low < high:
             raise ValueError(f"{text!r}: LOW must be below HIGH ({form})")
-        return stats.truncnorm((low - mean) / std, (high - mean) / std, loc=mean, scale=std)
+        return stats.truncnorm((low - mean) / std, (high - mean) / std, loc=mean, scale=std), form
     if kind == "uniform":
         low, high = (_number(a, w, form) for a, w in ((args[0], "LOW"), (args[1], "HIGH")))
         if not low < high:
             raise ValueError(f"{text!r}: LOW must be below HIGH ({form})")
-        return stats.uniform(low, high - low)
+        return stats.uniform(low, high - low), form
     if kind == "lognormal":
         median, sigma = (_number(a, w, form) for a, w in ((args[0], "MEDIAN"), (args[1], "SIGMA")))
         if not (median > 0.0 and sigma > 0.0):
             raise ValueError(f"{text!r}: MEDIAN and SIGMA must be positive ({form})")
-        return stats.lognorm(sigma, scale=median)
+        return stats.lognorm(sigma, scale=median), form
     low, mode, high = (
         _number(a, w, form) for a, w in zip(args, ("LOW", "MODE", "HIGH"), strict=True)
     )
     if not (low <= mode <= high and low < high):
         raise ValueError(f"{text!r}: expected LOW <= MODE <= HIGH with LOW < HIGH ({form})")
-    return stats.triang((mode - low) / (high - low), loc=low, scale=high - low)
+    return stats.triang((mode - low) / (high - low), loc=low, scale=high - low), form

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from .distributions import check_distribution, describe_distribution
 from .figures import History
-from .paths import number_at, resolve
+from .paths import is_integer_setting, number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
 __all__ = ["MAX_RUNS", "QUANTILES", "SAMPLINGS", "SAVE_FORMAT", "Ensemble", "ensemble"]
@@ -51,10 +51,21 @@ QUANTILES = (0.05, 0.5, 0.95)
 
 
 def _settings_tree(settings: Any) -> Any:
+    """The settings as a strict-JSON tree: numbers, texts, flags, lists and dicts; any other
+    value (a path, an enum) as its text, so that a summary never fails to be written."""
     from tapespring.report import jsonable_tree
 
+    def plain(value: Any) -> Any:
+        if isinstance(value, dict):
+            return {str(k): plain(v) for k, v in value.items()}
+        if isinstance(value, list | tuple):
+            return [plain(v) for v in value]
+        if value is None or isinstance(value, bool | int | float | str):
+            return value
+        return str(value)
+
     if is_dataclass(settings) and not isinstance(settings, type):
-        return jsonable_tree(asdict(settings))
+        return plain(jsonable_tree(asdict(settings)))
     return repr(settings)
 
 
@@ -217,7 +228,7 @@ class Ensemble:
             increase (a path that turns back, such as a pull beyond its maximum: compare such
             histories as lines, not as a band).
         """
-        histories = self.histories()
+        histories = [h for h in self.histories() if h[0].size]  # an empty one counts nowhere
         if not histories:
             raise ValueError("no run of the ensemble has a history")
         q = np.asarray(quantiles, dtype=float)
@@ -422,6 +433,13 @@ class Ensemble:
             ) from exc
 
 
+def _discrete(distribution: Any) -> bool:
+    """True for a SciPy discrete distribution (integer draws)."""
+    from scipy.stats import rv_discrete
+
+    return isinstance(getattr(distribution, "dist", None), rv_discrete)
+
+
 def _where(workers: int) -> str:
     """Where a study's runs ran, for a person."""
     if workers == 0:
@@ -529,7 +547,7 @@ def ensemble(
         If some runs failed (their settings refused, or the solver stopped); they are kept in
         ``runs`` with their message.
     """
-    from tapespring.sweep import check_workers, processes_for
+    from tapespring.sweep import check_workers
 
     if not isinstance(parameters, Mapping) or not parameters:
         raise ValueError(
@@ -541,8 +559,10 @@ def ensemble(
         raise ValueError(f"sampling must be one of {', '.join(SAMPLINGS)} (got {sampling!r})")
     if seed is None:
         seed = int(np.random.SeedSequence().entropy % 2**63)  # type: ignore[operator]
-    elif isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+    elif isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
         raise TypeError(f"seed must be a non-negative integer or None (got {seed!r})")
+    elif seed < 0:
+        raise ValueError(f"seed must be a non-negative integer or None (got {seed!r})")
     check_workers(workers)
     check_progress(progress)
     runner, settings = runner_for(scenario, settings, figures, history)
@@ -551,6 +571,11 @@ def ensemble(
         resolve(settings, name)
         number_at(settings, name)
         check_distribution(name, parameters[name])
+        if is_integer_setting(settings, name) and not _discrete(parameters[name]):
+            raise ValueError(
+                f"setting {name!r} is an integer: draw it from a discrete distribution such as "
+                f"scipy.stats.randint (got {describe_distribution(parameters[name])})"
+            )
     if len({resolve(settings, n) for n in names}) != len(names):
         raise ValueError(f"a setting is varied twice in {list(names)}")
     samples = draws([parameters[n] for n in names], n_runs, seed=int(seed), sampling=sampling)
@@ -564,7 +589,7 @@ def ensemble(
         return not (callback is not None and callback(run) is False)
 
     t0 = time.perf_counter()
-    ended, stopped = run_all(
+    ended, stopped, processes = run_all(
         runner, settings, values, workers=workers, executor=executor, report=report
     )
     result = Ensemble(
@@ -576,7 +601,7 @@ def ensemble(
         settings=settings,
         sampling=sampling,
         seed=int(seed),
-        workers=0 if executor is not None else processes_for(workers, n_runs),
+        workers=processes,
         cancelled=stopped,
         wall_s=time.perf_counter() - t0,
         history_labels=runner.history_labels,

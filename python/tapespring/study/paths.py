@@ -16,13 +16,43 @@ import numbers
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["assign", "check_settings", "number_at", "resolve", "value_at"]
+__all__ = [
+    "assign",
+    "check_settings",
+    "is_integer_setting",
+    "number_at",
+    "resolve",
+    "value_at",
+]
 
 
 def _fields(obj: object) -> dict[str, dataclasses.Field[Any]]:
     if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
         return {}
     return {f.name: f for f in dataclasses.fields(obj)}
+
+
+def _declared(obj: object, name: str) -> str:
+    """The declared type of field `name` of dataclass `obj` as a name (``float``, ``int``, ...;
+    empty for a type that is not a plain name)."""
+    kind = _fields(obj)[name].type
+    return kind if isinstance(kind, str) else getattr(kind, "__name__", "")
+
+
+def is_integer_setting(settings: object, name: str) -> bool:
+    """True if setting `name` holds integers: declared ``int``, or holding an int where its
+    declaration is not a plain number type (a float field with an integer default is a float)."""
+    path = resolve(settings, name).split(".")
+    owner: object = settings
+    for part in path[:-1]:
+        owner = getattr(owner, part)
+    declared = _declared(owner, path[-1])
+    if declared in ("float", "bool"):
+        return False
+    value = getattr(owner, path[-1])
+    return declared == "int" or (
+        isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    )
 
 
 def resolve(settings: object, name: str) -> str:
@@ -87,8 +117,9 @@ def number_at(settings: object, name: str) -> float:
 def assign(settings: Any, values: Mapping[str, Any]) -> Any:
     """`settings` with each setting of `values` (name: value) replaced, the others kept.
 
-    A number given for a numeric field must be finite; an integer field takes an integer value
-    only. The result is not validated: call :func:`check_settings`.
+    A number given for a numeric field must be finite; an integer field (declared ``int``) takes
+    an integer value only, a float field any number (also one whose default is written ``2``).
+    The result is not validated: call :func:`check_settings`.
 
     Raises
     ------
@@ -100,12 +131,13 @@ def assign(settings: Any, values: Mapping[str, Any]) -> Any:
     out = settings
     for name, value in values.items():
         path = resolve(out, name).split(".")
-        _check_value(name, value_at(out, name), value)
-        out = _replaced(out, path, value)
+        integer = is_integer_setting(out, name)
+        _check_value(name, value_at(out, name), value, integer=integer)
+        out = _replaced(out, path, value, integer=integer)
     return out
 
 
-def _check_value(name: str, old: object, new: object) -> None:
+def _check_value(name: str, old: object, new: object, *, integer: bool) -> None:
     if isinstance(old, bool):
         if not isinstance(new, bool):
             raise TypeError(f"setting {name!r} is a flag: give True or False (got {new!r})")
@@ -113,26 +145,24 @@ def _check_value(name: str, old: object, new: object) -> None:
     if isinstance(old, numbers.Real):
         if isinstance(new, bool) or not isinstance(new, numbers.Real):
             raise TypeError(f"setting {name!r} is a number (got {new!r})")
-        if isinstance(old, numbers.Integral) and not isinstance(new, numbers.Integral):
-            if not float(new).is_integer():
-                raise TypeError(f"setting {name!r} is an integer (got {new!r})")
         if not math.isfinite(float(new)):
             raise ValueError(f"setting {name!r} must be finite (got {new!r})")
+        if integer and not isinstance(new, numbers.Integral) and not float(new).is_integer():
+            raise TypeError(f"setting {name!r} is an integer (got {new!r})")
         return
     if isinstance(old, str) and not isinstance(new, str):
         raise TypeError(f"setting {name!r} is a text such as {old!r} (got {new!r})")
 
 
-def _replaced(obj: Any, path: list[str], value: Any) -> Any:
+def _replaced(obj: Any, path: list[str], value: Any, *, integer: bool) -> Any:
     head, *rest = path
     if rest:
-        value = _replaced(getattr(obj, head), rest, value)
-    elif isinstance(getattr(obj, head), numbers.Integral) and not isinstance(
-        getattr(obj, head), bool
-    ):
-        value = int(value)
-    elif isinstance(getattr(obj, head), float):
-        value = float(value)
+        value = _replaced(getattr(obj, head), rest, value, integer=integer)
+    elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+        old = getattr(obj, head)
+        if isinstance(old, numbers.Real) and not isinstance(old, bool):
+            number = float(value)
+            value = int(number) if integer else number
     return dataclasses.replace(obj, **{head: value})
 
 
@@ -141,9 +171,16 @@ def check_settings(settings: object) -> None:
 
     Raises
     ------
+    TypeError
+        If `settings` is a class, not settings (``BendingSetup``, not ``BendingSetup()``).
     ValueError
         Naming the bad value.
     """
+    if isinstance(settings, type):
+        raise TypeError(
+            f"settings must be an instance such as {settings.__name__}(), not the class "
+            f"{settings.__name__}"
+        )
     validate = getattr(settings, "validate", None)
     if callable(validate):
         validate()

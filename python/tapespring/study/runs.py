@@ -121,8 +121,14 @@ def runner_for(
             f"a scenario of your own ({name}) needs its settings and its figures (a function of "
             f"its result returning name: number); the ready-made ones are {', '.join(_names())}"
         )
+    if isinstance(settings, type):
+        check_settings(settings)  # refuses a class, saying an instance is needed
     if settings is None:
         settings = kind.default_settings()  # type: ignore[union-attr]
+    elif kind is not None and not isinstance(settings, type(kind.default_settings())):
+        raise TypeError(
+            f"the {kind.name} scenario takes a {kind.settings_class} (got {settings!r:.200})"
+        )
     check_settings(settings)
     keep: Callable[[Any], History] | None
     if callable(history):
@@ -183,7 +189,12 @@ def _run(task: _Task) -> StudyRun:
         error = _failure(exc)
     except Exception as exc:
         error = _failure(exc)
-    error = error or getattr(result, "error", None)  # a curve that stopped early (bend)
+    else:
+        if result is None:
+            error = "the scenario returned no result (None)"
+    stop = getattr(result, "error", None)
+    if error is None and isinstance(stop, str) and stop:
+        error = stop  # a curve that stopped early (bend): its message
     figures: dict[str, float] = {}
     history = None
     if result is not None:
@@ -213,32 +224,32 @@ def run_all(
     workers: int | None,
     executor: Any,
     report: Callable[[StudyRun], bool],
-) -> tuple[list[StudyRun], bool]:
+) -> tuple[list[StudyRun], bool, int]:
     """Run `settings` with each of `values` replaced; the runs refused by the settings' check
-    are recorded with their message, not run. ``report`` receives each run as it ends and may
-    return False to stop.
+    are recorded with their message, not run (and reported first). ``report`` receives each run
+    as it ends and may return False, or raise KeyboardInterrupt, to stop.
 
     Returns
     -------
-    (list of StudyRun, bool)
-        The runs that ended, in the study's order, and whether the study was stopped (by
-        `report` or Ctrl-C) before all ended.
+    (list of StudyRun, bool, int)
+        The runs that ended, in the study's order; whether the study was stopped (by `report`
+        or Ctrl-C) before all ended; the processes the runs ran in (1: this one; 0: on an
+        executor).
     """
-    from tapespring.sweep import WorkerDied, run_tasks
+    from tapespring.sweep import WorkerDied, processes_for, run_tasks
 
     runs: dict[int, StudyRun] = {}
     tasks: list[_Task] = []
-    stopped = False
+    refused: list[StudyRun] = []
     for i, v in enumerate(values):
         try:
             s = assign(settings, v)
             check_settings(s)
         except (TypeError, ValueError) as exc:
-            runs[i] = StudyRun(index=i, values=v, error=f"settings refused: {exc}")
-            if not report(runs[i]):
-                return [runs[k] for k in sorted(runs)], True
+            refused.append(StudyRun(index=i, values=v, error=f"settings refused: {exc}"))
             continue
         tasks.append(_Task(runner, i, v, s))
+    stopped = False
 
     def done(n: int, run: StudyRun) -> bool:
         nonlocal stopped
@@ -248,11 +259,20 @@ def run_all(
         return not stopped
 
     try:
-        stopped = run_tasks(_run, tasks, workers, done, executor=executor) or stopped
+        for run in refused:
+            if not done(run.index, run):
+                break
+        else:
+            stopped = run_tasks(_run, tasks, workers, done, executor=executor) or stopped
+    except KeyboardInterrupt:
+        stopped = True
     except WorkerDied as exc:
         lost = ", ".join(str(tasks[n].index) for n in exc.unfinished)
         raise WorkerDied(f"{exc} (runs: {lost})", exc.unfinished) from exc
-    return [runs[k] for k in sorted(runs)], stopped
+    ended = [runs[k] for k in sorted(runs)]
+    processes = 0 if executor is not None else processes_for(workers, len(tasks))
+    # A stop asked with the last run is no stop: every run ended.
+    return ended, stopped and len(ended) < len(values), processes
 
 
 def print_run(prefix: str, total: int, run: StudyRun) -> None:

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .ensembles import _settings_tree, _where, check_progress
-from .paths import number_at, resolve
+from .paths import is_integer_setting, number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
 __all__ = ["NONSMOOTH", "REL_STEP", "SensitivityStudy", "sensitivity"]
@@ -113,25 +113,36 @@ class SensitivityStudy:
     def changes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The figures' changes from the nominal run at each setting's step up and down, each of
         shape (figures, parameters) (NaN where a run failed)."""
-        up = np.column_stack([self._figures(2 * j + 1) for j in range(len(self.parameters))])
-        down = np.column_stack([self._figures(2 * j + 2) for j in range(len(self.parameters))])
+        up, down = self._sides()
         base = self.base[:, None]
         return up - base, down - base
+
+    def _sides(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The figures at each setting's step up and down, each (figures, parameters)."""
+        shape = (len(self.figure_names), len(self.parameters))
+        up = [self._figures(2 * j + 1) for j in range(shape[1])]
+        down = [self._figures(2 * j + 2) for j in range(shape[1])]
+        return np.array(up).T.reshape(shape), np.array(down).T.reshape(shape)
 
     @property
     def derivatives(self) -> NDArray[np.float64]:
         """d figure / d setting, shape (figures, parameters), in the figure's unit per the
-        setting's: central differences, one-sided where one side failed (NaN where both did)."""
-        up, down = self.changes
+        setting's: central differences (which need no nominal run), one-sided where one side
+        failed (NaN where both did, or one did and the nominal run too)."""
+        up, down = self._sides()
+        base = self.base[:, None]
         h = self.steps[None, :]
         central = (up - down) / (2.0 * h)
-        return np.where(np.isfinite(central), central, np.where(np.isfinite(up), up / h, -down / h))
+        one_sided = np.where(np.isfinite(up), (up - base) / h, (base - down) / h)
+        return np.where(np.isfinite(central), central, one_sided)
 
     @property
     def elasticities(self) -> NDArray[np.float64]:
         """``(d f / f) / (d p / p)``, shape (figures, parameters): the figure's relative change
-        per relative change of the setting (NaN where the figure is 0)."""
-        base = self.base[:, None]
+        per relative change of the setting (NaN where the figure is 0). The figure is the nominal
+        run's, or the mean of the two sides' if that run failed."""
+        up, down = self._sides()
+        base = np.where(np.isfinite(self.base[:, None]), self.base[:, None], (up + down) / 2.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             out = self.derivatives * self.nominal[None, :] / base
         return np.where(base != 0.0, out, math.nan)
@@ -229,7 +240,7 @@ class SensitivityStudy:
             f"  about {steps}",
         ]
         for run in self.failed[:3]:
-            lines.append(f"  run {run.index} failed: {run.error}")
+            lines.append(f"  run {run.index + 1} failed: {run.error}")
         if self.figure_names:
             lines += [
                 "",
@@ -279,13 +290,23 @@ def _steps(
     nominal = np.array([number_at(settings, n) for n in names])
     steps = np.empty(len(names))
     for j, name in enumerate(names):
+        if not math.isfinite(nominal[j]):
+            raise ValueError(f"{name!r} is {nominal[j]}: no derivative about a value not finite")
+        integer = is_integer_setting(settings, name)
         if isinstance(parameters, Mapping):
             step = parameters[name]
             if isinstance(step, bool) or not isinstance(step, numbers.Real):
                 raise TypeError(f"the step of {name!r} must be a number (got {step!r})")
             if not (math.isfinite(step) and step > 0.0):
                 raise ValueError(f"the step of {name!r} must be positive and finite (got {step})")
+            if integer and not float(step).is_integer():
+                raise ValueError(f"{name!r} is an integer: its step must be whole (got {step})")
             steps[j] = float(step)
+        elif integer:
+            raise ValueError(
+                f"{name!r} is an integer: a relative step does not fit it; give its step "
+                f"(parameters={{{name!r}: 1}})"
+            )
         elif nominal[j] == 0.0:
             raise ValueError(
                 f"{name!r} is 0: a relative step moves it nowhere; give its absolute step "
@@ -293,6 +314,11 @@ def _steps(
             )
         else:
             steps[j] = rel_step * abs(nominal[j])
+        if nominal[j] + steps[j] == nominal[j] or nominal[j] - steps[j] == nominal[j]:
+            raise ValueError(
+                f"the step of {name!r} ({steps[j]:.3g}) is too small to move its value "
+                f"{nominal[j]:.17g} in floating point"
+            )
     return names, nominal, steps
 
 
@@ -346,7 +372,7 @@ def sensitivity(
         that setting's derivative is then one-sided).
     """
     from tapespring.scenarios.setup import check_number
-    from tapespring.sweep import check_workers, processes_for
+    from tapespring.sweep import check_workers
 
     rel = check_number("rel_step", rel_step, positive=True)
     if rel > 0.5:
@@ -368,7 +394,7 @@ def sensitivity(
         return not (callback is not None and callback(run) is False)
 
     t0 = time.perf_counter()
-    ended, stopped = run_all(
+    ended, stopped, processes = run_all(
         runner, settings, values, workers=workers, executor=executor, report=report
     )
     result = SensitivityStudy(
@@ -378,14 +404,15 @@ def sensitivity(
         steps=steps,
         runs=tuple(ended),
         settings=settings,
-        workers=0 if executor is not None else processes_for(workers, len(values)),
+        workers=processes,
         cancelled=stopped,
         wall_s=time.perf_counter() - t0,
     )
     if result.failed:
         first = result.failed[0]
         warnings.warn(
-            f"{len(result.failed)} of {len(ended)} runs failed (run {first.index}: {first.error})",
+            f"{len(result.failed)} of {len(ended)} runs failed (run {first.index + 1}: "
+            f"{first.error})",
             StudyWarning,
             stacklevel=2,
         )
