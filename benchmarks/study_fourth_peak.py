@@ -7,7 +7,7 @@ large minimum of the bending angle, below -20 deg, near 2 s) with eta = 1.73e-4 
 eta = 2.1e-4 s (Figs. 29-32). This script draws eta, t and E (defaults below, each overridable),
 runs the deployment for 2.6 s on the paper's meshes for each draw, and prints, for the large
 minima: how many runs show the third, its depth and time, and which setting drives them (Spearman's
-rank correlation). About 40 s per run on one core; the runs go side by side on `--workers`.
+rank correlation). The runs go side by side on `--workers` (times in docs/studies.md).
 
     python benchmarks/study_fourth_peak.py --runs 12 --workers 2 --json fourth-peak.json
 """
@@ -85,7 +85,8 @@ def main(argv: list[str] | None = None) -> int:
         f"{ended} runs"
     )
     eta = result.drawn("eta")
-    for have, label in ((np.isfinite(third), "with it"), (~np.isfinite(third), "without it")):
+    ok = np.array([run.ok for run in result.runs])
+    for have, label in ((np.isfinite(third), "with it"), (ok & ~np.isfinite(third), "without it")):
         if have.any():
             print(f"  {label}: eta from {eta[have].min():.3e} to {eta[have].max():.3e} s")
     if args.json:

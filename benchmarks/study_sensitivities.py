@@ -11,8 +11,8 @@ differences at ``--rel-step``) about the spec's values, on the paper's meshes:
 - ``deploy``: the opposite-sense deployment's first extrema (1.2 s of motion).
 
 It prints each study's table of elasticities (``*``: the two one-sided changes disagree, the
-figure is not smooth there) and writes each study's JSON with ``--json-dir``. About 2 min per
-test with 2 workers.
+figure is not smooth there) and writes each study's JSON with ``--json-dir`` (times in
+docs/studies.md).
 
     python benchmarks/study_sensitivities.py --tests equilibrium pull --workers 2
 """

@@ -39,7 +39,16 @@ from concurrent.futures.process import BrokenProcessPool
 from logging.handlers import QueueHandler, QueueListener
 from typing import Any, TypeVar
 
-__all__ = ["MAX_WORKERS", "WorkerDied", "check_workers", "processes_for", "run_tasks", "sweep"]
+__all__ = [
+    "MAX_WORKERS",
+    "WorkerDied",
+    "check_importable",
+    "check_sendable",
+    "check_workers",
+    "processes_for",
+    "run_tasks",
+    "sweep",
+]
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -139,15 +148,40 @@ class _Relay(logging.Handler):
         logging.getLogger(record.name).handle(record)
 
 
-def _check_sendable(func: Callable[..., Any], tasks: Sequence[Any]) -> None:
-    """Refuse, before any worker starts, a function or task the workers cannot receive."""
-    main = sys.modules.get("__main__")
-    if getattr(func, "__module__", None) == "__main__" and not hasattr(main, "__file__"):
-        raise TypeError(
-            f"func {getattr(func, '__qualname__', func)!r} is defined in an interactive session "
-            "(a notebook, the REPL, python -c): worker processes cannot import it; define it in "
-            "a module of your own and import it from there, or run with workers=1"
-        )
+def check_importable(func: object, what: str = "func") -> None:
+    """Refuse a function that local worker processes cannot import: one defined in the main
+    module of an interactive session (a notebook, the REPL, ``python -c``, a script read from
+    standard input), which they would receive by name and fail to find. `what` names it in the
+    message (``func``, ``figures``, ...).
+
+    Raises
+    ------
+    TypeError
+        Naming the function and what to do instead.
+    """
+    if getattr(func, "__module__", None) != "__main__":
+        return
+    script = getattr(sys.modules.get("__main__"), "__file__", None)
+    if isinstance(script, str) and os.path.isfile(script):
+        return
+    raise TypeError(
+        f"{what} {getattr(func, '__qualname__', func)!r} is defined in an interactive session "
+        "(a notebook, the REPL, python -c, a script read from standard input): worker processes "
+        "cannot import it; define it in a module of your own and import it from there, or run "
+        "with workers=1"
+    )
+
+
+def check_sendable(func: Callable[..., Any], tasks: Sequence[Any]) -> None:
+    """Refuse, before any worker starts, a function or task local worker processes cannot
+    receive (:func:`check_importable`, or not picklable).
+
+    Raises
+    ------
+    TypeError
+        Naming the function or the task.
+    """
+    check_importable(func)
     try:
         pickle.dumps(func)
     except Exception as exc:
@@ -237,7 +271,7 @@ def run_tasks(
     if getattr(multiprocessing.current_process(), "_inheriting", False):
         # A spawned worker importing the script that started the study would start its own.
         raise RuntimeError(f"a worker process started a study while importing its script: {_GUARD}")
-    _check_sendable(func, tasks)
+    check_sendable(func, tasks)
     context = multiprocessing.get_context("spawn")
     records = context.Queue()
     listener = QueueListener(records, _Relay())
@@ -288,7 +322,7 @@ def _spawning() -> Iterator[None]:
     before = os.environ.get("RAYON_NUM_THREADS")
     # A script read from standard input (``python - < study.py``) is `__main__` with a file name
     # that is no file: a spawned worker would fail to import it and die. Its functions cannot be
-    # sent anyway (`_check_sendable`), so the workers are spawned without it.
+    # sent anyway (`check_importable` refuses them), so the workers are spawned without it.
     main = sys.modules.get("__main__")
     script = getattr(main, "__file__", None)
     hidden = isinstance(script, str) and not os.path.isfile(script)

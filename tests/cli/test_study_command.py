@@ -23,8 +23,6 @@ SENSITIVITY = ["study", "sensitivity", *BEND, "--no-progress"]
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
-PYTHON_DIR = Path(__file__).resolve().parents[2] / "python"
-
 
 def _table(path: Path, command: str) -> list[dict[str, str]]:
     """The rows of a study's CSV file, after its ``# tapespring <command>: {...}`` line."""
@@ -267,9 +265,9 @@ def test_the_outputs_must_not_share_a_file(tmp_path: Path, capsys: pytest.Captur
 
 def test_two_workers_from_the_command_line(tmp_path: Path) -> None:
     # The `tapespring` entry point spawns its workers (tapespring.sweep), each importing the
-    # package afresh: the runs and their figures are those of one process.
+    # package afresh: the runs and their figures are those of one process. The installed
+    # package, not the checkout's python/ (whose native module only an editable install builds).
     env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(PYTHON_DIR), env.get("PYTHONPATH")]))
     argv = [*ENSEMBLE, "--vary", "youngs_modulus=uniform:140e9:180e9", "--runs=3", "--json"]
     both = subprocess.run(
         [sys.executable, "-m", "tapespring.cli", *argv, "--workers=2"],

@@ -9,10 +9,10 @@ changes any setting of the scenario first. Settings are named by their dotted pa
 scenario's settings (:mod:`tapespring.study.paths`: ``tape.thickness``, ``eta``, ``duration``,
 ``mesh_size``), their values in SI units.
 
-Building the parser imports ``tapespring.study.figures`` and ``tapespring.study.sensitivities``
-for the scenarios' names and the default step (numpy; no scipy, matplotlib or native extension);
-the distributions (scipy) are parsed when ``--vary`` is given, the scenario runs and matplotlib
-are imported by the handlers.
+Building the parser imports ``tapespring.study``'s ``figures``, ``distributions``,
+``ensembles`` and ``sensitivities`` for the scenarios' names, the forms, the samplings and the
+default step (numpy; no scipy, matplotlib or native extension); the distributions (scipy) are
+parsed when ``--vary`` is given, the scenario runs and matplotlib are imported by the handlers.
 """
 
 from __future__ import annotations
@@ -139,7 +139,8 @@ def _register_ensemble(
             "\\\n      --runs 12 --workers 2 --plot fourth-peak.png\n"
             "\n"
             "exit codes: 0 success; 1 the study was stopped (Ctrl-C) or every run failed (the "
-            "outputs are\nstill written); 2 a command-line error."
+            "outputs are\nstill written; a worker process that died fails the runs it had not "
+            "reported); 2 a\ncommand-line error."
         ),
     )
     _common_options(p, names, "one row per run (its draws, its figures, its error)")
@@ -162,7 +163,7 @@ def _register_ensemble(
     )
     p.add_argument(
         "--seed",
-        type=_checked("seed", _check_seed),
+        type=_seed,
         default=0,
         help="seed of the draws: the same seed gives the same draws (default %(default)s)",
     )
@@ -179,6 +180,8 @@ def _register_ensemble(
 def _register_sensitivity(
     sub: argparse._SubParsersAction, names: tuple[str, ...], rel_step: float
 ) -> None:
+    from tapespring.study.sensitivities import MAX_REL_STEP, NONSMOOTH
+
     p = sub.add_parser(
         "sensitivity",
         help="derivatives and elasticities of a scenario's figures with respect to settings",
@@ -188,9 +191,10 @@ def _register_sensitivity(
             "with the setting stepped up and once stepped down (2 P + 1 runs for P settings), "
             "and report each figure's derivative and elasticity (df/f)/(dp/p) by central "
             "differences: the percentage change of the figure per percent of the setting. A "
-            "figure whose two one-sided changes disagree by more than a quarter of the larger "
-            "is flagged (*): a kink or jump within the steps, where the difference is no "
-            "derivative."
+            f"figure whose two one-sided changes disagree by more than {NONSMOOTH:g} of the "
+            "larger is flagged (*): a kink or jump within the steps, where the difference is no "
+            "derivative, or on a tiny elasticity the figure's own noise; ? where a run failed. "
+            "For a setting at 0 the table gives the derivatives (d/dp)."
         ),
         epilog=(
             "examples:\n"
@@ -222,7 +226,7 @@ def _register_sensitivity(
         type=_checked("rel_step", _check_rel_step),
         default=rel_step,
         help="step of each setting without its own STEP, as a fraction of its value, in (0, "
-        "0.5] (default %(default)g: 1 %%)",
+        f"{MAX_REL_STEP:g}] (default %(default)g: {100 * rel_step:g} %%)",
     )
     p.set_defaults(func=run_sensitivity, parser=p, command="study sensitivity")
 
@@ -288,14 +292,21 @@ def _check_runs(value: float) -> None:
         raise ValueError(f"runs must be an integer from 1 to {MAX_RUNS} (got {value:g})")
 
 
-def _check_seed(value: float) -> None:
-    if not _whole(value) or value < 0:
-        raise ValueError(f"seed must be an integer >= 0 (got {value:g})")
+def _seed(text: str) -> int:
+    """``--seed`` as an integer, read exactly (a recorded seed may exceed 2**53)."""
+    try:
+        value = int(text.strip())
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"seed must be an integer >= 0 (got {text!r})")
+    return value
 
 
 def _check_rel_step(value: float) -> None:
-    if not (math.isfinite(value) and 0.0 < value <= 0.5):
-        raise ValueError(f"rel_step must be in (0, 0.5] (got {value:g})")
+    from tapespring.study.sensitivities import check_rel_step
+
+    check_rel_step(value)
 
 
 def _value(settings: Any, name: str, text: str) -> Any:
@@ -308,7 +319,7 @@ def _value(settings: Any, name: str, text: str) -> Any:
     """
     from dataclasses import is_dataclass
 
-    from tapespring.study.paths import value_at
+    from tapespring.study.paths import is_integer_setting, value_at
 
     current = value_at(settings, name)
     if isinstance(current, bool):
@@ -316,7 +327,7 @@ def _value(settings: Any, name: str, text: str) -> Any:
         if text.lower() not in flags:
             raise ValueError(f"setting {name!r} is a flag: give true or false (got {text!r})")
         return flags[text.lower()]
-    if isinstance(current, int):
+    if isinstance(current, int) and is_integer_setting(settings, name):
         try:
             number = float(text)
         except ValueError:
@@ -324,7 +335,7 @@ def _value(settings: Any, name: str, text: str) -> Any:
         if not _whole(number):
             raise ValueError(f"setting {name!r} is an integer (got {text!r})")
         return int(number)
-    if isinstance(current, float):
+    if isinstance(current, float | int):
         try:
             number = float(text)
         except ValueError:
@@ -423,20 +434,14 @@ def _outputs(
 
 
 def _run_study(args: argparse.Namespace, start: Any) -> Any:
-    """Run `start()`, the study's StudyWarnings printed as ``warning: ...`` lines; None (after
-    an ``error:`` line) if a worker process died. The study's own refusal of its arguments
-    (before any run; the options' checks here should have found it first) is refused as the
-    options are."""
-    from tapespring.sweep import WorkerDied
-
+    """Run `start()`, the study's StudyWarnings printed as ``warning: ...`` lines (a worker
+    process that died fails the runs it had not reported, with the others kept). The study's own
+    refusal of its arguments (before any run; the options' checks here should have found it
+    first) is refused as the options are."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             result = start()
-        except WorkerDied as exc:
-            print_warnings(caught)
-            print(f"error: {exc}", file=sys.stderr)
-            return None
         except (TypeError, ValueError) as exc:
             refuse(args, str(exc))
     print_warnings(caught)
@@ -507,13 +512,19 @@ def run_ensemble(args: argparse.Namespace) -> int:
 def run_sensitivity(args: argparse.Namespace) -> int:
     """Handler of ``tapespring study sensitivity``; returns the exit code (0; 1 stopped, the
     nominal run or every run failed, or a worker died; 2 bad input)."""
-    from tapespring.study.paths import number_at
+    from tapespring.study.paths import is_integer_setting, number_at
     from tapespring.study.sensitivities import sensitivity
 
     refuse_shared_paths(args)
     settings = _settings(args)
     _names_checked(args, settings, "--parameter", [name for name, _ in args.parameters])
     for name, step in args.parameters:
+        if step is None and is_integer_setting(settings, name):
+            refuse(
+                args,
+                f"--parameter {name}: the setting is an integer, which a relative step does not "
+                f"fit: give its step, --parameter {name}=1",
+            )
         if step is None and number_at(settings, name) == 0.0:
             refuse(
                 args,

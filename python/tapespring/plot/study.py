@@ -102,14 +102,14 @@ def _scatter_figures(result: Ensemble) -> list[tuple[str, str | None, float, flo
     Spearman's rho, cv), at most `MAX_SCATTER_PANELS`, those with the largest coefficient of
     variation first (figures without one last, in the runs' order)."""
     stats = result.statistics()
-    correlations = result.correlations()
+    drivers = result.drivers()
     chosen = []
     for name, s in stats.items():
         if s["count"] < 1:
             continue  # no run gave it: nothing to draw
-        known = {p: r for p, r in correlations[name].items() if math.isfinite(r)}
-        driver = max(known, key=lambda p: abs(known[p])) if known else None
-        chosen.append((name, driver, known.get(driver, math.nan) if driver else math.nan, s["cv"]))
+        driver = drivers[name]
+        setting, rho = (None, math.nan) if driver is None else driver
+        chosen.append((name, setting, rho, s["cv"]))
     chosen.sort(key=lambda row: -row[3] if math.isfinite(row[3]) else math.inf)
     # A figure that does not vary (an integer count, a figure the settings do not move) shows
     # nothing against a setting: left out while there are others.
@@ -193,7 +193,7 @@ def _plot_scatter(
             color="tab:red",
             transform=blended_transform_factory(ax.transData, ax.transAxes),
             clip_on=False,
-            label="runs without this figure (failed)" if label else "_nolegend_",
+            label="runs without this figure" if label else "_nolegend_",
         )
     ax.set_xlabel(x_label, fontsize=9)
     ax.set_ylabel(y_label, fontsize=9)
@@ -215,7 +215,8 @@ def plot_ensemble(result: Ensemble) -> Figure:
     scatter most (largest coefficient of variation, at most :data:`MAX_SCATTER_PANELS`), each
     against the varied setting with the strongest Spearman rank correlation
     (:meth:`Ensemble.correlations`), rho and the cv in the panel's title; the runs that gave
-    no value of the figure (failed runs) are crosses along the panel's bottom at their draws.
+    no value of the figure (a failed run, or a peak it did not reach) are crosses along the
+    panel's bottom at their draws.
     Figures and settings are shown in the units their names give (displacements and lengths
     in mm, moduli in GPa, masses in g).
 

@@ -66,6 +66,8 @@ def _settings_tree(settings: Any) -> Any:
 
     if is_dataclass(settings) and not isinstance(settings, type):
         return plain(jsonable_tree(asdict(settings)))
+    if isinstance(settings, Mapping):  # a loaded study's settings: their JSON tree already
+        return plain(jsonable_tree(dict(settings)))
     return repr(settings)
 
 
@@ -280,16 +282,25 @@ class Ensemble:
             }
         )
 
+    def drivers(self) -> dict[str, tuple[str, float] | None]:
+        """Each figure's driving setting: the one with the strongest rank correlation
+        (:meth:`correlations`), and its rho; None where no correlation is known."""
+        out: dict[str, tuple[str, float] | None] = {}
+        for name, row in self.correlations().items():
+            known = {p: r for p, r in row.items() if math.isfinite(r)}
+            driver = max(known, key=lambda p: abs(known[p])) if known else None
+            out[name] = None if driver is None else (driver, known[driver])
+        return out
+
     def table(self) -> str:
-        """The statistics as a text table, one figure per row, with the strongest rank
-        correlation of each."""
+        """The statistics as a text table, one figure per row, with its driving setting
+        (:meth:`drivers`)."""
         stats = self.statistics()
-        corr = self.correlations()
+        drivers = self.drivers()
         header = ("figure", "n", "mean", "std", "cv", "p05", "median", "p95", "driver (rho)")
         rows: list[tuple[str, ...]] = [header]
         for name, s in stats.items():
-            known = {p: r for p, r in corr[name].items() if math.isfinite(r)}
-            driver = max(known, key=lambda p: abs(known[p])) if known else None
+            driver = drivers[name]
             rows.append(
                 (
                     name,
@@ -297,17 +308,10 @@ class Ensemble:
                     *(f"{s[k]:.5g}" for k in ("mean", "std")),
                     f"{s['cv']:.2%}" if math.isfinite(s["cv"]) else "nan",
                     *(f"{s[k]:.5g}" for k in ("p05", "median", "p95")),
-                    "-" if driver is None else f"{driver} ({known[driver]:+.2f})",
+                    "-" if driver is None else f"{driver[0]} ({driver[1]:+.2f})",
                 )
             )
-        widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
-        return "\n".join(
-            "  ".join(
-                c.ljust(w) if i == 0 else c.rjust(w)
-                for i, (c, w) in enumerate(zip(r, widths, strict=True))
-            )
-            for r in rows
-        )
+        return text_table(rows)
 
     def describe(self) -> str:
         """A few lines for a person: the design, the outcome and the table."""
@@ -330,8 +334,9 @@ class Ensemble:
         return "\n".join(lines)
 
     def write_csv(self, path: str | Path) -> None:
-        """One row per run that ended: its index, the varied settings, the figures, its error
-        and wall time."""
+        """One row per run that ended: its number (``run``, from 1: the summary's ``index`` + 1,
+        as the progress lines count), the varied settings, the figures, its error and wall
+        time."""
         figures = self.figure_names
         with open(path, "w", newline="", encoding="utf-8") as f:
             w = csv.writer(f)
@@ -433,6 +438,19 @@ class Ensemble:
             ) from exc
 
 
+def text_table(rows: list[tuple[str, ...]]) -> str:
+    """`rows` (the header first) as aligned columns: the first to the left, the others (numbers)
+    to the right."""
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    return "\n".join(
+        "  ".join(
+            c.ljust(w) if i == 0 else c.rjust(w)
+            for i, (c, w) in enumerate(zip(r, widths, strict=True))
+        )
+        for r in rows
+    )
+
+
 def _discrete(distribution: Any) -> bool:
     """True for a SciPy discrete distribution (integer draws)."""
     from scipy.stats import rv_discrete
@@ -516,7 +534,7 @@ def ensemble(
         (:mod:`tapespring.study.figures`) if None.
     history : callable, bool or None
         A run's result to the history kept for the band (abscissa, ordinate); None or True: the
-        scenario's; False: none.
+        ready-made scenario's (none for a scenario of your own); False: none.
     workers : int or None
         Runs side by side in that many processes (None: one per core; 1: one after the other
         in this process). A script using more than one runs its study under
@@ -538,14 +556,14 @@ def ensemble(
     ValueError
         For an unknown scenario or setting, a setting that is not a number, an empty
         `parameters`, settings their check refuses, or an unknown `sampling`: before any run.
-    tapespring.sweep.WorkerDied
-        If a worker process died.
+        TypeError too for a function local workers cannot receive (defined in a notebook, with
+        `workers` > 1), before any run.
 
     Warns
     -----
     StudyWarning
-        If some runs failed (their settings refused, or the solver stopped); they are kept in
-        ``runs`` with their message.
+        If some runs failed (their settings refused, the solver stopped, a worker process died
+        before reporting them); they are kept in ``runs`` with their message.
     """
     from tapespring.sweep import check_workers
 

@@ -198,14 +198,17 @@ def _run(task: _Task) -> StudyRun:
     figures: dict[str, float] = {}
     history = None
     if result is not None:
+        # A partial result may lack what the figures read: a stop is then the message.
         try:
             figures = {str(k): float(v) for k, v in task.runner.figures(result).items()}
-            if task.runner.history is not None:
+        except Exception as exc:
+            error = error or _failure(exc, "figures: ")
+        if task.runner.history is not None:
+            try:
                 x, y = task.runner.history(result)
                 history = (np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        except Exception as exc:
-            # A partial result may lack what the figures read: a stop is then the message.
-            error = error or _failure(exc, "figures: ")
+            except Exception as exc:
+                error = error or _failure(exc, "history: ")
     return StudyRun(
         index=task.index,
         values=task.values,
@@ -236,7 +239,13 @@ def run_all(
         or Ctrl-C) before all ended; the processes the runs ran in (1: this one; 0: on an
         executor).
     """
-    from tapespring.sweep import WorkerDied, processes_for, run_tasks
+    from tapespring.sweep import (
+        WorkerDied,
+        check_importable,
+        check_sendable,
+        processes_for,
+        run_tasks,
+    )
 
     runs: dict[int, StudyRun] = {}
     tasks: list[_Task] = []
@@ -249,6 +258,14 @@ def run_all(
             refused.append(StudyRun(index=i, values=v, error=f"settings refused: {exc}"))
             continue
         tasks.append(_Task(runner, i, v, s))
+    # What the runs' processes cannot receive is refused before any run is reported.
+    if executor is not None:
+        if not callable(getattr(executor, "submit", None)):
+            raise TypeError(f"executor must be a concurrent.futures.Executor (got {executor!r})")
+    elif processes_for(workers, len(tasks)) > 1:
+        for what in ("scenario", "figures", "history"):
+            check_importable(getattr(runner, what), what)
+        check_sendable(_run, tasks)
     stopped = False
 
     def done(n: int, run: StudyRun) -> bool:
@@ -267,8 +284,14 @@ def run_all(
     except KeyboardInterrupt:
         stopped = True
     except WorkerDied as exc:
-        lost = ", ".join(str(tasks[n].index) for n in exc.unfinished)
-        raise WorkerDied(f"{exc} (runs: {lost})", exc.unfinished) from exc
+        # The runs that ended are kept; those not reported fail with the worker's death.
+        for n in exc.unfinished:
+            task = tasks[n]
+            runs[task.index] = StudyRun(
+                index=task.index,
+                values=task.values,
+                error="a worker process died (killed, out of memory) before reporting this run",
+            )
     ended = [runs[k] for k in sorted(runs)]
     processes = 0 if executor is not None else processes_for(workers, len(tasks))
     # A stop asked with the last run is no stop: every run ended.

@@ -29,16 +29,37 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .ensembles import _settings_tree, _where, check_progress
+from .ensembles import _settings_tree, _where, check_progress, text_table
 from .paths import is_integer_setting, number_at, resolve
 from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
 
-__all__ = ["NONSMOOTH", "REL_STEP", "SensitivityStudy", "sensitivity"]
+__all__ = [
+    "MAX_REL_STEP",
+    "NONSMOOTH",
+    "REL_STEP",
+    "SensitivityStudy",
+    "check_rel_step",
+    "sensitivity",
+]
 
 #: Default step: 1 % of each setting. Small enough that a smooth figure's central difference is
 #: within about 1e-4 of its derivative (the error is h^2 f''' / 6), large enough that the solver's
 #: tolerances (1e-4 of the forces, the time steps' error control) stay below the change.
 REL_STEP = 0.01
+
+#: Largest relative step: beyond half its value a setting's step down reaches 0.
+MAX_REL_STEP = 0.5
+
+
+def check_rel_step(value: object) -> float:
+    """`value` as a relative step in (0, :data:`MAX_REL_STEP`], or a ValueError naming it."""
+    from tapespring.scenarios.setup import check_number
+
+    step = check_number("rel_step", value, positive=False)
+    if not 0.0 < step <= MAX_REL_STEP:
+        raise ValueError(f"rel_step must be in (0, {MAX_REL_STEP:g}] (got {value})")
+    return step
+
 
 #: A figure is flagged as not smooth in a setting when its two one-sided changes differ by more
 #: than this share of the larger: `|df+ + df-| > NONSMOOTH max(|df+|, |df-|)` (0 for a straight
@@ -139,13 +160,14 @@ class SensitivityStudy:
     @property
     def elasticities(self) -> NDArray[np.float64]:
         """``(d f / f) / (d p / p)``, shape (figures, parameters): the figure's relative change
-        per relative change of the setting (NaN where the figure is 0). The figure is the nominal
-        run's, or the mean of the two sides' if that run failed."""
+        per relative change of the setting (NaN where the figure or the setting is 0: a setting
+        at 0, such as the release's eta, has only :attr:`derivatives`). The figure is the
+        nominal run's, or the mean of the two sides' if that run failed."""
         up, down = self._sides()
         base = np.where(np.isfinite(self.base[:, None]), self.base[:, None], (up + down) / 2.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             out = self.derivatives * self.nominal[None, :] / base
-        return np.where(base != 0.0, out, math.nan)
+        return np.where((base != 0.0) & (self.nominal[None, :] != 0.0), out, math.nan)
 
     @property
     def nonsmooth(self) -> NDArray[np.bool_]:
@@ -158,6 +180,13 @@ class SensitivityStudy:
             return (np.abs(up + down) > NONSMOOTH * larger) & (larger > floor)
 
     @property
+    def assessed(self) -> NDArray[np.bool_]:
+        """Where :attr:`nonsmooth` could be decided: both sides and the nominal run gave the
+        figure. Shape (figures, parameters); elsewhere smoothness is unknown, not smooth."""
+        up, down = self.changes
+        return np.isfinite(up) & np.isfinite(down)
+
+    @property
     def failed(self) -> tuple[StudyRun, ...]:
         """The runs that gave no figures."""
         return tuple(run for run in self.runs if not run.ok)
@@ -167,7 +196,7 @@ class SensitivityStudy:
         derivative, elasticity and smoothness; the runs; the settings."""
         from tapespring.report import jsonable_tree
 
-        d, e, rough = self.derivatives, self.elasticities, self.nonsmooth
+        d, e, rough, known = self.derivatives, self.elasticities, self.nonsmooth, self.assessed
         up, down = self.changes
         figures = {
             name: {
@@ -178,7 +207,7 @@ class SensitivityStudy:
                         "elasticity": float(e[i, j]),
                         "change_up": float(up[i, j]),
                         "change_down": float(down[i, j]),
-                        "smooth": not bool(rough[i, j]),
+                        "smooth": None if not known[i, j] else not bool(rough[i, j]),
                     }
                     for j, p in enumerate(self.parameters)
                 },
@@ -206,26 +235,29 @@ class SensitivityStudy:
         )  # fmt: skip
 
     def table(self) -> str:
-        """The elasticities as a text table (figures as rows, settings as columns); ``*`` marks
-        a figure not smooth in that setting."""
-        e, rough = self.elasticities, self.nonsmooth
-        header = ("figure", "nominal", *self.parameters)
+        """The elasticities as a text table (figures as rows, settings as columns; for a setting
+        at 0 the derivatives, its column marked ``d/dp``); ``*`` marks a figure not smooth in
+        that setting, ``?`` one whose smoothness is unknown (a run failed)."""
+        e, d, rough, known = self.elasticities, self.derivatives, self.nonsmooth, self.assessed
+        at_zero = self.nominal == 0.0
+        header = (
+            "figure",
+            "nominal",
+            *(f"{p} (d/dp)" if at_zero[j] else p for j, p in enumerate(self.parameters)),
+        )
         rows = [header]
         for i, name in enumerate(self.figure_names):
-            cells = [
-                ("nan" if not math.isfinite(e[i, j]) else f"{e[i, j]:+.3f}")
-                + ("*" if rough[i, j] else " ")
-                for j in range(len(self.parameters))
-            ]
+            cells = []
+            for j in range(len(self.parameters)):
+                value = d[i, j] if at_zero[j] else e[i, j]
+                text = (
+                    "nan"
+                    if not math.isfinite(value)
+                    else (f"{value:+.3g}" if at_zero[j] else f"{value:+.3f}")
+                )
+                cells.append(text + ("?" if not known[i, j] else "*" if rough[i, j] else " "))
             rows.append((name, f"{self.base[i]:.5g}", *cells))
-        widths = [max(len(r[k]) for r in rows) for k in range(len(header))]
-        return "\n".join(
-            "  ".join(
-                c.ljust(w) if k == 0 else c.rjust(w)
-                for k, (c, w) in enumerate(zip(r, widths, strict=True))
-            )
-            for r in rows
-        )
+        return text_table(rows)
 
     def describe(self) -> str:
         """A few lines for a person: the steps, the outcome and the elasticities."""
@@ -245,15 +277,16 @@ class SensitivityStudy:
             lines += [
                 "",
                 "elasticities (d f / f) / (d p / p); *: the two sides differ (a kink or jump "
-                "within the steps, or, on a tiny elasticity, the figure's own noise)",
+                "within the steps, or, on a tiny elasticity, the figure's own noise); ?: not "
+                "known (a run failed)",
                 self.table(),
             ]
         return "\n".join(lines)
 
     def write_csv(self, path: str | Path) -> None:
         """One row per figure and setting: nominal value, derivative, elasticity, the two
-        one-sided changes and whether they agree."""
-        d, e, rough = self.derivatives, self.elasticities, self.nonsmooth
+        one-sided changes and whether they agree (empty where unknown)."""
+        d, e, rough, known = self.derivatives, self.elasticities, self.nonsmooth, self.assessed
         up, down = self.changes
         with open(path, "w", newline="", encoding="utf-8") as f:
             w = csv.writer(f)
@@ -266,7 +299,8 @@ class SensitivityStudy:
                     w.writerow(
                         [name, p, repr(float(self.base[i])), repr(float(self.nominal[j])),
                          repr(float(self.steps[j])), repr(float(d[i, j])), repr(float(e[i, j])),
-                         repr(float(up[i, j])), repr(float(down[i, j])), not rough[i, j]]
+                         repr(float(up[i, j])), repr(float(down[i, j])),
+                         "" if not known[i, j] else not rough[i, j]]
                     )  # fmt: skip
 
     def write_json(self, path: str | Path) -> None:
@@ -347,7 +381,7 @@ def sensitivity(
     settings : object, optional
         The nominal settings; the scenario's defaults if None.
     rel_step : float
-        The relative step, in (0, 0.5] (default :data:`REL_STEP`, 1 %).
+        The relative step, in (0, :data:`MAX_REL_STEP`] (default :data:`REL_STEP`, 1 %).
     figures : callable, optional
         A run's result to its figures; the scenario's defaults if None.
     workers, executor, progress
@@ -361,22 +395,17 @@ def sensitivity(
     ------
     TypeError, ValueError
         For bad arguments (an unknown or non-numeric setting, a setting at 0 without its step,
-        a step out of range), before any run.
-    tapespring.sweep.WorkerDied
-        If a worker process died.
+        a step out of range, a function local workers cannot receive), before any run.
 
     Warns
     -----
     StudyWarning
         If some runs failed (a step outside a setting's range is refused by the settings' check:
-        that setting's derivative is then one-sided).
+        that setting's derivative is then one-sided; the solver stopped; a worker died).
     """
-    from tapespring.scenarios.setup import check_number
     from tapespring.sweep import check_workers
 
-    rel = check_number("rel_step", rel_step, positive=True)
-    if rel > 0.5:
-        raise ValueError(f"rel_step must be at most 0.5 (got {rel_step})")
+    rel = check_rel_step(rel_step)
     check_workers(workers)
     check_progress(progress)
     runner, settings = runner_for(scenario, settings, figures, False)
