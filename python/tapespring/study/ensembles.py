@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from .distributions import check_distribution, describe_distribution
 from .figures import History
 from .paths import is_integer_setting, number_at, resolve
-from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
+from .runs import StudyRun, reporter, run_all, runner_for, warn_failed
 
 __all__ = ["MAX_RUNS", "QUANTILES", "SAMPLINGS", "SAVE_FORMAT", "Ensemble", "ensemble"]
 
@@ -599,13 +599,7 @@ def ensemble(
     samples = draws([parameters[n] for n in names], n_runs, seed=int(seed), sampling=sampling)
     values = [{n: float(samples[i, j]) for j, n in enumerate(names)} for i in range(n_runs)]
 
-    callback = progress if callable(progress) else None
-
-    def report(run: StudyRun) -> bool:
-        if progress is True:
-            print_run(f"ensemble of {runner.name}", n_runs, run)
-        return not (callback is not None and callback(run) is False)
-
+    report = reporter(f"ensemble of {runner.name}", n_runs, progress)
     t0 = time.perf_counter()
     ended, stopped, processes = run_all(
         runner, settings, values, workers=workers, executor=executor, report=report
@@ -624,14 +618,7 @@ def ensemble(
         wall_s=time.perf_counter() - t0,
         history_labels=runner.history_labels,
     )
-    if result.failed:
-        first = result.failed[0]
-        warnings.warn(
-            f"{len(result.failed)} of {len(ended)} runs failed (run {first.index + 1}: "
-            f"{first.error}); they are left out of the statistics",
-            StudyWarning,
-            stacklevel=2,
-        )
+    warn_failed(result.failed, len(ended), "; they are left out of the statistics")
     if progress is True:
         print(
             f"ensemble of {runner.name}: {len(ended)} runs in {result.wall_s:.1f} s",

@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +17,16 @@ import numpy as np
 from .figures import History, ScenarioKind, kind_of, scenario_named
 from .paths import assign, check_settings
 
-__all__ = ["Runner", "StudyRun", "StudyWarning", "print_run", "run_all", "runner_for"]
+__all__ = [
+    "Runner",
+    "StudyRun",
+    "StudyWarning",
+    "print_run",
+    "reporter",
+    "run_all",
+    "runner_for",
+    "warn_failed",
+]
 
 
 class StudyWarning(UserWarning):
@@ -296,6 +306,33 @@ def run_all(
     processes = 0 if executor is not None else processes_for(workers, len(tasks))
     # A stop asked with the last run is no stop: every run ended.
     return ended, stopped and len(ended) < len(values), processes
+
+
+def reporter(
+    prefix: str, total: int, progress: bool | Callable[[StudyRun], bool | None] | None
+) -> Callable[[StudyRun], bool]:
+    """A study's report of each run that ends: a line on stderr with ``progress=True``, the
+    callable's answer otherwise (False stops the study)."""
+    callback = progress if callable(progress) else None
+
+    def report(run: StudyRun) -> bool:
+        if progress is True:
+            print_run(prefix, total, run)
+        return not (callback is not None and callback(run) is False)
+
+    return report
+
+
+def warn_failed(failed: Sequence[StudyRun], ended: int, note: str = "") -> None:
+    """A StudyWarning for a study whose runs did not all give their figures (none if all did),
+    for the study's caller (two frames up)."""
+    if failed:
+        first = failed[0]
+        warnings.warn(
+            f"{len(failed)} of {ended} runs failed (run {first.index + 1}: {first.error}){note}",
+            StudyWarning,
+            stacklevel=3,
+        )
 
 
 def print_run(prefix: str, total: int, run: StudyRun) -> None:

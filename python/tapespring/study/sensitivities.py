@@ -20,7 +20,6 @@ import math
 import numbers
 import sys
 import time
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,7 +30,7 @@ from numpy.typing import NDArray
 
 from .ensembles import _settings_tree, _where, check_progress, text_table
 from .paths import is_integer_setting, number_at, resolve
-from .runs import StudyRun, StudyWarning, print_run, run_all, runner_for
+from .runs import StudyRun, reporter, run_all, runner_for, warn_failed
 
 __all__ = [
     "MAX_REL_STEP",
@@ -415,13 +414,7 @@ def sensitivity(
         values.append({name: float(nominal[j] + steps[j])})
         values.append({name: float(nominal[j] - steps[j])})
 
-    callback = progress if callable(progress) else None
-
-    def report(run: StudyRun) -> bool:
-        if progress is True:
-            print_run(f"sensitivity of {runner.name}", len(values), run)
-        return not (callback is not None and callback(run) is False)
-
+    report = reporter(f"sensitivity of {runner.name}", len(values), progress)
     t0 = time.perf_counter()
     ended, stopped, processes = run_all(
         runner, settings, values, workers=workers, executor=executor, report=report
@@ -437,14 +430,7 @@ def sensitivity(
         cancelled=stopped,
         wall_s=time.perf_counter() - t0,
     )
-    if result.failed:
-        first = result.failed[0]
-        warnings.warn(
-            f"{len(result.failed)} of {len(ended)} runs failed (run {first.index + 1}: "
-            f"{first.error})",
-            StudyWarning,
-            stacklevel=2,
-        )
+    warn_failed(result.failed, len(ended))
     if progress is True:
         print(f"sensitivity of {runner.name}: {len(ended)} runs in {result.wall_s:.1f} s",
               file=sys.stderr)  # fmt: skip
