@@ -180,7 +180,7 @@ def _register_ensemble(
 def _register_sensitivity(
     sub: argparse._SubParsersAction, names: tuple[str, ...], rel_step: float
 ) -> None:
-    from tapespring.study.sensitivities import MAX_REL_STEP, NONSMOOTH
+    from tapespring.study.sensitivities import MAX_REL_STEP, NONSMOOTH, check_rel_step
 
     p = sub.add_parser(
         "sensitivity",
@@ -223,7 +223,7 @@ def _register_sensitivity(
     )
     p.add_argument(
         "--rel-step",
-        type=_checked("rel_step", _check_rel_step),
+        type=_checked("rel_step", check_rel_step),
         default=rel_step,
         help="step of each setting without its own STEP, as a fraction of its value, in (0, "
         f"{MAX_REL_STEP:g}] (default %(default)g: {100 * rel_step:g} %%)",
@@ -301,12 +301,6 @@ def _seed(text: str) -> int:
     if value < 0:
         raise argparse.ArgumentTypeError(f"seed must be an integer >= 0 (got {text!r})")
     return value
-
-
-def _check_rel_step(value: float) -> None:
-    from tapespring.study.sensitivities import check_rel_step
-
-    check_rel_step(value)
 
 
 def _value(settings: Any, name: str, text: str) -> Any:

@@ -369,7 +369,7 @@ class Ensemble:
             "format": SAVE_FORMAT,
             "distributions": list(self.distributions),
             "varied": list(self.parameters),
-            "samples": jsonable_tree(self.samples.tolist()),
+            "samples": self.samples.tolist(),
             "history_labels": list(self.history_labels),
             "histories": [
                 None if run.history is None else [run.history[0].tolist(), run.history[1].tolist()]
