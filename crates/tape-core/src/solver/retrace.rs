@@ -18,6 +18,10 @@
 //! * far behind: more than twice the two steps' lengths back along the path (a sharp but genuine
 //!   limit point does not match: its neighbours are recent);
 //! * parallel: `|cos| > 0.8` between the increment and the segment;
+//! * the same stability: where the number of negative eigenvalues of the tangent is known, the
+//!   state's must be that of one end of the segment (on a deep tape section the unstable branch
+//!   beyond the snap runs back beside the loading branch, nearer to it than a step, its fold only
+//!   beginning to form; the count tells the two apart, the distance does not);
 //! * confirmed: two successive states must match.
 //!
 //! Memory: the points are thinned (every other one dropped, the first kept) whenever they hold
@@ -40,6 +44,8 @@ struct Mark {
     increment: usize,
     /// First state after a jump: no segment leads to it.
     piece_start: bool,
+    /// Negative eigenvalues of the tangent there, if counted.
+    negative: Option<usize>,
 }
 
 /// The part of the path already followed, and how it was met again.
@@ -85,17 +91,18 @@ impl PathMemory {
             .collect()
     }
 
-    /// A state reached by a jump or a relaxation: the path restarts there.
-    pub fn restart(&mut self, state: &State, reference: &State) {
+    /// A state reached by a jump or a relaxation (with its stability count, if known): the path
+    /// restarts there.
+    pub fn restart(&mut self, state: &State, reference: &State, negative: Option<usize>) {
         self.pending = false;
-        self.push(state, reference, true);
+        self.push(state, reference, true, negative);
     }
 
-    /// Records a converged state of the path; `Some` if it confirms that the path is on a stretch
-    /// followed before.
-    pub fn visit(&mut self, state: &State, reference: &State) -> Option<Return> {
+    /// Records a converged state of the path (with its stability count, if known); `Some` if it
+    /// confirms that the path is on a stretch followed before.
+    pub fn visit(&mut self, state: &State, reference: &State, negative: Option<usize>) -> Option<Return> {
         self.increments += 1;
-        let found = self.push(state, reference, false);
+        let found = self.push(state, reference, false, negative);
         let confirmed = found.is_some() && self.pending;
         self.pending = found.is_some();
         if confirmed {
@@ -106,7 +113,7 @@ impl PathMemory {
     }
 
     /// Appends `state`; returns what it meets of the old path (if anything).
-    fn push(&mut self, state: &State, reference: &State, piece_start: bool) -> Option<Return> {
+    fn push(&mut self, state: &State, reference: &State, piece_start: bool, negative: Option<usize>) -> Option<Return> {
         let z = Self::point(state, reference);
         let norm = z.iter().map(|v| v * v).sum::<f64>().sqrt();
         let (arc, found) = match (&self.last, piece_start) {
@@ -114,7 +121,7 @@ impl PathMemory {
                 let step: Vec<f64> = z.iter().zip(&last.z).map(|(a, b)| a - b).collect();
                 let len = step.iter().map(|v| v * v).sum::<f64>().sqrt();
                 let arc = last.arc + len;
-                (arc, self.meet(&z, norm, &step, len, arc, state.t))
+                (arc, self.meet(&z, norm, &step, len, arc, state.t, negative))
             }
             (Some(last), true) => (last.arc, None),
             (None, _) => (0.0, None),
@@ -126,6 +133,7 @@ impl PathMemory {
             arc,
             increment: self.increments,
             piece_start,
+            negative,
         };
         if let Some(last) = self.last.replace(mark) {
             self.marks.push(last);
@@ -143,7 +151,17 @@ impl PathMemory {
     }
 
     /// The old segment that the step `step` (of length `len`) to `z` lies on, if any.
-    fn meet(&self, z: &[f64], norm: f64, step: &[f64], len: f64, arc: f64, t: f64) -> Option<Return> {
+    #[allow(clippy::too_many_arguments)]
+    fn meet(
+        &self,
+        z: &[f64],
+        norm: f64,
+        step: &[f64],
+        len: f64,
+        arc: f64,
+        t: f64,
+        negative: Option<usize>,
+    ) -> Option<Return> {
         if len == 0.0 {
             return None;
         }
@@ -156,6 +174,11 @@ impl PathMemory {
             let near = 0.25 * len.max(seg_len);
             if arc - b.arc <= 2.0 * (len + seg_len) {
                 continue;
+            }
+            if let (Some(n), Some(na), Some(nb)) = (negative, a.negative, b.negative) {
+                if n != na && n != nb {
+                    continue;
+                }
             }
             // Cheap bounds first: the distance to the segment is at least the distance of the
             // norms to the norm range of its ends.
@@ -233,11 +256,11 @@ mod tests {
         let reference = state(0.0, 0.0, 0.0);
         // Out along u, then back along the same line: found once two states confirm it.
         let mut m = PathMemory::new();
-        m.restart(&reference, &reference);
+        m.restart(&reference, &reference, None);
         let mut found = None;
         for k in (1..=10).chain((0..10).rev()) {
             let u = f64::from(k);
-            if let Some(r) = m.visit(&state(u, 0.0, u), &reference) {
+            if let Some(r) = m.visit(&state(u, 0.0, u), &reference, None) {
                 found = Some((u, r));
                 break;
             }
@@ -246,21 +269,39 @@ mod tests {
         assert!(r.reversed && u >= 5.0 && (r.t_turn - 10.0).abs() < 1e-12, "u = {u}");
         // A circle closes a loop in the same sense.
         let mut m = PathMemory::new();
-        m.restart(&reference, &reference);
+        m.restart(&reference, &reference, None);
         let found = (1..60).find_map(|k| {
             let a = f64::from(k) * 0.2;
-            m.visit(&state(a.sin(), 1.0 - a.cos(), a), &reference)
+            m.visit(&state(a.sin(), 1.0 - a.cos(), a), &reference, None)
         });
         assert!(found.is_some_and(|r| !r.reversed));
         // A hairpin (out along u, back along a parallel line a step away) is not the same path.
         let mut m = PathMemory::new();
-        m.restart(&reference, &reference);
+        m.restart(&reference, &reference, None);
         let back: Vec<(f64, f64)> = (0..=10)
             .map(|k| (f64::from(k), 0.0))
             .chain((0..=10).rev().map(|k| (f64::from(k), 1.0)))
             .collect();
         assert!(back
             .iter()
-            .all(|&(u, v)| m.visit(&state(u, v, u), &reference).is_none()));
+            .all(|&(u, v)| m.visit(&state(u, v, u), &reference, None).is_none()));
+    }
+
+    #[test]
+    fn a_branch_beside_the_old_one_with_another_stability_is_not_met() {
+        let reference = state(0.0, 0.0, 0.0);
+        // Out along u (stable), then back a tenth of a step beside it: met when the counts are
+        // unknown or equal, not when the way back is unstable.
+        let walk = |back: Option<usize>| {
+            let mut m = PathMemory::new();
+            m.restart(&reference, &reference, Some(0));
+            (1..=10)
+                .map(|k| (f64::from(k), 0.0, Some(0)))
+                .chain((0..10).rev().map(|k| (f64::from(k), 0.1, back)))
+                .find_map(|(u, v, n)| m.visit(&state(u, v, u), &reference, n))
+        };
+        assert!(walk(None).is_some_and(|r| r.reversed));
+        assert!(walk(Some(0)).is_some_and(|r| r.reversed));
+        assert!(walk(Some(1)).is_none());
     }
 }

@@ -815,7 +815,7 @@ pub fn solve_static(
                 Flow::Stop => break,
             },
         };
-        if w.too_coarse(state, &saved) {
+        if w.too_coarse(state, &saved) || w.skipped_instabilities(state, &saved) {
             continue;
         }
         let flow = match w.jump_at_limit(state, &saved) {
@@ -990,7 +990,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             scale,
         };
         if let Some(m) = &mut w.p.memory {
-            m.restart(state, &w.s.system.reference);
+            m.restart(state, &w.s.system.reference, None);
         }
         if w.locate {
             // The start of the path is the first point of the location history (the assembly is
@@ -1244,6 +1244,41 @@ impl<'a, 'b> Walk<'a, 'b> {
         true
     }
 
+    /// A converged arc-length increment from a stable state to one with more than one negative
+    /// eigenvalue of the tangent stepped over several critical points at once, where a path from
+    /// a stable state meets the first one alone: past the peak moment of a deep tape section
+    /// (110 deg) such a step went from 0 to 7 and left the path for a tangle of unstable branches
+    /// that closed on itself. It is retried shorter, until half the cut-backs are spent (critical
+    /// points closer than that, as the double bifurcations of a symmetric structure, are then
+    /// stepped over as before). Steps between unstable states are left alone: beside the
+    /// near-neutral modes of a fold that can move along the tape, their counts flicker (a check
+    /// on any change by more than one doubled the states of the thin soft tape's equal-sense path
+    /// near -58 deg, to no other effect).
+    fn skipped_instabilities(&mut self, state: &mut State, saved: &State) -> bool {
+        let params = self.s.params;
+        let (true, true, Some(0)) = (self.arc_control, params.stability, self.p.last_negative) else {
+            return false;
+        };
+        if self.p.control.cutbacks >= params.max_cutbacks / 2 {
+            return false;
+        }
+        let Ok(n) = self.s.negative_eigenvalues() else {
+            return false;
+        };
+        if n <= 1 || self.p.control.reject().is_err() {
+            return false;
+        }
+        log::debug!(
+            "stability count 0 -> {n} across t = {} .. {}: cut back",
+            saved.t,
+            state.t
+        );
+        *state = saved.clone();
+        self.s.invalidate();
+        self.s.stats.cutbacks += 1;
+        true
+    }
+
     /// A converged arc-length increment that went back in load factor, on the path of a slowly
     /// driven test: jump to the stable equilibrium beyond the limit point. `None` if there is
     /// nothing to jump from (or no stable equilibrium: the path is then followed through it).
@@ -1491,7 +1526,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             .p
             .memory
             .as_mut()
-            .and_then(|m| m.visit(state, &self.s.system.reference))
+            .and_then(|m| m.visit(state, &self.s.system.reference, self.p.last_negative))
         {
             let end = self.lambda_end.unwrap_or(f64::NAN);
             let detail = if back.reversed {
@@ -1654,7 +1689,7 @@ impl<'a, 'b> Walk<'a, 'b> {
         self.path.steps.push(st);
         self.s.previous = None;
         if let Some(m) = &mut self.p.memory {
-            m.restart(state, &self.s.system.reference);
+            m.restart(state, &self.s.system.reference, self.p.last_negative);
         }
         self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
         self.p.neutral_reached = false;
