@@ -109,3 +109,48 @@ def test_drivers_name_the_setting_of_the_strongest_rank_correlation():
     setting, rho = drivers["e"]  # type: ignore[misc]
     assert setting == "a" and rho == 1.0
     assert np.isfinite(e.values("f")).all()
+
+
+def test_a_varied_setting_is_read_back_by_any_of_its_names():
+    # `thickness` is the set-up's field, reachable as `spec.thickness` too; an ensemble, loaded or
+    # not, gives its draws under either name.
+    e = ensemble(
+        H.scenario,
+        {"thickness": stats.uniform(1e-4, 1e-4)},
+        H.Settings(),
+        figures=H.figures,
+        runs=3,
+        seed=1,
+    )
+    np.testing.assert_array_equal(e.drawn("spec.thickness"), e.drawn("thickness"))
+    np.testing.assert_array_equal(e.values("t"), 1e3 * e.drawn("spec.thickness"))
+    with pytest.raises(KeyError, match="'a' was not varied"):
+        e.drawn("a")
+    with pytest.raises(KeyError, match="'nothing' was not varied"):
+        e.drawn("nothing")
+
+
+def test_an_unfrozen_scipy_distribution_is_refused():
+    # scipy.stats.norm itself has a ppf: that of the standard normal, which the user did not ask
+    # for. It is refused before any run, naming the setting and the way to freeze it.
+    with pytest.raises(TypeError, match=r"'a' must be frozen.*scipy\.stats\.norm\(mean, std\)"):
+        ensemble(H.scenario, {"a": stats.norm}, H.Settings(), figures=H.figures, runs=2)
+    with pytest.raises(TypeError, match=r"not scipy\.stats\.randint"):
+        ensemble(H.scenario, {"n": stats.randint}, H.Settings(), figures=H.figures, runs=2)
+
+
+def test_a_distribution_drawing_infinities_is_refused_before_any_run():
+    # A finite median, but draws that overflow: lognormal with sigma = 400 (the command line's
+    # lognormal:1:230 %) reaches infinity in its upper tail. Refused before any run (no run is
+    # made: the progress callback is never called).
+    seen = []
+    with pytest.raises(ValueError, match=r"distribution of 'a' .* not finite numbers in 64 runs"):
+        ensemble(
+            H.scenario,
+            {"a": stats.lognorm(400.0, scale=1.0)},
+            H.Settings(),
+            figures=H.figures,
+            runs=64,
+            progress=lambda *args: seen.append(args),
+        )
+    assert not seen

@@ -27,15 +27,24 @@ def check_distribution(name: str, distribution: object) -> None:
     Raises
     ------
     TypeError
-        If it has no ``ppf``.
+        If it has no ``ppf``, or is a SciPy distribution not frozen (``scipy.stats.norm``
+        rather than ``scipy.stats.norm(mean, std)``).
     ValueError
         If its median is not a finite number.
     """
+    from scipy.stats import rv_continuous, rv_discrete
+
     ppf = getattr(distribution, "ppf", None)
     if not callable(ppf):
         raise TypeError(
             f"the distribution of {name!r} must be a SciPy frozen distribution such as "
             f"scipy.stats.norm(mean, std) (got {distribution!r})"
+        )
+    if isinstance(distribution, (rv_continuous, rv_discrete)):
+        # Unfrozen, its ppf takes the defaults (loc 0, scale 1): the standard one, not yours.
+        raise TypeError(
+            f"the distribution of {name!r} must be frozen with its parameters, e.g. "
+            f"scipy.stats.norm(mean, std), not scipy.stats.{distribution.name}"
         )
     try:
         median = float(ppf(0.5))
@@ -58,8 +67,12 @@ def describe_distribution(distribution: Any) -> str:
         for k, v in getattr(distribution, "kwds", {}).items()
     ]
     text = f"{name}({', '.join(args + kwds)})"
+    import numpy as np
+
     try:
-        mean, std = float(distribution.mean()), float(distribution.std())
+        # A heavy tail's moments overflow to inf (lognormal with a large sigma): shown as such.
+        with np.errstate(over="ignore", invalid="ignore"):
+            mean, std = float(distribution.mean()), float(distribution.std())
     except (AttributeError, TypeError, ValueError):
         return text
     # SciPy's arguments are its own (a uniform's are its low end and width): the moments say it

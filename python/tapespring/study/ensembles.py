@@ -152,10 +152,22 @@ class Ensemble:
         KeyError
             For a setting not varied.
         """
-        if parameter not in self.parameters:
-            raise KeyError(f"{parameter!r} was not varied; varied: {', '.join(self.parameters)}")
-        j = self.parameters.index(parameter)
+        j = self._parameter_index(parameter)
         return np.array([self.samples[run.index, j] for run in self.runs])
+
+    def _parameter_index(self, parameter: str) -> int:
+        """Column of varied setting `parameter`, by the name it was varied under or any other name
+        of the same setting (``spec.tape.thickness`` for ``tape.thickness``)."""
+        if parameter in self.parameters:
+            return self.parameters.index(parameter)
+        try:
+            full = resolve(self.settings, parameter)
+            for j, name in enumerate(self.parameters):
+                if resolve(self.settings, name) == full:
+                    return j
+        except (TypeError, ValueError):
+            pass
+        raise KeyError(f"{parameter!r} was not varied; varied: {', '.join(self.parameters)}")
 
     def statistics(self) -> dict[str, dict[str, float]]:
         """Each figure's statistics over the runs that gave it: ``count``, ``mean``, ``std``
@@ -476,7 +488,9 @@ def draws(distributions: list[Any], runs: int, *, seed: int, sampling: str) -> N
         u = qmc.LatinHypercube(d=d, rng=rng).random(runs)
     else:
         u = rng.random((runs, d))
-    return np.column_stack([dist.ppf(u[:, j]) for j, dist in enumerate(distributions)])
+    # An overflow in a tail is reported by the caller's check of the draws, naming the setting.
+    with np.errstate(over="ignore"):
+        return np.column_stack([dist.ppf(u[:, j]) for j, dist in enumerate(distributions)])
 
 
 def check_runs(runs: object) -> int:
@@ -597,6 +611,13 @@ def ensemble(
     if len({resolve(settings, n) for n in names}) != len(names):
         raise ValueError(f"a setting is varied twice in {list(names)}")
     samples = draws([parameters[n] for n in names], n_runs, seed=int(seed), sampling=sampling)
+    for j, name in enumerate(names):
+        bad = int(np.count_nonzero(~np.isfinite(samples[:, j])))
+        if bad:
+            raise ValueError(
+                f"the distribution of {name!r} ({describe_distribution(parameters[name])}) drew "
+                f"{bad} values that are not finite numbers in {n_runs} runs: narrow it"
+            )
     values = [{n: float(samples[i, j]) for j, n in enumerate(names)} for i in range(n_runs)]
 
     report = reporter(f"ensemble of {runner.name}", n_runs, progress)
