@@ -1,8 +1,8 @@
 """The heavy top on its pin, shared by the dynamics tests: ``from _heavy_top import heavy_top``.
 
 The heavy top of issue 8, 6.b (Brüls, Cardona & Arnold 2012; the model of
-`crates/tape-core/tests/rigid_dynamics.rs`): a rigid body spinning about a fixed point at the
-origin under gravity, its data below. Units SI.
+`crates/tape-core/tests/validation/rigid_dynamics.rs`): a rigid body spinning about a fixed point
+at the origin under gravity, its data below. Units SI.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """tapespring.analysis and tapespring.results: the model vocabulary, steps, run and its results.
 
-Mechanics is proven in the Rust tests (crates/tape-core/tests/analysis_steps.rs,
+Mechanics is proven in the Rust tests (crates/tape-core/tests/validation/analysis_steps.rs,
 gravity_parts.rs); these check the Python side of the same features on small models, with
 global balances that hold exactly (to the Newton tolerance) whatever the mesh:
 

@@ -206,12 +206,12 @@ def test_free_flight_of_a_curved_strip_keeps_its_energy():
 
 
 def test_energy_tolerance_from_rest_under_a_load_applied_at_once():
-    # `energy_tolerance` (its physics: crates/tape-core/tests/free_flight.rs) on a strip starting
-    # from rest under its push: the first steps move it by less than the positions' round-off
-    # tells energies apart (1e-20 J after 1e-5 s), and the scheme damps its drilling rotations
-    # whatever the step. Without the remainder's round-off floor the steps shrank to min_step at
-    # 1e-5 s. Measured: 306 steps (66 rejected) against 26; the remainder at the end 5.8e-13 J
-    # against 2.8e-12 J without, of 6.7e-10 J of kinetic energy at its peak.
+    # `energy_tolerance` (its physics: crates/tape-core/tests/validation/free_flight.rs) on a strip
+    # starting from rest under its push: the first steps move it by less than the positions'
+    # round-off tells energies apart (1e-20 J after 1e-5 s), and the scheme damps its drilling
+    # rotations whatever the step. Without the remainder's round-off floor the steps shrank to
+    # min_step at 1e-5 s. Measured: 306 steps (66 rejected) against 26; the remainder at the end
+    # 5.8e-13 J against 2.8e-12 J without, of 6.7e-10 J of kinetic energy at its peak.
     free = run(strip_model()[0], [Step.dynamic(duration=0.05)])
     held = run(strip_model()[0], [Step.dynamic(duration=0.05, energy_tolerance=1e-5)])
     assert held.error is None

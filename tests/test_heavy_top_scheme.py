@@ -1,15 +1,15 @@
 """The heavy top against an independent implementation of the same integrator.
 
-`crates/tape-core/tests/rigid_dynamics.rs` checks the heavy top of Brüls, Cardona & Arnold (2012)
-against the published reference: second order, converging onto it (Richardson-extrapolated
-error 6.9e-5 m at 1 s and 2.7e-4 m at 2 s), with a raw error of 1.0e-2 m at h = 2e-4 s. Issue 8 asks
-for 5e-4 m at that step. This test shows that the raw error is the scheme's own, not the code's:
-a few lines of numpy and scipy integrate the same equations with the Lie-group generalised-alpha
-method (Arnold & Brüls 2007; spatial angular velocities, `R_{n+1} = exp(D) R_n`), and the core's
-run lands on the same states to Newton's tolerance. The scheme in the body frame
-(`R_{n+1} = R_n exp(D)`), the other classical choice, is no closer to the reference: 9.2e-3 m at
-h = 2e-4 s (7.9e-3 m at rho_inf = 0.9, 1.0e-2 m for the spatial form at rho_inf = 1), measured with
-this module's integrator switched to the body frame.
+`crates/tape-core/tests/validation/rigid_dynamics.rs` checks the heavy top of Brüls, Cardona &
+Arnold (2012) against the published reference: second order, converging onto it
+(Richardson-extrapolated error 6.9e-5 m at 1 s and 2.7e-4 m at 2 s), with a raw error of 1.0e-2 m at
+h = 2e-4 s. Issue 8 asks for 5e-4 m at that step. This test shows that the raw error is the scheme's
+own, not the code's: a few lines of numpy and scipy integrate the same equations with the Lie-group
+generalised-alpha method (Arnold & Brüls 2007; spatial angular velocities, `R_{n+1} = exp(D) R_n`),
+and the core's run lands on the same states to Newton's tolerance. The scheme in the body frame
+(`R_{n+1} = R_n exp(D)`), the other classical choice, is no closer to the reference: 9.2e-3 m at h =
+2e-4 s (7.9e-3 m at rho_inf = 0.9, 1.0e-2 m for the spatial form at rho_inf = 1), measured with this
+module's integrator switched to the body frame.
 
 The 5e-4 m of issue 8 is the bound of a public regression test (Kynema's
 `dynamic_heavy_top.cpp`: "maximum observed error is ~2.05e-4") whose model is another one: a

@@ -1,5 +1,5 @@
 """Edge cases of ``stop_at_monitor_zero`` through the binding (the mechanics in full are in
-crates/tape-core/tests/monitor_zero_edges.rs): bad option values, a zero at or near
+crates/tape-core/tests/validation/monitor_zero_edges.rs): bad option values, a zero at or near
 ``lambda_end``, a monitor on a rotation, and a progress callback that cancels on the state that
 crossed the zero.
 

@@ -368,7 +368,8 @@ def test_a_deployment_stopped_in_its_fold_reports_no_motion(monkeypatch) -> None
 
 def test_the_energy_tolerance_reaches_the_motion_step(capsys) -> None:
     # DeploymentSettings.energy_tolerance (its effect: docs/scenarios.md; the solver's option:
-    # crates/tape-core/tests/free_flight.rs) is the motion's step option, saved with the run.
+    # crates/tape-core/tests/validation/free_flight.rs) is the motion's step option, saved with
+    # the run.
     sim = deploy(DeploymentSettings(spec=COARSE, duration=0.05, energy_tolerance=1e-4))
     steps = sim.results.settings["steps"]
     assert steps[-1]["energy_tolerance"] == 1e-4

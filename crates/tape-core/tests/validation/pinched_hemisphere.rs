@@ -24,7 +24,7 @@
 //! of 0.094 (observed 0.0933, 0.0930, 0.0933 at N = 8, 16, 32), and, as linear theory demands for
 //! this load case, u_y at B equal and opposite to u_x at A.
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use tape_core::{Dof, Model, Result};

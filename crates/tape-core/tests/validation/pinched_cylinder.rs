@@ -27,7 +27,7 @@
 //! not go further: under a point load the Reissner-Mindlin deflection grows like log(1/h) (the
 //! shear deformation is singular), so finer meshes slowly overshoot 1.8248e-5 (N = 64 gives 1.007).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::FRAC_PI_2;
 

@@ -21,7 +21,7 @@
 //! is 1e-11 m of the middle's deflection, 6e-9 of the buckle's height: hence 1e-9 of the peak and
 //! 1e-8 of the height (measured: 2e-13 and 7e-12).
 
-mod common;
+use crate::common;
 
 use common::zero::{pushed_strip, L};
 

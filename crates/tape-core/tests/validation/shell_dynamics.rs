@@ -15,7 +15,7 @@
 //!   accounts for the lost energy to 1e-3 of it;
 //! * runs on one and on two threads give the same history bit for bit.
 
-mod common;
+use crate::common;
 
 use tape_core::solver::{DynamicParams, Stats};
 use tape_core::{run, History, Model, Outputs, Result, StepKind};

@@ -17,7 +17,7 @@
 //! step that overshoots lambda_end (initial increment 1.0 against lambda_end = -1) must land on it
 //! instead of carrying the path away.
 
-mod common;
+use crate::common;
 
 use tape_core::solver::{solve_static, Control, StaticParams, StaticPath};
 use tape_core::{Error, Result, System};

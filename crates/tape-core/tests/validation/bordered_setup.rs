@@ -24,7 +24,7 @@ use tape_core::samples::paper_tape_section;
 use tape_core::solver::{DynamicParams, NewtonParams};
 use tape_core::{run, Dof, History, Model, Outputs, Result, State, Step, System, TimeFunction};
 
-mod common;
+use crate::common;
 
 const L: f64 = 0.06;
 const SPACING: f64 = 0.04;

@@ -11,7 +11,7 @@
 //! the non-symmetric rotation terms) is non-zero. The scatter is serial in element order in both
 //! paths, so the results must be identical, not merely close: no tolerance.
 
-mod common;
+use crate::common;
 
 use tape_core::assembly::Assembled;
 use tape_core::mesh::generate::{tape_spring, TapeGeometry};

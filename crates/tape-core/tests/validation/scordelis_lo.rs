@@ -27,7 +27,7 @@
 //! within 1 % of 0.3024 (observed: 1.1 % and 0.6 % low), convergence from below and monotone, and
 //! the error divided by at least 1.5 per mesh doubling.
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use tape_core::mesh::generate::cylindrical_panel;

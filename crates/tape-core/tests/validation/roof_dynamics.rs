@@ -72,7 +72,7 @@
 //!
 //! Each of these failures was checked once by hand (ramps of 1000 and 300 `T1`, `zeta` = 0).
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use tape_core::model::Marker;

@@ -26,7 +26,7 @@
 //! of Ko et al.) all four cases must be within 0.5 % of the references, which is the spread of the
 //! published MITC4+ values (0.9971 to 0.9982); observed 0.9981 to 0.9986.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::FRAC_PI_2;
 

@@ -13,7 +13,7 @@
 //! print 3 decimals, so half a unit of the last digit (5e-4) is allowed on top; each test states
 //! its own exceptions and why.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::FRAC_PI_2;
 

@@ -12,7 +12,7 @@
 //! refactor by the dedicated bending driver; the other tests compare paths with themselves (split
 //! into steps or not) and with the small-deflection beam.
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use tape_core::mesh::generate::flat_plate;

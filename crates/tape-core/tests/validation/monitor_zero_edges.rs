@@ -30,7 +30,7 @@
 //! `stop_at_monitor_zero`). With `tol_force = 1e-10` and forces below 1e3 N the floor governs, so
 //! the tolerances below are that floor, or what it moves the structure by at the stiffnesses above.
 
-mod common;
+use crate::common;
 
 use common::zero::{arc, driven, outputs, tight, L};
 

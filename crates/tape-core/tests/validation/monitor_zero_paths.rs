@@ -41,7 +41,7 @@
 //! measured on the paths, reaction over deflection) in cases 1-3, the strip's moment per end
 //! rotation at each zero in case 4 (measured on the path itself).
 
-mod common;
+use crate::common;
 
 use common::zero::{arc, driven, outputs, pushed_strip, tight, L};
 

@@ -23,7 +23,7 @@
 //!   formula (Timoshenko & Young, "Vibration Problems in Engineering", 4th ed., 1974, sec. 5.13);
 //! * the free decay of the released cantilever of `shell_dynamics.rs` has the modal period.
 
-mod common;
+use crate::common;
 
 use tape_core::mesh::generate::flat_plate;
 use tape_core::model::Load;

@@ -16,7 +16,7 @@
 //! * A part placed by a rotation and a translation gives the rotated, translated results of the
 //!   same part built in place (objectivity of the whole chain: placement, element, ties, loads).
 
-mod common;
+use crate::common;
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use tape_core::mesh::generate::flat_plate;
