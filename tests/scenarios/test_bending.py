@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -166,6 +166,19 @@ def test_a_deep_section_traces_its_whole_path_through_the_snap(alpha_deg):
         # 2 mm (+8.8 % on 4 mm). At 120 deg the 2 mm mesh is still far from converged there
         # (+10.8 %, +26 % on 4 mm).
         assert s.m_star == pytest.approx(s.m_star_analytical, rel=0.10)
+
+
+def test_a_whole_path_that_stops_names_the_slow_tests_path_as_the_way_on():
+    # 90 deg in equal sense on 4 mm: the whole path (jump=False) meets a tangle of unstable
+    # branches past the snap and closes a loop (measured: stops at -4.46 deg). The message says
+    # so and names jump=True, which reaches -30 deg on the same tape (measured: 1.0 s).
+    setup = BendingSetup(alpha_deg=90.0, theta_max_deg=-30.0, mesh_size=4e-3)
+    whole = bend(setup)
+    assert whole.error is not None and "returned onto itself" in whole.error
+    assert "jump=True" in whole.error and "--path jump" in whole.error
+    slow = bend(replace(setup, jump=True))
+    assert slow.error is None and slow.theta_deg[-1] == pytest.approx(-30.0)
+    assert "jump=True" not in str(slow.error)
 
 
 def test_initial_stiffness_lies_between_beam_and_plate_bending_stiffness(small_angle):
