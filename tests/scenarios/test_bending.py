@@ -178,7 +178,6 @@ def test_a_whole_path_that_stops_names_the_slow_tests_path_as_the_way_on():
     assert "jump=True" in whole.error and "--path jump" in whole.error
     slow = bend(replace(setup, jump=True))
     assert slow.error is None and slow.theta_deg[-1] == pytest.approx(-30.0)
-    assert "jump=True" not in str(slow.error)
 
 
 def test_initial_stiffness_lies_between_beam_and_plate_bending_stiffness(small_angle):

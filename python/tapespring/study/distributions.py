@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 __all__ = ["FORMS", "check_distribution", "describe_distribution", "parse_distribution"]
 
 #: The command line's forms, ``KIND:ARG:...``, and what each argument is. A normal's standard
@@ -67,8 +69,6 @@ def describe_distribution(distribution: Any) -> str:
         for k, v in getattr(distribution, "kwds", {}).items()
     ]
     text = f"{name}({', '.join(args + kwds)})"
-    import numpy as np
-
     try:
         # A heavy tail's moments overflow to inf (lognormal with a large sigma): shown as such.
         with np.errstate(over="ignore", invalid="ignore"):

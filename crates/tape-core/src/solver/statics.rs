@@ -1235,7 +1235,13 @@ impl<'a, 'b> Walk<'a, 'b> {
                 }
                 Ok(None) | Err(_) => true,
             };
-        if !coarse || self.p.control.reject().is_err() {
+        coarse && self.retry_shorter(state, saved)
+    }
+
+    /// Halves the increment and goes back to `saved` for a converged step the path must not take
+    /// (false, leaving `state` as it is, once the controller gives up: the step is then taken).
+    fn retry_shorter(&mut self, state: &mut State, saved: &State) -> bool {
+        if self.p.control.reject().is_err() {
             return false;
         }
         *state = saved.clone();
@@ -1262,21 +1268,19 @@ impl<'a, 'b> Walk<'a, 'b> {
         if self.p.control.cutbacks >= params.max_cutbacks / 2 {
             return false;
         }
-        let Ok(n) = self.s.negative_eigenvalues() else {
+        // The plain count, as recorded: a neutral mode's test (one negative pivot) is not needed.
+        let Ok(n) = self
+            .s
+            .factorise()
+            .and_then(|()| self.s.system.linear.negative_eigenvalues())
+        else {
             return false;
         };
-        if n <= 1 || self.p.control.reject().is_err() {
+        if n <= 1 {
             return false;
         }
-        log::debug!(
-            "stability count 0 -> {n} across t = {} .. {}: cut back",
-            saved.t,
-            state.t
-        );
-        *state = saved.clone();
-        self.s.invalidate();
-        self.s.stats.cutbacks += 1;
-        true
+        log::debug!("stability count 0 -> {n} across t = {} .. {}", saved.t, state.t);
+        self.retry_shorter(state, saved)
     }
 
     /// A converged arc-length increment that went back in load factor, on the path of a slowly
