@@ -61,9 +61,17 @@ def alive(pid: int) -> bool:
 
 
 def run_script(tmp_path: Path, body: str) -> subprocess.Popen[str]:
-    """Starts `body` (after the imports of this folder's tasks) as a script in its own session."""
+    """Starts `body` (after the imports of this folder's tasks) as a script in its own session,
+    with Ctrl-C handled as in a terminal: a test run started in the background by a shell
+    without job control (``pytest &`` in a script, as a CI harness may) ignores SIGINT, and a
+    child started from it would inherit that and never see the tests' Ctrl-C."""
     script = tmp_path / "study.py"
-    script.write_text(f"import sys\nsys.path.insert(0, {str(TESTS)!r})\n" + textwrap.dedent(body))
+    prologue = (
+        "import signal\nimport sys\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        f"sys.path.insert(0, {str(TESTS)!r})\n"
+    )
+    script.write_text(prologue + textwrap.dedent(body))
     return subprocess.Popen(
         [sys.executable, str(script)],
         stdout=subprocess.PIPE,
