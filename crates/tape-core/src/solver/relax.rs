@@ -69,7 +69,7 @@ impl Driver<'_> {
         let mut offset = last_dlambda.map_or(1e-3, |dl| 0.25 * dl.abs()).max(1e-6);
         for _ in 0..8 {
             *state = saved.clone();
-            self.relax(state, saved.t + travel * offset)?;
+            self.relax(state, saved.t + travel * offset, None)?;
             let distance = self.distance(state, saved);
             log::trace!(
                 "jump from t = {}: offset {offset:.3e}, distance {distance:.3e}, ds {ds:.3e}",
@@ -111,13 +111,17 @@ impl Driver<'_> {
         let mut trial = state.clone();
         let push = self.push_amount(&mode);
         self.push_along(&mut trial, &mode, push);
-        if self.relax(&mut trial, state.t).is_err() || self.distance(&trial, state) < 0.5 * push {
+        // The flow descends the potential: once below the level that counts as left, it stays
+        // below, and the rest of the way to the stable equilibrium (three quarters of the
+        // relaxation where the equal-sense tape leaves its path) tells nothing more.
+        let left = energy - NEUTRAL_ENERGY * energy.abs();
+        if self.relax(&mut trial, state.t, Some(left)).is_err() || self.distance(&trial, state) < 0.5 * push {
             self.invalidate();
             return Ok(false);
         }
         let relaxed = self.asm.energy + self.asm.gravity_energy;
         self.invalidate();
-        Ok(relaxed < energy - NEUTRAL_ENERGY * energy.abs())
+        Ok(relaxed < left)
     }
 
     /// A stable equilibrium at load factor `lambda`, relaxed from `from`; `state` ends there, with
@@ -127,7 +131,7 @@ impl Driver<'_> {
     /// [`Error::NotConverged`] if no stable equilibrium is found (`state` is then `from`).
     pub fn relax_at(&mut self, state: &mut State, from: &State, lambda: f64) -> Result<()> {
         *state = from.clone();
-        if let Err(e) = self.relax(state, lambda) {
+        if let Err(e) = self.relax(state, lambda, None) {
             *state = from.clone();
             return Err(e);
         }
@@ -193,7 +197,7 @@ impl Driver<'_> {
             for sign in [1.0, -1.0] {
                 let mut trial = start.clone();
                 self.push_along(&mut trial, &mode, sign * push);
-                if self.relax(&mut trial, t_switch).is_err() || self.distance(&trial, &start) < 0.5 * push {
+                if self.relax(&mut trial, t_switch, None).is_err() || self.distance(&trial, &start) < 0.5 * push {
                     continue;
                 }
                 let energy = self.asm.energy + self.asm.gravity_energy;
@@ -320,9 +324,10 @@ impl Driver<'_> {
         self.system.update(state, &push, 0.0);
     }
 
-    /// Moves the load factor to `lambda` and relaxes `state` to a stable equilibrium there.
-    /// Returns the pseudo-steps used.
-    fn relax(&mut self, state: &mut State, lambda: f64) -> Result<usize> {
+    /// Moves the load factor to `lambda` and relaxes `state` to a stable equilibrium there, or,
+    /// with `below`, until a pseudo-step ends at a potential energy below it \[J\] (`state` is then
+    /// on the way, with its pieces assembled).
+    fn relax(&mut self, state: &mut State, lambda: f64, below: Option<f64>) -> Result<()> {
         const MAX_STEPS: usize = 400;
         let n = self.system.n_free();
         let zero = vec![0.0; n];
@@ -342,12 +347,15 @@ impl Driver<'_> {
             self.assemble(state);
             let (ok, rr) = self.converged(None);
             log::trace!("relaxation step {step}: beta {beta:.1e}, residual {rr:.3e}");
+            if below.is_some_and(|e| self.asm.energy + self.asm.gravity_energy < e) {
+                return Ok(());
+            }
             if ok && beta <= 1e-6 {
                 // A negative eigenvalue at round-off level is a neutral mode (a fold free to slide
                 // along a uniform tape: measured -7e-16 of the largest diagonal entry), not an
                 // instability the flow can leave: the state is as stable as it gets.
                 if self.negative_eigenvalues()? == 0 {
-                    return Ok(step);
+                    return Ok(());
                 }
                 beta = beta.max(1e-3);
             }
