@@ -719,7 +719,8 @@ struct PathState {
     arc: f64,
     /// Converged states kept for the location of events and refinement (cleared at jumps).
     history: Vec<Point>,
-    /// Negative eigenvalues of the last recorded state (if counted).
+    /// Negative eigenvalues of the last recorded state (if counted; before the first, 0 if the
+    /// path starts with a neutral mode, see `neutral_from_start`).
     last_negative: Option<usize>,
     /// After a jump or a branch switch: the load-factor increment of the restarting step.
     restart: Option<f64>,
@@ -728,6 +729,9 @@ struct PathState {
     /// The state of the increment being tried is unstable only by a neutral mode (see
     /// [`Driver::leaves`]): it is recorded without it.
     neutral_reached: bool,
+    /// On a path that switches branches: its start and every state since were stable but for one
+    /// neutral mode (see `Walk::starts_neutral`), which each new state is recounted for.
+    neutral_from_start: bool,
     /// Steps are being shortened towards an instability found real (see `CLOSE_IN`).
     closing_in: bool,
     /// Largest norm of the external loads at the states recorded so far \[N\].
@@ -972,6 +976,7 @@ impl<'a, 'b> Walk<'a, 'b> {
                 restart: None,
                 memory: arc_control.then(PathMemory::new),
                 neutral_reached: false,
+                neutral_from_start: false,
                 closing_in: false,
                 max_load: 0.0,
                 unresolved: None,
@@ -998,7 +1003,32 @@ impl<'a, 'b> Walk<'a, 'b> {
             w.s.assemble(state);
             w.push_history(state);
         }
+        if w.starts_neutral(state) {
+            w.p.last_negative = Some(0);
+            w.p.neutral_from_start = true;
+        }
         Ok(w)
+    }
+
+    /// On a path that switches branches, whether its start `state` is stable but for one neutral
+    /// mode (a balanced body, a fold free to slide): one negative pivot, at round-off level by
+    /// [`Driver::negative_eigenvalues`]. Its states then leave that mode out of their counts, as
+    /// the states located on the path do (`events::discount_neutral`) and a state the path restarts
+    /// from does (`Walk::push_relaxed`); else the start, never counted, is not known stable, and
+    /// every state would count it. The tangent factorised is the one the first step needs anyway;
+    /// a failure here is the first step's to report.
+    fn starts_neutral(&mut self, state: &State) -> bool {
+        if !self.switching() {
+            return false;
+        }
+        if !self.s.fresh {
+            self.s.assemble(state);
+        }
+        let plain = self
+            .s
+            .factorise()
+            .and_then(|()| self.s.system.linear.negative_eigenvalues());
+        matches!(plain, Ok(1)) && matches!(self.s.negative_eigenvalues(), Ok(0))
     }
 
     /// The next increment; `None` once the path is at its end (or the first arc-length step
@@ -1276,7 +1306,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         else {
             return false;
         };
-        if n <= 1 {
+        // The neutral mode a path starts with (see `Walk::starts_neutral`) is one of the pivots.
+        if n <= 1 + usize::from(self.p.neutral_from_start) {
             return false;
         }
         log::debug!("stability count 0 -> {n} across t = {} .. {}", saved.t, state.t);
@@ -1346,6 +1377,22 @@ impl<'a, 'b> Walk<'a, 'b> {
     /// (a bifurcation), when branches are switched: leave it for the stable branch. `None` if it
     /// is not the case, or the instability is not one the state leaves (the path goes on).
     fn switch_at_bifurcation(&mut self, state: &mut State, saved: &State) -> Option<Flow> {
+        if self.p.neutral_from_start {
+            // The path's neutral mode, recounted as at its start (in either direction of the load
+            // factor): testing it by relaxation at each state would only find it neutral again.
+            match self.keeps_neutral() {
+                Ok(true) => {
+                    self.p.neutral_reached = true;
+                    return None;
+                }
+                // Gone, or now beyond round-off: the state is tested as after any stable one.
+                Ok(false) => self.p.neutral_from_start = false,
+                Err(e) => {
+                    self.path.error = Some(e);
+                    return Some(Flow::Stop);
+                }
+            }
+        }
         let forward = self
             .lambda_end
             .is_some_and(|end| (state.t - saved.t) * (end - saved.t) > 0.0);
@@ -1452,6 +1499,16 @@ impl<'a, 'b> Walk<'a, 'b> {
         } else {
             Flow::Stop
         })
+    }
+
+    /// Whether the converged state of the increment (its tangent assembled) still has one negative
+    /// pivot, at round-off level (see [`Driver::negative_eigenvalues`]).
+    ///
+    /// # Errors
+    /// A failure of the linear algebra.
+    fn keeps_neutral(&mut self) -> Result<bool> {
+        self.s.factorise()?;
+        Ok(self.s.system.linear.negative_eigenvalues()? == 1 && self.s.negative_eigenvalues()? == 0)
     }
 
     /// A converged arc-length increment that crossed the final load factor: the path ends with a
@@ -1697,6 +1754,8 @@ impl<'a, 'b> Walk<'a, 'b> {
         }
         self.p.restart = self.p.last_dlambda.map(|dl| 0.5 * dl.abs());
         self.p.neutral_reached = false;
+        // The restarting state's own count governs from here.
+        self.p.neutral_from_start = false;
         self.p.closing_in = false;
         self.p.control.cutbacks = 0;
         self.p.history.clear();
