@@ -48,6 +48,9 @@ from tapespring.study.paths import assign, number_at, resolve
 #: The stand-in's nominal settings: a = 2, b = 3, eta = 0.
 S = H.Settings()
 U = stats.uniform(1.0, 3.0)  # a in [1, 4]: every run valid
+#: a in [-1, 3], some draws refused (a must be > 0): with seed 0, run 0 of 4 (-0.94, 1.68, 0.28,
+#: 2.87), runs 0 and 3 of 8.
+A_SOME_REFUSED = {"a": stats.uniform(-1.0, 4.0)}
 
 #: The bending scenario on the 4 mm mesh to 30 deg, past its snap: 0.3 s a run.
 BEND = BendingSetup(mesh_size=4e-3, theta_max_deg=30.0)
@@ -123,6 +126,9 @@ ENSEMBLE_REFUSALS = [
     ({"a": U}, {"executor": 3}, TypeError, "executor must be a concurrent.futures.Executor"),
     # The stand-in here is a closure: it cannot be sent to a worker process.
     ({"a": U}, {"workers": 2}, TypeError, "cannot be sent to worker processes"),
+    # The same with the first draw refused (a < 0): it is not reported either.
+    (A_SOME_REFUSED, {"workers": 2}, TypeError, "cannot be sent to worker processes"),
+    (A_SOME_REFUSED, {"executor": 3}, TypeError, "executor must be"),
     ({"a": U}, {"figures": 3}, TypeError, "figures must be a function"),
     ({"a": U}, {"figures": None}, TypeError, "needs its settings and its figures"),
     ({"a": U}, {"history": 3}, TypeError, "history must be a function"),
@@ -476,6 +482,57 @@ def test_ctrl_c_in_the_progress_of_a_refused_run_keeps_the_runs_so_far():
     except KeyboardInterrupt:  # not raised on: pytest would end the session
         pytest.fail("Ctrl-C escaped the study")
     assert e.cancelled and len(e.runs) >= 1
+
+
+def test_with_one_worker_each_run_is_reported_once_in_order_a_refused_one_when_its_turn_comes():
+    events: list[tuple[str, float]] = []
+
+    def logged(s):
+        events.append(("run", s.a))
+        return H.scenario(s)
+
+    def progress(run):
+        events.append(("report", run.values["a"]))
+
+    e = quietly(
+        ensemble, logged, A_SOME_REFUSED, S, figures=H.figures, runs=8, seed=0, progress=progress
+    )
+    a = e.drawn("a").tolist()
+    assert [i for i, ai in enumerate(a) if ai <= 0.0] == [0, 3]
+    expected: list[tuple[str, float]] = []
+    for ai in a:
+        expected += [("report", ai)] if ai <= 0.0 else [("run", ai), ("report", ai)]
+    assert events == expected
+    assert [r.index for r in e.runs] == list(range(8)) and not e.cancelled
+
+
+def test_with_two_workers_each_run_is_reported_once_a_refused_one_after_the_runs_before_it():
+    seen: list[Any] = []
+    e = quietly(run_ensemble, A_SOME_REFUSED, runs=8, seed=0, workers=2, progress=seen.append)
+    order = [r.index for r in seen]
+    assert sorted(order) == list(range(8)) and e.workers == 2
+    refused = [(k, run.index) for k, run in enumerate(seen) if not run.ok]
+    assert [i for _, i in refused] == [0, 3]
+    for k, i in refused:  # at the first report after every run before it
+        first = min(p for p in range(len(order) + 1) if set(range(i)) <= set(order[:p]))
+        assert k == first, order
+    assert [r.index for r in e.runs] == list(range(8)) and not e.cancelled
+
+
+def test_a_study_in_two_workers_checks_that_they_can_receive_its_runs_once(monkeypatch):
+    # The check pickles every run's settings: `run_tasks` does it, the study not again.
+    import tapespring.sweep
+
+    calls: list[int] = []
+    check_sendable = tapespring.sweep.check_sendable
+
+    def counted(func, tasks):
+        calls.append(len(tasks))
+        check_sendable(func, tasks)
+
+    monkeypatch.setattr(tapespring.sweep, "check_sendable", counted)
+    e = quietly(run_ensemble, A_SOME_REFUSED, runs=4, seed=0, workers=2)
+    assert calls == [3] and e.workers == 2 and len(e.runs) == 4
 
 
 def test_false_on_the_last_run_does_not_cancel_a_study_whose_runs_all_ended():

@@ -18,7 +18,7 @@ import _review_tasks as R
 import numpy as np
 import pytest
 from scipy import stats
-from tapespring.study import Ensemble, StudyWarning, ensemble, sensitivity
+from tapespring.study import Ensemble, StudyRun, StudyWarning, ensemble, sensitivity
 
 TESTS = Path(__file__).resolve().parent
 
@@ -26,6 +26,8 @@ TESTS = Path(__file__).resolve().parent
 def test_a_dead_worker_fails_the_runs_it_did_not_report_and_keeps_the_others():
     # Draws of a in (1, 5) over 6 runs: those above 3 end their worker. The pool breaks with the
     # first; its runs not reported fail with the death's message, the reported ones are kept.
+    # Every run is reported once, the failed ones too.
+    seen: list[StudyRun] = []
     with pytest.warns(StudyWarning, match="worker process died"):
         e = ensemble(
             R.scenario_dying_above_3,
@@ -35,8 +37,10 @@ def test_a_dead_worker_fails_the_runs_it_did_not_report_and_keeps_the_others():
             runs=6,
             seed=4,
             workers=2,
+            progress=seen.append,
         )
     assert len(e.runs) == 6 and not e.cancelled
+    assert sorted(seen, key=lambda r: r.index) == list(e.runs)
     dead = [r for r in e.runs if not r.ok]
     assert dead and all("worker process died" in str(r.error) for r in dead)
     for r in e.runs:

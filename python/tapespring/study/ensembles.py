@@ -86,7 +86,7 @@ class Ensemble:
     samples : ndarray, shape (runs, parameters)
         Every draw, in the order of the runs (those not run after a stop included).
     runs : tuple of StudyRun
-        The runs that ended, in order; the failed ones with their message.
+        The runs that ended, in index order; the failed ones with their message.
     settings : object
         The settings every run started from.
     sampling : str
@@ -556,8 +556,11 @@ def ensemble(
     executor : concurrent.futures.Executor, optional
         Where to run them instead (a Dask cluster's ``client.get_executor()``).
     progress : bool or callable, optional
-        True: a line on stderr per run. A callable receives each :class:`StudyRun` as it ends
-        and may return False to stop the study (the runs that ended are kept, ``cancelled``).
+        True: a line on stderr per run. A callable receives each :class:`StudyRun` once, as it
+        ends, and may return False to stop the study (the runs that ended are kept,
+        ``cancelled``). With one worker that is the runs' order (a run whose settings are
+        refused is reported when its turn comes); with more, or an executor, the order they end
+        in (a refused one once every run before it has been reported).
 
     Returns
     -------

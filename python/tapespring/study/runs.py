@@ -239,71 +239,97 @@ def run_all(
     report: Callable[[StudyRun], bool],
 ) -> tuple[list[StudyRun], bool, int]:
     """Run `settings` with each of `values` replaced; the runs refused by the settings' check
-    are recorded with their message, not run (and reported first). ``report`` receives each run
-    as it ends and may return False, or raise KeyboardInterrupt, to stop.
+    are recorded with their message, not run.
+
+    ``report`` receives each run once, as it ends, and may return False, or raise
+    KeyboardInterrupt, to stop. In this process (one worker) that is the runs' index order: a
+    refused run ends when its turn comes, before the next run starts. In worker processes or on
+    an executor the runs are reported in the order they end, a refused run as soon as every run
+    before it has been reported but not before the first run that ran (what the workers cannot
+    receive is refused before any run is reported). After a worker's death, the runs it left
+    unreported fail with that message and are reported with the rest, in index order.
 
     Returns
     -------
     (list of StudyRun, bool, int)
-        The runs that ended, in the study's order; whether the study was stopped (by `report`
-        or Ctrl-C) before all ended; the processes the runs ran in (1: this one; 0: on an
+        The runs that ended, in index order; whether the study was stopped (by `report` or
+        Ctrl-C) before all ended; the processes the runs ran in (1: this one; 0: on an
         executor).
+
+    Raises
+    ------
+    TypeError
+        If the runs cannot be sent to the worker processes or `executor` is no executor
+        (:func:`tapespring.sweep.run_tasks`), before any run is reported.
     """
-    from tapespring.sweep import (
-        WorkerDied,
-        check_importable,
-        check_sendable,
-        processes_for,
-        run_tasks,
-    )
+    from tapespring.sweep import WorkerDied, check_importable, processes_for, run_tasks
 
     runs: dict[int, StudyRun] = {}
     tasks: list[_Task] = []
-    refused: list[StudyRun] = []
+    waiting: dict[int, StudyRun] = {}  # refused runs not reported yet, by index
     for i, v in enumerate(values):
         try:
             s = assign(settings, v)
             check_settings(s)
         except (TypeError, ValueError) as exc:
-            refused.append(StudyRun(index=i, values=v, error=f"settings refused: {exc}"))
+            waiting[i] = StudyRun(index=i, values=v, error=f"settings refused: {exc}")
             continue
         tasks.append(_Task(runner, i, v, s))
-    # What the runs' processes cannot receive is refused before any run is reported.
-    if executor is not None:
-        if not callable(getattr(executor, "submit", None)):
-            raise TypeError(f"executor must be a concurrent.futures.Executor (got {executor!r})")
-    elif processes_for(workers, len(tasks)) > 1:
+    processes = 0 if executor is not None else processes_for(workers, len(tasks))
+    if processes > 1:
+        # The runner's functions travel inside the tasks, which pickle here by reference even
+        # where a worker could not import them: each is checked, and named, by itself.
         for what in ("scenario", "figures", "history"):
             check_importable(getattr(runner, what), what)
-        check_sendable(_run, tasks)
     stopped = False
+    reached = 0  # every run below this index has been reported
 
-    def done(n: int, run: StudyRun) -> bool:
+    def record(run: StudyRun) -> bool:
         nonlocal stopped
         runs[run.index] = run
         if not report(run):
             stopped = True
         return not stopped
 
-    try:
-        for run in refused:
-            if not done(run.index, run):
+    def release() -> bool:
+        """Report the refused runs whose turn has come: every run before them reported."""
+        nonlocal reached
+        while not stopped:
+            while reached in runs:
+                reached += 1
+            if reached not in waiting:
                 break
-        else:
+            record(waiting.pop(reached))
+        return not stopped
+
+    def done(n: int, run: StudyRun) -> bool:
+        return release() and record(run) and release()
+
+    try:
+        # `run_tasks` (with `check_sendable`, the one pickling check) refuses what worker
+        # processes cannot receive before any run: with them, the refused runs wait for it. In
+        # this process nothing is refused once the runs start: those before the first go now.
+        if processes != 1 or release():
             stopped = run_tasks(_run, tasks, workers, done, executor=executor) or stopped
+            release()  # those after the last run (all of them if none ran)
     except KeyboardInterrupt:
         stopped = True
     except WorkerDied as exc:
         # The runs that ended are kept; those not reported fail with the worker's death.
         for n in exc.unfinished:
             task = tasks[n]
-            runs[task.index] = StudyRun(
+            waiting[task.index] = StudyRun(
                 index=task.index,
                 values=task.values,
                 error="a worker process died (killed, out of memory) before reporting this run",
             )
+        try:
+            release()
+        except KeyboardInterrupt:
+            stopped = True
+        # The study has ended: a stop asked now leaves no run out.
+        runs.update(waiting)
     ended = [runs[k] for k in sorted(runs)]
-    processes = 0 if executor is not None else processes_for(workers, len(tasks))
     # A stop asked with the last run is no stop: every run ended.
     return ended, stopped and len(ended) < len(values), processes
 
