@@ -1578,8 +1578,10 @@ impl<'a, 'b> Walk<'a, 'b> {
             }
         }
         if let (true, Some(end)) = (self.arc_control, self.lambda_end) {
+            // A first step from a start at the end has not reached it by leaving it; one that lands
+            // on it exactly (a linear response: `land` takes only steps that cross) has.
             let reached = (state.t - end) * (saved.t - end) <= 0.0;
-            if reached && self.p.last_dlambda.is_some() {
+            if reached && (self.p.last_dlambda.is_some() || saved.t != end) {
                 return Flow::Stop;
             }
         }
