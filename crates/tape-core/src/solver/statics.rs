@@ -117,6 +117,9 @@ pub(super) struct Driver<'a> {
     tangent_predictor: bool,
     /// Increment of the last converged step, for the arc-length secant predictor.
     pub previous: Option<(Vec<f64>, f64)>,
+    /// Fraction of the standard push along a critical mode that the last trial push which
+    /// relaxed used (1 until a shorter one was needed, see `Driver::pushed_relaxed`).
+    pub push_factor: f64,
     pub weights: Vec<f64>,
     /// Rates of the constrained DOFs, `value f'(t)`, at the current state.
     rates: Vec<f64>,
@@ -730,7 +733,7 @@ struct PathState {
     /// [`Driver::leaves`]): it is recorded without it.
     neutral_reached: bool,
     /// On a path that switches branches: its start and every state since were stable but for one
-    /// neutral mode (see `Walk::starts_neutral`), which each new state is recounted for.
+    /// neutral mode (see `Walk::stable_start`), which each new state is recounted for.
     neutral_from_start: bool,
     /// Steps are being shortened towards an instability found real (see `CLOSE_IN`).
     closing_in: bool,
@@ -948,6 +951,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             strict_turns: true,
             tangent_predictor: true,
             previous: None,
+            push_factor: 1.0,
             weights,
             rates,
             c_lambda,
@@ -1003,23 +1007,25 @@ impl<'a, 'b> Walk<'a, 'b> {
             w.s.assemble(state);
             w.push_history(state);
         }
-        if w.starts_neutral(state) {
+        if let Some(neutral) = w.stable_start(state) {
             w.p.last_negative = Some(0);
-            w.p.neutral_from_start = true;
+            w.p.neutral_from_start = neutral;
         }
         Ok(w)
     }
 
-    /// On a path that switches branches, whether its start `state` is stable but for one neutral
-    /// mode (a balanced body, a fold free to slide): one negative pivot, at round-off level by
-    /// [`Driver::negative_eigenvalues`]. Its states then leave that mode out of their counts, as
-    /// the states located on the path do (`events::discount_neutral`) and a state the path restarts
-    /// from does (`Walk::push_relaxed`); else the start, never counted, is not known stable, and
-    /// every state would count it. The tangent factorised is the one the first step needs anyway;
-    /// a failure here is the first step's to report.
-    fn starts_neutral(&mut self, state: &State) -> bool {
+    /// On a path that switches branches, whether its start `state` is stable (`Some(false)`) or
+    /// stable but for one neutral mode (`Some(true)`: a balanced body, a fold free to slide; one
+    /// negative pivot, at round-off level by [`Driver::negative_eigenvalues`]); `None` if it is
+    /// unstable, not counted, or the path does not switch. A stable start lets the first step be
+    /// tested for a bifurcation as every later one is (`last_negative == Some(0)`); with a neutral
+    /// mode, the path's states leave it out of their counts, as the states located on the path do
+    /// (`events::discount_neutral`) and a state the path restarts from does (`Walk::push_relaxed`),
+    /// where every state would count it otherwise. The tangent factorised is the one the first
+    /// step needs anyway; a failure here is the first step's to report.
+    fn stable_start(&mut self, state: &State) -> Option<bool> {
         if !self.switching() {
-            return false;
+            return None;
         }
         if !self.s.fresh {
             self.s.assemble(state);
@@ -1028,7 +1034,11 @@ impl<'a, 'b> Walk<'a, 'b> {
             .s
             .factorise()
             .and_then(|()| self.s.system.linear.negative_eigenvalues());
-        matches!(plain, Ok(1)) && matches!(self.s.negative_eigenvalues(), Ok(0))
+        match plain {
+            Ok(0) => Some(false),
+            Ok(1) => matches!(self.s.negative_eigenvalues(), Ok(0)).then_some(true),
+            _ => None,
+        }
     }
 
     /// The next increment; `None` once the path is at its end (or the first arc-length step
@@ -1306,7 +1316,7 @@ impl<'a, 'b> Walk<'a, 'b> {
         else {
             return false;
         };
-        // The neutral mode a path starts with (see `Walk::starts_neutral`) is one of the pivots.
+        // The neutral mode a path starts with (see `Walk::stable_start`) is one of the pivots.
         if n <= 1 + usize::from(self.p.neutral_from_start) {
             return false;
         }

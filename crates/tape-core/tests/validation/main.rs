@@ -13,6 +13,7 @@ mod common;
 mod analysis_steps;
 mod assembly_agreement;
 mod bordered_setup;
+mod branch_switching;
 mod cantilever_rollup;
 mod free_flight;
 mod gravity_parts;
