@@ -18,12 +18,11 @@
 
 use crate::common;
 
-use common::zero::{arc, pushed_strip, tight};
+use common::zero::{arc, compress, displacement_gap, nudge, pushed_strip, tight};
 
-use tape_core::model::Load;
 use tape_core::output::Fields;
-use tape_core::solver::{Control, Event, StaticParams};
-use tape_core::{run, Dof, Model, Outputs, Result, RunResult, Step, TimeFunction};
+use tape_core::solver::{Event, StaticParams};
+use tape_core::{run, Dof, Model, Outputs, Result, RunResult, Step};
 
 /// End shortening \[m\]: 1.5 times the clamped-pinned strip's Euler shortening.
 const PUSH_IN: f64 = 5e-5;
@@ -35,16 +34,6 @@ fn strip() -> Result<(Model, Vec<usize>)> {
 
 fn last_fields(r: &RunResult) -> &Fields {
     r.history.fields.last().expect("fields recorded")
-}
-
-/// Largest difference of the nodal displacements \[m\], `b` mirrored in z if `mirror`.
-fn gap(a: &Fields, b: &Fields, mirror: bool) -> f64 {
-    let sz = if mirror { -1.0 } else { 1.0 };
-    a.displacements
-        .iter()
-        .zip(&b.displacements)
-        .flat_map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - sz * q[2]])
-        .fold(0.0, |m: f64, d| m.max(d.abs()))
 }
 
 /// The first arc-length step reaches the end of the push at once, past the bifurcation: the
@@ -86,37 +75,15 @@ fn the_first_step_of_a_switching_path_is_tested_for_a_bifurcation() -> Result<()
     assert_eq!(h.negative_eigenvalues[last], 0, "counts {:?}", h.negative_eigenvalues);
 
     let (mut nudged, middle) = strip()?;
-    for &n in &middle {
-        nudged.add_load_with(Load {
-            id: None,
-            node: n,
-            dof: Dof::Uz,
-            value: 1.0 / 3.0,
-            function: TimeFunction::Table {
-                points: vec![(0.0, 0.0), (0.5, 1.0), (1.0, 0.0)],
-            },
-            active: true,
-        })?;
-    }
-    let push = Step::new_static(
-        "push",
-        StaticParams {
-            control: Control::Load {
-                lambda_end: 1.0,
-                increments: 20,
-            },
-            newton: tight(),
-            ..StaticParams::default()
-        },
-    );
-    let reference = run(&nudged, &[push], &outputs, &mut |_| true)?;
+    nudge(&mut nudged, &middle)?;
+    let reference = run(&nudged, &[compress()], &outputs, &mut |_| true)?;
     assert!(reference.error.is_none(), "{:?}", reference.error);
     let (a, b) = (last_fields(&r), last_fields(&reference));
     let buckle = b
         .displacements
         .iter()
         .fold(0.0, |m: f64, d| m.max(d[2].abs()));
-    let off = gap(a, b, false).min(gap(a, b, true));
+    let off = displacement_gap(a, b, false).min(displacement_gap(a, b, true));
     assert!(buckle > 5e-4, "the reference is buckled: {buckle:e} m");
     assert!(off < 1e-8, "{off:e} m from the buckled strip");
     Ok(())

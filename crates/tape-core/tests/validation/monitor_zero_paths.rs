@@ -43,7 +43,7 @@
 
 use crate::common;
 
-use common::zero::{arc, driven, outputs, pushed_strip, tight, L};
+use common::zero::{arc, compress, displacement_gap, driven, nudge, outputs, pushed_strip, tight, L};
 
 use std::sync::{Mutex, Once};
 use std::thread::{self, ThreadId};
@@ -120,17 +120,6 @@ fn fields(h: &History, i: usize) -> &Fields {
         .iter()
         .find(|f| f.record == i)
         .unwrap_or_else(|| panic!("no fields at record {i}"))
-}
-
-/// Largest difference of the nodal displacements of two sets of fields \[m\], `b` mirrored in z
-/// (its z components negated) if `mirror`.
-fn displacement_gap(a: &Fields, b: &Fields, mirror: bool) -> f64 {
-    let sz = if mirror { -1.0 } else { 1.0 };
-    a.displacements
-        .iter()
-        .zip(&b.displacements)
-        .flat_map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - sz * q[2]])
-        .fold(0.0, |m: f64, d| m.max(d.abs()))
 }
 
 /// Largest nodal deflection (z) of a set of fields \[m\].
@@ -696,18 +685,7 @@ const TURN: f64 = -0.12;
 /// `TURN` (step 1, arc-length, the end's moment monitored, stopping as `stop` says).
 fn pinned_strip(stop: ZeroStop) -> Result<(Model, Vec<Step>, usize)> {
     let (mut model, end, middle) = pushed_strip(0.0, PUSH_IN, &[Dof::Uy, Dof::Uz, Dof::Rx, Dof::Rz])?;
-    for &n in &middle {
-        model.add_load_with(Load {
-            id: None,
-            node: n,
-            dof: Dof::Uz,
-            value: 1.0 / 3.0,
-            function: TimeFunction::Table {
-                points: vec![(0.0, 0.0), (0.5, 1.0), (1.0, 0.0)],
-            },
-            active: true,
-        })?;
-    }
+    nudge(&mut model, &middle)?;
     model.add_constraint(Constraint {
         id: Some("drive".into()),
         node: end,
@@ -716,17 +694,6 @@ fn pinned_strip(stop: ZeroStop) -> Result<(Model, Vec<Step>, usize)> {
         function: TimeFunction::Ramp { start: 1.0, end: 2.0 },
         active: false,
     })?;
-    let compress = Step::new_static(
-        "compress",
-        StaticParams {
-            control: Control::Load {
-                lambda_end: 1.0,
-                increments: 20,
-            },
-            newton: tight(),
-            ..StaticParams::default()
-        },
-    );
     let mut turn = Step::new_static(
         "turn",
         StaticParams {
@@ -735,7 +702,7 @@ fn pinned_strip(stop: ZeroStop) -> Result<(Model, Vec<Step>, usize)> {
         },
     );
     turn.activate.push("drive".into());
-    Ok((model, vec![compress, turn], end))
+    Ok((model, vec![compress(), turn], end))
 }
 
 /// Case 4. A zero of a moment that the structure pushes the motion through stops `Any` and not

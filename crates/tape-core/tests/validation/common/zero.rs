@@ -1,11 +1,13 @@
-//! Builders shared by the tests of `stop_at_monitor_zero` (`monitor_zero*.rs`): arc-length steps
-//! with a monitored reaction, and the steel strip clamped at one end and pushed in at the other.
+//! Builders shared by the tests of `stop_at_monitor_zero` (`monitor_zero*.rs`) and of branch
+//! switching: arc-length steps with a monitored reaction, and the steel strip clamped at one end
+//! and pushed in at the other.
 
 use nalgebra::Vector3;
 use tape_core::mesh::generate::flat_plate;
-use tape_core::model::Constraint;
+use tape_core::model::{Constraint, Load};
+use tape_core::output::Fields;
 use tape_core::solver::{Control, Monitor, NewtonParams, StaticParams, ZeroStop};
-use tape_core::{Dof, Model, Outputs, Result, TimeFunction};
+use tape_core::{Dof, Model, Outputs, Result, Step, TimeFunction};
 
 /// Length of the strips \[m\].
 pub const L: f64 = 0.2;
@@ -74,4 +76,48 @@ pub fn pushed_strip(poisson: f64, push_in: f64, held: &[Dof]) -> Result<(Model, 
         active: true,
     })?;
     Ok((model, end, middle))
+}
+
+/// Nudges the strip at its `middle` section along +z (1 N in all, rising to t = 1/2 and gone by
+/// t = 1), so that a push chooses that side to buckle to.
+pub fn nudge(model: &mut Model, middle: &[usize]) -> Result<()> {
+    for &n in middle {
+        model.add_load_with(Load {
+            id: None,
+            node: n,
+            dof: Dof::Uz,
+            value: 1.0 / 3.0,
+            function: TimeFunction::Table {
+                points: vec![(0.0, 0.0), (0.5, 1.0), (1.0, 0.0)],
+            },
+            active: true,
+        })?;
+    }
+    Ok(())
+}
+
+/// The push to its end under load control (20 increments, Newton as [`tight`]).
+pub fn compress() -> Step {
+    Step::new_static(
+        "compress",
+        StaticParams {
+            control: Control::Load {
+                lambda_end: 1.0,
+                increments: 20,
+            },
+            newton: tight(),
+            ..StaticParams::default()
+        },
+    )
+}
+
+/// Largest difference of the nodal displacements of two sets of fields \[m\], `b` mirrored in z
+/// (its z components negated) if `mirror`.
+pub fn displacement_gap(a: &Fields, b: &Fields, mirror: bool) -> f64 {
+    let sz = if mirror { -1.0 } else { 1.0 };
+    a.displacements
+        .iter()
+        .zip(&b.displacements)
+        .flat_map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - sz * q[2]])
+        .fold(0.0, |m: f64, d| m.max(d.abs()))
 }
