@@ -1036,7 +1036,7 @@ impl<'a, 'b> Walk<'a, 'b> {
             .and_then(|()| self.s.system.linear.negative_eigenvalues());
         match plain {
             Ok(0) => Some(false),
-            Ok(1) => matches!(self.s.negative_eigenvalues(), Ok(0)).then_some(true),
+            Ok(1) => matches!(self.keeps_neutral(), Ok(true)).then_some(true),
             _ => None,
         }
     }
@@ -1511,8 +1511,9 @@ impl<'a, 'b> Walk<'a, 'b> {
         })
     }
 
-    /// Whether the converged state of the increment (its tangent assembled) still has one negative
-    /// pivot, at round-off level (see [`Driver::negative_eigenvalues`]).
+    /// Whether the driver's state (its tangent assembled: the path's start, or the converged state
+    /// of the increment) has one negative pivot, at round-off level (see
+    /// [`Driver::negative_eigenvalues`]).
     ///
     /// # Errors
     /// A failure of the linear algebra.
