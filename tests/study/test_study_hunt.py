@@ -519,6 +519,27 @@ def test_with_two_workers_each_run_is_reported_once_a_refused_one_after_the_runs
     assert [r.index for r in e.runs] == list(range(8)) and not e.cancelled
 
 
+@pytest.mark.parametrize("how", ["false", "ctrl-c"])
+def test_a_stop_asked_on_a_refused_run_keeps_the_run_that_had_just_ended(how):
+    # On an executor run 0 (refused) is reported once run 1 has ended, before it: the stop asked
+    # then must not drop run 1, which ended (one thread: it ends first).
+    from concurrent.futures import ThreadPoolExecutor
+
+    def stop_on_refused(run):
+        if not run.ok:
+            if how == "false":
+                return False
+            raise KeyboardInterrupt
+        return None
+
+    with ThreadPoolExecutor(1) as pool:
+        e = quietly(
+            run_ensemble, A_SOME_REFUSED, runs=4, seed=0, executor=pool, progress=stop_on_refused
+        )
+    assert e.cancelled and [(r.index, r.ok) for r in e.runs] == [(0, False), (1, True)]
+    assert e.values("f")[1] == 9.0 * e.drawn("a")[1]
+
+
 def test_a_study_in_two_workers_checks_that_they_can_receive_its_runs_once(monkeypatch):
     # The check pickles every run's settings: `run_tasks` does it, the study not again.
     import tapespring.sweep

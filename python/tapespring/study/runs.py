@@ -247,7 +247,9 @@ def run_all(
     an executor the runs are reported in the order they end, a refused run as soon as every run
     before it has been reported but not before the first run that ran (what the workers cannot
     receive is refused before any run is reported). After a worker's death, the runs it left
-    unreported fail with that message and are reported with the rest, in index order.
+    unreported fail with that message and are reported with the rest, in index order. A run that
+    ended is kept even where `report`, told of a refused run before it, stops the study first
+    (`report` is then not told of it).
 
     Returns
     -------
@@ -303,7 +305,11 @@ def run_all(
         return not stopped
 
     def done(n: int, run: StudyRun) -> bool:
-        return release() and record(run) and release()
+        try:
+            return release() and record(run) and release()
+        finally:
+            # Kept even where the report of a refused run before it stopped the study first.
+            runs.setdefault(run.index, run)
 
     try:
         # `run_tasks` (with `check_sendable`, the one pickling check) refuses what worker
