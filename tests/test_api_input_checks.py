@@ -13,6 +13,9 @@ Three defects of a robustness review (D06, D13, D14), each fixed in the Python l
   ``True`` became 1; a dict given as ``run(..., outputs=...)`` gave an AttributeError.
 * ``Step.static(..., deactivate="push")`` iterated the string: ids ``'p'``, ``'u'``, ... (an
   unknown id, or with ids ``"a"``, ``"b"`` and ``"ab"``, ``"ab"`` switched off ``a`` and ``b``).
+
+A progress argument is refused by one check wherever a callable is taken (analyses, studies,
+identification), each naming what its callable takes.
 """
 
 import json
@@ -22,6 +25,9 @@ import numpy as np
 import pytest
 from _plate import plate
 from tapespring import Outputs, Results, Step, run
+from tapespring.identify.static import identify_static
+from tapespring.shell import solve_static
+from tapespring.study import ensemble, sensitivity
 
 # ---------------------------------------------------------------------------------------------
 # D13: Results.load checks what it reads before anything uses it
@@ -258,3 +264,23 @@ def test_deactivating_one_id_given_as_a_string_switches_off_that_id_only():
     assert results.total_reaction("uz")[-1] == pytest.approx(-2.0, rel=1e-6)
     assert results.total_reaction("uy")[-1] == pytest.approx(-2.0, rel=1e-6)
     assert results.total_reaction("ux")[-1] == pytest.approx(0.0, abs=1e-9)
+
+
+# ---------------------------------------------------------------------------------------------
+# One check of a progress argument: each entry point taking a callable names what it takes
+
+
+@pytest.mark.parametrize(
+    ("call", "arguments"),
+    [
+        (lambda p: run(plate(), [Step.static()], progress=p), "(step, name, t)"),
+        (lambda p: solve_static(plate(), progress=p), "(index, t)"),
+        (lambda p: ensemble("bend", {"tape.thickness": None}, progress=p), "(run)"),
+        (lambda p: sensitivity("bend", ["tape.thickness"], progress=p), "(run)"),
+        (lambda p: identify_static(None, progress=p), "(evaluation)"),
+    ],
+)
+def test_a_progress_of_the_wrong_type_is_refused_naming_what_it_takes(call, arguments):
+    message = f"progress must be True, False, None or a callable {arguments}, not str: 'yes'"
+    with pytest.raises(TypeError, match=re.escape(message)):
+        call("yes")

@@ -429,11 +429,11 @@ def _check_bool(name: str, value: object) -> None:
 
 def _check_progress(progress: object, arguments: str) -> None:
     """Raise TypeError unless `progress` is True, False, None or a callable taking
-    `arguments` (named in the message)."""
+    `arguments` (named in the message, such as ``"(step, name, t)"``)."""
     if not (progress is None or isinstance(progress, bool) or callable(progress)):
         raise TypeError(
             f"progress must be True, False, None or a callable {arguments}, not "
-            f"{type(progress).__name__}"
+            f"{type(progress).__name__}: {progress!r:.200}"
         )
 
 

@@ -961,6 +961,8 @@ def identify_static(
     tapespring.sweep.WorkerDied
         If a worker process died (killed, out of memory).
     """
+    # Imported here: `analysis` loads the compiled core, which importing this module does not.
+    from tapespring.analysis import _check_progress
     from tapespring.scenarios.setup import check_count
     from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
 
@@ -975,8 +977,7 @@ def identify_static(
     check_workers(workers)
     if not isinstance(sensitivity, bool):
         raise TypeError(f"sensitivity must be True or False (got {sensitivity!r})")
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise TypeError(f"progress must be True, False, None or a callable (got {progress!r})")
+    _check_progress(progress, "(evaluation)")
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
         raise TypeError(f"settings must be an EquilibriumSettings (got {settings!r})")

@@ -503,9 +503,12 @@ def check_runs(runs: object) -> int:
 
 
 def check_progress(progress: object) -> None:
-    """Refuse a `progress` that is not a bool, None or a callable."""
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise TypeError(f"progress must be True, False, None or a callable (got {progress!r})")
+    """Refuse a study's `progress` that is not a bool, None or a callable of a
+    :class:`StudyRun` (:func:`tapespring.analysis._check_progress`)."""
+    # Imported here: `analysis` loads the compiled core, which importing this module does not.
+    from tapespring.analysis import _check_progress
+
+    _check_progress(progress, "(run)")
 
 
 def ensemble(
