@@ -1,8 +1,8 @@
 """Independent runs side by side (`tapespring.sweep`): the results of each task reach their
 index whatever the order the workers end them in, a stop or Ctrl-C ends the study without
-waiting for the runs still going and leaves no process behind, a failed run or a dead worker is
-reported, not lost, what the workers cannot receive is refused before any starts, and an
-executor of the user's (a cluster's) runs the tasks alike.
+waiting for the runs still going and leaves no process behind (a stop keeps those that ended),
+a failed run or a dead worker is reported, not lost, what the workers cannot receive is refused
+before any starts, and an executor of the user's (a cluster's) runs the tasks alike.
 
 Each spawned worker is a fresh interpreter (0.1 to 0.3 s to start with numpy); the tasks sleep
 rather than compute so that the order in which they end is set by the test, with margins of
@@ -118,6 +118,47 @@ def test_on_done_returning_false_stops_the_study_at_once(workers):
     assert time.perf_counter() - start < 10.0
     # Stopping at the last task is no stop.
     assert run_tasks(square_after, [(1, 0.0)], workers, lambda i, r: False) is False
+
+
+@pytest.mark.parametrize("where", ["workers", "executor"])
+def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monkeypatch, where):
+    # Every run ends before the study looks (`wait` returns them all at once): the stop asked on
+    # the first must not drop the three others, which ended. They are handed over too (their
+    # answers no longer count), and no stop is reported: every run ended.
+    import concurrent.futures
+
+    import tapespring.sweep
+
+    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
+    tasks = [(x, 0.0) for x in range(4)]
+    got: dict[int, int] = {}
+
+    def stop_on_first(i, r):
+        got[i] = r[0]
+        return False
+
+    if where == "workers":
+        stopped = run_tasks(square_after, tasks, 2, stop_on_first)
+    else:
+        with ThreadPoolExecutor(2) as threads:
+            stopped = run_tasks(square_after, tasks, on_done=stop_on_first, executor=threads)
+    assert got == {0: 0, 1: 1, 2: 4, 3: 9} and stopped is False
+
+
+def test_a_stop_keeps_a_run_that_ended_while_on_done_was_called():
+    # Task 0 ends at once, task 1 after 0.2 s, while on_done takes 1 s over task 0 and stops;
+    # task 2 (3 s) is still going: it is dropped, as task 1 is not.
+    tasks = [(0, 0.0), (1, 0.2), (2, 3.0)]
+    got: list[int] = []
+
+    def slow_stop(i, r):
+        got.append(i)
+        time.sleep(1.0)
+        return False
+
+    with ThreadPoolExecutor(3) as threads:
+        assert run_tasks(square_after, tasks, on_done=slow_stop, executor=threads) is True
+        assert got == [0, 1]
 
 
 @pytest.mark.parametrize("workers", [1, 2])

@@ -224,7 +224,8 @@ def run_tasks(
         Receives the index of each task in `tasks` and its result; returning False stops the
         study: runs not started are dropped and local runs still going are ended at once (on an
         `executor`, runs not started are cancelled; those already running go on there, their
-        results dropped).
+        results dropped). The runs that had ended by then (with the one it stopped on, or
+        while it was called) are handed to it all the same, their answers ignored.
     executor
         Where to run the tasks instead of local processes: any `concurrent.futures.Executor`
         (Dask: ``distributed.Client(address).get_executor()``). It is not shut down.
@@ -377,6 +378,7 @@ def _run_on(
                     exc.add_note(f"(task {i} of {len(tasks)}: {tasks[i]!r:.200})")
                     raise
                 if on_done(i, result) is False:
+                    _hand_over_ended(pending, on_done)
                     return bool(pending)
         return False
     except KeyboardInterrupt:
@@ -393,6 +395,17 @@ def _run_on(
             if pending and isinstance(pool, ProcessPoolExecutor):
                 _terminate(pool)
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _hand_over_ended(
+    pending: dict[Future[R], int], on_done: Callable[[int, R], bool | None]
+) -> None:
+    """After a stop, hands `on_done` the runs that have ended all the same (with the run it was
+    asked on, or while it was asked), in index order, and takes them out of `pending`; its
+    answer no longer counts. A run that failed is left: the study stopped before reaching it."""
+    for future in sorted((f for f in pending if f.done()), key=pending.__getitem__):
+        if not future.cancelled() and future.exception() is None:
+            on_done(pending.pop(future), future.result())
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:

@@ -397,6 +397,15 @@ def stop_after(n: int, how: str):
     return callback
 
 
+def stopped_keeping_what_ended(study, callback, n: int, total: int) -> None:
+    """`study`, run side by side and stopped by ``stop_after(n, "false")``, kept the runs the
+    callback was told of and those that had ended with them, of which it was not told; it is
+    cancelled unless every run ended (with instant runs, how many had is not set)."""
+    kept = {r.index for r in study.runs}
+    assert len(callback.seen) == n and {r.index for r in callback.seen} <= kept
+    assert study.cancelled == (len(kept) < total)
+
+
 @pytest.mark.parametrize("how", ["false", "ctrl-c"])
 def test_a_stopped_ensemble_keeps_the_runs_that_ended(how):
     callback = stop_after(3, how)
@@ -430,7 +439,7 @@ def test_two_workers_stop_on_ctrl_c_in_a_run_and_on_false_keeping_correct_runs()
     assert e.cancelled and len(e.runs) < 8
     callback = stop_after(2, "false")
     f = run_ensemble({"a": U}, runs=8, seed=2, workers=2, progress=callback)
-    assert f.cancelled and len(f.runs) == 2
+    stopped_keeping_what_ended(f, callback, 2, 8)
     for study in (e, f):
         assert all(r.ok for r in study.runs)
         np.testing.assert_array_equal(study.values("f"), 9.0 * study.drawn("a"))
@@ -449,15 +458,14 @@ def test_a_study_on_an_executor_is_the_study_in_this_process():
     parameters = {"a": stats.uniform(-0.5, 5.0), "inner.b": stats.norm(3.0, 0.3)}
     settings = replace(S, stop_above=3.5, nan_above=3.0)
     here = quietly(run_ensemble, parameters, settings, runs=10, seed=3)
+    callback = stop_after(2, "false")
     with ThreadPoolExecutor(2) as pool:
         there = quietly(run_ensemble, parameters, settings, runs=10, seed=3, executor=pool)
-        stopped = run_ensemble(
-            {"a": U}, runs=10, seed=3, executor=pool, progress=stop_after(2, "false")
-        )
+        stopped = run_ensemble({"a": U}, runs=10, seed=3, executor=pool, progress=callback)
         s_there = sensitivity(H.scenario, ["a", "inner.b"], S, figures=H.figures, executor=pool)
     assert there.workers == 0 and "on an executor" in there.describe()
     same_runs(here, there)
-    assert stopped.cancelled and len(stopped.runs) == 2
+    stopped_keeping_what_ended(stopped, callback, 2, 10)
     s_here = sensitivity(H.scenario, ["a", "inner.b"], S, figures=H.figures)
     same_runs(s_here, s_there)
 
@@ -538,6 +546,27 @@ def test_a_stop_asked_on_a_refused_run_keeps_the_run_that_had_just_ended(how):
         )
     assert e.cancelled and [(r.index, r.ok) for r in e.runs] == [(0, False), (1, True)]
     assert e.values("f")[1] == 9.0 * e.drawn("a")[1]
+
+
+def test_a_stop_asked_on_a_run_keeps_the_runs_that_had_ended_with_it(monkeypatch):
+    # Every run ends before the study looks (`wait` returns them all at once): the stop asked on
+    # the first reported must not drop the three others, which ended. The callback is not told
+    # of them; the study is not cancelled, since every run ended.
+    import concurrent.futures
+
+    import tapespring.sweep
+
+    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
+    seen: list[int] = []
+
+    def stop_on_first(run):
+        seen.append(run.index)
+        return False
+
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        e = run_ensemble({"a": U}, runs=4, seed=0, executor=pool, progress=stop_on_first)
+    assert seen == [0] and [r.index for r in e.runs] == [0, 1, 2, 3] and not e.cancelled
+    assert np.array_equal(e.values("f"), 9.0 * e.drawn("a"))
 
 
 def test_a_study_in_two_workers_checks_that_they_can_receive_its_runs_once(monkeypatch):

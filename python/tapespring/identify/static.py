@@ -944,7 +944,8 @@ def identify_static(
     progress : bool or callable, optional
         True: one line per run on stderr. A callable receives each :class:`StaticEvaluation` as
         it ends (at the end of its start's search with ``workers`` > 1) and may return False to
-        stop (the result is then marked ``cancelled``).
+        stop (the result is then marked ``cancelled``; with ``workers`` > 1, the starts that had
+        ended by then are kept, the callable not told of their runs).
 
     Returns
     -------
@@ -1039,7 +1040,8 @@ def identify_static(
         def record(n: int, outcome: _SearchOutcome) -> bool:
             nonlocal asked_stop
             outcomes[n] = outcome
-            if not all(report(e) for e in outcome.evaluations):
+            # A start handed over after a stop (it had ended too) is kept, not reported.
+            if not asked_stop and not all(report(e) for e in outcome.evaluations):
                 # Kept here: run_tasks reports no stop when it comes with the last start.
                 asked_stop = True
             return not asked_stop

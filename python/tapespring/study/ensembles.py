@@ -560,10 +560,11 @@ def ensemble(
         Where to run them instead (a Dask cluster's ``client.get_executor()``).
     progress : bool or callable, optional
         True: a line on stderr per run. A callable receives each :class:`StudyRun` once, as it
-        ends, and may return False to stop the study (the runs that ended are kept,
-        ``cancelled``). With one worker that is the runs' order (a run whose settings are
-        refused is reported when its turn comes); with more, or an executor, the order they end
-        in (a refused one once every run before it has been reported).
+        ends, and may return False to stop the study (the runs that ended are kept, those that
+        ended with the one it stopped on too, though it is not told of them; ``cancelled``).
+        With one worker that is the runs' order (a run whose settings are refused is reported
+        when its turn comes); with more, or an executor, the order they end in (a refused one
+        once every run before it has been reported).
 
     Returns
     -------
