@@ -9,7 +9,7 @@ whose free response is ``z = A exp(-epsilon omega0 t) cos(omega_d t + phi)`` wit
 period apart, and their absolute values decay as ``A' exp(-epsilon omega0 t)``.
 
 Procedure (as in the paper): pick the peaks (maxima and minima, `extract_peaks`)
-whose absolute value, about the equilibrium, lies in the window
+whose swing about the equilibrium, ``|z_k - c|``, lies in the window
 ``[z_min, z_max]`` (paper: 0.4 to 4 mm), then fit with
 `scipy.optimize.least_squares`:
 
@@ -18,16 +18,25 @@ whose absolute value, about the equilibrium, lies in the window
    nearest to it with the parity of its two peaks (odd from a maximum to a minimum,
    even between two of a kind), the half period being measured between the
    selected peaks and their neighbours of the other kind, in or out of the window
-   (about an offset equilibrium the window may keep the maxima only, two half
-   periods apart). If a gap is not such a count, the peaks within a few times the
-   noise of the window's edges (`_EDGE_NOISE`: in or out of it by the noise's choice)
-   are left aside and the check is made again on the others;
+   (at its edges the window may keep one kind only, two half periods apart). If a gap
+   is not such a count, the peaks within a few times the noise of the window's edges
+   (`_EDGE_NOISE`: in or out of it by the noise's choice) are left aside and the check
+   is made again on the others;
 2. the peak values ``z_k = c + s_k A' exp(-a (t_k - t_first))`` with
-   ``s_k = +-1`` for maxima and minima and ``c`` a small offset of the
-   equilibrium, which gives the decay rate ``a = epsilon omega0``.
+   ``s_k = +-1`` for maxima and minima and ``c`` the equilibrium (fitted, from the
+   one the swings are measured from), which gives the decay rate ``a = epsilon omega0``.
 
 Peaks count from a prominence of ``z_min`` (or less: 8 times the noise), as a
 peak that swings by ``z_min`` stands that far above the troughs either side.
+
+The equilibrium ``c`` the swings are measured from is the decay's own (`_equilibrium`): any
+three successive extrema of a free decay fix it, as their values ``c + A/r, c - A, c + r A``
+(up to sign) hold three unknowns; the median of these estimates over the peaks that swing
+within the window. Where it is within `_EDGE_NOISE` times the noise of ``z = 0`` (where peaks
+are in or out of the window by the noise's choice anyway), the swings are measured from
+``z = 0``, as ``z`` is given about the equilibrium. About an equilibrium farther off, ``|z|``
+would keep the wrong peaks: 2 mm off, the swings from 2 mm down to the noise (peaks at
+``|z|`` of about 2 mm) and up to 6 mm (4 mm on the other side).
 
 Then ``omega0 = sqrt(omega_d^2 + a^2)``, ``epsilon = a / omega0`` and the
 period ``Delta t = 2 pi / (omega0 sqrt(1 - epsilon^2)) = 2 pi / omega_d``
@@ -42,7 +51,7 @@ import math
 import numbers
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -54,7 +63,8 @@ __all__ = ["DampingFit", "check_window", "fit_damping", "select_window_peaks"]
 
 
 def check_window(window: object) -> tuple[float, float]:
-    """The range of |peak| a damping fit uses, `window` = (low, high) [m], as two floats.
+    """The range of peak swings about the equilibrium a damping fit uses, `window` = (low, high)
+    [m], as two floats.
 
     Raises
     ------
@@ -141,16 +151,19 @@ def select_window_peaks(
     prominence: float | None = None,
     t_start: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Peaks (maxima and minima, time order) with ``window[0] <= |z| <= window[1]``.
+    """Peaks (maxima and minima, time order) that swing by ``window[0]`` to ``window[1]`` about
+    the decay's equilibrium: the peaks `fit_damping` starts from.
 
     Parameters
     ----------
     t : ndarray, shape (m,)
         Sampling instants [s].
     z : ndarray, shape (m,)
-        Displacement about the equilibrium [m].
+        Displacement [m], about the equilibrium or about a level near it (the swings are
+        measured from the decay's own equilibrium where it is measurably off, module docs).
     window : (float, float)
-        Range of absolute peak values kept [m]; paper: (0.4e-3, 4e-3).
+        Range of swings ``|z_k - c|`` of the peaks kept about the equilibrium ``c`` [m];
+        paper: (0.4e-3, 4e-3).
     prominence : float, optional
         Passed to `extract_peaks`; default: the smaller of `extract_peaks`' default and
         ``window[0]``.
@@ -160,10 +173,31 @@ def select_window_peaks(
     Returns
     -------
     time, value : ndarray
-        The selected peaks.
+        The selected peaks: instants [s] and values of ``z`` (not swings) [m].
     """
-    time, value, _, keep, _ = _all_peaks(t, z, window, prominence, t_start)
-    return time[keep], value[keep]
+    peaks = _all_peaks(t, z, window, prominence, t_start)
+    return peaks.time[peaks.keep], peaks.value[peaks.keep]
+
+
+#: Half-width of the band about each edge of the window, in standard deviations of the noise,
+#: where a peak is in or out by the noise's choice: a refined peak value is off by less than one
+#: (`extract_peaks`), so a peak measured 3 of them inside the window has its true value inside
+#: but for at most 0.13 % of peaks. An equilibrium within that band of ``z = 0`` moves in or out
+#: of the window only peaks that the noise may move as well, so the swings are measured from
+#: ``z = 0`` there (`_equilibrium`), and a fit about it is the fit about zero.
+_EDGE_NOISE = 3.0
+
+
+class _AllPeaks(NamedTuple):
+    """Every peak from ``t_start`` on and those in the window (`_all_peaks`)."""
+
+    time: np.ndarray  # [s]
+    value: np.ndarray  # unit of z
+    kind: np.ndarray  # +1 maximum, -1 minimum
+    swing: np.ndarray  # |value - centre|, unit of z
+    keep: np.ndarray  # mask of the peaks whose swing is in the window
+    centre: float  # the equilibrium the swings are measured from, unit of z
+    noise: float  # of z (`extract_peaks`' estimate), unit of z
 
 
 def _all_peaks(
@@ -172,9 +206,9 @@ def _all_peaks(
     window: tuple[float, float],
     prominence: float | None,
     t_start: float | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
-    """Every peak from ``t_start`` on (time, value, kind +1/-1), the mask of those in the
-    window, and the noise of ``z`` (`extract_peaks`' estimate, unit of ``z``)."""
+) -> _AllPeaks:
+    """Every peak from ``t_start`` on, their swings about the decay's equilibrium
+    (`_equilibrium`) and the mask of those whose swing lies in the window."""
     lo, hi = check_window(window)
     if prominence is None and lo > 0:
         # A peak that swings by `lo` or more about the equilibrium stands at least `lo` above
@@ -193,8 +227,40 @@ def _all_peaks(
     if t_start is not None:
         after = time >= t_start
         time, value, kind = time[after], value[after], kind[after]
-    keep = (np.abs(value) >= lo) & (np.abs(value) <= hi)
-    return time, value, kind, keep, peaks.noise
+    centre = _equilibrium(value, kind, lo, hi, peaks.noise)
+    with np.errstate(over="ignore"):  # a swing beyond the floats (inf) is out of the window
+        swing = np.abs(value - centre)  # with centre 0, |value| to the bit
+    keep = (swing >= lo) & (swing <= hi)
+    return _AllPeaks(time, value, kind, swing, keep, centre, peaks.noise)
+
+
+def _equilibrium(value: np.ndarray, kind: np.ndarray, lo: float, hi: float, noise: float) -> float:
+    """The equilibrium the peaks swing about (unit of the values): 0 where it is within
+    `_EDGE_NOISE` times ``noise`` of it, or where no three successive extrema swing within
+    ``[lo, hi]``.
+
+    Three successive extrema of a free decay about ``c``, ``z_(k-1) = c - s A / r``,
+    ``z_k = c + s A``, ``z_(k+1) = c - s r A`` (``s = +-1``, ``r`` the ratio of successive
+    swings), fix ``c``: with ``d1 = z_k - z_(k-1) = s A (1 + 1/r)`` and ``d2 = z_(k+1) - z_k
+    = -s A (1 + r)``, ``r = -d2 / d1`` and ``c = z_k + d1 d2 / (d1 - d2)``, exact for any
+    damping (the mean of neighbouring extrema is off by half the decay between them: 0.8 %
+    of the swing at a damping ratio of 0.5 %, 24 % at 20 %). Their median, over the middle
+    extrema that swing within the window about their own estimate, leaves out those of a
+    spurious extremum and of the noise's extrema once the decay has sunk into it.
+    """
+    mid = np.flatnonzero((kind[1:-1] != kind[:-2]) & (kind[1:-1] != kind[2:])) + 1
+    unit = power_of_two_scale(value)  # d1 d2 of values near 1e200 overflows
+    v = value / unit
+    d1, d2 = v[mid] - v[mid - 1], v[mid + 1] - v[mid]
+    # A maximum above both neighbours, a minimum below: d1 - d2 is then |d1| + |d2| > 0.
+    mid, d1, d2 = (x[(kind[mid] * d1 > 0) & (kind[mid] * d2 < 0)] for x in (mid, d1, d2))
+    estimate = v[mid] + d1 * d2 / (d1 - d2)
+    swing = np.abs(v[mid] - estimate)  # in `unit`s, as the window below
+    estimate = estimate[(swing >= lo / unit) & (swing <= hi / unit)]
+    if estimate.size == 0:
+        return 0.0
+    centre = float(np.median(estimate)) * unit
+    return 0.0 if abs(centre) <= _EDGE_NOISE * noise else centre
 
 
 def _half_period_index(
@@ -204,13 +270,14 @@ def _half_period_index(
 
     ``time``, ``kind``: every peak (`_all_peaks`); ``keep``: those in the window. Peaks of a
     free decay are half a damped period apart and alternate between maxima and minima, but the
-    window may keep one kind only over a stretch: about an equilibrium offset by ``c`` the
-    maxima leave the window at ``lo - c`` and the minima at ``lo + c``, so the selected peaks
-    may all be maxima two half periods apart. The half period is therefore measured on the
-    selected peaks and their neighbours in the whole sequence (of the other kind, wherever
-    their value), never on the selected peaks alone; each gap then counts the number of half
-    periods of its parity (odd between a maximum and a minimum, even between two of a kind)
-    nearest to ``gap / half``.
+    window may keep one kind only over a stretch: where the swings are measured from a level
+    ``c`` off the decay's equilibrium (``z = 0`` for one within the noise band of it,
+    `_equilibrium`), the maxima leave the window at ``lo - c`` and the minima at ``lo + c``, so
+    the selected peaks may all be maxima two half periods apart. The half period is therefore
+    measured on the selected peaks and their neighbours in the whole sequence (of the other
+    kind, wherever their value), never on the selected peaks alone; each gap then counts the
+    number of half periods of its parity (odd between a maximum and a minimum, even between two
+    of a kind) nearest to ``gap / half``.
 
     Raises
     ------
@@ -251,20 +318,13 @@ def _half_period_index(
     return np.concatenate(([0], np.cumsum(steps))), half
 
 
-#: Half-width of the band about each edge of the window, in standard deviations of the noise,
-#: where a peak is in or out by the noise's choice: a refined peak value is off by less than one
-#: (`extract_peaks`), so a peak measured 3 of them inside the window has its true value inside
-#: but for at most 0.13 % of peaks.
-_EDGE_NOISE = 3.0
-
-
 def _clear_of_edges(
-    value: np.ndarray, keep: np.ndarray, lo: float, hi: float, noise: float
+    swing: np.ndarray, keep: np.ndarray, lo: float, hi: float, noise: float
 ) -> np.ndarray:
-    """The mask of the peaks in ``keep`` whose |value| lies more than `_EDGE_NOISE` times
+    """The mask of the peaks in ``keep`` whose swing lies more than `_EDGE_NOISE` times
     ``noise`` inside the window ``[lo, hi]`` (all in the unit of the values)."""
     margin = _EDGE_NOISE * noise
-    return keep & (np.abs(value) >= lo + margin) & (np.abs(value) <= hi - margin)
+    return keep & (swing >= lo + margin) & (swing <= hi - margin)
 
 
 # A fitted envelope that grows over the peaks by more than this fraction (the rounding and
@@ -278,18 +338,18 @@ def _raise_undetermined(fit: Any, sign: np.ndarray) -> None:
     the offset, amplitude and rate of ``c + s_k A exp(-a t)``.
 
     Peaks on both sides of the equilibrium fix the offset between them. Peaks on one side only
-    (the swing's other extrema below the window's low end, about an equilibrium off by more
-    than that) fix it through the envelope's curvature alone; where the noise hides that
-    curvature the fit slides along ``A -> inf, a -> 0, c -> -inf`` (a straight line through the
-    peaks) until its evaluations run out, with a damping ratio near zero: measured, 7 maxima of a
-    1 mm decay (damping ratio 1.8 %) about an equilibrium 0.74 mm off, noise 0.04 mm, fitted
-    4.5e-5 with an offset of -0.28 m.
+    fix it through the envelope's curvature alone; where the noise hides that curvature the fit
+    slides along ``A -> inf, a -> 0, c -> -inf`` (a straight line through the peaks) until its
+    evaluations run out, with a damping ratio near zero: measured, while peaks were selected by
+    |z|, 7 maxima of a 1 mm decay (damping ratio 1.8 %) about an equilibrium 0.74 mm off, noise
+    0.04 mm, fitted 4.5e-5 with an offset of -0.28 m. With the swings measured from the decay's
+    equilibrium, both sides' peaks are in the window or out of it together but at its edges.
     """
     one_side = "maxima" if sign[0] > 0 else "minima"
     why = (
         f"the peaks in the window are all {one_side}, so only the envelope's curvature sets the "
-        "offset, and the noise hides it; take z about an equilibrium nearer the record's (its "
-        "end may still swing) or lower the window's low end so that both sides' peaks count"
+        "offset, and the noise hides it; lower the window's low end so that both sides' peaks "
+        "count"
         if np.all(sign == sign[0])
         else "the peaks do not follow a decaying exponential about one equilibrium"
     )
@@ -326,12 +386,14 @@ def fit_damping(
     t : ndarray, shape (m,)
         Sampling instants [s].
     z : ndarray, shape (m,)
-        Displacement about the equilibrium [m] (any unit works; the window is in
-        the same unit).
+        Displacement [m] (any unit works; the window is in the same unit), about the
+        equilibrium or about a level near it: the swings are measured from the decay's own
+        equilibrium (module docs), from ``z = 0`` where that is within 3 times the noise.
     window : (float, float)
-        Range of absolute peak values used [m]; paper: (0.4e-3, 4e-3). Where the peaks in it
-        are not spaced as a free decay's, those within 3 times the noise of its edges are left
-        aside (module docs) and the fit goes on with the others.
+        Range of the swings ``|z_k - c|`` of the peaks used about the equilibrium ``c`` [m];
+        paper: (0.4e-3, 4e-3). Where the peaks in it are not spaced as a free decay's, those
+        within 3 times the noise of its edges are left aside (module docs) and the fit goes on
+        with the others.
     prominence : float, optional
         Peak prominence threshold (see `extract_peaks`); default: the smaller of
         `extract_peaks`' default and ``window[0]``.
@@ -356,23 +418,26 @@ def fit_damping(
     """
     if t_start is not None and not math.isfinite(t_start):
         raise ValueError(f"t_start must be finite [s], got {t_start}")
-    time_all, value_all, kind_all, keep, noise = _all_peaks(t, z, window, prominence, t_start)
+    peaks = _all_peaks(t, z, window, prominence, t_start)
+    time_all, value_all, kind_all, keep = peaks.time, peaks.value, peaks.kind, peaks.keep
     if np.count_nonzero(keep) < 3:
         raise ValueError(
-            f"only {np.count_nonzero(keep)} peak(s) with |z| in [{window[0]:g}, {window[1]:g}]; "
-            "at least 3 are needed for a damping fit"
+            f"only {np.count_nonzero(keep)} peak(s) swinging by [{window[0]:g}, {window[1]:g}] "
+            f"about the equilibrium (z = {peaks.centre:g}); at least 3 are needed for a damping "
+            "fit"
         )
     try:
         k, half = _half_period_index(time_all, kind_all, keep)
     except ValueError as refused:
-        # About an equilibrium off from the one z is taken about, one side's extrema leave the
-        # window's low end before the other's, and as the decay sinks into the noise they, or
-        # noise extrema, hover at that edge: in or out of the window by the noise, at instants
-        # the noise sets (a noise maximum 1.4 half periods after a true one; a lone one many
-        # seconds on, a count of half periods too long to be whole). Their spacing tells nothing
-        # of the decay: the fit goes on with the peaks clear of the edges if their spacing is
-        # that of a free decay. A fit that passes with every peak in the window is left as it is.
-        clear = _clear_of_edges(value_all, keep, *check_window(window), noise)
+        # About an equilibrium off from the one the swings are measured from (z = 0 where it is
+        # within the noise band of it), one side's extrema leave the window's low end before the
+        # other's, and as the decay sinks into the noise they, or noise extrema, hover at that
+        # edge: in or out of the window by the noise, at instants the noise sets (a noise
+        # maximum 1.4 half periods after a true one; a lone one many seconds on, a count of half
+        # periods too long to be whole). Their spacing tells nothing of the decay: the fit goes
+        # on with the peaks clear of the edges if their spacing is that of a free decay. A fit
+        # that passes with every peak in the window is left as it is.
+        clear = _clear_of_edges(peaks.swing, keep, *check_window(window), peaks.noise)
         if np.count_nonzero(clear) < 3 or np.array_equal(clear, keep):
             raise
         try:
@@ -396,8 +461,9 @@ def fit_damping(
     # squares of the residuals, near 1e-200 underflowed them).
     unit = power_of_two_scale(value)
     scaled = value / unit
+    c0 = peaks.centre / unit  # the fit starts from the equilibrium the swings are measured from
     tau = time - time[0]
-    a0 = max(np.log(abs(scaled[0]) / abs(scaled[-1])) / max(tau[-1], h), 1e-6)
+    a0 = max(np.log(abs(scaled[0] - c0) / abs(scaled[-1] - c0)) / max(tau[-1], h), 1e-6)
 
     def value_model(p: np.ndarray) -> np.ndarray:
         c, amp, rate = p
@@ -411,7 +477,8 @@ def fit_damping(
         e = np.exp(-rate * tau)
         return np.column_stack((np.ones_like(tau), sign * e, -sign * amp * tau * e))
 
-    fit_z = least_squares(value_residual, x0=[0.0, abs(scaled[0]), a0], jac=value_jac, method="trf")
+    x0 = [c0, abs(scaled[0] - c0), a0]
+    fit_z = least_squares(value_residual, x0=x0, jac=value_jac, method="trf")
     if not fit_z.success:
         _raise_undetermined(fit_z, sign)
     c, amp, rate = fit_z.x
