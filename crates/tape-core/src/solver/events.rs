@@ -480,7 +480,7 @@ fn needs_refinement(s: &Driver, b: &Point, c: &Point) -> bool {
 
 /// Recounts the negative eigenvalues of a state found with one, leaving out a neutral mode (see
 /// [`Driver::negative_eigenvalues`]); the driver's pieces are then those of that state.
-fn discount_neutral(s: &mut Driver, f: &mut Found) -> Result<()> {
+pub(super) fn discount_neutral(s: &mut Driver, f: &mut Found) -> Result<()> {
     if f.step.negative_eigenvalues == Some(1) {
         s.invalidate();
         s.assemble(&f.state);

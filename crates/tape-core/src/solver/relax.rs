@@ -17,7 +17,7 @@
 //! the stable equilibria reached, the one of lowest potential energy is the branch followed (the
 //! two are mirror images when the bifurcation is symmetric; the sign of the mode then decides).
 
-use super::events::Found;
+use super::events::{discount_neutral, Found};
 use super::statics::Driver;
 use super::{Event, StaticStep};
 use crate::error::{Clock, Error, Result};
@@ -113,23 +113,31 @@ impl Driver<'_> {
     /// # Errors
     /// A failure of the linear algebra.
     pub fn leaves(&mut self, state: &State) -> Result<bool> {
-        let mode = self.inverse_iteration()?;
+        let mode = self.inverse_iteration(&[])?;
+        // A neutral mode nearest zero (a balanced body beside a part that buckles) hides any
+        // further negative pivot's instability: that one's mode, the next nearest zero, is tried
+        // too. Found now, while the state's tangent is factorised.
+        let beyond = if self.system.linear.negative_eigenvalues()? >= 2 && self.is_neutral(&mode) {
+            Some(self.inverse_iteration(std::slice::from_ref(&mode))?)
+        } else {
+            None
+        };
         let energy = self.asm.energy + self.asm.gravity_energy;
-        let push = self.push_amount(&mode);
         // The flow descends the potential: once below the level that counts as left, it stays
         // below, and the rest of the way to the stable equilibrium (three quarters of the
         // relaxation where the equal-sense tape leaves its path) tells nothing more.
         let left = energy - NEUTRAL_ENERGY * energy.abs();
-        if self
-            .pushed_relaxed(state, &mode, push, state.t, Some(left))
-            .is_none()
-        {
+        for mode in std::iter::once(mode).chain(beyond) {
+            let push = self.push_amount(&mode);
+            let relaxed = self
+                .pushed_relaxed(state, &mode, push, state.t, Some(left))
+                .map(|_| self.asm.energy + self.asm.gravity_energy);
             self.invalidate();
-            return Ok(false);
+            if relaxed.is_some_and(|e| e < left) {
+                return Ok(true);
+            }
         }
-        let relaxed = self.asm.energy + self.asm.gravity_energy;
-        self.invalidate();
-        Ok(relaxed < left)
+        Ok(false)
     }
 
     /// A stable equilibrium at load factor `lambda`, relaxed from `from`; `state` ends there, with
@@ -150,11 +158,19 @@ impl Driver<'_> {
 
     /// Between the stable converged state `stable` and the unstable one `unstable` reached from it
     /// without a limit point (and left, see [`Driver::leaves`]), locates the bifurcation, and moves
-    /// `state` to a stable equilibrium on the branch leaving it (see the module notes).
+    /// `state` to a stable equilibrium on the branch leaving it (see the module notes). With
+    /// `neutral` (the path has a neutral mode from its start) the states of the location leave
+    /// that mode out of their counts, as the path's own states do.
     ///
     /// # Errors
     /// A failure of the linear algebra, or no stable equilibrium found either way.
-    pub fn switch_branch(&mut self, state: &mut State, stable: &State, unstable: &State) -> Result<Switch> {
+    pub fn switch_branch(
+        &mut self,
+        state: &mut State,
+        stable: &State,
+        unstable: &State,
+        neutral: bool,
+    ) -> Result<Switch> {
         // The bifurcation, by bisection along the path between the stable and unstable states.
         // Near it the tangent is nearly singular along the critical mode, which the hyperplane
         // does not fix: a solve that fails there counts as past it.
@@ -170,7 +186,11 @@ impl Driver<'_> {
                 break;
             }
             let mid = 0.5 * (lo + hi);
-            match self.on_plane(stable, &chord, mid, None) {
+            let mut found = self.on_plane(stable, &chord, mid, None);
+            if let (true, Some(f)) = (neutral, found.as_mut()) {
+                discount_neutral(self, f)?;
+            }
+            match found {
                 Some(found) if found.step.negative_eigenvalues == Some(0) => {
                     lo = mid;
                     last_stable = Some(found);
@@ -236,26 +256,50 @@ impl Driver<'_> {
     }
 
     /// The eigenvector of the tangent's eigenvalue nearest zero at `at` (inverse iteration with
-    /// the LDL^T of the symmetric part), of unit weighted norm.
+    /// the LDL^T of the symmetric part), of unit weighted norm. At a stable state with a negative
+    /// pivot (a neutral mode, left out of its count) a neutral mode nearest zero is passed over
+    /// for the next: the mode that turns critical is the one beside it.
     fn critical_mode(&mut self, at: &State) -> Result<Vec<f64>> {
         self.invalidate();
         self.assemble(at);
         self.factorise()?;
-        self.inverse_iteration()
+        let mode = self.inverse_iteration(&[])?;
+        if self.system.linear.negative_eigenvalues()? >= 1 && self.is_neutral(&mode) {
+            return self.inverse_iteration(std::slice::from_ref(&mode));
+        }
+        Ok(mode)
     }
 
-    /// Inverse iteration with the factorised tangent's symmetric part.
-    fn inverse_iteration(&mut self) -> Result<Vec<f64>> {
+    /// Whether `mode`'s Rayleigh quotient is zero to round-off (see [`NEUTRAL`]), of either sign.
+    fn is_neutral(&self, mode: &[f64]) -> bool {
+        self.relative_rayleigh(mode).abs() <= NEUTRAL
+    }
+
+    /// Inverse iteration with the factorised tangent's symmetric part, orthogonal to the
+    /// eigenvectors `found` (of that part; the Euclidean product): the eigenvector of the
+    /// eigenvalue nearest zero but theirs.
+    fn inverse_iteration(&mut self, found: &[Vec<f64>]) -> Result<Vec<f64>> {
         let n = self.system.n_free();
         // A deterministic start with components along every DOF.
         #[allow(clippy::cast_precision_loss)]
         let mut mode: Vec<f64> = (0..n)
             .map(|i| ((i as f64) * 0.618_033_988_749_895).fract() - 0.5)
             .collect();
+        // Removed before each solve and after it: a solve with the nearly singular tangent
+        // amplifies the round-off left along a mode of an eigenvalue at round-off level by as
+        // much as its inverse.
+        let deflate = |v: &mut [f64]| {
+            for m in found {
+                let c = dot(v, m) / dot(m, m);
+                v.iter_mut().zip(m).for_each(|(x, y)| *x -= c * y);
+            }
+        };
         for _ in 0..30 {
+            deflate(&mut mode);
             self.system
                 .linear
                 .solve_symmetric_part_in_place(&mut mode)?;
+            deflate(&mut mode);
             let norm = self.dot_w(&mode, &mode).sqrt();
             if !(norm.is_finite() && norm > 0.0) {
                 return Err(Error::Factorisation(
@@ -283,7 +327,7 @@ impl Driver<'_> {
         if count != 1 {
             return Ok(count);
         }
-        let mode = self.inverse_iteration()?;
+        let mode = self.inverse_iteration(&[])?;
         Ok(usize::from(self.relative_rayleigh(&mode) <= -NEUTRAL))
     }
 
@@ -307,16 +351,18 @@ impl Driver<'_> {
     /// a bifurcation the potential is flat along the mode to second order: a push scaled on the
     /// path's steps (which close in on it) would stay within the relaxation's tolerance.
     fn push_amount(&self, mode: &[f64]) -> f64 {
-        let largest = self
-            .system
-            .dofs
-            .free_dofs
-            .iter()
-            .zip(mode)
-            .filter(|((_, dof), _)| !dof.is_rotation())
-            .map(|(_, v)| v.abs())
-            .fold(0.0, f64::max);
         let lc = self.system.char_length;
+        let (mut translation, mut rotation) = (0.0, 0.0);
+        for ((_, dof), v) in self.system.dofs.free_dofs.iter().zip(mode) {
+            if dof.is_rotation() {
+                rotation = v.abs().max(rotation);
+            } else {
+                translation = v.abs().max(translation);
+            }
+        }
+        // A mode of rotations alone (a body turning about a held point) has translations of
+        // round-off, by which the push would be astronomical: it is pushed by its rotations.
+        let largest = translation.max(1e-3 * rotation * lc);
         if largest > 0.0 {
             PUSH * lc / largest
         } else {
@@ -407,7 +453,11 @@ impl Driver<'_> {
                 let mut k = self.asm.k_ff.clone();
                 let mut r = self.r.clone();
                 for (i, &p) in diag.iter().enumerate() {
-                    let c = beta * self.asm.k_ff[p].abs().max(1e-12);
+                    // A negative diagonal entry (the gravity stiffness of a balanced body) is
+                    // lifted to its magnitude first: no beta of the shift alone makes it positive
+                    // short of beta = 1, at which the flow over the rest crawls.
+                    let kii = self.asm.k_ff[p];
+                    let c = beta * kii.abs().max(1e-12) + 2.0 * (-kii).max(0.0);
                     k[p] += c;
                     r[i] += c * acc[i];
                 }
@@ -459,4 +509,9 @@ impl Driver<'_> {
             detail: "relaxation past a limit point found no stable equilibrium".into(),
         })
     }
+}
+
+/// Euclidean dot product.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

@@ -1395,8 +1395,15 @@ impl<'a, 'b> Walk<'a, 'b> {
                     self.p.neutral_reached = true;
                     return None;
                 }
-                // Gone, or now beyond round-off: the state is tested as after any stable one.
-                Ok(false) => self.p.neutral_from_start = false,
+                // Gone (no negative pivot left): the path's states are counted plainly from here.
+                // Beside another negative pivot, or beyond round-off: this state is tested as
+                // after any stable one, and the mode is still recounted at the next (the steps
+                // that close in on an instability found here go back to states that keep it).
+                Ok(false) => {
+                    if matches!(self.s.system.linear.negative_eigenvalues(), Ok(0)) {
+                        self.p.neutral_from_start = false;
+                    }
+                }
                 Err(e) => {
                     self.path.error = Some(e);
                     return Some(Flow::Stop);
@@ -1461,7 +1468,10 @@ impl<'a, 'b> Walk<'a, 'b> {
         }
         self.p.closing_in = false;
         let reached = state.clone();
-        let switch = match self.s.switch_branch(state, saved, &reached) {
+        let switch = match self
+            .s
+            .switch_branch(state, saved, &reached, self.p.neutral_from_start)
+        {
             Ok(switch) => switch,
             Err(e) => {
                 // No stable branch found: the path itself is followed, its states recorded with

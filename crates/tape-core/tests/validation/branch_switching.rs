@@ -15,10 +15,16 @@
 //! the path's state is left (2 % of the characteristic length, 2 mm): from there the relaxation
 //! failed, and the unstable straight strip was recorded as stable (its mode taken for a neutral
 //! one); the push is now retried shorter (`Driver::pushed_relaxed`).
+//!
+//! Beside the strip, a balanced rigid pendulum (see `common::zero::add_pendulum`) gives the path
+//! a neutral mode from its start. Its eigenvalue, -10 eps of the tangent's largest diagonal
+//! entry, stays nearest zero past the Euler load, where the straight strip has two negative
+//! eigenvalues: the instability test, the location of the bifurcation and its critical mode
+//! must each look past the neutral mode to the strip's.
 
 use crate::common;
 
-use common::zero::{arc, compress, displacement_gap, nudge, pushed_strip, tight};
+use common::zero::{add_pendulum, arc, compress, displacement_gap, largest_diagonal, nudge, pushed_strip, tight};
 
 use tape_core::output::Fields;
 use tape_core::solver::{Event, StaticParams};
@@ -45,15 +51,46 @@ fn last_fields(r: &RunResult) -> &Fields {
 /// straight strip, unstable; with the push not retried it ended there recorded as stable.
 #[test]
 fn the_first_step_of_a_switching_path_is_tested_for_a_bifurcation() -> Result<()> {
+    let (model, _) = strip()?;
+    switches_to_the_buckled_strip(&model, 0.05, "the strip, 0.05")?;
+    switches_to_the_buckled_strip(&model, 1.0, "the strip")
+}
+
+/// The strip pushed as above, and beside it the balanced pendulum (an inverted one whose gravity
+/// stiffness is -10 eps of the tangent's largest diagonal entry: a neutral mode, present from the
+/// path's start, left out of the counts), with a first arc of 1/20 of the push and of all of it.
+/// Before, the path went on along the straight strip past the Euler load, recorded with two
+/// negative eigenvalues, in five ways, each found and mended in turn (with any one of the first
+/// four left as it was, this test fails): `Driver::leaves` pushed along the pendulum's mode
+/// alone; the closing in on the instability cleared the path's neutral mode, so that its retried
+/// states, stable but for the pendulum, were taken as past the bifurcation; the bisection that
+/// locates it counted the pendulum at every state, so found no stable one; the relaxations
+/// from the pushes crawled (the pendulum's negative diagonal entry kept the pseudo-time shift
+/// near `beta = 1`); and a push along the pendulum's mode, of rotations alone, was sized by its
+/// round-off translations (1e161: the relaxation failed on non-finite numbers, which only
+/// happened to give the right verdict).
+#[test]
+fn a_bifurcation_beside_a_neutral_mode_switches_along_its_own_mode() -> Result<()> {
+    let (mut model, _) = strip()?;
+    let d = largest_diagonal(&model)?;
+    add_pendulum(&mut model, -10.0 * f64::EPSILON * d)?;
+    for first in [0.05, 1.0] {
+        switches_to_the_buckled_strip(&model, first, &format!("beside a pendulum, first arc {first}"))?;
+    }
+    Ok(())
+}
+
+/// Runs `model` (the strip, and whatever is beside it) on a switching arc-length path to the end
+/// of the push (first increment `first`) and checks it ends on the buckled strip, stable.
+fn switches_to_the_buckled_strip(model: &Model, first: f64, case: &str) -> Result<()> {
     let outputs = Outputs {
         reactions: Vec::new(),
         field_interval: 1,
     };
-    let (model, _) = strip()?;
     let switching = Step::new_static(
         "push",
         StaticParams {
-            control: arc(1.0, 1.0),
+            control: arc(1.0, first),
             newton: tight(),
             stability: true,
             jump_at_limit_points: true,
@@ -61,18 +98,22 @@ fn the_first_step_of_a_switching_path_is_tested_for_a_bifurcation() -> Result<()
             ..StaticParams::default()
         },
     );
-    let r = run(&model, &[switching], &outputs, &mut |_| true)?;
-    assert!(r.error.is_none(), "{:?}", r.error);
+    let r = run(model, &[switching], &outputs, &mut |_| true)?;
+    assert!(r.error.is_none(), "{case}: {:?}", r.error);
     let h = &r.history;
     let last = h.len() - 1;
-    assert_eq!(h.t[last], 1.0, "load factors {:?}", h.t);
+    assert_eq!(h.t[last], 1.0, "{case}: load factors {:?}", h.t);
     assert!(
         h.event.contains(&Some(Event::BranchSwitch)),
-        "events {:?}, counts {:?}",
+        "{case}: events {:?}, counts {:?}",
         h.event,
         h.negative_eigenvalues
     );
-    assert_eq!(h.negative_eigenvalues[last], 0, "counts {:?}", h.negative_eigenvalues);
+    assert_eq!(
+        h.negative_eigenvalues[last], 0,
+        "{case}: counts {:?}",
+        h.negative_eigenvalues
+    );
 
     let (mut nudged, middle) = strip()?;
     nudge(&mut nudged, &middle)?;
@@ -85,6 +126,6 @@ fn the_first_step_of_a_switching_path_is_tested_for_a_bifurcation() -> Result<()
         .fold(0.0, |m: f64, d| m.max(d[2].abs()));
     let off = displacement_gap(a, b, false).min(displacement_gap(a, b, true));
     assert!(buckle > 5e-4, "the reference is buckled: {buckle:e} m");
-    assert!(off < 1e-8, "{off:e} m from the buckled strip");
+    assert!(off < 1e-8, "{case}: {off:e} m from the buckled strip");
     Ok(())
 }

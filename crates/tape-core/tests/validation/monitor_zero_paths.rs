@@ -43,15 +43,16 @@
 
 use crate::common;
 
-use common::zero::{arc, compress, displacement_gap, driven, nudge, outputs, pushed_strip, tight, L};
+use common::zero::{
+    add_pendulum, arc, compress, displacement_gap, driven, largest_diagonal, nudge, outputs, pushed_strip, tight, L,
+};
 
 use std::sync::{Mutex, Once};
 use std::thread::{self, ThreadId};
 
-use nalgebra::{Matrix3, Vector3};
-use tape_core::assembly::Assembled;
+use nalgebra::Vector3;
 use tape_core::mesh::generate::flat_plate;
-use tape_core::model::{Constraint, Gravity, Load, RigidBody};
+use tape_core::model::{Constraint, Load};
 use tape_core::output::Fields;
 use tape_core::solver::{Control, Event, NewtonParams, StaticParams, ZeroStop};
 use tape_core::{run, Dof, History, Model, Result, RunResult, Step, System, TimeFunction};
@@ -484,45 +485,6 @@ fn a_force_that_jumps_across_zero_within_a_step_is_passed() -> Result<()> {
 
 // ---------------------------------------------------------------------------------------------
 // Case 3: the neutral mode at a located zero.
-
-/// Adds case 3's rigid body: a node beside the strip (within its bounding box, so that `L_c` is
-/// unchanged) held but for its rotation about y, carrying a mass m whose centre lies e = 10 mm
-/// above it (`stiffness < 0`: inverted, gravity's stiffness about y `-m g e`) or below it
-/// (`> 0`: hanging, `+m g e`), m chosen so that this stiffness is `stiffness` \[N m/rad\]. The
-/// node is tied to no element: that stiffness is its whole row and column of the tangent, so its
-/// LDL^T pivot is exactly it, of its sign whatever its size, and its mode is the unit rotation
-/// of the node.
-fn add_pendulum(model: &mut Model, stiffness: f64) -> Result<usize> {
-    let (g, e) = (9.81, 0.01);
-    let node = model.add_node(Vector3::new(0.1, 0.005, 0.0))?;
-    model.fix(&[node], &[Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Rz])?;
-    model.add_rigid_body(RigidBody {
-        node,
-        mass: stiffness.abs() / (g * e),
-        centre_of_mass: Vector3::new(0.0, 0.0, -stiffness.signum() * e),
-        inertia: Matrix3::zeros(),
-    })?;
-    model.set_gravity(Gravity {
-        id: None,
-        acceleration: Vector3::new(0.0, 0.0, -g),
-        function: TimeFunction::Constant,
-        active: true,
-    })?;
-    Ok(node)
-}
-
-/// The largest diagonal entry of the tangent at the undeformed state \[N/m\]: what
-/// `Driver::negative_eigenvalues` measures a neutral mode's Rayleigh quotient against.
-fn largest_diagonal(model: &Model) -> Result<f64> {
-    let mut system = System::try_new(model)?;
-    let state = system.initial_state();
-    let mut asm = Assembled::default();
-    system.assemble(&state, true, &mut asm);
-    Ok((0..system.n_free())
-        .filter_map(|i| system.pattern_ff.find(i, i))
-        .map(|p| asm.k_ff[p].abs())
-        .fold(0.0, f64::max))
-}
 
 /// Case 3's cantilever: a 10 N tip load held by the drive (20 mm per unit t, so the zero lies
 /// near t = 0.5), and the largest diagonal entry of its tangent.

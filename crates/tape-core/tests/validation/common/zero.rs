@@ -1,13 +1,14 @@
 //! Builders shared by the tests of `stop_at_monitor_zero` (`monitor_zero*.rs`) and of branch
 //! switching: arc-length steps with a monitored reaction, and the steel strip clamped at one end
-//! and pushed in at the other.
+//! and pushed in at the other, and a rigid pendulum of chosen stiffness beside it.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
+use tape_core::assembly::Assembled;
 use tape_core::mesh::generate::flat_plate;
-use tape_core::model::{Constraint, Load};
+use tape_core::model::{Constraint, Gravity, Load, RigidBody};
 use tape_core::output::Fields;
 use tape_core::solver::{Control, Monitor, NewtonParams, StaticParams, ZeroStop};
-use tape_core::{Dof, Model, Outputs, Result, Step, TimeFunction};
+use tape_core::{Dof, Model, Outputs, Result, Step, System, TimeFunction};
 
 /// Length of the strips \[m\].
 pub const L: f64 = 0.2;
@@ -120,4 +121,43 @@ pub fn displacement_gap(a: &Fields, b: &Fields, mirror: bool) -> f64 {
         .zip(&b.displacements)
         .flat_map(|(p, q)| [p[0] - q[0], p[1] - q[1], p[2] - sz * q[2]])
         .fold(0.0, |m: f64, d| m.max(d.abs()))
+}
+
+/// Adds a rigid pendulum: a node beside a strip (within its bounding box, so that `L_c` is
+/// unchanged) held but for its rotation about y, carrying a mass m whose centre lies e = 10 mm
+/// above it (`stiffness < 0`: inverted, gravity's stiffness about y `-m g e`) or below it
+/// (`> 0`: hanging, `+m g e`), m chosen so that this stiffness is `stiffness` \[N m/rad\]. The
+/// node is tied to no element: that stiffness is its whole row and column of the tangent, so its
+/// LDL^T pivot is exactly it, of its sign whatever its size, and its mode is the unit rotation
+/// of the node.
+pub fn add_pendulum(model: &mut Model, stiffness: f64) -> Result<usize> {
+    let (g, e) = (9.81, 0.01);
+    let node = model.add_node(Vector3::new(0.1, 0.005, 0.0))?;
+    model.fix(&[node], &[Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Rz])?;
+    model.add_rigid_body(RigidBody {
+        node,
+        mass: stiffness.abs() / (g * e),
+        centre_of_mass: Vector3::new(0.0, 0.0, -stiffness.signum() * e),
+        inertia: Matrix3::zeros(),
+    })?;
+    model.set_gravity(Gravity {
+        id: None,
+        acceleration: Vector3::new(0.0, 0.0, -g),
+        function: TimeFunction::Constant,
+        active: true,
+    })?;
+    Ok(node)
+}
+
+/// The largest diagonal entry of the tangent at the undeformed state \[N/m\]: what
+/// `Driver::negative_eigenvalues` measures a neutral mode's Rayleigh quotient against.
+pub fn largest_diagonal(model: &Model) -> Result<f64> {
+    let mut system = System::try_new(model)?;
+    let state = system.initial_state();
+    let mut asm = Assembled::default();
+    system.assemble(&state, true, &mut asm);
+    Ok((0..system.n_free())
+        .filter_map(|i| system.pattern_ff.find(i, i))
+        .map(|p| asm.k_ff[p].abs())
+        .fold(0.0, f64::max))
 }
