@@ -120,11 +120,13 @@ def test_on_done_returning_false_stops_the_study_at_once(workers):
     assert run_tasks(square_after, [(1, 0.0)], workers, lambda i, r: False) is False
 
 
+@pytest.mark.parametrize("how", ["false", "ctrl-c"])
 @pytest.mark.parametrize("where", ["workers", "executor"])
-def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monkeypatch, where):
+def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monkeypatch, where, how):
     # Every run ends before the study looks (`wait` returns them all at once): the stop asked on
-    # the first must not drop the three others, which ended. They are handed over too (their
-    # answers no longer count), and no stop is reported: every run ended.
+    # the first (False, or Ctrl-C in on_done) must not drop the three others, which ended. They
+    # are handed over too (their answers no longer count). No stop is reported on False, since
+    # every run ended; Ctrl-C is reported all the same.
     import concurrent.futures
 
     import tapespring.sweep
@@ -135,6 +137,8 @@ def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monke
 
     def stop_on_first(i, r):
         got[i] = r[0]
+        if how == "ctrl-c" and len(got) == 1:
+            raise KeyboardInterrupt
         return False
 
     if where == "workers":
@@ -142,7 +146,7 @@ def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monke
     else:
         with ThreadPoolExecutor(2) as threads:
             stopped = run_tasks(square_after, tasks, on_done=stop_on_first, executor=threads)
-    assert got == {0: 0, 1: 1, 2: 4, 3: 9} and stopped is False
+    assert got == {0: 0, 1: 1, 2: 4, 3: 9} and stopped is (how == "ctrl-c")
 
 
 def test_a_stop_keeps_a_run_that_ended_while_on_done_was_called():

@@ -225,7 +225,8 @@ def run_tasks(
         study: runs not started are dropped and local runs still going are ended at once (on an
         `executor`, runs not started are cancelled; those already running go on there, their
         results dropped). The runs that had ended by then (with the one it stopped on, or
-        while it was called) are handed to it all the same, their answers ignored.
+        while it was called) are handed to it all the same, their answers ignored; so too
+        where it raises KeyboardInterrupt (Ctrl-C while it runs), a stop reported as such.
     executor
         Where to run the tasks instead of local processes: any `concurrent.futures.Executor`
         (Dask: ``distributed.Client(address).get_executor()``). It is not shut down.
@@ -377,7 +378,12 @@ def _run_on(
                 except Exception as exc:
                     exc.add_note(f"(task {i} of {len(tasks)}: {tasks[i]!r:.200})")
                     raise
-                if on_done(i, result) is False:
+                try:
+                    stop = on_done(i, result) is False
+                except KeyboardInterrupt:
+                    _hand_over_ended(pending, on_done)
+                    return True  # even with nothing left: `sweep` raises Ctrl-C again on it
+                if stop:
                     _hand_over_ended(pending, on_done)
                     return bool(pending)
         return False

@@ -324,13 +324,14 @@ def test_a_progress_callback_stops_the_search(fake_runs: list[tuple[float, float
     assert result.sensitivity is None  # no more runs after a stop
 
 
+@pytest.mark.parametrize("how", ["false", "ctrl-c"])
 def test_a_stop_keeps_the_starts_that_had_ended_with_it(
-    fake_runs: list[tuple[float, float]], monkeypatch: pytest.MonkeyPatch
+    fake_runs: list[tuple[float, float]], monkeypatch: pytest.MonkeyPatch, how: str
 ) -> None:
     # The three starts run side by side (threads, so that they share the closed-form runs) and
     # all end before the identification looks (`wait` returns them all at once): the stop asked
-    # on the first run reported must not drop the two other starts, which ended, nor tell the
-    # callback of their runs.
+    # on the first run reported (False, or Ctrl-C in the callback) must not drop the two other
+    # starts, which ended, nor tell the callback of their runs.
     import concurrent.futures
 
     import tapespring.sweep
@@ -338,6 +339,13 @@ def test_a_stop_keeps_the_starts_that_had_ended_with_it(
     monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
     run_tasks = tapespring.sweep.run_tasks
     seen: list[StaticEvaluation] = []
+
+    def stop(evaluation: StaticEvaluation) -> bool:
+        seen.append(evaluation)
+        if how == "ctrl-c":
+            raise KeyboardInterrupt
+        return False
+
     with concurrent.futures.ThreadPoolExecutor(3) as pool:
         monkeypatch.setattr(
             tapespring.sweep,
@@ -346,9 +354,7 @@ def test_a_stop_keeps_the_starts_that_had_ended_with_it(
                 func, tasks, workers, on_done, executor=pool
             ),
         )
-        result = identify_static(
-            None, starts=3, workers=3, progress=lambda e: seen.append(e) or False
-        )
+        result = identify_static(None, starts=3, workers=3, progress=stop)
     assert len(seen) == 1 and result.cancelled and len(result.searches) == 3
     assert len(result.evaluations) == len(fake_runs)
 

@@ -1041,9 +1041,13 @@ def identify_static(
             nonlocal asked_stop
             outcomes[n] = outcome
             # A start handed over after a stop (it had ended too) is kept, not reported.
-            if not asked_stop and not all(report(e) for e in outcome.evaluations):
-                # Kept here: run_tasks reports no stop when it comes with the last start.
-                asked_stop = True
+            try:
+                if not asked_stop and not all(report(e) for e in outcome.evaluations):
+                    # Kept here: run_tasks reports no stop when it comes with the last start.
+                    asked_stop = True
+            except KeyboardInterrupt:
+                asked_stop = True  # a stop too: the starts handed over then are not reported
+                raise
             return not asked_stop
 
         try:

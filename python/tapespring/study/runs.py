@@ -247,9 +247,10 @@ def run_all(
     an executor the runs are reported in the order they end, a refused run as soon as every run
     before it has been reported but not before the first run that ran (what the workers cannot
     receive is refused before any run is reported). After a worker's death, the runs it left
-    unreported fail with that message and are reported with the rest, in index order. A run that
-    ended is kept even where `report`, told of a refused run before it, stops the study first
-    (`report` is then not told of it).
+    unreported fail with that message and are reported with the rest, in index order. The runs
+    that had ended when `report` stopped the study (False or Ctrl-C) are kept, `report` not told
+    of them; so is a run that ended where `report`, told of a refused run before it, stops the
+    study first.
 
     Returns
     -------
@@ -289,8 +290,13 @@ def run_all(
     def record(run: StudyRun) -> bool:
         nonlocal stopped
         runs[run.index] = run
-        if not report(run):
+        try:
+            if not report(run):
+                stopped = True
+        except KeyboardInterrupt:
+            # A stop as False is: the runs `run_tasks` then hands over are kept, not reported.
             stopped = True
+            raise
         return not stopped
 
     def release() -> bool:
