@@ -386,7 +386,8 @@ class MaxMassResult:
     errors : tuple of str
         One line per run that did not reach the final angle.
     cancelled : bool
-        True if the progress callback (or Ctrl-C) stopped the study.
+        True if the progress callback (or Ctrl-C) stopped the study before every point had
+        run.
     workers : int
         Processes that ran it (1: the calling one).
     """
@@ -667,7 +668,9 @@ def max_mass(
         The grid and the set-up; Table 4's range, 5 x 5 points, both senses by default.
     progress : bool or callable, optional
         True shows a progress bar on stderr; a callable receives ``(done, total)`` runs after
-        each one and may return False to stop (the result is then marked `cancelled`).
+        each one and may return False to stop (the result is then marked `cancelled` unless
+        every point had run; with ``workers`` > 1 the points that had ended with the one it
+        stopped on are kept, the callable not told of them).
     workers : int or None, optional
         Runs side by side in that many worker processes (None: one per core; default 1: one
         after the other in this process). The results are the same; on 2 cores two workers take
@@ -724,9 +727,10 @@ def max_mass(
         bar = tqdm(total=total, unit=" runs", file=sys.stderr, desc="max-mass", leave=False)
     start = time.perf_counter()
     done = 0
+    asked_stop = False
 
     def record(n: int, run: _PointRun) -> bool:
-        nonlocal ndof, done
+        nonlocal ndof, done, asked_stop
         i, j, k = points[n]
         done += 1
         run_wall[i, j, k] = run.wall_s
@@ -739,7 +743,14 @@ def max_mass(
         if bar is not None:
             bar.set_postfix_str(label(n), refresh=False)
             bar.update(1)
-        return not (callable(progress) and progress(done, total) is False)
+        # A point handed over after a stop (it had ended too) is kept, not reported.
+        if callable(progress) and not asked_stop:
+            try:
+                asked_stop = progress(done, total) is False
+            except KeyboardInterrupt:
+                asked_stop = True  # a stop too: the points handed over then are not reported
+                raise
+        return not asked_stop
 
     tasks = [(settings, senses[i], float(t_grid[j]), float(e_grid[k])) for i, j, k in points]
     try:
@@ -762,8 +773,9 @@ def max_mass(
         ndof=ndof,
         wall_s=time.perf_counter() - start,
         errors=tuple(errors[n] for n in sorted(errors)),
-        # (run_tasks: a stop at the last run is no stop, the study ended.)
-        cancelled=stopped,
+        # A stop once every point has run (with the last, or with those handed over after it,
+        # False or Ctrl-C) is no stop: the grid is whole.
+        cancelled=stopped and done < total,
         workers=processes_for(workers, total),
     )
 
