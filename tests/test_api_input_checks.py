@@ -15,11 +15,14 @@ Three defects of a robustness review (D06, D13, D14), each fixed in the Python l
   unknown id, or with ids ``"a"``, ``"b"`` and ``"ab"``, ``"ab"`` switched off ``a`` and ``b``).
 
 A progress argument is refused by one check wherever a callable is taken (analyses, studies,
-identification), each naming what its callable takes.
+identification), each naming what its callable takes; the studies and the identification check
+it without loading the compiled core, which their runs load where they run.
 """
 
 import json
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -284,3 +287,23 @@ def test_a_progress_of_the_wrong_type_is_refused_naming_what_it_takes(call, argu
     message = f"progress must be True, False, None or a callable {arguments}, not str: 'yes'"
     with pytest.raises(TypeError, match=re.escape(message)):
         call("yes")
+
+
+def test_studies_and_identification_check_their_progress_without_the_compiled_core():
+    probe = (
+        "import sys\n"
+        "from tapespring.identify.static import identify_static\n"
+        "from tapespring.study import ensemble, sensitivity\n"
+        "for call in (lambda: ensemble('bend', {'tape.thickness': None}, progress='yes'),\n"
+        "             lambda: sensitivity('bend', ['tape.thickness'], progress='yes'),\n"
+        "             lambda: identify_static(None, progress='yes')):\n"
+        "    try:\n"
+        "        call()\n"
+        "    except TypeError as exc:\n"
+        "        assert str(exc).startswith('progress must be'), exc\n"
+        "    else:\n"
+        "        raise AssertionError('accepted')\n"
+        "print('tapespring._core' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False"]

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from tapespring import _core
+from tapespring._checks import check_progress as _check_progress
 from tapespring._core import ConvergenceError, Model, TapeError
 from tapespring._indices import index
 from tapespring.modes import SystemMatrices
@@ -425,16 +426,6 @@ def _check_bool(name: str, value: object) -> None:
     """Raise TypeError unless `value` is a bool: ``"no"`` would be taken as true."""
     if not isinstance(value, bool | np.bool_):
         raise TypeError(f"{name} must be True or False, not {type(value).__name__}: {value!r}")
-
-
-def _check_progress(progress: object, arguments: str) -> None:
-    """Raise TypeError unless `progress` is True, False, None or a callable taking
-    `arguments` (named in the message, such as ``"(step, name, t)"``)."""
-    if not (progress is None or isinstance(progress, bool) or callable(progress)):
-        raise TypeError(
-            f"progress must be True, False, None or a callable {arguments}, not "
-            f"{type(progress).__name__}: {progress!r:.200}"
-        )
 
 
 #: A `run` progress callback ``progress(step_index, step_name, t)``: a false value other than

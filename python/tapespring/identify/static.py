@@ -55,6 +55,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from tapespring._checks import check_progress
 from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
 from tapespring.scenarios.setup import (
     PAPER_BOUNDS,
@@ -962,8 +963,6 @@ def identify_static(
     tapespring.sweep.WorkerDied
         If a worker process died (killed, out of memory).
     """
-    # Imported here: `analysis` loads the compiled core, which importing this module does not.
-    from tapespring.analysis import _check_progress
     from tapespring.scenarios.setup import check_count
     from tapespring.sweep import WorkerDied, check_workers, processes_for, run_tasks
 
@@ -978,7 +977,7 @@ def identify_static(
     check_workers(workers)
     if not isinstance(sensitivity, bool):
         raise TypeError(f"sensitivity must be True or False (got {sensitivity!r})")
-    _check_progress(progress, "(evaluation)")
+    check_progress(progress, "(evaluation)")
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
         raise TypeError(f"settings must be an EquilibriumSettings (got {settings!r})")

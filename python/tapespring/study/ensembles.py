@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tapespring import _checks
+
 from .distributions import check_distribution, describe_distribution
 from .figures import History
 from .paths import is_integer_setting, number_at, resolve
@@ -504,11 +506,8 @@ def check_runs(runs: object) -> int:
 
 def check_progress(progress: object) -> None:
     """Refuse a study's `progress` that is not a bool, None or a callable of a
-    :class:`StudyRun` (:func:`tapespring.analysis._check_progress`)."""
-    # Imported here: `analysis` loads the compiled core, which importing this module does not.
-    from tapespring.analysis import _check_progress
-
-    _check_progress(progress, "(run)")
+    :class:`StudyRun` (:func:`tapespring._checks.check_progress`)."""
+    _checks.check_progress(progress, "(run)")
 
 
 def ensemble(
