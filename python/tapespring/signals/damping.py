@@ -253,7 +253,8 @@ def _equilibrium(value: np.ndarray, kind: np.ndarray, lo: float, hi: float, nois
     v = value / unit
     d1, d2 = v[mid] - v[mid - 1], v[mid + 1] - v[mid]
     # A maximum above both neighbours, a minimum below: d1 - d2 is then |d1| + |d2| > 0.
-    mid, d1, d2 = (x[(kind[mid] * d1 > 0) & (kind[mid] * d2 < 0)] for x in (mid, d1, d2))
+    keep = (kind[mid] * d1 > 0) & (kind[mid] * d2 < 0)
+    mid, d1, d2 = mid[keep], d1[keep], d2[keep]
     estimate = v[mid] + d1 * d2 / (d1 - d2)
     swing = np.abs(v[mid] - estimate)  # in `unit`s, as the window below
     estimate = estimate[(swing >= lo / unit) & (swing <= hi / unit)]
