@@ -325,7 +325,8 @@ def analyze_trials(
     n_peaks : int
         Deployment: number of maxima and minima analysed, from 1 to `MAX_N_PEAKS` (1000).
     window : (float, float)
-        Vibration: range of absolute peak displacements fitted [m], 0 <= low < high.
+        Vibration: range of the peaks' swings about the decay's equilibrium fitted [m]
+        (`tapespring.signals.damping.fit_damping`), 0 <= low < high.
     span : int
         Quasi-static: force smoothing span [samples], >= 1.
     span_time : float, optional

@@ -113,7 +113,8 @@ def analyze_vibration(
     marker : str
         Marker whose vertical (z) coordinate is analysed.
     window : (float, float)
-        Range of absolute peak displacements used [m] (paper: 0.4 to 4 mm).
+        Range of the peaks' swings about the decay's equilibrium used [m] (paper: 0.4 to 4 mm;
+        `tapespring.signals.damping.fit_damping`).
     prominence : float, optional
         Peak prominence threshold [m].
     tail_fraction : float
@@ -140,7 +141,8 @@ def analyze_vibration(
     low, _ = check_window(window)
     travel = float(np.ptp(z_abs))
     if not travel > 0 or travel < low:
-        # |z| about any equilibrium is at most the range: no peak can reach the window.
+        # A swing about an equilibrium within the record's range is at most the range: no peak
+        # can reach the window.
         raise TrialError(
             label,
             f"the tip marker {marker!r} does not move enough: its height spans "
@@ -237,7 +239,7 @@ def analyze_vibration_group(
     markers : (str, str, str)
         Names of markers 1 (a small interface), 2 (rod) and 3 (tip); the tip is analysed.
     window : (float, float)
-        Range of absolute peak displacements fitted [m].
+        Range of the peaks' swings about the decay's equilibrium fitted [m] (`analyze_vibration`).
 
     Returns
     -------
