@@ -276,8 +276,9 @@ def test_a_recorded_decay_with_no_damping_is_refused(twin: VibrationSimulation) 
 
 class _AffineVibrate:
     """A stand-in for `vibrate`: eps_fit = offset + slope eta; no fit below `floor` (the decay
-    ends above the window) or above `ceiling` (it crosses the window too fast); a
-    ConvergenceError at run `stop_at` (1-based)."""
+    ends above the window) or above `ceiling` (it crosses the window too fast); the decay about
+    `equilibrium` [m] (the loaded one z is taken about: 0); a ConvergenceError at run `stop_at`
+    (1-based)."""
 
     def __init__(
         self,
@@ -288,9 +289,10 @@ class _AffineVibrate:
         ceiling: float = 1.0,
         stop_at: int | None = None,
         period: float = 0.108,
+        equilibrium: float = 0.0,
     ) -> None:
         self.offset, self.slope, self.floor, self.ceiling = offset, slope, floor, ceiling
-        self.stop_at, self.period = stop_at, period
+        self.stop_at, self.period, self.equilibrium = stop_at, period, equilibrium
         self.etas: list[float] = []
 
     def __call__(self, settings: VibrationSettings, *, progress: bool = False) -> Any:
@@ -305,15 +307,16 @@ class _AffineVibrate:
         fit: Fit | None = Fit(eps, self.period * 1.005)
         error = None
         if eps < self.floor or eps > self.ceiling:
-            fit, error = None, "only 0 peak(s) with |z| in the window (a stand-in)"
-        # Still swinging at 5 mm at the end when too little damped, at rest when too much.
-        amplitude = 5e-3 if eps < self.floor else (0.0 if eps > self.ceiling else 1e-3)
+            fit, error = None, "only 0 peak(s) swinging in the window (a stand-in)"
+        # Still swinging at 5 mm at the end when too little damped, by 0.1 mm (below the window)
+        # when too much.
+        amplitude = 5e-3 if eps < self.floor else (1e-4 if eps > self.ceiling else 1e-3)
         return Simulation(
             fit=fit,
             fit_error=error,
             modal_periods_s=np.array([self.period]),
             time_s=t,
-            displacement_m=amplitude * np.cos(2.0 * np.pi * t / self.period),
+            displacement_m=self.equilibrium + amplitude * np.cos(2.0 * np.pi * t / self.period),
             settings=settings,
             wall_s=0.0,
         )
@@ -348,11 +351,14 @@ def test_an_affine_fit_is_met_in_two_runs(monkeypatch: pytest.MonkeyPatch) -> No
     assert out.eta_s == pytest.approx(0.004 * 0.108 / math.pi, rel=1e-6)
 
 
+@pytest.mark.parametrize("equilibrium", [0.0, 1e-3, -2e-3])
 def test_a_first_guess_without_a_fit_raises_eta_until_one_fits(
-    monkeypatch: pytest.MonkeyPatch,
+    equilibrium: float, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Half the Kelvin-Voigt slope puts the first guess at half the target, below the fits."""
-    fake = _AffineVibrate(offset=0.0, slope=0.5 * math.pi / 0.108, floor=0.004)
+    fake = _AffineVibrate(
+        offset=0.0, slope=0.5 * math.pi / 0.108, floor=0.004, equilibrium=equilibrium
+    )
     monkeypatch.setattr(damping, "vibrate", fake)
     out = identify_damping(0.005, SETTINGS)
     assert out.converged, out.describe()
@@ -361,10 +367,16 @@ def test_a_first_guess_without_a_fit_raises_eta_until_one_fits(
     assert out.damping_ratio == pytest.approx(0.005, rel=0.005)
 
 
+@pytest.mark.parametrize("equilibrium", [0.0, 1e-3, -2e-3])
 def test_a_first_guess_crossing_the_window_too_fast_lowers_eta(
-    monkeypatch: pytest.MonkeyPatch,
+    equilibrium: float, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    fake = _AffineVibrate(offset=0.0, slope=3.0 * math.pi / 0.108, ceiling=0.01)
+    """Also where the decay settles off the equilibrium z is taken about: the window holds
+    swings about the decay's own (`fit_damping`), and a decay swinging by 0.1 mm about 1 mm has
+    crossed it. Counted by |z|, it ended above the window's 0.4 mm, and eta was raised."""
+    fake = _AffineVibrate(
+        offset=0.0, slope=3.0 * math.pi / 0.108, ceiling=0.01, equilibrium=equilibrium
+    )
     monkeypatch.setattr(damping, "vibrate", fake)
     out = identify_damping(0.005, SETTINGS)
     assert out.converged, out.describe()

@@ -164,7 +164,7 @@ class FakeVibrate:
         fit: Fit | None = Fit(eps, 0.1085)
         error = None
         if eps < self.floor:
-            fit, error = None, "only 0 peak(s) with |z| in the window (a stand-in)"
+            fit, error = None, "only 0 peak(s) swinging in the window (a stand-in)"
         amplitude = 5e-3 if fit is None else 1e-3
         return Simulation(fit=fit, fit_error=error, modal_periods_s=np.array([0.108]), time_s=t,
                            displacement_m=amplitude * np.cos(2 * np.pi * t / 0.108),

@@ -3,8 +3,9 @@ Sec. 5.2, Tables 7-8).
 
 The paper adjusts the viscosity ``eta`` [s] of the tapes' Kelvin-Voigt material until the
 simulated free decay of the set-up with the additional weight, fitted as the recordings are
-(peaks within +-[0.4, 4] mm, :func:`tapespring.signals.damping.fit_damping`), has the measured
-damping ratio (Table 7: 0.509 %; the paper's model: eta = 1.73e-4 s, 0.505 %).
+(peaks swinging by 0.4 to 4 mm about the decay's equilibrium,
+:func:`tapespring.signals.damping.fit_damping`), has the measured damping ratio (Table 7:
+0.509 %; the paper's model: eta = 1.73e-4 s, 0.505 %).
 
 Each evaluation is a run of :func:`tapespring.scenarios.vibration.vibrate` with ``spec.eta``
 replaced. The fitted damping ratio is nearly affine in eta::
@@ -36,11 +37,12 @@ evaluated, never an extrapolation. Eta stays >= 0: when the affine model puts th
 confirms it, the search stops there with ``converged`` False.
 
 A run whose decay cannot be fitted (fewer than 3 peaks in the window) brackets the search: if its
-decay ended above the window's low end, eta was too low (the decay had not yet crossed the window
-within ``duration``); otherwise too high (it crossed the window in fewer than 3 peaks). With no
-fitted run yet, eta is raised to what would bring the decay to the middle of the window by the
-end, or halved; once a fitted run exists, a step into a failed range means the damping ratio
-sought cannot be fitted with these settings, and the search stops saying what to change.
+decay still swung beyond the window's low end at the end, eta was too low (the decay had not yet
+crossed the window within ``duration``); otherwise too high (it crossed the window in fewer than
+3 peaks). With no fitted run yet, eta is raised to what would bring the decay to the middle of
+the window by the end, or halved; once a fitted run exists, a step into a failed range means the
+damping ratio sought cannot be fitted with these settings, and the search stops saying what to
+change.
 """
 
 from __future__ import annotations
@@ -542,8 +544,13 @@ class _Search:
         if t.size == 0:
             return True
         period = self.modal_period(sim)
-        tail = t >= t[-1] - (period if math.isfinite(period) else 0.0)
-        return float(np.max(np.abs(z[tail]))) > sim.settings.window[0]
+        # Without a modal period, the paper's model's (as `next_eta`): a range needs both swings.
+        tail = z[t >= t[-1] - (period if math.isfinite(period) else PAPER_MODEL.period)]
+        # The window holds swings about the decay's own equilibrium (`fit_damping`), which may be
+        # off the loaded one z is taken about. Half the range over a period, the mean of its two
+        # swings, is the same about any equilibrium; |z| counted the offset as swing, so a decay
+        # that settled 1 mm off had "ended above" a 0.4 mm low end, and eta was raised.
+        return 0.5 * float(np.ptp(tail)) > sim.settings.window[0]
 
     def _fitted(self) -> list[DampingRun]:
         return [r for r in self.runs if r.damping_ratio is not None]
