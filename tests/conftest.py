@@ -36,3 +36,34 @@ except ImportError as exc:  # a missing extension fails the run: the tests must 
         f"the native extension tapespring._core cannot be imported ({exc}): "
         "install the package with `pip install .` (a Rust toolchain is needed)"
     ) from exc
+
+
+@pytest.fixture
+def runs_end_before_looked(monkeypatch):
+    """Every run of `tapespring.sweep.run_tasks` has ended before the study looks: its `wait`
+    returns them all at once (how a stop meets runs that ended with the one it is asked on)."""
+    import concurrent.futures
+
+    import tapespring.sweep
+
+    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
+
+
+@pytest.fixture
+def tasks_on_threads(monkeypatch, runs_end_before_looked):
+    """`tapespring.sweep.run_tasks` runs its tasks on a pool of four threads, so that stand-in
+    runs patched into this process reach them, each ended before the study looks."""
+    import concurrent.futures
+
+    import tapespring.sweep
+
+    run_tasks = tapespring.sweep.run_tasks
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        monkeypatch.setattr(
+            tapespring.sweep,
+            "run_tasks",
+            lambda func, tasks, workers, on_done: run_tasks(
+                func, tasks, workers, on_done, executor=pool
+            ),
+        )
+        yield

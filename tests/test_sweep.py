@@ -122,16 +122,12 @@ def test_on_done_returning_false_stops_the_study_at_once(workers):
 
 @pytest.mark.parametrize("how", ["false", "ctrl-c"])
 @pytest.mark.parametrize("where", ["workers", "executor"])
-def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(monkeypatch, where, how):
+@pytest.mark.usefixtures("runs_end_before_looked")
+def test_a_stop_keeps_the_runs_that_had_ended_with_the_one_it_was_asked_on(where, how):
     # Every run ends before the study looks (`wait` returns them all at once): the stop asked on
     # the first (False, or Ctrl-C in on_done) must not drop the three others, which ended. They
     # are handed over too (their answers no longer count). No stop is reported on False, since
     # every run ended; Ctrl-C is reported all the same.
-    import concurrent.futures
-
-    import tapespring.sweep
-
-    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
     tasks = [(x, 0.0) for x in range(4)]
     got: dict[int, int] = {}
 

@@ -325,19 +325,14 @@ def test_a_progress_callback_stops_the_search(fake_runs: list[tuple[float, float
 
 
 @pytest.mark.parametrize("how", ["false", "ctrl-c"])
+@pytest.mark.usefixtures("tasks_on_threads")
 def test_a_stop_keeps_the_starts_that_had_ended_with_it(
-    fake_runs: list[tuple[float, float]], monkeypatch: pytest.MonkeyPatch, how: str
+    fake_runs: list[tuple[float, float]], how: str
 ) -> None:
     # The three starts run side by side (threads, so that they share the closed-form runs) and
     # all end before the identification looks (`wait` returns them all at once): the stop asked
     # on the first run reported (False, or Ctrl-C in the callback) must not drop the two other
     # starts, which ended, nor tell the callback of their runs.
-    import concurrent.futures
-
-    import tapespring.sweep
-
-    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
-    run_tasks = tapespring.sweep.run_tasks
     seen: list[StaticEvaluation] = []
 
     def stop(evaluation: StaticEvaluation) -> bool:
@@ -346,15 +341,7 @@ def test_a_stop_keeps_the_starts_that_had_ended_with_it(
             raise KeyboardInterrupt
         return False
 
-    with concurrent.futures.ThreadPoolExecutor(3) as pool:
-        monkeypatch.setattr(
-            tapespring.sweep,
-            "run_tasks",
-            lambda func, tasks, workers, on_done: run_tasks(
-                func, tasks, workers, on_done, executor=pool
-            ),
-        )
-        result = identify_static(None, starts=3, workers=3, progress=stop)
+    result = identify_static(None, starts=3, workers=3, progress=stop)
     assert len(seen) == 1 and result.cancelled and len(result.searches) == 3
     assert len(result.evaluations) == len(fake_runs)
 

@@ -260,14 +260,12 @@ def test_a_stop_with_workers_keeps_the_points_done_in_their_cells():
 
 
 @pytest.mark.parametrize("how", ["false", "ctrl-c"])
+@pytest.mark.usefixtures("tasks_on_threads")
 def test_a_stop_with_workers_keeps_the_points_that_had_ended_with_it_untold(monkeypatch, how):
     # Every point ends before the study looks (stand-in runs on threads, `wait` returning them
     # all at once): the stop asked on the first reported keeps the three others, which ended,
     # without telling the callback of them. The grid is then whole: not cancelled.
-    import concurrent.futures
-
     import tapespring.scenarios.max_mass as module
-    import tapespring.sweep
 
     def stand_in(task):
         _, _, thickness, modulus = task
@@ -275,8 +273,6 @@ def test_a_stop_with_workers_keeps_the_points_that_had_ended_with_it_untold(monk
         return module._PointRun(moment=moment, stable=True, error=None, wall_s=0.0, ndof=6)
 
     monkeypatch.setattr(module, "_bend_point", stand_in)
-    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
-    run_tasks = tapespring.sweep.run_tasks
     calls: list[tuple[int, int]] = []
 
     def stop(done, total):
@@ -285,15 +281,7 @@ def test_a_stop_with_workers_keeps_the_points_that_had_ended_with_it_untold(monk
             raise KeyboardInterrupt
         return False
 
-    with concurrent.futures.ThreadPoolExecutor(2) as pool:
-        monkeypatch.setattr(
-            tapespring.sweep,
-            "run_tasks",
-            lambda func, tasks, workers, on_done: run_tasks(
-                func, tasks, workers, on_done, executor=pool
-            ),
-        )
-        result = max_mass(OPPOSITE_CORNERS, progress=stop, workers=2)
+    result = max_mass(OPPOSITE_CORNERS, progress=stop, workers=2)
     assert calls == [(1, 4)] and not result.cancelled
     t, e = np.meshgrid(OPPOSITE_CORNERS.thicknesses, OPPOSITE_CORNERS.youngs_moduli, indexing="ij")
     np.testing.assert_array_equal(result.residual_moment[0], t * e)

@@ -556,16 +556,14 @@ def test_a_stop_asked_on_a_refused_run_keeps_the_run_that_had_just_ended(how):
 
 
 @pytest.mark.parametrize("how", ["false", "ctrl-c"])
-def test_a_stop_asked_on_a_run_keeps_the_runs_that_had_ended_with_it(monkeypatch, how):
+@pytest.mark.usefixtures("runs_end_before_looked")
+def test_a_stop_asked_on_a_run_keeps_the_runs_that_had_ended_with_it(how):
     # Every run ends before the study looks (`wait` returns them all at once): the stop asked on
     # the first reported (False, or Ctrl-C in the callback) must not drop the three others,
     # which ended. The callback is not told of them; the study is not cancelled, since every
     # run ended.
     import concurrent.futures
 
-    import tapespring.sweep
-
-    monkeypatch.setattr(tapespring.sweep, "wait", lambda fs, **_: concurrent.futures.wait(fs))
     seen: list[int] = []
 
     def stop_on_first(run):

@@ -158,7 +158,8 @@ impl Lcg {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// Euclidean dot product.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

@@ -20,6 +20,7 @@
 use super::events::{discount_neutral, Found};
 use super::statics::Driver;
 use super::{Event, StaticStep};
+use crate::eigen::dot;
 use crate::error::{Clock, Error, Result};
 use crate::state::State;
 
@@ -337,8 +338,8 @@ impl Driver<'_> {
         self.system
             .pattern_ff
             .mul_add(&self.asm.k_ff, mode, &mut km);
-        let num: f64 = mode.iter().zip(&km).map(|(a, b)| a * b).sum();
-        let den: f64 = mode.iter().map(|a| a * a).sum();
+        let num = dot(mode, &km);
+        let den = dot(mode, mode);
         let diag = (0..mode.len())
             .filter_map(|i| self.system.pattern_ff.find(i, i))
             .map(|p| self.asm.k_ff[p].abs())
@@ -509,9 +510,4 @@ impl Driver<'_> {
             detail: "relaxation past a limit point found no stable equilibrium".into(),
         })
     }
-}
-
-/// Euclidean dot product.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
