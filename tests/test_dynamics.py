@@ -313,12 +313,17 @@ def test_record_0_holds_the_inertia_of_the_first_moving_step(modal_first):
 
 def test_the_pin_of_the_heavy_top_feels_the_centre_of_mass_acceleration():
     # The heavy top of issue 8, 6.b (tests/_heavy_top.py), over 0.4 s at h = 0.1 ms: nutating
-    # and precessing, the
-    # pin's force reaches 757 N (five times the weight). It must be m a_com - m g, with a_com the
-    # second difference of the marker track at the centre of mass. The difference is the second
-    # difference's own error, h^2 / 12 times the track's fourth derivative: measured 3.6e-4 of the
-    # peak, second order (5.8e-3, 1.4e-3, 3.6e-4 at h = 0.4, 0.2, 0.1 ms). Bound 1e-3. A pin force
-    # without the inertia would be the weight, 610 N off at the peak.
+    # and precessing, the pin's force reaches 757 N (five times the weight). It must be
+    # m a_com - m g, with a_com the second difference of the marker track at the centre of mass.
+    # A pin force without the inertia would be the weight, 610 N off at the peak.
+    # The core advances the centre on its own, the discrete system of a joint held by a
+    # multiplier at index 3, whose force starts with the known transient of index-3
+    # generalised-alpha: it alternates about m a_com - m g from step to step, 1.9 N at most (0.25 %
+    # of the peak) at this step, first order in h (3.8 N at 0.2 ms), decaying by 0.76 a step;
+    # an independent implementation of the same equations has the same numbers, and the joint
+    # model's multiplier 3.6 N (tests/test_heavy_top_scheme.py). Bound 5e-3 of the peak over
+    # the run, and from the 20th step on 1e-3 of it (measured 1.1e-4 there: the transient's tail
+    # and the second difference's own error, h^2 / 12 times the track's fourth derivative).
     h = 1e-4
     model, pin = heavy_top()
     outputs = Outputs(reactions=[(pin, d) for d in ("ux", "uy", "uz")])
@@ -332,7 +337,9 @@ def test_the_pin_of_the_heavy_top_feels_the_centre_of_mass_acceleration():
     expected = MASS * a_com - MASS * GRAVITY
     peak = np.abs(reaction).max()
     assert peak > 4.0 * MASS * np.linalg.norm(GRAVITY)
-    assert np.abs(reaction[1:-1] - expected).max() < 1e-3 * peak
+    gap = np.abs(reaction[1:-1] - expected).max(axis=1)
+    assert gap.max() < 5e-3 * peak
+    assert gap[20:].max() < 1e-3 * peak
 
 
 def test_a_rigidly_spinning_damped_shell_dissipates_nothing():

@@ -398,7 +398,7 @@ def stop_after(n: int, how: str):
 
 
 def stopped_keeping_what_ended(study, callback, n: int, total: int) -> None:
-    """`study`, run side by side and stopped by ``stop_after(n, "false")``, kept the runs the
+    """`study`, run side by side and stopped by ``stop_after(n, how)``, kept the runs the
     callback was told of and those that had ended with them, of which it was not told; it is
     cancelled unless every run ended (with instant runs, how many had is not set)."""
     kept = {r.index for r in study.runs}
@@ -446,9 +446,12 @@ def test_two_workers_stop_on_ctrl_c_in_a_run_and_on_false_keeping_correct_runs()
 
 
 def test_two_workers_stop_on_ctrl_c_in_the_progress_callback():
+    # As after a False return, the runs that had ended with the one the callback stopped on are
+    # kept without telling it: whether one had depends on the workers' timing (runs [0, 2, 3, 4]
+    # were kept for [0, 2, 3] seen in one suite run on a busy machine).
     callback = stop_after(3, "ctrl-c")
     e = run_ensemble({"a": U}, runs=10, seed=2, workers=2, progress=callback)
-    assert e.cancelled and [r.index for r in e.runs] == sorted(r.index for r in callback.seen)
+    stopped_keeping_what_ended(e, callback, 3, 10)
     np.testing.assert_array_equal(e.values("f"), 9.0 * e.drawn("a"))
 
 

@@ -121,6 +121,88 @@ impl NodeInertia {
         (f, moment)
     }
 
+    /// Offset of the centre of mass from the node in the body frame \[m\], if the body has mass
+    /// and its centre is off the node.
+    #[must_use]
+    pub fn centre(&self) -> Option<Vector3<f64>> {
+        (self.mass > 0.0 && self.moment != Vector3::zeros()).then(|| self.moment / self.mass)
+    }
+
+    /// The rotary part of a body with mass: its inertia tensor about the centre of mass, with no
+    /// mass, so that [`Self::forces`] and [`Self::jacobian`] of it are the rotational inertia alone.
+    fn about_centre(&self) -> Self {
+        let c = self.moment / self.mass;
+        Self {
+            mass: 0.0,
+            moment: Vector3::zeros(),
+            inertia: self.inertia - (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * self.mass,
+        }
+    }
+
+    /// Velocity and acceleration of the centre of mass \[m/s, m/s^2\] (spatial) of a node moving
+    /// as `m` at velocity `v`: `v + w x s_R / m`, `a + dw/dt x s_R / m + w x (w x s_R / m)`.
+    #[must_use]
+    pub fn centre_motion(&self, m: &Motion, v: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        if self.mass <= 0.0 {
+            return (*v, *m.a);
+        }
+        let u = m.r * self.moment / self.mass;
+        (v + m.w.cross(&u), m.a + m.dw.cross(&u) + m.w.cross(&m.w.cross(&u)))
+    }
+
+    /// Inertia force and moment about the node \[N, N m\] when the centre of mass accelerates at
+    /// `com_acc` \[m/s^2\] (spatial) and the body turns as `m` (whose `a` is not used): `m com_acc`
+    /// at the centre and the rotary inertia about it. The same as [`Self::forces`] when `com_acc`
+    /// is the rigid motion's ([`Self::centre_motion`]); a time integrator that advances the centre
+    /// on its own gives it its own acceleration. The body must have mass.
+    #[must_use]
+    pub fn forces_at_centre(&self, m: &Motion, com_acc: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let zero = Vector3::zeros();
+        let (_, moment) = self.about_centre().forces(&Motion { a: &zero, ..*m });
+        let f = com_acc * self.mass;
+        let u = m.r * self.moment / self.mass;
+        (f, moment + u.cross(&f))
+    }
+
+    /// Derivative of [`Self::forces_at_centre`] with respect to the node's translation and spatial
+    /// rotation increments, as [`Self::jacobian`], when the centre's acceleration follows its
+    /// position `x + R c` as `d com_acc = beta' d(x + R c)`.
+    #[must_use]
+    pub fn jacobian_at_centre(
+        &self,
+        m: &Motion,
+        com_acc: &Vector3<f64>,
+        beta_p: f64,
+        gamma_p: f64,
+        p: &Matrix3<f64>,
+    ) -> Matrix6<f64> {
+        let zero = Vector3::zeros();
+        let mut jac = self
+            .about_centre()
+            .jacobian(&Motion { a: &zero, ..*m }, beta_p, gamma_p, p);
+        // d(R c) = -[R c]x d theta; the moment (R c) x f turns with the body.
+        let u = skew(&(m.r * self.moment / self.mass));
+        let f = skew(&(com_acc * self.mass));
+        let mb = self.mass * beta_p;
+        let mut block = |row: usize, col: usize, add: Matrix3<f64>| {
+            let mut view = jac.fixed_view_mut::<3, 3>(row, col);
+            view += add;
+        };
+        block(0, 0, Matrix3::identity() * mb);
+        block(0, 3, -u * mb);
+        block(3, 0, u * mb);
+        block(3, 3, f * u - u * u * mb);
+        jac
+    }
+
+    /// Kinetic energy \[J\] with the centre of mass moving at `com_v` and the body turning at `w`
+    /// (spatial): `m |com_v|^2 / 2 + w . J_G w / 2`. The body must have mass.
+    #[must_use]
+    pub fn kinetic_energy_at_centre(&self, r: &Matrix3<f64>, com_v: &Vector3<f64>, w: &Vector3<f64>) -> f64 {
+        let (_, j) = self.about_centre().spatial(r);
+        0.5 * self.mass * com_v.norm_squared() + 0.5 * w.dot(&(j * w))
+    }
+
     /// Derivative of [`Self::forces`] with respect to the node's translation and spatial rotation
     /// increments `(delta x, delta theta)` (`R <- exp(delta theta^) R`), when the accelerations
     /// and velocities follow them as `d a = beta' delta x`, `d dw/dt = beta' P delta theta`,
@@ -199,6 +281,79 @@ mod tests {
             gamma_p,
             &p,
         );
+        let eps = 1e-6;
+        for k in 0..6 {
+            let fd = |sign: f64| {
+                let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
+                if k < 3 {
+                    dx[k] = sign * eps;
+                } else {
+                    dth[k - 3] = sign * eps;
+                }
+                forces(&rotate(&q1, &dth), &dx)
+            };
+            let col = (fd(1.0) - fd(-1.0)) / (2.0 * eps);
+            let err = (col - jac.column(k)).norm() / jac.column(k).norm().max(1.0);
+            assert!(err < 1e-6, "column {k}: fd {col:?} vs {:?}", jac.column(k));
+        }
+    }
+
+    /// The forces with the centre's own acceleration: those of the rigid motion when it is the
+    /// rigid one, and their Jacobian against finite differences, the centre's acceleration moved
+    /// by its displacement.
+    #[test]
+    fn forces_at_the_centre_of_mass() {
+        let mut body = NodeInertia::default();
+        let j = Matrix3::new(0.3, 0.02, -0.01, 0.02, 0.5, 0.03, -0.01, 0.03, 0.4);
+        body.add(2.0, &Vector3::new(0.1, -0.3, 0.2), &j);
+        body.add(0.5, &Vector3::new(-0.2, 0.1, 0.05), &Matrix3::zeros());
+        let c = body.centre().expect("off the node");
+        let q0 = UnitQuaternion::from_scaled_axis(Vector3::new(0.4, -0.2, 0.9));
+        let d0 = Vector3::new(0.05, 0.02, -0.04);
+        let q1 = UnitQuaternion::from_scaled_axis(d0) * q0;
+        let r1 = q1.to_rotation_matrix().into_inner();
+        let (a, w, dw, v) = (
+            Vector3::new(1.0, -2.0, 0.5),
+            Vector3::new(3.0, -1.0, 2.0),
+            Vector3::new(-4.0, 5.0, 1.0),
+            Vector3::new(0.2, 0.1, -0.3),
+        );
+        let motion = Motion {
+            r: &r1,
+            a: &a,
+            w: &w,
+            dw: &dw,
+        };
+        let (_, rigid_acc) = body.centre_motion(&motion, &v);
+        let (f0, m0) = body.forces(&motion);
+        let (f1, m1) = body.forces_at_centre(&motion, &rigid_acc);
+        assert!((f1 - f0).norm() < 1e-12 * f0.norm() && (m1 - m0).norm() < 1e-12 * m0.norm());
+        let (rv, rw) = (r1, w);
+        let energy = body.kinetic_energy(&rv, &v, &rw);
+        let (com_v, _) = body.centre_motion(&motion, &v);
+        let at_centre = body.kinetic_energy_at_centre(&rv, &com_v, &rw);
+        assert!((energy - at_centre).abs() < 1e-12 * energy, "{energy} vs {at_centre}");
+
+        let com_acc = Vector3::new(0.7, 1.1, -0.6);
+        let (beta_p, gamma_p) = (7.0, 3.0);
+        let forces = |q: &UnitQuaternion<f64>, dx: &Vector3<f64>| {
+            let th = (q * q0.inverse()).scaled_axis() - d0;
+            let r = q.to_rotation_matrix().into_inner();
+            let moved = dx + (r - r1) * c;
+            let (w, dw, acc) = (w + th * gamma_p, dw + th * beta_p, com_acc + moved * beta_p);
+            let (f, m) = body.forces_at_centre(
+                &Motion {
+                    r: &r,
+                    a: &a,
+                    w: &w,
+                    dw: &dw,
+                },
+                &acc,
+            );
+            Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+        };
+        let p = tangent_inverse(&-d0);
+        let jac = body.jacobian_at_centre(&motion, &com_acc, beta_p, gamma_p, &p);
         let eps = 1e-6;
         for k in 0..6 {
             let fd = |sign: f64| {

@@ -29,6 +29,14 @@ pub struct State {
     /// Nodal angular accelerations [rad/s^2].
     #[serde(default)]
     pub dw: Vec<Vector3<f64>>,
+    /// Velocity of the centre of mass of each independent node's rigid body [m/s]: in dynamic
+    /// steps, the time integrator's own for a body whose centre of mass is off its node (see
+    /// `solver::dynamics`), otherwise zero.
+    #[serde(default)]
+    pub com_v: Vec<Vector3<f64>>,
+    /// Acceleration of that centre of mass [m/s^2], as `com_v`.
+    #[serde(default)]
+    pub com_acc: Vec<Vector3<f64>>,
 }
 
 impl State {
@@ -41,7 +49,9 @@ impl State {
             v: zeros.clone(),
             w: zeros.clone(),
             acc: zeros.clone(),
-            dw: zeros,
+            dw: zeros.clone(),
+            com_v: zeros.clone(),
+            com_acc: zeros,
             x,
             q,
         }
@@ -50,7 +60,14 @@ impl State {
     /// Sets every velocity and acceleration to zero (the state a static step leaves).
     pub fn stop(&mut self) {
         let n = self.x.len();
-        for v in [&mut self.v, &mut self.w, &mut self.acc, &mut self.dw] {
+        for v in [
+            &mut self.v,
+            &mut self.w,
+            &mut self.acc,
+            &mut self.dw,
+            &mut self.com_v,
+            &mut self.com_acc,
+        ] {
             v.clear();
             v.resize(n, Vector3::zeros());
         }
