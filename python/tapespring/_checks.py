@@ -7,6 +7,15 @@ that process the core's import.
 
 from __future__ import annotations
 
+import numpy as np
+
+
+def check_bool(name: str, value: object) -> None:
+    """Raise TypeError unless `value` (the argument `name`) is a bool: ``"no"`` would be taken
+    as true."""
+    if not isinstance(value, bool | np.bool_):
+        raise TypeError(f"{name} must be True or False, not {type(value).__name__}: {value!r}")
+
 
 def check_progress(progress: object, arguments: str) -> None:
     """Raise TypeError unless `progress` is True, False, None or a callable taking

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from tapespring import _core
+from tapespring._checks import check_bool as _check_bool
 from tapespring._checks import check_progress as _check_progress
 from tapespring._core import ConvergenceError, Model, TapeError
 from tapespring._indices import index
@@ -420,12 +421,6 @@ def _reaction_dofs(reactions: Any) -> tuple[tuple[int, str], ...]:
             raise ValueError(f"{what} asks for {key!r} twice ({what}[{k}] is {pair!r})")
         pairs.append(key)
     return tuple(pairs)
-
-
-def _check_bool(name: str, value: object) -> None:
-    """Raise TypeError unless `value` is a bool: ``"no"`` would be taken as true."""
-    if not isinstance(value, bool | np.bool_):
-        raise TypeError(f"{name} must be True or False, not {type(value).__name__}: {value!r}")
 
 
 #: A `run` progress callback ``progress(step_index, step_name, t)``: a false value other than

@@ -31,8 +31,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tapespring import _core
+from tapespring._checks import check_bool as _check_bool
+from tapespring._checks import check_progress as _check_progress
 from tapespring._core import ConvergenceError, Model, TapeError
-from tapespring.analysis import DOFS, Outputs, Step, _check_bool, _check_progress, run
+from tapespring.analysis import DOFS, Outputs, Step, run
 from tapespring.results import Results
 
 __all__ = [

@@ -195,7 +195,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         nargs=2,
         default=None,
         metavar=("LOW", "HIGH"),
-        help="vibration: |peak| range fitted [m] (default "
+        help="vibration: range of the peaks' swing about the equilibrium fitted [m] (default "
         + " ".join(f"{w:g}" for w in defaults["window"].default)
         + " m)",
     )

@@ -129,7 +129,7 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         nargs=2,
         default=[w * 1e3 for w in d.window],
         metavar=("LOW", "HIGH"),
-        help="range of |peak| fitted [mm] (default "
+        help="range of the peaks' swing about the equilibrium fitted [mm] (default "
         + " ".join(f"{w * 1e3:g}" for w in d.window)
         + " mm; paper: 0.4 4 mm)",
     )

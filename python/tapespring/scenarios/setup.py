@@ -206,7 +206,7 @@ class PaperResults:
     vibration_initial_displacement : float
         Initial displacement of the small-vibration tests [m] (Sec. 5.2).
     vibration_peak_window : tuple of float
-        Range of |peak| used in the damping fit [m] (Sec. 5.2).
+        Range of the peaks' swing about the equilibrium used in the damping fit [m] (Sec. 5.2).
     first_max_peak_time_opposite, extra_peak_time_equal : float
         Sec. 6.1: the first maximum peak of the opposite-sense deployment [s], and the fourth
         large equal-sense peak of the model with the identified eta [s] (approximate).

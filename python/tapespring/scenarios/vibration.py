@@ -140,7 +140,8 @@ class VibrationSettings:
     rho_inf : float
         Spectral radius at infinity of generalised-alpha (paper: 0.7; Fig. 26 varies it).
     window : tuple of float
-        Range of |peak| used in the fit [m] (paper: 0.4 to 4 mm).
+        Range of the peaks' swing about the decay's equilibrium used in the fit [m]
+        (`fit_damping`; paper: 0.4 to 4 mm).
     sample_rate : float
         Rate at which the decay is recorded [Hz]; the steps land on its multiples and are at
         most one sample long. Default 400 Hz, every other instant of the paper's 800 Hz motion
