@@ -238,14 +238,44 @@ mod tests {
     use super::*;
     use crate::rotation::{rotate, tangent_inverse};
 
-    /// The Jacobian against finite differences of the forces, with the accelerations and
-    /// velocities moved by the generalised-alpha relations.
-    #[test]
-    fn jacobian_matches_finite_differences() {
+    /// A body of two masses, one with rotary inertia, its centre off the node.
+    fn two_masses() -> NodeInertia {
         let mut body = NodeInertia::default();
         let j = Matrix3::new(0.3, 0.02, -0.01, 0.02, 0.5, 0.03, -0.01, 0.03, 0.4);
         body.add(2.0, &Vector3::new(0.1, -0.3, 0.2), &j);
         body.add(0.5, &Vector3::new(-0.2, 0.1, 0.05), &Matrix3::zeros());
+        body
+    }
+
+    /// Checks the Jacobian `jac` column by column against central differences of
+    /// `forces(rotation, translation)` about the rotation `q1` and no translation.
+    fn assert_matches_differences(
+        jac: &Matrix6<f64>,
+        q1: &UnitQuaternion<f64>,
+        forces: impl Fn(&UnitQuaternion<f64>, &Vector3<f64>) -> Vector6<f64>,
+    ) {
+        let eps = 1e-6;
+        for k in 0..6 {
+            let fd = |sign: f64| {
+                let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
+                if k < 3 {
+                    dx[k] = sign * eps;
+                } else {
+                    dth[k - 3] = sign * eps;
+                }
+                forces(&rotate(q1, &dth), &dx)
+            };
+            let col = (fd(1.0) - fd(-1.0)) / (2.0 * eps);
+            let err = (col - jac.column(k)).norm() / jac.column(k).norm().max(1.0);
+            assert!(err < 1e-6, "column {k}: fd {col:?} vs {:?}", jac.column(k));
+        }
+    }
+
+    /// The Jacobian against finite differences of the forces, with the accelerations and
+    /// velocities moved by the generalised-alpha relations.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let body = two_masses();
         let q0 = UnitQuaternion::from_scaled_axis(Vector3::new(0.4, -0.2, 0.9));
         let d0 = Vector3::new(0.05, 0.02, -0.04);
         let q1 = UnitQuaternion::from_scaled_axis(d0) * q0;
@@ -281,21 +311,7 @@ mod tests {
             gamma_p,
             &p,
         );
-        let eps = 1e-6;
-        for k in 0..6 {
-            let fd = |sign: f64| {
-                let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
-                if k < 3 {
-                    dx[k] = sign * eps;
-                } else {
-                    dth[k - 3] = sign * eps;
-                }
-                forces(&rotate(&q1, &dth), &dx)
-            };
-            let col = (fd(1.0) - fd(-1.0)) / (2.0 * eps);
-            let err = (col - jac.column(k)).norm() / jac.column(k).norm().max(1.0);
-            assert!(err < 1e-6, "column {k}: fd {col:?} vs {:?}", jac.column(k));
-        }
+        assert_matches_differences(&jac, &q1, forces);
     }
 
     /// The forces with the centre's own acceleration: those of the rigid motion when it is the
@@ -303,10 +319,7 @@ mod tests {
     /// by its displacement.
     #[test]
     fn forces_at_the_centre_of_mass() {
-        let mut body = NodeInertia::default();
-        let j = Matrix3::new(0.3, 0.02, -0.01, 0.02, 0.5, 0.03, -0.01, 0.03, 0.4);
-        body.add(2.0, &Vector3::new(0.1, -0.3, 0.2), &j);
-        body.add(0.5, &Vector3::new(-0.2, 0.1, 0.05), &Matrix3::zeros());
+        let body = two_masses();
         let c = body.centre().expect("off the node");
         let q0 = UnitQuaternion::from_scaled_axis(Vector3::new(0.4, -0.2, 0.9));
         let d0 = Vector3::new(0.05, 0.02, -0.04);
@@ -354,21 +367,7 @@ mod tests {
         };
         let p = tangent_inverse(&-d0);
         let jac = body.jacobian_at_centre(&motion, &com_acc, beta_p, gamma_p, &p);
-        let eps = 1e-6;
-        for k in 0..6 {
-            let fd = |sign: f64| {
-                let (mut dx, mut dth) = (Vector3::zeros(), Vector3::zeros());
-                if k < 3 {
-                    dx[k] = sign * eps;
-                } else {
-                    dth[k - 3] = sign * eps;
-                }
-                forces(&rotate(&q1, &dth), &dx)
-            };
-            let col = (fd(1.0) - fd(-1.0)) / (2.0 * eps);
-            let err = (col - jac.column(k)).norm() / jac.column(k).norm().max(1.0);
-            assert!(err < 1e-6, "column {k}: fd {col:?} vs {:?}", jac.column(k));
-        }
+        assert_matches_differences(&jac, &q1, forces);
     }
 
     /// The kinetic energy's derivative along a motion is the power of the inertia forces.

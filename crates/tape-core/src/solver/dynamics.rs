@@ -460,6 +460,16 @@ type Pair = [Vector3<f64>; 2];
 /// centre of mass ([`Integrator::centres`]), that centre.
 type Alg = [Vector3<f64>; 3];
 
+/// The motion of node `i` in `state`, its body frame turned by `r`.
+fn node_motion<'a>(state: &'a State, r: &'a Matrix3<f64>, i: usize) -> Motion<'a> {
+    Motion {
+        r,
+        a: &state.acc[i],
+        w: &state.w[i],
+        dw: &state.dw[i],
+    }
+}
+
 struct Integrator<'a> {
     system: &'a mut System,
     alpha: Alpha,
@@ -551,11 +561,7 @@ impl Integrator<'_> {
                 }
             }
             if jumped {
-                let r = self
-                    .system
-                    .node_rotation(start, i)
-                    .to_rotation_matrix()
-                    .into_inner();
+                let r = self.body_frame(start, i);
                 work += body.kinetic_energy(&r, &v, &w) - body.kinetic_energy(&r, &start.v[i], &start.w[i]);
             }
         }
@@ -604,13 +610,7 @@ impl Integrator<'_> {
                 }
             }
             if let Some(c) = self.centres[i] {
-                let rotation = |s: &State| {
-                    self.system
-                        .node_rotation(s, i)
-                        .to_rotation_matrix()
-                        .into_inner()
-                };
-                let d = state.x[i] - start.x[i] + (rotation(state) - rotation(start)) * c;
+                let d = state.x[i] - start.x[i] + (self.body_frame(state, i) - self.body_frame(start, i)) * c;
                 let [ac, vc, dvc] = advance3(&self.alpha, h, &d, &start.com_v[i], &start.com_acc[i], &a[i][2]);
                 (state.com_v[i], state.com_acc[i]) = (vc, dvc);
                 a_new[i][2] = ac;
@@ -621,21 +621,19 @@ impl Integrator<'_> {
         a_new
     }
 
+    /// Rotation of independent node `i`'s body frame in `state`, from the reference configuration.
+    fn body_frame(&self, state: &State, i: usize) -> Matrix3<f64> {
+        self.system
+            .node_rotation(state, i)
+            .to_rotation_matrix()
+            .into_inner()
+    }
+
     /// Velocity and acceleration of the centre of mass of independent node `i`'s body when it
     /// moves rigidly with the node in `state` \[m/s, m/s^2\].
     fn rigid_centre(&self, state: &State, i: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let r = self
-            .system
-            .node_rotation(state, i)
-            .to_rotation_matrix()
-            .into_inner();
-        let motion = Motion {
-            r: &r,
-            a: &state.acc[i],
-            w: &state.w[i],
-            dw: &state.dw[i],
-        };
-        self.system.inertia[i].centre_motion(&motion, &state.v[i])
+        let r = self.body_frame(state, i);
+        self.system.inertia[i].centre_motion(&node_motion(state, &r, i), &state.v[i])
     }
 
     /// Kinetic energy \[J\] of `state`, with the centres of mass advanced on their own moving at
@@ -644,11 +642,7 @@ impl Integrator<'_> {
         (0..state.x.len())
             .filter_map(|i| self.centres[i].map(|_| i))
             .map(|i| {
-                let r = self
-                    .system
-                    .node_rotation(state, i)
-                    .to_rotation_matrix()
-                    .into_inner();
+                let r = self.body_frame(state, i);
                 let body = &self.system.inertia[i];
                 let (rigid, _) = self.rigid_centre(state, i);
                 body.kinetic_energy_at_centre(&r, &state.com_v[i], &state.w[i])
@@ -670,17 +664,8 @@ impl Integrator<'_> {
             if self.system.dofs.master[i].is_some() || body.is_empty() {
                 continue;
             }
-            let r = self
-                .system
-                .node_rotation(state, i)
-                .to_rotation_matrix()
-                .into_inner();
-            let motion = Motion {
-                r: &r,
-                a: &state.acc[i],
-                w: &state.w[i],
-                dw: &state.dw[i],
-            };
+            let r = self.body_frame(state, i);
+            let motion = node_motion(state, &r, i);
             let centre = self.centres[i];
             let (f, m) = match centre {
                 Some(_) => body.forces_at_centre(&motion, &state.com_acc[i]),
@@ -1023,11 +1008,7 @@ impl Integrator<'_> {
             if self.system.dofs.master[i].is_some() {
                 continue;
             }
-            let r = self
-                .system
-                .node_rotation(state, i)
-                .to_rotation_matrix()
-                .into_inner();
+            let r = self.body_frame(state, i);
             // Velocity-dependent inertia forces at zero acceleration.
             let zero = Vector3::zeros();
             let (g_f, g_m) = body.forces(&Motion {
