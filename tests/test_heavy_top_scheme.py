@@ -63,16 +63,19 @@ def consistent_start() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return z[0:3], z[3:6], z[6:9]
 
 
-def newton(residual, z, step: float, tol: float, k: int) -> np.ndarray:  # noqa: ANN001
-    """Root of `residual` from `z` by Newton on a central-difference Jacobian (steps `step`), to
-    `tol` in every component (fsolve's progress test stalls at these systems' round-off and
-    warns); `k` names the time step in the failure."""
+def newton(residual, z, step, tol, k: int) -> np.ndarray:  # noqa: ANN001
+    """Root of `residual` from `z` by Newton on a central-difference Jacobian (steps `step`, a
+    number or one per unknown), to `tol` (a number or one per component) in every component
+    (fsolve's progress test stalls at these systems' round-off and warns); `k` names the time
+    step in the failure."""
+    steps = np.diag(np.broadcast_to(step, np.shape(z)))
     for _ in range(20):
         f = residual(z)
-        if np.max(np.abs(f)) < tol:
+        if np.all(np.abs(f) < tol):
             return z
-        steps = step * np.eye(len(z))
-        jac = np.column_stack([(residual(z + e) - residual(z - e)) / (2.0 * step) for e in steps])
+        jac = np.column_stack(
+            [(residual(z + e) - residual(z - e)) / (2.0 * e[i]) for i, e in enumerate(steps)]
+        )
         z = z - np.linalg.solve(jac, f)
     raise AssertionError(f"Newton failed at step {k}: residual {np.max(np.abs(f)):.3g}")
 
@@ -145,7 +148,9 @@ def joint_top(h: float, duration: float, rho_inf: float) -> dict[float, np.ndarr
     v = np.concatenate([np.cross(w, x), w])
     dv = np.concatenate([dvx, dw])
     a = dv.copy()
-    steps = np.diag(np.concatenate([np.full(6, 1e-3), np.full(3, 1e-4)]))  # accelerations, N
+    steps = np.concatenate([np.full(6, 1e-3), np.full(3, 1e-4)])  # accelerations, N
+    # Forces of about 150 N to 1e-8 N, the joint (scaled by 1 / (beta h^2)) to 1e-14 m.
+    tols = np.concatenate([np.full(6, 1e-8), np.full(3, 1e-14 / (beta * h * h))])
     out = {}
     for k in range(round(duration / h)):
 
@@ -167,19 +172,7 @@ def joint_top(h: float, duration: float, rho_inf: float) -> dict[float, np.ndarr
                 ]
             )
 
-        # Newton on a central-difference Jacobian (fsolve's progress test stalls at this
-        # system's round-off and warns): forces of about 150 N to 1e-8 N, the joint to 1e-14 m.
-        z = np.concatenate([a, lam])
-        for _ in range(20):
-            f = residual(z)
-            if np.max(np.abs(f[0:6])) < 1e-8 and np.max(np.abs(f[6:9])) * beta * h * h < 1e-14:
-                break
-            jac = np.column_stack(
-                [(residual(z + e) - residual(z - e)) / (2.0 * e[i]) for i, e in enumerate(steps)]
-            )
-            z = z - np.linalg.solve(jac, f)
-        else:
-            raise AssertionError(f"Newton failed at step {k}: residual {np.max(np.abs(f)):.3g}")
+        z = newton(residual, np.concatenate([a, lam]), steps, tols, k)
         a, v, dv, x, r = advance(z)
         lam = z[6:9]
         t = (k + 1) * h

@@ -96,6 +96,16 @@ fn heavy_top() -> Result<Model> {
     Ok(model)
 }
 
+/// Largest change of the kinetic and gravity energy over the history, relative to the initial
+/// kinetic energy.
+fn energy_drift(hist: &History) -> f64 {
+    let energy = |k: usize| hist.kinetic_energy[k] + hist.gravity_energy[k];
+    (0..hist.len())
+        .map(|k| (energy(k) - energy(0)).abs())
+        .fold(0.0, f64::max)
+        / hist.kinetic_energy[0]
+}
+
 /// Record of the history at time `t` (steps land on output times).
 fn at(h: &History, t: f64) -> usize {
     h.t.iter()
@@ -120,12 +130,7 @@ fn heavy_top_matches_the_reference_solution() -> Result<()> {
         let hist = &result.history;
         // The top's energy, with the kinetic energy of the centre's own velocity: the motion
         // keeps it, the scheme to second order.
-        let energy = |k: usize| hist.kinetic_energy[k] + hist.gravity_energy[k];
-        let drift = (0..hist.len())
-            .map(|k| (energy(k) - energy(0)).abs())
-            .fold(0.0, f64::max)
-            / hist.kinetic_energy[0];
-        drifts.push(drift);
+        drifts.push(energy_drift(hist));
         let com = hist.marker("com").expect("marker");
         let mut u = Vec::new();
         for (t, _) in &references {
@@ -268,18 +273,7 @@ fn heavy_top_at_rho_inf_one_runs_through() -> Result<()> {
     assert!(result.error.is_none(), "{:?}", result.error);
     let hist = &result.history;
     assert!((hist.t[hist.len() - 1] - 10.0).abs() < 1e-9);
-    let energy: Vec<f64> = hist
-        .kinetic_energy
-        .iter()
-        .zip(&hist.gravity_energy)
-        .map(|(k, g)| k + g)
-        .collect();
-    let scale = hist.kinetic_energy[0];
-    let drift = energy
-        .iter()
-        .map(|e| (e - energy[0]).abs())
-        .fold(0.0, f64::max)
-        / scale;
+    let drift = energy_drift(hist);
     eprintln!("rho_inf = 1, 10 s: energy drift {drift:.3e} of the kinetic energy");
     assert!(drift < 1e-3, "energy drift {drift:e}");
     let com = hist.marker("com").expect("marker");
