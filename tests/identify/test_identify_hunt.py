@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from _vibrate_stand_in import Fit, Simulation, no_run
+from _vibrate_stand_in import Fit, NoRun, Simulation, no_run
 from hypothesis import given
 from hypothesis import strategies as st
 from property_settings import examples
@@ -406,8 +406,11 @@ def test_a_bad_progress_is_refused_before_any_vibration_run(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(damping, "vibrate", no_run)
-    with pytest.raises(TypeError, match="progress"):
+    with pytest.raises(TypeError, match="progress must be True or False, not str"):
         identify_damping(0.005, VIBRATION, progress="yes")  # type: ignore[arg-type]
+    # NumPy's bool is a bool here, as everywhere in the API: past the checks, to the first run.
+    with pytest.raises(NoRun):
+        identify_damping(0.005, VIBRATION, progress=np.bool_(False))
 
 
 # Fixed (was a defect): StaticIdentification.summary() (documented JSON-ready) holds NaN when
@@ -572,6 +575,7 @@ def test_starts_from_a_generator_an_array_or_tuples_agree(fake: FakeEvaluate) ->
         ({"xatol": -1e-3}, ValueError, "xatol"),
         ({"workers": 2.0}, TypeError, "workers"),
         ({"workers": True}, TypeError, "workers"),
+        ({"sensitivity": "no"}, TypeError, "sensitivity must be True or False, not str"),
         ({"bounds": replace(PAPER_BOUNDS, thickness_min=math.nan)}, ValueError, "thickness_min"),
     ],
 )

@@ -58,6 +58,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tapespring._checks import check_bool
 from tapespring.scenarios.setup import (
     MAX_ETA,
     PAPER_MODEL,
@@ -352,8 +353,7 @@ def identify_damping(
     ):
         raise ValueError(f"rel_tolerance must be a number in (0, 1) (got {rel_tolerance!r})")
     check_count("max_runs", max_runs, minimum=1)
-    if not isinstance(progress, bool):
-        raise TypeError(f"progress must be True or False (got {progress!r})")
+    check_bool("progress", progress)
     if on_run is not None and not callable(on_run):
         raise TypeError(f"on_run must be callable or None (got {on_run!r})")
 

@@ -55,7 +55,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tapespring._checks import check_progress
+from tapespring._checks import check_bool, check_progress
 from tapespring.scenarios.equilibrium import TABLE6_ROWS, EquilibriumSettings
 from tapespring.scenarios.setup import (
     PAPER_BOUNDS,
@@ -975,8 +975,7 @@ def identify_static(
     check_number("xatol", xatol, positive=True)
     check_number("fatol", fatol, positive=True)
     check_workers(workers)
-    if not isinstance(sensitivity, bool):
-        raise TypeError(f"sensitivity must be True or False (got {sensitivity!r})")
+    check_bool("sensitivity", sensitivity)
     check_progress(progress, "(evaluation)")
     settings = EquilibriumSettings() if settings is None else settings
     if not isinstance(settings, EquilibriumSettings):
