@@ -19,19 +19,26 @@ OMEGA0 = np.array([0.0, 150.0, -4.61538])  # rad/s, body frame (= spatial at t =
 GRAVITY = np.array([0.0, 0.0, -9.81])  # m/s^2
 
 
-def body_on_a_pin(mass: float, centre: npt.ArrayLike, inertia: npt.ArrayLike) -> tuple[Model, int]:
-    """A rigid body on a reference node at the origin pinned in ux, uy, uz (its rotations free),
-    with a marker ``"com"`` at its centre of mass `centre` [m]; `inertia` [kg m^2] is about the
-    centre of mass. The model's shell is a clamped, massless steel plate (100 x 100 x 1 mm) 10 m
-    away that takes no part. Returns the model and the pin's node."""
+def free_body(mass: float, centre: npt.ArrayLike, inertia: npt.ArrayLike) -> tuple[Model, int]:
+    """A rigid body on a free reference node at the origin, with a marker ``"com"`` at its centre
+    of mass `centre` [m]; `inertia` [kg m^2] is about the centre of mass. The model's shell is a
+    clamped, massless steel plate (100 x 100 x 1 mm) 10 m away that takes no part. Returns the
+    model and the body's node."""
     nodes, quads, _ = flat_plate_mesh(0.1, 0.1, 1, 1)
     nodes = np.asarray(nodes) + [0.0, 0.0, 10.0]
     model = Model(nodes, quads, thickness=1e-3, youngs_modulus=2e11, poisson=0.3)
     model.fix([0, 1, 2, 3], "all")
-    pin = model.add_node([0.0, 0.0, 0.0])
+    node = model.add_node([0.0, 0.0, 0.0])
+    model.add_rigid_body(node, mass, centre_of_mass=centre, inertia=inertia)
+    model.add_marker("com", node, offset=centre)
+    return model, node
+
+
+def body_on_a_pin(mass: float, centre: npt.ArrayLike, inertia: npt.ArrayLike) -> tuple[Model, int]:
+    """`free_body` with its node pinned in ux, uy, uz (its rotations free). Returns the model and
+    the pin's node."""
+    model, pin = free_body(mass, centre, inertia)
     model.fix(pin, ["ux", "uy", "uz"])
-    model.add_rigid_body(pin, mass, centre_of_mass=centre, inertia=inertia)
-    model.add_marker("com", pin, offset=centre)
     return model, pin
 
 
