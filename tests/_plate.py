@@ -1,10 +1,12 @@
-"""Shared tiny model of the input-check tests: ``from _plate import plate``."""
+"""Shared tiny models of the tests: ``from _plate import plate``, ``bent_strip``."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from tapespring import Model, shell
+from tapespring.analysis import Outputs, Step, run
+from tapespring.results import Results
 
 
 def plate(**section: Any) -> Model:
@@ -16,3 +18,18 @@ def plate(**section: Any) -> Model:
     model = Model(nodes, quads, node_sets=sets, **(defaults | section))
     model.fix("x0")
     return model
+
+
+def bent_strip(field_interval: int) -> tuple[Model, int, Results]:
+    """A 100 x 10 x 1 mm strip of 6 x 1 quads clamped along x = 0, its free end tied to a node of
+    no element (`tip`, at the end's middle) pulled up by 20 N in four load increments: five
+    records (load factors 0 to 1), the tip 35 mm up at the end, nodal fields kept every
+    `field_interval`-th record (0: none). Returns the model, the tip node and the results."""
+    nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.01, 6, 1)
+    model = Model(nodes, quads, node_sets=sets, thickness=1e-3, youngs_modulus=2e11, poisson=0.0)
+    model.fix("x0", "all")
+    tip = model.add_node([0.1, 0.005, 0.0])
+    model.tie("x1", tip)
+    model.add_load(tip, "uz", 20.0)
+    outputs = Outputs(field_interval=field_interval)
+    return model, tip, run(model, [Step.static("load", increments=4)], outputs=outputs)

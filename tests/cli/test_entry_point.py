@@ -29,6 +29,7 @@ def test_top_level_help_lists_both_commands(capsys):
         ("release", "--plot", "no folder"),
         ("deploy", "--vtu", "no folder"),
         ("deploy", "--snapshots", "no folder"),
+        ("deploy", "--animate", "no folder"),
         ("vibrate", "--csv", "no folder"),
         ("pull", "--plot", "no folder"),
         ("max-mass", "--csv", "no folder"),

@@ -223,6 +223,9 @@ def test_vibrate_names_a_fixed_step_too_long_for_the_duration_in_steps(capsys):
         # Six snapshots of 2.5 ms were one kept record drawn six times ("t = 2.002 s" six times).
         (["--snapshots", "{d}/s.png", "--duration", "0.0025"], 1),
         (["--snapshots", "{d}/s.png", "--vtu", "{d}/v.pvd", "--duration", "0.05"], 4),
+        # The animation by the snapshots' rule: ten frames and more where the samples allow.
+        (["--animate", "{d}/a.gif"], 16),
+        (["--animate", "{d}/a.gif", "--vtu", "{d}/v.pvd", "--duration", "0.05"], 4),
     ],
 )
 def test_deploy_keeps_fields_often_enough_for_distinct_snapshots(

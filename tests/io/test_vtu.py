@@ -9,21 +9,15 @@ import xml.etree.ElementTree as ET
 import meshio
 import numpy as np
 import pytest
-from tapespring.analysis import Model, Outputs, Step, run
+from _plate import bent_strip
+from tapespring.analysis import Model, Step, run
 from tapespring.io import write_pvd
 from tapespring.shell import flat_plate_mesh
 
 
 @pytest.fixture(scope="module")
 def bent():
-    nodes, quads, sets = flat_plate_mesh(0.1, 0.01, 6, 1)
-    model = Model(nodes, quads, node_sets=sets, thickness=1e-3, youngs_modulus=2e11, poisson=0.0)
-    model.fix("x0", "all")
-    tip = model.add_node([0.1, 0.005, 0.0])
-    model.tie("x1", tip)
-    model.add_load(tip, "uz", 20.0)
-    results = run(model, [Step.static("load", increments=4)], outputs=Outputs(field_interval=2))
-    return model, tip, results
+    return bent_strip(field_interval=2)
 
 
 def test_series_holds_the_deformed_mesh(bent, tmp_path):

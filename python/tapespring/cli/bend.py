@@ -230,12 +230,7 @@ def _image_file(text: str) -> str:
     ``fig`` gives ``fig.png`` and ``fig.`` too (its rule: the text after the last dot of the name,
     trailing dots dropped), so that the command names the file it wrote (it said ``wrote fig``
     of a file ``fig.png``) and `refuse_shared_paths` compares the real names."""
-    _output_file(text)
-    suffix = os.path.splitext(text)[1].lower().lstrip(".")
-    if not suffix:
-        named = text.rstrip(".") + ".png"
-        _output_file(named)  # "fig" may be a file and "fig.png" a folder
-        return named
+    named, suffix = _with_suffix(text, "png")
     from matplotlib.backend_bases import FigureCanvasBase
 
     formats = FigureCanvasBase.get_supported_filetypes()
@@ -257,7 +252,34 @@ def _image_file(text: str) -> str:
                 f"cannot write {text}: matplotlib writes '.pgf' with {tex}, which is not "
                 "installed (not on PATH); choose another format, such as .pdf or .svg"
             )
-    return text
+    return named
+
+
+def _with_suffix(text: str, default: str) -> tuple[str, str]:
+    """The file name `text` checked as `_output_file` checks it, with ``.default`` added if it
+    has no suffix (matplotlib's rule: the text after the last dot of the name, trailing dots
+    dropped, so ``fig`` and ``fig.`` are ``fig.png``), and its suffix, lower case, no dot."""
+    _output_file(text)
+    suffix = os.path.splitext(text)[1].lower().lstrip(".")
+    if suffix:
+        return text, suffix
+    named = f"{text.rstrip('.')}.{default}"
+    _output_file(named)  # "fig" may be a file and "fig.png" a folder
+    return named, default
+
+
+@_path_type
+def _gif_file(text: str) -> str:
+    """An argparse type: the animated GIF the command will write (as `_output_file`), ``.gif``
+    added to a name without a suffix (as `_image_file` adds ``.png``, so that the command names
+    the file it wrote); any other suffix is refused, as the animation is written as a GIF
+    whatever the name says."""
+    named, suffix = _with_suffix(text, "gif")
+    if suffix != "gif":
+        raise argparse.ArgumentTypeError(
+            f"cannot write {text}: an animation is an animated GIF, give a name ending in .gif"
+        )
+    return named
 
 
 @_path_type
@@ -290,16 +312,16 @@ def _vtu_file(text: str) -> str:
 
 
 #: The options naming a file a command writes, as `refuse_shared_paths` reads them.
-_OUTPUT_OPTIONS = ("csv", "plot", "snapshots", "vtu")
+_OUTPUT_OPTIONS = ("animate", "csv", "plot", "snapshots", "vtu")
 
 
 def refuse_shared_paths(args: argparse.Namespace) -> None:
     """Refuse (as `refuse`) outputs that would overwrite each other or the recording the command
-    reads: ``--csv``, ``--plot``, ``--snapshots`` and ``--vtu`` (its ``.pvd`` file and the folder
-    of its VTU files) naming one file, or naming the ``--experiment`` recording or a CSV
-    recording's force side file (``<stem>.forces.csv``). Each writer replaced the file silently:
-    ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's table.
-    Paths are compared once resolved (``./rec.csv``, a symbolic link)."""
+    reads: ``--animate``, ``--csv``, ``--plot``, ``--snapshots`` and ``--vtu`` (its ``.pvd`` file
+    and the folder of its VTU files) naming one file, or naming the ``--experiment`` recording or
+    a CSV recording's force side file (``<stem>.forces.csv``). Each writer replaced the file
+    silently: ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's
+    table. Paths are compared once resolved (``./rec.csv``, a symbolic link)."""
     read: dict[Path, str] = {}
     experiment = getattr(args, "experiment", None)
     if experiment:

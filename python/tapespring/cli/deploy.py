@@ -8,11 +8,13 @@ from typing import TYPE_CHECKING
 from .bend import (
     _count,
     _field,
+    _gif_file,
     _image_file,
     _input_file,
     _vtu_file,
     refuse,
     refuse_shared_paths,
+    warn,
     wrote,
 )
 from .scenario_options import (
@@ -50,6 +52,7 @@ FLEXIBLE_SAMPLE_RATE = 2000.0
 
 def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``deploy`` command to a CLI (`sub` from ``add_subparsers``)."""
+    from tapespring.plot.animation import MAX_FRAMES
     from tapespring.scenarios.deployment import DeploymentSettings
     from tapespring.scenarios.setup import SUPPORTS
 
@@ -134,6 +137,15 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="FILE.png",
         help="draw the set-up from the side at the release and every --duration/5 s (Fig. 13)",
     )
+    p.add_argument(
+        "--animate",
+        type=_gif_file,
+        metavar="FILE.gif",
+        help="write the set-up's motion from the side, from the release to the end, as an "
+        "animated GIF: one frame per kept record, as --vtu keeps them (more often on a short "
+        f"run, as for --snapshots), at most {MAX_FRAMES} frames, at {ANIMATION_FPS:g} frames "
+        "per second (.gif added to a name without a suffix)",
+    )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(
         p,
@@ -150,16 +162,22 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 #: Records between two kept nodal fields for ``--vtu`` (50 Hz at the default 800 Hz samples).
 VTU_INTERVAL = 16
 
+#: Frame rate of ``--animate`` [frames/s]: at `VTU_INTERVAL` and 800 Hz samples, 50 kept fields
+#: a second of motion, so a second of motion plays in 2.5 s.
+ANIMATION_FPS = 20.0
+
 
 def _field_interval(args: argparse.Namespace, rate: float) -> int:
-    """Records between two kept nodal fields: none without ``--vtu`` or ``--snapshots``, else
-    every `VTU_INTERVAL`-th, fewer with ``--snapshots`` on a run too short for six distinct
-    snapshots at that interval: each is drawn at the kept record nearest its time, and on
-    ``--duration 0.0025`` the six were one state drawn six times ("t = 2.002 s" six times). At
-    most a tenth of the samples in a fifth of the duration keeps them apart."""
-    if not (args.vtu or args.snapshots):
+    """Records between two kept nodal fields: none without ``--vtu``, ``--snapshots`` or
+    ``--animate``, else every `VTU_INTERVAL`-th, fewer for the figures (``--snapshots``,
+    ``--animate``) on a run too short for ten kept fields at that interval. The snapshots are
+    drawn at the kept records nearest their times, and on ``--duration 0.0025`` the six were
+    one state drawn six times ("t = 2.002 s" six times); the animation had a frame or two. At
+    most a tenth of the samples in a fifth of the duration keeps six snapshots apart and gives
+    the animation ten frames or more where the run has that many samples."""
+    if not (args.vtu or args.snapshots or args.animate):
         return 0
-    if not args.snapshots:
+    if not (args.snapshots or args.animate):
         return VTU_INTERVAL
     return max(1, min(VTU_INTERVAL, int(args.duration * rate / 10.0)))
 
@@ -229,6 +247,17 @@ def run(args: argparse.Namespace) -> int:
 
     def fields(result: DeploymentSimulation) -> None:
         write_vtu(args, result.results, result.setup.model)
+        drawn = [f"--{name}" for name in ("snapshots", "animate") if getattr(args, name)]
+        if not drawn:
+            return
+        if result.time_s.size == 0:
+            # Stopped in the static steps (exit code 1 follows): no motion to draw; its last
+            # time ended the command in an IndexError traceback.
+            warn(f"{' and '.join(drawn)} not written: the run stopped before the release")
+            return
+        # Simulation time of the release: the records' time runs on from the static steps.
+        span = float(result.time_s[-1])
+        t0 = float(result.results.t[-1]) - span
         if args.snapshots:
             import matplotlib
 
@@ -236,14 +265,25 @@ def run(args: argparse.Namespace) -> int:
             from tapespring.plot.snapshots import plot_snapshots
             from tapespring.report import save_figure
 
-            # Simulation time of the release: the records' time runs on from the static steps.
-            span = float(result.time_s[-1])
-            t0 = float(result.results.t[-1]) - span
             times = [t0 + k * span / 5.0 for k in range(6)]
             ax = plot_snapshots(result.results, result.setup.model, times)
             save_figure(ax.figure, args.snapshots)
             if not args.json:
                 print(wrote(args.snapshots))
+        if args.animate:
+            from tapespring.plot.animation import animate_deformation
+            from tapespring.plot.snapshots import _field_records
+
+            # The motion after the release: from the kept record nearest it (the snapshots'
+            # first) to the last, subsampled to MAX_FRAMES by the writer.
+            results = result.results
+            (first,) = _field_records(results, [t0])
+            records = [r for r in results.field_records.tolist() if r >= first]
+            path = animate_deformation(
+                results, result.setup.model, args.animate, records, fps=ANIMATION_FPS
+            )
+            if not args.json:
+                print(wrote(path))
 
     def columns(result: DeploymentSimulation) -> dict:
         rows = result.sample_rows()

@@ -30,6 +30,10 @@ setup, max_mass, numerical_damping, support, snapshots
     the folded equilibrium, Sec. 5.1), the maximum mass (Fig. 7), the numerical damping study
     (Fig. 26), the flexible support's clamp force (Fig. 33) and side views of the deformed model
     (Fig. 13). Some return a Figure rather than axes.
+
+animation
+    The deformed model as an animated GIF, one field record a frame (writes a file and returns
+    its path, not axes).
 """
 
 from typing import TYPE_CHECKING
@@ -38,6 +42,7 @@ from tapespring._lazy import lazy_exports
 
 if TYPE_CHECKING:
     # What the lazy __getattr__ below returns, for the type checker (not imported at run time).
+    from .animation import animate_deformation
     from .bending import plot_bending
     from .identify import plot_damping_identification, plot_static_identification
     from .max_mass import plot_max_mass
@@ -60,6 +65,7 @@ if TYPE_CHECKING:
     )
 
 __all__ = [
+    "animate_deformation",
     "plot_angle_histories",
     "plot_bending",
     "plot_clamp_forces",
@@ -108,6 +114,7 @@ __getattr__, __dir__ = lazy_exports(
         "numerical_damping": ["plot_numerical_damping"],
         "support": ["plot_clamp_forces"],
         "snapshots": ["plot_snapshots"],
+        "animation": ["animate_deformation"],
         "study": ["plot_ensemble", "plot_sensitivity"],
     },
 )

@@ -1,15 +1,22 @@
-"""Snapshots of the deformed model superimposed in one view (paper Fig. 13 style)."""
+"""Snapshots of the deformed model superimposed in one view (paper Fig. 13 style).
+
+The drawing of one configuration (the shell quads projected on the view plane, the nodes of no
+element as dots) and the choice of its field records are kept here and shared with the
+animation of :mod:`tapespring.plot.animation`.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from numbers import Integral
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from matplotlib.artist import Artist
     from matplotlib.axes import Axes
+    from numpy.typing import NDArray
 
     from tapespring.analysis import Model
     from tapespring.results import Results
@@ -68,19 +75,11 @@ def plot_snapshots(
         not kept.
     """
     from matplotlib import colormaps
-    from matplotlib.collections import PolyCollection
     from matplotlib.lines import Line2D
 
-    from tapespring.io.vtu import reference_mesh
-
-    if len(view) != 2 or view[0] == view[1] or any(c not in _AXES for c in view):
-        raise ValueError(f"view must be two distinct letters of 'xyz' (e.g. 'xz'), got {view!r}")
-    if len(records_or_times) == 0:
-        raise ValueError("records_or_times is empty: give at least one record or time")
+    h, v = _view_axes(view)
     records = _field_records(results, records_or_times)
-    nodes, quads = reference_mesh(results, model)
-    isolated = np.setdiff1d(np.arange(nodes.shape[0]), quads.ravel())
-    h, v = (_AXES.index(c) for c in view)
+    nodes, quads, isolated = _mesh(results, model)
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -88,30 +87,78 @@ def plot_snapshots(
     colours = colormaps[cmap](np.linspace(0.35, 1.0, len(records)))
     handles = []
     for k, (r, colour) in enumerate(zip(records, colours, strict=True)):
-        u, _ = results.field(r)
-        x = 1e3 * (nodes + u)
-        polys = x[quads][:, :, [h, v]]
-        ax.add_collection(
-            PolyCollection(
-                list(polys),
-                facecolors=[(*colour[:3], 0.25)],
-                edgecolors=[colour],
-                linewidths=0.6,
-                zorder=2 + k,
-            ),
-            autolim=True,
-        )
-        if isolated.size:
-            ax.plot(x[isolated, h], x[isolated, v], "o", ms=2.5, color=colour, zorder=2 + k)
+        x = _positions_mm(results, nodes, r)
+        _draw_configuration(ax, x[:, [h, v]], quads, isolated, tuple(colour), zorder=2 + k)
         handles.append(Line2D([], [], color=colour, lw=2.0, label=_label(results, r)))
     ax.autoscale_view()
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel(f"{view[0]} [mm]")
-    ax.set_ylabel(f"{view[1]} [mm]")
-    ax.grid(True, lw=0.4, alpha=0.5)
+    _decorate(ax, view, adjustable="datalim")
     if legend:
         ax.legend(handles=handles, fontsize=8, loc="best")
     return ax
+
+
+def _view_axes(view: str) -> tuple[int, int]:
+    """The indices (0 to 2) of the `view`'s horizontal and vertical axes; ValueError unless it
+    is two distinct letters of ``"xyz"``."""
+    if len(view) != 2 or view[0] == view[1] or any(c not in _AXES for c in view):
+        raise ValueError(f"view must be two distinct letters of 'xyz' (e.g. 'xz'), got {view!r}")
+    return _AXES.index(view[0]), _AXES.index(view[1])
+
+
+def _mesh(
+    results: Results, model: Model | None
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]:
+    """The reference nodes [m], the shell quads and the nodes of no quad (rigid bodies,
+    reference nodes: drawn as dots)."""
+    from tapespring.io.vtu import reference_mesh
+
+    nodes, quads = reference_mesh(results, model)
+    return nodes, quads, np.setdiff1d(np.arange(nodes.shape[0]), quads.ravel())
+
+
+def _positions_mm(results: Results, nodes: NDArray[np.float64], record: int) -> NDArray[np.float64]:
+    """The nodes' deformed positions at a field record [mm], shape (n_nodes, 3)."""
+    u, _ = results.field(record)
+    return 1e3 * (nodes + u)
+
+
+def _draw_configuration(
+    ax: Axes,
+    xy: NDArray[np.float64],
+    quads: NDArray[np.int64],
+    isolated: NDArray[np.int64],
+    colour: tuple[float, ...],
+    *,
+    zorder: float,
+) -> list[Artist]:
+    """Draw one configuration: the quads of the projected positions `xy` (n_nodes, 2) [mm],
+    edges in `colour` (RGBA) and faces in it at a quarter opacity, the `isolated` nodes as dots.
+    Returns the artists drawn (to remove them for the next frame of an animation)."""
+    from matplotlib.collections import PolyCollection
+
+    faces = PolyCollection(
+        list(xy[quads]),
+        facecolors=[(*colour[:3], 0.25)],
+        edgecolors=[colour],
+        linewidths=0.6,
+        zorder=zorder,
+    )
+    artists: list[Artist] = [ax.add_collection(faces, autolim=True)]
+    if isolated.size:
+        artists += ax.plot(
+            xy[isolated, 0], xy[isolated, 1], "o", ms=2.5, color=colour, zorder=zorder
+        )
+    return artists
+
+
+def _decorate(ax: Axes, view: str, *, adjustable: Literal["box", "datalim"]) -> None:
+    """Equal aspect, the axes' names in mm, a grid. The aspect is kept by widening the limits
+    (`adjustable` ``"datalim"``) or, where the limits are fixed, by shrinking the axes box
+    (``"box"``: with both limits set, matplotlib drops one of them to keep "datalim")."""
+    ax.set_aspect("equal", adjustable=adjustable)
+    ax.set_xlabel(f"{view[0]} [mm]")
+    ax.set_ylabel(f"{view[1]} [mm]")
+    ax.grid(True, lw=0.4, alpha=0.5)
 
 
 def _label(results: Any, record: int) -> str:
@@ -123,14 +170,24 @@ def _label(results: Any, record: int) -> str:
     return f"t = {results.t[record]:.4g} s"
 
 
-def _field_records(results: Results, records_or_times: Sequence[int | float]) -> list[int]:
-    """The field records of the snapshots: records as given, times to the nearest field record."""
+def _kept_records(results: Results) -> NDArray[np.int64]:
+    """The records whose nodal fields were kept; ValueError if there are none."""
     kept = np.asarray(results.field_records, dtype=np.int64)
     if kept.size == 0:
         raise ValueError(
             "the results hold no nodal fields: run the analysis with "
             "outputs=Outputs(field_interval=...)"
         )
+    return kept
+
+
+def _field_records(results: Results, records_or_times: Sequence[int | float]) -> list[int]:
+    """The field records of the snapshots: records as given, times to the nearest field record.
+
+    ValueError if none is given; TypeError for a bool (see :func:`plot_snapshots`)."""
+    if len(records_or_times) == 0:
+        raise ValueError("records_or_times is empty: give at least one record or time")
+    kept = _kept_records(results)
     out = []
     for item in records_or_times:
         if isinstance(item, bool | np.bool_):
