@@ -30,11 +30,11 @@ def test_deploy_writes_the_motion_after_the_release(tmp_path, monkeypatch, capsy
     path = tmp_path / "motion.gif"
     assert f"  wrote {path}\n" in capsys.readouterr().out
     ((results, records, kwargs),) = asked
-    assert kwargs == {"fps": 20.0}
-    # From the kept record nearest the release (here the release itself: the fold's last
-    # record, the first row of the deployment's histories) to the end.
+    # From the release state (the fold's last record, the first row of the deployment's
+    # histories) to the end, the frames timed from it.
     first = results.in_step(2)[0] - 1
     assert results.t[first] == pytest.approx(results.t[-1] - 0.01)
+    assert kwargs == {"fps": 20.0, "time_origin": results.t[first]}
     assert records == list(range(first, results.n_records))
     # Kept often enough for an animation of 8 samples: every record.
     assert np.array_equal(np.diff(results.field_records), np.ones(results.field_records.size - 1))

@@ -102,6 +102,8 @@ def test_the_view_is_fixed_and_covers_every_frame(bent):
         ({"frames": True}, ValueError, "frames must be an integer >= 1"),
         ({"frames": 2.0}, ValueError, "frames must be an integer >= 1"),
         ({"frames": 6}, ValueError, "frames must be at most the 5 records selected"),
+        ({"time_origin": np.nan}, ValueError, "time_origin must be finite"),
+        ({"time_origin": "0"}, ValueError, "time_origin must be a number"),
     ],
 )
 def test_bad_input_is_refused_naming_it(bent, tmp_path, kwargs, error, words):
@@ -118,3 +120,20 @@ def test_results_without_fields_are_refused(tmp_path):
         animate_deformation(r, model, tmp_path / "none.gif")
     with pytest.raises(ValueError, match="the results hold no nodal fields"):
         animate_deformation(r, model, tmp_path / "none.gif", [0])
+
+
+def test_frames_from_the_time_origin_are_titled_with_the_time_since_it(tmp_path):
+    from _plate import held_strip
+
+    model, r = held_strip()
+    start = int(r.in_step(1)[0]) - 1
+    fig = Figure()
+    ax = fig.add_subplot()
+    records = [0, start, r.n_records - 1]
+    draw = animation_module._frame_drawer(
+        ax, r, model, records, "xz", (0.0, 0.0, 1.0, 1.0), float(r.t[start])
+    )
+    titles = [draw(k)[-1].get_text() for k in range(3)]
+    assert titles == ["load factor 0", "t = 0 s", f"t = {r.t[-1] - 1.0:.4g} s"]
+    path = animate_deformation(r, model, tmp_path / "held.gif", records, time_origin=1.0)
+    assert len(_frames(path)) == 3

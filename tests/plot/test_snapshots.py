@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 from _plate import bent_strip
 from tapespring.plot.snapshots import plot_snapshots
@@ -44,3 +45,26 @@ def test_snapshots_refuse_bad_views_and_records(bent):
     with pytest.raises(ValueError, match="records_or_times is empty"):
         plot_snapshots(r, model, [], ax=ax)
     plt.close(fig)
+
+
+def test_records_from_the_time_origin_are_labelled_with_the_time_since_it():
+    from _plate import held_strip
+
+    model, r = held_strip()
+    # The static step's last record is the state the dynamic step starts from, at the
+    # analysis time 1 (its load factor), where the dynamic step's clock starts.
+    start = int(r.in_step(1)[0]) - 1
+    assert r.t[start] == 1.0 and r.t[-1] == pytest.approx(1.002)
+
+    def labels(**kwargs):
+        ax = plot_snapshots(r, model, [0, start, -1], **kwargs)
+        plt.close(ax.figure)
+        return [t.get_text() for t in ax.get_legend().get_texts()]
+
+    assert labels() == ["load factor 0", "load factor 1", "t = 1.002 s"]
+    assert labels(time_origin=1.0) == ["load factor 0", "t = 0 s", "t = 0.002 s"]
+    # Before the origin, the records keep their own labels.
+    assert labels(time_origin=1.001) == ["load factor 0", "load factor 1", "t = 0.001 s"]
+    for bad, words in ((np.inf, "time_origin must be finite"), (True, "must be a number")):
+        with pytest.raises(ValueError, match=words):
+            plot_snapshots(r, model, [-1], time_origin=bad)

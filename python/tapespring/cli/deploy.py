@@ -255,9 +255,12 @@ def run(args: argparse.Namespace) -> int:
             # time ended the command in an IndexError traceback.
             warn(f"{' and '.join(drawn)} not written: the run stopped before the release")
             return
-        # Simulation time of the release: the records' time runs on from the static steps.
+        # The release state (the last record before the release step, the histories' first
+        # row) and its analysis time: the records' time runs on from the static steps.
+        results = result.results
+        first = int(results.in_step(result.release_step)[0]) - 1
+        t0 = float(results.t[first])
         span = float(result.time_s[-1])
-        t0 = float(result.results.t[-1]) - span
         if args.snapshots:
             import matplotlib
 
@@ -266,21 +269,23 @@ def run(args: argparse.Namespace) -> int:
             from tapespring.report import save_figure
 
             times = [t0 + k * span / 5.0 for k in range(6)]
-            ax = plot_snapshots(result.results, result.setup.model, times)
+            ax = plot_snapshots(results, result.setup.model, times, time_origin=t0)
             save_figure(ax.figure, args.snapshots)
             if not args.json:
                 print(wrote(args.snapshots))
         if args.animate:
             from tapespring.plot.animation import animate_deformation
-            from tapespring.plot.snapshots import _field_records
 
-            # The motion after the release: from the kept record nearest it (the snapshots'
-            # first) to the last, subsampled to MAX_FRAMES by the writer.
-            results = result.results
-            (first,) = _field_records(results, [t0])
+            # The motion from the release state to the end (the kept records among them),
+            # subsampled to MAX_FRAMES by the writer, timed from the release.
             records = [r for r in results.field_records.tolist() if r >= first]
             path = animate_deformation(
-                results, result.setup.model, args.animate, records, fps=ANIMATION_FPS
+                results,
+                result.setup.model,
+                args.animate,
+                records,
+                fps=ANIMATION_FPS,
+                time_origin=t0,
             )
             if not args.json:
                 print(wrote(path))

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .snapshots import (
+    _check_time_origin,
     _decorate,
     _draw_configuration,
     _field_records,
@@ -63,6 +64,7 @@ def animate_deformation(
     view: str = "xz",
     fps: float = 20.0,
     frames: int | None = None,
+    time_origin: float | None = None,
 ) -> Path:
     """Write an animated GIF of the deformed model, one field record a frame.
 
@@ -95,6 +97,9 @@ def animate_deformation(
         Number of frames, at most the number of records selected: the records are subsampled
         evenly, the first and the last kept. None (default): every record selected, at most
         `MAX_FRAMES`.
+    time_origin : float, optional
+        Title the frames at or after this analysis time [s] with the time since it, as
+        :func:`plot_snapshots` labels them. None (default): the analysis time.
 
     Returns
     -------
@@ -108,8 +113,8 @@ def animate_deformation(
     ValueError
         If `path` does not end in ``.gif``, `view` is not two distinct axes, `fps` is not a
         finite number in [`MIN_FPS`, `MAX_FPS`], `frames` is not an integer >= 1 or exceeds the
-        records selected, the results hold no nodal fields, `records_or_times` is empty, or a
-        record's fields were not kept.
+        records selected, the results hold no nodal fields, `records_or_times` is empty, a
+        record's fields were not kept, or `time_origin` is not a finite number.
     """
     from matplotlib import colormaps
     from matplotlib.animation import FuncAnimation, PillowWriter
@@ -121,6 +126,7 @@ def animate_deformation(
     if path.suffix.lower() != ".gif":
         raise ValueError(f"path must end in .gif (an animated GIF), got {str(path)!r}")
     _view_axes(view)
+    _check_time_origin(time_origin)
     rate = check_bounded("fps", fps, positive=True, low=MIN_FPS, high=MAX_FPS, unit="frames/s")
     if records_or_times is None:
         selected = _kept_records(results).tolist()
@@ -132,7 +138,7 @@ def animate_deformation(
     fig = Figure(figsize=FIGSIZE)
     # The dark end of the snapshots' colour map: the last snapshot's colour.
     colour = colormaps["Blues"](1.0)
-    draw = _frame_drawer(fig.add_subplot(), results, model, records, view, colour)
+    draw = _frame_drawer(fig.add_subplot(), results, model, records, view, colour, time_origin)
     animation = FuncAnimation(fig, draw, frames=len(records), repeat=False)
     # matplotlib's stub types fps as an int; the writer only divides by it (a frame lasts
     # int(1000 / fps) ms), so 0.5 frames/s is 2 s a frame, as documented.
@@ -166,6 +172,7 @@ def _frame_drawer(
     records: list[int],
     view: str,
     colour: tuple[float, ...],
+    time_origin: float | None = None,
 ) -> Callable[[int], list[Artist]]:
     """Set `ax` up for the frames of `records` (limits over all of them, labels) and return the
     function that draws frame ``k`` (record ``records[k]``) in place of the one before."""
@@ -185,6 +192,6 @@ def _frame_drawer(
         for artist in drawn:
             artist.remove()
         drawn[:] = _draw_configuration(ax, xy[k], quads, isolated, colour, zorder=2)
-        return [*drawn, ax.set_title(_label(results, records[k]))]
+        return [*drawn, ax.set_title(_label(results, records[k], time_origin))]
 
     return draw

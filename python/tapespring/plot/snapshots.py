@@ -35,6 +35,7 @@ def plot_snapshots(
     ax: Axes | None = None,
     cmap: str = "Blues",
     legend: bool = True,
+    time_origin: float | None = None,
 ) -> Axes:
     """Draw the deformed model at chosen records or times, superimposed, in a plane view.
 
@@ -60,7 +61,11 @@ def plot_snapshots(
     cmap : str
         Matplotlib colour map of the fading (from its light end to its dark end).
     legend : bool
-        Label each snapshot with its time [s].
+        Label each snapshot with its time [s] (its load factor in a static step).
+    time_origin : float, optional
+        Label the records at or after this analysis time [s] with the time since it, static or
+        dynamic (the release's time for a deployment: its last static record, the state it
+        starts from, reads "t = 0 s"). None (default): the analysis time.
 
     Returns
     -------
@@ -71,13 +76,14 @@ def plot_snapshots(
     TypeError
         If an item of `records_or_times` is a bool.
     ValueError
-        If `view` is not two distinct axes, no snapshot is asked for, or a record's fields were
-        not kept.
+        If `view` is not two distinct axes, no snapshot is asked for, a record's fields were
+        not kept, or `time_origin` is not a finite number.
     """
     from matplotlib import colormaps
     from matplotlib.lines import Line2D
 
     h, v = _view_axes(view)
+    _check_time_origin(time_origin)
     records = _field_records(results, records_or_times)
     nodes, quads, isolated = _mesh(results, model)
     if ax is None:
@@ -89,7 +95,7 @@ def plot_snapshots(
     for k, (r, colour) in enumerate(zip(records, colours, strict=True)):
         x = _positions_mm(results, nodes, r)
         _draw_configuration(ax, x[:, [h, v]], quads, isolated, tuple(colour), zorder=2 + k)
-        handles.append(Line2D([], [], color=colour, lw=2.0, label=_label(results, r)))
+        handles.append(Line2D([], [], color=colour, lw=2.0, label=_label(results, r, time_origin)))
     ax.autoscale_view()
     _decorate(ax, view, adjustable="datalim")
     if legend:
@@ -161,8 +167,22 @@ def _decorate(ax: Axes, view: str, *, adjustable: Literal["box", "datalim"]) -> 
     ax.grid(True, lw=0.4, alpha=0.5)
 
 
-def _label(results: Any, record: int) -> str:
-    """The record's time in a dynamic step [s], or its load factor in a static one."""
+def _check_time_origin(time_origin: float | None) -> None:
+    """ValueError unless `time_origin` is None or a finite number."""
+    from tapespring.scenarios.setup import check_number
+
+    if time_origin is not None:
+        check_number("time_origin", time_origin, positive=False)
+
+
+def _label(results: Any, record: int, time_origin: float | None = None) -> str:
+    """The record's time in a dynamic step [s], or its load factor in a static one; from
+    `time_origin` on, the time since it."""
+    t = float(results.t[record])
+    if time_origin is not None and t >= time_origin:
+        # A static step's load factor is its records' analysis time: the next step's clock
+        # starts from it.
+        return f"t = {t - time_origin:.4g} s"
     kinds = [s.get("kind") for s in results.settings.get("steps", [])]
     step = int(results.step[record])
     if 0 <= step < len(kinds) and kinds[step] != "dynamic":
