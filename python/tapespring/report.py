@@ -95,7 +95,8 @@ def summary_dict(analysis: TrialsAnalysis[Any]) -> dict[str, object]:
     -------
     dict
         ``kind``, ``n_trials``, ``skipped`` (file and problem of each trial left
-        out) and per-kind statistics; NaN is written as None.
+        out) and per-kind statistics, each dimensional key ending in its unit
+        (``period_s``); NaN is written as None.
     """
     protocol = protocol_for(analysis.kind)
     out: dict[str, object] = {"kind": analysis.kind, "n_trials": len(analysis.results)}

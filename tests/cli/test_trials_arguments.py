@@ -80,7 +80,7 @@ def test_a_force_file_given_with_its_marker_file_is_read_with_it(tmp_path, capsy
     assert _analyze(tmp_path, forces, marker, "--kind", "quasi-static") == 0
     out = json.loads(capsys.readouterr().out)
     assert [t["name"] for t in out["trials"]] == ["pull"]
-    assert out["trials"][0]["max_force"] > 0  # the forces were read
+    assert out["trials"][0]["max_force_N"] > 0  # the forces were read
 
 
 def test_a_lone_force_file_is_skipped_like_any_bad_trial(tmp_path, capsys):

@@ -71,8 +71,8 @@ def test_generated_valid_trials_give_finite_statistics(senses, seed, spread, n_p
     assert data["n_trials"] == len(senses) and data["skipped"] == []
     assert all(math.isfinite(x) for x in _numbers(data))
     for group in data["groups"]:
-        assert len(group["peaks"]["max_amplitude"]["mean"]) == n_peaks
-        assert group["initial_angle"]["mean"] is not None
+        assert len(group["peaks"]["max_amplitude_rad"]["mean"]) == n_peaks
+        assert group["initial_angle_rad"]["mean"] is not None
 
 
 bad_options = st.one_of(

@@ -103,8 +103,8 @@ def test_quasi_static_json_reports_force_and_displacement(dataset, tmp_path, cap
     assert code == 0
     data = json.loads(capsys.readouterr().out)
     # Drawn around 9.8 N (3.3 %) and 10.8 mm (5.5 %): within 4 spreads.
-    assert data["max_force"]["mean"] == pytest.approx(9.8, rel=4 * 0.033)
-    assert data["displacement_at_max"]["mean"] == pytest.approx(10.8e-3, rel=4 * 0.055)
+    assert data["max_force_N"]["mean"] == pytest.approx(9.8, rel=4 * 0.033)
+    assert data["displacement_at_max_m"]["mean"] == pytest.approx(10.8e-3, rel=4 * 0.055)
     assert not (tmp_path / "pull_test.png").exists()
 
 

@@ -177,8 +177,8 @@ def test_span_time_equals_the_span_in_samples(tmp_path, capsys):
     by_samples = json.loads(capsys.readouterr().out)
     assert _run([*argv, "--span-time", "0.0253"]) == 0  # 101.2 samples at 4 kHz
     by_time = json.loads(capsys.readouterr().out)
-    assert by_time["trials"][0]["span"] == 101
-    assert by_time["max_force"] == by_samples["max_force"]
+    assert by_time["trials"][0]["span_samples"] == 101
+    assert by_time["max_force_N"] == by_samples["max_force_N"]
     err = refused(["trials", "analyze", *argv, "--span", "101", "--span-time", "0.02"], capsys)
     assert "argument --span-time: not allowed with argument --span" in err
 
@@ -190,8 +190,8 @@ def test_json_summary_has_the_peaks_of_each_trial(tmp_path, capsys):
     trials = json.loads(capsys.readouterr().out)["trials"]
     for t in trials:
         maxima = t["peaks"]["maxima"]
-        assert len(maxima["time"]) == len(maxima["amplitude"]) == 4
-        assert maxima["amplitude_deg"][0] == pytest.approx(np.rad2deg(maxima["amplitude"][0]))
+        assert len(maxima["time_s"]) == len(maxima["amplitude_rad"]) == 4
+        assert maxima["amplitude_deg"][0] == pytest.approx(np.rad2deg(maxima["amplitude_rad"][0]))
 
 
 def test_peaks_beyond_those_found_have_no_table_rows(tmp_path, capsys):
@@ -210,6 +210,6 @@ def test_peaks_beyond_those_found_have_no_table_rows(tmp_path, capsys):
     assert not any(",nan" in r or r.endswith(",") for r in csv_rows[1:])
     assert _run([*argv, "--no-figures", "--json", "--n-peaks", "1000"]) == 0
     group = json.loads(capsys.readouterr().out)["groups"][0]
-    counts = group["peaks"]["max_amplitude"]["count"]
+    counts = group["peaks"]["max_amplitude_rad"]["count"]
     assert len(counts) == 1000 and counts[-1] == 0
     assert sum(1 for c in counts if c > 0) == sum(r.startswith("max peak ") for r in peak_rows)

@@ -499,21 +499,31 @@ def _table_rows(analysis: TrialsAnalysis[DeploymentResult]) -> list[list[str]]:
     return rows
 
 
+#: JSON names of the peak statistics (`PeakStatistics` fields): amplitudes are angles, time
+#: separations durations.
+_PEAK_JSON_NAMES = {
+    "max_amplitude": "max_amplitude_rad",
+    "min_amplitude": "min_amplitude_rad",
+    "max_separation": "max_separation_s",
+    "min_separation": "min_separation_s",
+}
+
+
 def _summary(analysis: TrialsAnalysis[DeploymentResult]) -> dict[str, object]:
     groups = []
     for g in analysis.groups:
         peaks = {}
-        for field in ("max_amplitude", "min_amplitude", "max_separation", "min_separation"):
+        for field, name in _PEAK_JSON_NAMES.items():
             s = getattr(g.peaks, field)
-            peaks[field] = {
+            peaks[name] = {
                 k: jsonable(getattr(s, k)) for k in ("mean", "std", "max_diff", "cv", "count")
             }
         groups.append(
             {
                 "sense": g.sense,
                 "n_trials": len(g.results),
-                "initial_angle": summary_json(g.initial_angle, deg=True),
-                "lateral_max": summary_json(g.lateral_max),
+                "initial_angle_rad": summary_json(g.initial_angle, deg=True),
+                "lateral_max_m": summary_json(g.lateral_max),
                 "peaks": peaks,
             }
         )
@@ -521,19 +531,19 @@ def _summary(analysis: TrialsAnalysis[DeploymentResult]) -> dict[str, object]:
         {
             "name": r.name,
             "sense": r.sense,
-            "release_time": r.release_time,
+            "release_time_s": r.release_time,
             "initial_angle_deg": float(np.rad2deg(r.initial_angle)),
-            "phase_ii_start": r.phases.phase_ii_start,
-            "phase_iii_start": r.phases.phase_iii_start,
-            "lateral_max": r.lateral_max,
-            "tip_circle_radius": r.tip_circle.radius if r.tip_circle else None,
+            "phase_ii_start_s": r.phases.phase_ii_start,
+            "phase_iii_start_s": r.phases.phase_iii_start,
+            "lateral_max_m": r.lateral_max,
+            "tip_circle_radius_m": r.tip_circle.radius if r.tip_circle else None,
             "frame": r.frame,
             "peaks": {
                 kind: {
-                    "time": ext.time,
-                    "amplitude": ext.value,
+                    "time_s": ext.time,
+                    "amplitude_rad": ext.value,
                     "amplitude_deg": np.rad2deg(ext.value),
-                    "separation": ext.separation,
+                    "separation_s": ext.separation,
                 }
                 for kind, ext in (("maxima", r.peaks.maxima), ("minima", r.peaks.minima))
             },

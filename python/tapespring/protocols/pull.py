@@ -318,15 +318,22 @@ def _table_rows(analysis: TrialsAnalysis[PullTestResult]) -> list[list[str]]:
     return rows
 
 
+#: JSON names of the `summaries`, with their units as the scenario commands' JSON has them.
+_JSON_NAMES = {"max_force": "max_force_N", "displacement_at_max": "displacement_at_max_m"}
+
+
 def _summary(analysis: TrialsAnalysis[PullTestResult]) -> dict[str, object]:
-    out: dict[str, object] = {k: summary_json(v) for k, v in analysis.summaries.items()}
+    out: dict[str, object] = {
+        _JSON_NAMES[k]: summary_json(v) for k, v in analysis.summaries.items()
+    }
     out["trials"] = [
         {
             "name": r.name,
-            "max_force": r.test.max_force,
-            "displacement_at_max": r.test.displacement_at_max,
+            "max_force_N": r.test.max_force,
+            "displacement_at_max_m": r.test.displacement_at_max,
             "buckled": r.test.buckled,
-            "span": r.test.span,
+            # the span used, in samples, whether given so or as `--span-time` (seconds)
+            "span_samples": r.test.span,
         }
         for r in analysis.results
     ]

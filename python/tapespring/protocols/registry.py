@@ -140,7 +140,9 @@ class Protocol(Generic[ResultT]):
         `tapespring.report.SUMMARY_HEADER`).
     summary : callable
         ``summary(analysis) -> dict``: the numbers of the kind, for
-        `tapespring.report.summary_dict`.
+        `tapespring.report.summary_dict`; a dimensional number's key ends in its SI unit
+        (``period_s``, ``max_force_N``, a statistics block ``lateral_max_m``), as in the
+        scenario commands' JSON.
     write_files : callable
         ``write_files(analysis, folder, figures) -> list of Path``: the tables (and figures) of the
         kind, written by `tapespring.report.write_report` after the summary table.

@@ -284,10 +284,21 @@ def _table_rows(analysis: TrialsAnalysis[VibrationResult]) -> list[list[str]]:
     return rows
 
 
+#: JSON names of the `summaries`, with their units as the scenario commands' JSON has them.
+_JSON_NAMES = {
+    "damping_ratio": "damping_ratio",
+    "period": "period_s",
+    "session_damping_ratio": "session_damping_ratio",
+    "session_period": "session_period_s",
+}
+
+
 def _summary(analysis: TrialsAnalysis[VibrationResult]) -> dict[str, object]:
-    out: dict[str, object] = {k: summary_json(v) for k, v in analysis.summaries.items()}
+    out: dict[str, object] = {
+        _JSON_NAMES[k]: summary_json(v) for k, v in analysis.summaries.items()
+    }
     out["sessions"] = [
-        {"session": s, "n_trials": n, "damping_ratio": e, "period": p}
+        {"session": s, "n_trials": n, "damping_ratio": e, "period_s": p}
         for s, n, e, p in analysis.sessions
     ]
     out["trials"] = [
@@ -295,8 +306,8 @@ def _summary(analysis: TrialsAnalysis[VibrationResult]) -> dict[str, object]:
             "name": r.name,
             "session": r.session,
             "damping_ratio": r.fit.damping_ratio,
-            "period": r.fit.period,
-            "omega0": r.fit.omega0,
+            "period_s": r.fit.period,
+            "omega0_rad_s": r.fit.omega0,
             "n_peaks": r.fit.n_peaks,
             "r_squared": jsonable(r.fit.r_squared),
         }
