@@ -1,6 +1,7 @@
 """Command line `tapespring trials analyze`, and the example dataset script."""
 
 import argparse
+import csv
 import importlib.util
 import json
 from pathlib import Path
@@ -84,6 +85,24 @@ def test_deployment_report_tables_figures_and_summary(dataset, tmp_path, capsys)
         "force_and_angle_equal.png",
     ):
         assert (tmp_path / name).is_file(), name
+    # The peak statistics name their units: amplitudes in degrees, as the summary table shows
+    # them (they were written in radians, unnamed).
+    with (tmp_path / "peak_statistics_opposite.csv").open() as fh:
+        stats = list(csv.DictReader(fh))
+    with (tmp_path / "summary.csv").open() as fh:
+        summary = {row["quantity"]: row for row in csv.DictReader(fh)}
+    units = {row["quantity"]: row["unit"] for row in stats}
+    assert units == {
+        "max_amplitude": "deg",
+        "min_amplitude": "deg",
+        "max_separation": "s",
+        "min_separation": "s",
+    }
+    first = next(r for r in stats if r["quantity"] == "max_amplitude" and r["peak"] == "1")
+    shown = summary["max peak 1 (opposite)"]
+    assert shown["unit"] == "deg"
+    assert float(first["mean"]) == pytest.approx(float(shown["mean"]), rel=1e-3)
+    assert float(first["mean"]) > 10.0  # degrees, not radians
 
 
 def test_quasi_static_json_reports_force_and_displacement(dataset, tmp_path, capsys):

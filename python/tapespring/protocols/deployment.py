@@ -499,13 +499,14 @@ def _table_rows(analysis: TrialsAnalysis[DeploymentResult]) -> list[list[str]]:
     return rows
 
 
-#: JSON names of the peak statistics (`PeakStatistics` fields): amplitudes are angles, time
-#: separations durations.
-_PEAK_JSON_NAMES = {
-    "max_amplitude": "max_amplitude_rad",
-    "min_amplitude": "min_amplitude_rad",
-    "max_separation": "max_separation_s",
-    "min_separation": "min_separation_s",
+#: The peak statistics (`PeakStatistics` fields) with their stored SI unit (amplitudes are
+#: angles, separations durations): the JSON names them ``<field>_<unit>``; the CSV table shows
+#: the amplitudes in degrees, as the summary table and the figures do.
+_PEAK_STATISTICS_UNITS = {
+    "max_amplitude": "rad",
+    "min_amplitude": "rad",
+    "max_separation": "s",
+    "min_separation": "s",
 }
 
 
@@ -513,9 +514,9 @@ def _summary(analysis: TrialsAnalysis[DeploymentResult]) -> dict[str, object]:
     groups = []
     for g in analysis.groups:
         peaks = {}
-        for field, name in _PEAK_JSON_NAMES.items():
+        for field, unit in _PEAK_STATISTICS_UNITS.items():
             s = getattr(g.peaks, field)
-            peaks[name] = {
+            peaks[f"{field}_{unit}"] = {
                 k: jsonable(getattr(s, k)) for k in ("mean", "std", "max_diff", "cv", "count")
             }
         groups.append(
@@ -626,14 +627,16 @@ def _write_files(
         tag = g.sense or "all"
         rows = []
         n = np.size(g.peaks.max_amplitude.mean)
-        for field in ("max_amplitude", "min_amplitude", "max_separation", "min_separation"):
+        for field, si_unit in _PEAK_STATISTICS_UNITS.items():
             s = getattr(g.peaks, field)
+            unit, scale = ("deg", 180 / np.pi) if si_unit == "rad" else (si_unit, 1.0)
             for k in range(n):
-                rows.append([field, k + 1, s.mean[k], s.std[k], s.max_diff[k], s.cv[k], s.count[k]])
+                stats = [scale * s.mean[k], scale * s.std[k], scale * s.max_diff[k]]
+                rows.append([field, unit, k + 1, *stats, s.cv[k], s.count[k]])
         files.append(
             write_table(
                 folder / f"peak_statistics_{tag}.csv",
-                ["quantity", "peak", "mean", "std", "max diff", "cv", "n"],
+                ["quantity", "unit", "peak", "mean", "std", "max diff", "cv", "n"],
                 rows,
             )
         )
