@@ -19,7 +19,6 @@ the paper's meshes): the chain goes on with its best run, and says so in an
 from __future__ import annotations
 
 import math
-import numbers
 import time
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -32,9 +31,6 @@ from tapespring.scenarios.setup import (
     PAPER_BOUNDS,
     PAPER_MODEL,
     IdentificationBounds,
-    SetupSpec,
-    check_count,
-    check_spec,
 )
 from tapespring.scenarios.vibration import VibrationSettings
 
@@ -321,23 +317,15 @@ def _check_damping_arguments(
     same values, the vibration settings validated with the tape at the corners of `bounds`
     (any t and E the search can find; a bad `bounds` is left to :func:`identify_static`)."""
     damping._target(damping_ratio)
-    if not isinstance(vibration, VibrationSettings):
-        raise TypeError(f"vibration must be a VibrationSettings (got {vibration!r})")
-    if not isinstance(vibration.spec, SetupSpec):
-        check_spec(vibration.spec)
+    settings = damping.check_settings(vibration, "vibration")
     if isinstance(bounds, IdentificationBounds):
         bounds.validate()
         for corner in (
             (bounds.thickness_min, bounds.youngs_modulus_min),
             (bounds.thickness_max, bounds.youngs_modulus_max),
         ):
-            damping._with_eta(_with_tape(vibration, *corner), 0.0).validate()
-    real = isinstance(rel_tolerance, numbers.Real) and not isinstance(rel_tolerance, bool)
-    if not (real and 0.0 < float(rel_tolerance) < 1.0):  # type: ignore[arg-type]
-        raise ValueError(f"rel_tolerance must be a number in (0, 1) (got {rel_tolerance!r})")
-    check_count("max_runs", max_runs, minimum=1)
-    if on_run is not None and not callable(on_run):
-        raise TypeError(f"on_run must be callable or None (got {on_run!r})")
+            damping.check_settings(_with_tape(settings, *corner), "vibration")
+    damping.check_search(rel_tolerance, max_runs, on_run)
 
 
 def _with_tape(settings: VibrationSettings, thickness: float, modulus: float) -> VibrationSettings:

@@ -340,22 +340,9 @@ def identify_damping(
     from tapespring.analysis import ConvergenceError
 
     target, measured_period = _target(damping_ratio)
-    if not isinstance(settings, VibrationSettings):
-        raise TypeError(f"settings must be a VibrationSettings (got {settings!r})")
-    if not isinstance(settings.spec, SetupSpec):
-        check_spec(settings.spec)  # its message, before replace() fails on a non-dataclass
-    # The settings' own eta is replaced by every run: it is not theirs to refuse.
-    _with_eta(settings, 0.0).validate()
-    if (
-        isinstance(rel_tolerance, bool)
-        or not isinstance(rel_tolerance, numbers.Real)
-        or not 0.0 < float(rel_tolerance) < 1.0
-    ):
-        raise ValueError(f"rel_tolerance must be a number in (0, 1) (got {rel_tolerance!r})")
-    check_count("max_runs", max_runs, minimum=1)
+    check_settings(settings)
+    check_search(rel_tolerance, max_runs, on_run)
     check_bool("progress", progress)
-    if on_run is not None and not callable(on_run):
-        raise TypeError(f"on_run must be callable or None (got {on_run!r})")
 
     start = time.perf_counter()
     search = _Search(target, settings, float(rel_tolerance))
@@ -426,6 +413,33 @@ def identify_damping(
     if not out.converged:
         warnings.warn(f"damping identification: {message}", IdentificationWarning, stacklevel=2)
     return out
+
+
+def check_settings(settings: object, name: str = "settings") -> VibrationSettings:
+    """:func:`identify_damping`'s check of its vibration settings: TypeError unless a
+    `VibrationSettings`, ValueError for a field its ``validate()`` refuses (`name` names the
+    argument). Returns `settings`, typed."""
+    if not isinstance(settings, VibrationSettings):
+        raise TypeError(f"{name} must be a VibrationSettings (got {settings!r})")
+    if not isinstance(settings.spec, SetupSpec):
+        check_spec(settings.spec)  # its message, before replace() fails on a non-dataclass
+    # The settings' own eta is replaced by every run: it is not theirs to refuse.
+    _with_eta(settings, 0.0).validate()
+    return settings
+
+
+def check_search(rel_tolerance: object, max_runs: object, on_run: object) -> None:
+    """:func:`identify_damping`'s checks of its search's `rel_tolerance`, `max_runs` and
+    `on_run` (ValueError, or TypeError for an `on_run` that is not callable)."""
+    if (
+        isinstance(rel_tolerance, bool)
+        or not isinstance(rel_tolerance, numbers.Real)
+        or not 0.0 < float(rel_tolerance) < 1.0
+    ):
+        raise ValueError(f"rel_tolerance must be a number in (0, 1) (got {rel_tolerance!r})")
+    check_count("max_runs", max_runs, minimum=1)
+    if on_run is not None and not callable(on_run):
+        raise TypeError(f"on_run must be callable or None (got {on_run!r})")
 
 
 def _target(value: object) -> tuple[float, float | None]:
