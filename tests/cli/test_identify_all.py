@@ -131,7 +131,17 @@ def _no_run(*args: Any, **kwargs: Any) -> Any:
         (["--period=0.1", "--period-experiment=x.csv"], "--period and --period-experiment", True),
         (["--experiment=x.csv"], "unrecognized arguments: --experiment", True),
         (["--thickness=1e-4"], "unrecognized arguments: --thickness", True),
-        (["--csv=x.csv", "--vibration-experiment=x.csv"], "--csv x.csv would overwrite", True),
+        # The message names the option that reads the recording (it said --experiment).
+        (
+            ["--csv=x.csv", "--vibration-experiment=x.csv"],
+            "--csv x.csv would overwrite the --vibration-experiment recording x.csv",
+            True,
+        ),
+        (
+            ["--csv=x.csv", "--period-experiment=x.csv"],
+            "--csv x.csv would overwrite the --period-experiment recording x.csv",
+            True,
+        ),
     ],
 )
 def test_bad_input_is_refused_before_any_run(

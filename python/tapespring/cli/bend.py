@@ -315,17 +315,18 @@ def _vtu_file(text: str) -> str:
 _OUTPUT_OPTIONS = ("animate", "csv", "plot", "snapshots", "vtu")
 
 
-def refuse_shared_paths(args: argparse.Namespace) -> None:
+def refuse_shared_paths(args: argparse.Namespace, option: str = "--experiment") -> None:
     """Refuse (as `refuse`) outputs that would overwrite each other or the recording the command
     reads: ``--animate``, ``--csv``, ``--plot``, ``--snapshots`` and ``--vtu`` (its ``.pvd`` file
     and the folder of its VTU files) naming one file, or naming the ``--experiment`` recording or
     a CSV recording's force side file (``<stem>.forces.csv``). Each writer replaced the file
     silently: ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's
-    table. Paths are compared once resolved (``./rec.csv``, a symbolic link)."""
+    table. Paths are compared once resolved (``./rec.csv``, a symbolic link). `option` names the
+    recording's option in the messages (``--period-experiment`` of ``identify``)."""
     read: dict[Path, str] = {}
     experiment = getattr(args, "experiment", None)
     if experiment:
-        read[Path(experiment).resolve()] = f"the --experiment recording {experiment}"
+        read[Path(experiment).resolve()] = f"the {option} recording {experiment}"
         if Path(experiment).suffix.lower() == ".csv":
             from tapespring.trials.csv import forces_file_of
 
@@ -335,7 +336,7 @@ def refuse_shared_paths(args: argparse.Namespace) -> None:
                 side = None
             if side is not None:
                 read[side.resolve()] = (
-                    f"the force side file {str(side)!r} of the --experiment recording"
+                    f"the force side file {str(side)!r} of the {option} recording"
                 )
     written: dict[Path, str] = {}
     for name in _OUTPUT_OPTIONS:

@@ -77,12 +77,12 @@ def _experiment_option(p: argparse._ActionsContainer, what: str, option: str) ->
 _DECAY = "a free decay (a vibration test)"
 
 
-def _refuse_shared_paths(args: argparse.Namespace, recordings: list[str]) -> None:
-    """`refuse_shared_paths` for each of the `recordings` read (the outputs among themselves
-    without any)."""
-    paths: list[str | None] = [*recordings] or [None]
-    for path in paths:
-        refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}))
+def _refuse_shared_paths(args: argparse.Namespace, recordings: dict[str, list[str]]) -> None:
+    """`refuse_shared_paths` for each recording read, `recordings` by option (the outputs among
+    themselves without any); the messages name each recording's option."""
+    read = [(option, path) for option, paths in recordings.items() for path in paths]
+    for option, path in read or [("--experiment", None)]:
+        refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}), option)
 
 
 def _analyzed(paths: list[str], analyze: Any, test: str) -> list[Any]:
@@ -271,7 +271,9 @@ def run_static(args: argparse.Namespace) -> int:
     analysis refuses)."""
     from tapespring.identify.static import identify_static
 
-    _refuse_shared_paths(args, args.experiments + args.period_experiments)
+    _refuse_shared_paths(
+        args, {"--experiment": args.experiments, "--period-experiment": args.period_experiments}
+    )
     measured, period = _static_target(args, args.experiments, "--experiment")
     return _finish(
         args,
@@ -429,7 +431,7 @@ def run_damping(args: argparse.Namespace) -> int:
     recording the analysis refuses)."""
     from tapespring.identify.damping import identify_damping
 
-    _refuse_shared_paths(args, args.experiments)
+    _refuse_shared_paths(args, {"--experiment": args.experiments})
     measured = _damping_target(args, args.experiments, "--experiment")
     return _finish(
         args,
@@ -508,7 +510,14 @@ def run_all(args: argparse.Namespace) -> int:
     from tapespring.identify.chain import identify_all
 
     decays = args.vibration_experiments
-    _refuse_shared_paths(args, args.static_experiments + args.period_experiments + decays)
+    _refuse_shared_paths(
+        args,
+        {
+            "--static-experiment": args.static_experiments,
+            "--period-experiment": args.period_experiments,
+            "--vibration-experiment": decays,
+        },
+    )
     measured, period = _static_target(args, args.static_experiments, "--static-experiment")
     damping_ratio = _damping_target(args, decays, "--vibration-experiment")
 
