@@ -15,9 +15,9 @@ deploy, pull, vibrate, equilibrium
     The paper's set-up: deployment (Sec. 4.1, 6.1), quasi-static pull (Sec. 4.2, 6.2),
     small-amplitude vibrations (Sec. 5.2) and the static identification configuration
     (Sec. 5.1); see :mod:`tapespring.scenarios`.
-identify static, identify damping
+identify static, identify damping, identify all
     The tapes' thickness and Young's modulus from the static identification test (Sec. 5.1),
-    and their Kelvin-Voigt viscosity from a damping ratio (Sec. 5.2); see
+    their Kelvin-Voigt viscosity from a damping ratio (Sec. 5.2), or both in that order; see
     :mod:`tapespring.cli.identify`.
 study ensemble, study sensitivity
     A scenario run over settings drawn from distributions (each figure's statistics and rank
