@@ -80,7 +80,9 @@ _DECAY = "a free decay (a vibration test)"
 def _refuse_shared_paths(args: argparse.Namespace, recordings: dict[str, list[str]]) -> None:
     """`refuse_shared_paths` for each recording read, `recordings` by option (the outputs among
     themselves without any); the messages name each recording's option."""
-    read = [(option, path) for option, paths in recordings.items() for path in paths]
+    read: list[tuple[str, str | None]] = [
+        (option, path) for option, paths in recordings.items() for path in paths
+    ]
     for option, path in read or [("--experiment", None)]:
         refuse_shared_paths(argparse.Namespace(**{**vars(args), "experiment": path}), option)
 
