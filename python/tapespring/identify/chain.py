@@ -52,15 +52,12 @@ T = TypeVar("T")
 class ChainedIdentification:
     """The tapes' t, E and eta identified in the paper's order, and both identifications.
 
+    The identified values are read from the two identifications: `thickness_m` [m] and
+    `youngs_modulus_Pa` [Pa] (the static one's, NaN if it found none), `eta_s` [s] (NaN without
+    a damping identification).
+
     Attributes
     ----------
-    thickness_m : float
-        The tapes' thickness [m] (the static identification's; NaN if it found none).
-    youngs_modulus_Pa : float
-        Their Young's modulus [Pa] (NaN if none was found).
-    eta_s : float
-        Their Kelvin-Voigt viscosity [s], identified with that t and E (NaN without a damping
-        identification).
     static : StaticIdentification
         The identification of t and E (Sec. 5.1).
     damping : DampingIdentification or None
@@ -81,9 +78,6 @@ class ChainedIdentification:
         Wall time of both [s].
     """
 
-    thickness_m: float
-    youngs_modulus_Pa: float
-    eta_s: float
     static: StaticIdentification
     damping: DampingIdentification | None
     vibration_settings: VibrationSettings
@@ -91,6 +85,22 @@ class ChainedIdentification:
     message: str
     warnings: tuple[str, ...]
     wall_s: float
+
+    @property
+    def thickness_m(self) -> float:
+        """The tapes' thickness [m] (the static identification's; NaN if it found none)."""
+        return self.static.thickness_m
+
+    @property
+    def youngs_modulus_Pa(self) -> float:
+        """Their Young's modulus [Pa] (NaN if none was found)."""
+        return self.static.youngs_modulus_Pa
+
+    @property
+    def eta_s(self) -> float:
+        """Their Kelvin-Voigt viscosity [s], identified with that t and E (NaN without a
+        damping identification)."""
+        return math.nan if self.damping is None else self.damping.eta_s
 
     @property
     def complete(self) -> bool:
@@ -368,9 +378,6 @@ class _Chain:
         self, static: StaticIdentification, found: DampingIdentification | None, message: str
     ) -> ChainedIdentification:
         return ChainedIdentification(
-            thickness_m=static.thickness_m,
-            youngs_modulus_Pa=static.youngs_modulus_Pa,
-            eta_s=math.nan if found is None else found.eta_s,
             static=static,
             damping=found,
             vibration_settings=self.vibration,
