@@ -392,6 +392,30 @@ def test_folded_equilibrium_is_where_the_push_vanishes(tmp_path, capsys) -> None
     assert "the paper's experiment:  110.9 mm" in result.describe()
 
 
+@pytest.mark.parametrize(
+    ("thickness", "modulus"),
+    [(1.3100559229332383e-4, 176.35565604882693e9), (1.3856692071767323e-4, 150.27841043264963e9)],
+)
+def test_the_folded_equilibrium_is_located_where_newton_from_the_chord_failed(
+    thickness, modulus, caplog
+) -> None:
+    from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+
+    # Two tapes from the static identification's search on the 3 mm meshes (the second next to
+    # the paper's t and E), whose push passed its folded equilibrium: the force rose through
+    # zero between two states (-0.13 to +0.10 N) and the zero search solved the planes at 0.598
+    # and 0.602 of their chord but not the ones between, starting Newton from the chord, far from
+    # the curved path. The path went on to the step limit and the run scored as no equilibrium.
+    # Newton now starts from the bracket's nearer equilibrium.
+    tape = replace(PAPER_SETUP.tape, thickness=thickness, youngs_modulus=modulus)
+    spec = replace(PAPER_SETUP, tape=tape, mesh_tape=3e-3, mesh_plates=3e-3)
+    with caplog.at_level("WARNING", logger="tapespring.core"):
+        result = equilibrium(EquilibriumSettings(spec=spec))
+    assert result.found and result.results.event[-1] == "monitor_zero"
+    assert abs(result.force_N[-1]) < 1e-5
+    assert not [r for r in caplog.records if "changed sign" in r.getMessage()]
+
+
 def test_a_path_without_the_equilibrium_says_why() -> None:
     from tapespring.scenarios.equilibrium import _not_found
 

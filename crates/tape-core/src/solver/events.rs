@@ -4,7 +4,8 @@
 //! monitored reaction where the path is to stop ([`super::ZeroStop`]) is located the same way.
 //!
 //! Every extra equilibrium is found on a hyperplane across a chord between two converged states
-//! `z_a`, `z_b` (`z = (q, lambda)`, in the arc-length metric): predictor `z_a + s (z_b - z_a)`,
+//! `z_a`, `z_b` (`z = (q, lambda)`, in the arc-length metric): predictor `z_a + s (z_b - z_a)`
+//! (for a zero, the nearest equilibrium found so far moved along the chord onto the plane),
 //! corrections orthogonal to the chord (Riks' normal plane), so that `s` is a coordinate along the
 //! path between them. An extremum is searched for in `s` by successive parabolic interpolation
 //! with golden-section safeguards (Brent's minimisation without derivatives); the driver's state
@@ -141,12 +142,25 @@ impl Driver<'_> {
         s: f64,
         monitor: Option<usize>,
     ) -> Option<Found> {
+        self.on_plane_from((from, 0.0), chord, s, monitor)
+    }
+
+    /// [`Self::on_plane`] from an equilibrium `from.0` on the plane at fraction `from.1` of the
+    /// same chord: the predictor moves it along the chord by the difference, so that Newton starts
+    /// beside the path, not on the chord, which a strongly curved path leaves far behind.
+    pub(super) fn on_plane_from(
+        &mut self,
+        (from, origin): (&State, f64),
+        chord: &(Vec<f64>, f64),
+        s: f64,
+        monitor: Option<usize>,
+    ) -> Option<Found> {
         let mut state = from.clone();
         self.invalidate();
         let inc = Increment::Plane {
             chord: chord.0.clone(),
             chord_lambda: chord.1,
-            fraction: s,
+            fraction: s - origin,
         };
         let out = self.increment(&mut state, &inc).ok()?;
         let step = self.record(&state, &out).ok()?;
@@ -282,7 +296,10 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point]) -> Result<Optio
 /// by regula falsi along the chord (Illinois: the end that stays is halved in value so that the
 /// bracket closes from both sides; bisection where Newton fails on the secant's plane), until the
 /// reaction is within its resolution of zero ([`Driver::zero_floor`]: the state is then an
-/// equilibrium without the constraint as closely as the path's states are with it). `None` if the
+/// equilibrium without the constraint as closely as the path's states are with it). Each plane's
+/// Newton starts from the bracket's nearer end, an equilibrium, moved onto it along the chord: on
+/// the set-up's push near its folded equilibrium, Newton from the chord failed on planes between
+/// two it had solved, 0.4 % of the chord apart. `None` if the
 /// bracket closes to the load factor's round-off or `2 MAX_EVALUATIONS` planes are tried first (a
 /// reaction that jumps across zero has none to find), or Newton fails on the secant's plane and
 /// the bisection's. Where the reaction crosses zero more than once between `a` and `b` (steps
@@ -293,15 +310,23 @@ fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> 
     // Bracket (s, reaction as regula falsi weighs it, load factor): `l` on `a`'s side of the zero.
     let mut l = (0.0, a.monitor, a.state.t);
     let mut r = (1.0, b.monitor, b.state.t);
+    // The bracket's ends as equilibria, each plane's Newton starting from the nearer one.
+    let mut ends = (a.state.clone(), b.state.clone());
     let tol = 1e-12 * a.state.t.abs().max(b.state.t.abs()).max(1.0);
     let mut kept = 0_i8;
     for _ in 0..2 * MAX_EVALUATIONS {
         let span = r.0 - l.0;
         // The secant's zero, kept off the ends.
         let secant = (l.0 - l.1 * span / (r.1 - l.1)).clamp(l.0 + 1e-3 * span, r.0 - 1e-3 * span);
-        let f = s
-            .on_plane(&a.state, &chord, secant, monitor)
-            .or_else(|| s.on_plane(&a.state, &chord, l.0 + 0.5 * span, monitor))?;
+        let mut solve = |at: f64| {
+            let from = if at - l.0 <= r.0 - at {
+                (&ends.0, l.0)
+            } else {
+                (&ends.1, r.0)
+            };
+            s.on_plane_from(from, &chord, at, monitor)
+        };
+        let f = solve(secant).or_else(|| solve(l.0 + 0.5 * span))?;
         let g = f.monitor;
         if g.abs() <= floor {
             return Some(f);
@@ -309,12 +334,14 @@ fn search_zero(s: &mut Driver, a: &Point, b: &Point, monitor: Option<usize>) -> 
         let point = (f.s, g, f.step.lambda);
         if g * a.monitor > 0.0 {
             l = point;
+            ends.0 = f.state;
             if kept == 1 {
                 r.1 *= 0.5;
             }
             kept = 1;
         } else {
             r = point;
+            ends.1 = f.state;
             if kept == -1 {
                 l.1 *= 0.5;
             }
