@@ -155,6 +155,20 @@ def test_release_step_keeps_the_state_continuous_and_markers_follow_their_node()
     assert list(results.ndof) == [results.ndof[0], results.ndof[0] + 1]
 
 
+def test_each_steps_last_fields_are_kept_whatever_the_interval():
+    model, tip = strip()
+    model.prescribe(tip, "uz", 5e-4, id="push")
+    steps = [
+        Step.static("push", increments=4, **TIGHT),
+        Step.static("release", lambda_end=2.0, increments=10, deactivate=["push"], **TIGHT),
+    ]
+    # Records 0 (the initial state) to 14; every 6th is kept (0, 6, 12), and the push's last
+    # (4: the state the release starts from) and the run's last (14) too.
+    results = run(model, steps, outputs=Outputs(field_interval=6))
+    assert list(results.field_records) == [0, 4, 6, 12, 14]
+    assert results.field(4)[0][tip, 2] == pytest.approx(5e-4, rel=1e-9)
+
+
 @examples(ci=6, long=40)
 @given(force=st.floats(1.0, 30.0), sign=st.sampled_from([-1.0, 1.0]))
 def test_a_push_stops_where_the_strip_carries_its_load_alone(force, sign):

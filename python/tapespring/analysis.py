@@ -372,7 +372,7 @@ class Outputs:
         ``(node, dof)`` a constraint of the model acts on, in model order.
     field_interval : int
         Record nodal displacements [m] and rotations [rad] every `field_interval`-th record (the
-        last one always); 0 records none.
+        first one and each step's last always); 0 records none.
 
     Node indices and `field_interval` are integers >= 0 (an integral float such as ``2.0`` is
     accepted, as by the `Model` methods). A fractional value (``1.5`` is refused, not

@@ -671,8 +671,11 @@ pub fn run(
         );
         result.stats.add(&stats);
         result.step_stats.push(stats);
-        for s in records {
-            let keep = interval > 0 && history.len() % interval == 0;
+        // Each step's last state too: the state the next step starts from (a release's) is
+        // drawn and written whatever the interval.
+        let n = records.len();
+        for (j, s) in records.into_iter().enumerate() {
+            let keep = interval > 0 && (history.len() % interval == 0 || j + 1 == n);
             history.push(k, s, keep);
         }
         if cancelled {

@@ -18,7 +18,7 @@ pub struct Outputs {
     /// free. Empty: every (node, DOF) that a constraint of the model acts on, in model order.
     pub reactions: Vec<(usize, Dof)>,
     /// Record nodal displacements and rotations at every `field_interval`-th recorded state (the
-    /// initial and the last state always): 0 records none.
+    /// initial state and each step's last always): 0 records none.
     pub field_interval: usize,
 }
 

@@ -133,7 +133,7 @@ class DeploymentSettings:
         analysis's :data:`~tapespring.protocols.registry.MAX_N_PEAKS` (1000).
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th record, for
-        ParaView series and snapshots (0: none; the last record is always kept when > 0).
+        ParaView series and snapshots (0: none; each step's last record is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)

@@ -96,7 +96,7 @@ class EquilibriumSettings:
         default set-up; Table 6: marker 3 about 112 mm down), so it only needs to lie beyond it.
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th state of the push
-        path, for ParaView series (0: none; the last state is always kept when > 0).
+        path, for ParaView series (0: none; each step's last state is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)

@@ -83,7 +83,7 @@ class PullSettings:
         end).
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th state of the path,
-        for ParaView series (0: none; the last state is always kept when > 0).
+        for ParaView series (0: none; each step's last state is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)

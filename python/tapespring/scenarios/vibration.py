@@ -163,7 +163,7 @@ class VibrationSettings:
         Vibration modes computed about the loaded equilibrium, 1 to :data:`MAX_MODES`.
     field_interval : int
         Keep the nodal displacements and rotations every `field_interval`-th record, for
-        ParaView series (0: none; the last record is always kept when > 0).
+        ParaView series (0: none; each step's last record is always kept when > 0).
     """
 
     spec: SetupSpec = field(default_factory=lambda: PAPER_SETUP)
