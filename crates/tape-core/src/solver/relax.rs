@@ -38,6 +38,10 @@ const NEUTRAL_ENERGY: f64 = 1e-5;
 /// Largest growth of the load-factor offset between two trials of a jump (see [`Driver::jump`]).
 const JUMP_GROWTH: f64 = 16.0;
 
+/// Relaxations past a limit point that may fail, each followed by one further past it, before the
+/// jump is given up (see [`Driver::jump`]).
+const MAX_JUMP_FAILURES: usize = 1;
+
 /// Largest translation of a trial push along a critical mode, as a fraction of the model's
 /// characteristic length (half its bounding box's diagonal: 1 mm on the 100 mm tape).
 const PUSH: f64 = 0.02;
@@ -75,9 +79,28 @@ impl Driver<'_> {
         ds: f64,
     ) -> Result<()> {
         let mut offset = last_dlambda.map_or(1e-3, |dl| 0.25 * dl.abs()).max(1e-6);
+        let mut failures = 0;
         for _ in 0..8 {
             *state = saved.clone();
-            self.relax(state, saved.t + travel * offset, None)?;
+            match self.relax(state, saved.t + travel * offset, None) {
+                Ok(()) => {}
+                // Just past a limit point the flow crawls by the saddle it leaves (the set-up's
+                // push, 3.5e-5 past its buckle, used up its pseudo-time steps); further past it
+                // it leaves faster.
+                Err(Error::NotConverged { .. }) if failures < MAX_JUMP_FAILURES => {
+                    log::debug!(
+                        "jump from t = {}: no relaxation at offset {offset:.3e}, trying further",
+                        saved.t
+                    );
+                    failures += 1;
+                    offset *= JUMP_GROWTH;
+                    continue;
+                }
+                Err(e) => {
+                    *state = saved.clone();
+                    return Err(e);
+                }
+            }
             let distance = self.distance(state, saved);
             log::trace!(
                 "jump from t = {}: offset {offset:.3e}, distance {distance:.3e}, ds {ds:.3e}",
