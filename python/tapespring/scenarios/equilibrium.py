@@ -212,18 +212,44 @@ def _paper_table6(experiment: bool = False) -> dict[str, float]:
 
 
 def _not_found(force_N: np.ndarray) -> str:
-    """Why a push path has no folded equilibrium: too short, or the force rose through zero
-    after its largest holding force without the solver locating the zero (it jumped across)."""
+    """Why a push path has no folded equilibrium, read from the pushing force [N] past the
+    buckle (from the first state whose force fell below half the largest before it, up to the
+    first that exceeds that largest again: beyond it a push too long for the set-up crushes it
+    with forces of kN). Held back (negative) there and rising through zero: the solver did not
+    locate the zero (it jumped across). Positive all along, falling and rising again: the folded
+    set-up does not stay down under the weight alone (stiff tapes: on 3 and 5 mm meshes from
+    t = 0.168 mm with E from 172 GPa, and t = 0.2 mm from 124 GPa, within Table 4's bounds).
+    Otherwise (no buckle, or the force still falling or held back at the end) the push was too
+    short."""
     f = np.asarray(force_N, dtype=float)
-    if f.size >= 3:
-        hold = 1 + int(np.nanargmin(f[1:]))
-        if f[hold] < 0.0 and np.any((f[hold:-1] < 0.0) & (f[hold + 1 :] >= 0.0)):
-            return (
-                "no folded equilibrium on the push path: the pushing force rose through zero "
-                "without a state in between bringing it to zero (it jumped across: see the "
-                "solver's warning)"
-            )
-    return "no folded equilibrium on the push path (push further)"
+    push_further = "no folded equilibrium on the push path (push further)"
+    peak = np.maximum.accumulate(f[1:]) if f.size >= 3 else np.zeros(0)
+    fell = np.flatnonzero((peak > 0.0) & (f[1:] < 0.5 * peak))
+    if not fell.size:
+        return push_further
+    start, top = 1 + int(fell[0]), float(peak[fell[0]])
+    above = np.flatnonzero(f[start:] > top)
+    end = start + int(above[0]) if above.size else f.size
+    past = f[start:end]
+    if np.isnan(past).all():
+        return push_further
+    low = int(np.nanargmin(past))
+    if past[low] < 0.0 and (
+        end < f.size or np.any((past[low:-1] < 0.0) & (past[low + 1 :] >= 0.0))
+    ):
+        return (
+            "no folded equilibrium on the push path: the pushing force rose through zero "
+            "without a state in between bringing it to zero (it jumped across: see the "
+            "solver's warning)"
+        )
+    if past[low] >= 0.0 and (end < f.size or low < past.size - 1):
+        return (
+            "no folded equilibrium on the push path: past the buckle the pushing force fell "
+            f"from {top:.3g} N to {past[low]:.3g} N and rose again without changing sign, so "
+            "the folded set-up does not stay down under the weight alone (the tapes lift it "
+            "back); a longer push would not find one"
+        )
+    return push_further
 
 
 @dataclass(frozen=True)
