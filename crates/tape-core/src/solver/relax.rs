@@ -65,8 +65,9 @@ pub(super) struct Switch {
 impl Driver<'_> {
     /// From the converged `saved` state before a limit point, finds a stable equilibrium a little
     /// beyond it (load factor `saved.t + travel * offset`, the offset grown until the state
-    /// leaves `saved`'s branch by more than half the arc length `ds`); `state` ends there, with
-    /// its pieces assembled.
+    /// leaves `saved`'s branch by more than half the arc length `ds`, and once by
+    /// [`JUMP_GROWTH`] after a relaxation that finds nothing); `state` ends there, with its pieces
+    /// assembled.
     ///
     /// # Errors
     /// [`Error::NotConverged`] if no stable equilibrium is found.
