@@ -17,6 +17,7 @@ from _cli import refused
 from tapespring.protocols import analyze_deployment
 from tapespring.scenarios.deployment import (
     DEFAULT_ENERGY_TOLERANCE,
+    FOLD_ANGLE_TOLERANCE_DEG,
     DeploymentSettings,
     DeploymentSimulation,
     deploy,
@@ -38,6 +39,10 @@ def test_release_starts_at_the_papers_angle_at_rest(opposite: DeploymentSimulati
     # The fold turns the free end by exactly the initial angle; markers 1-2 sit on it (the rod
     # between them bends a little under gravity: 5e-5 deg measured).
     assert opposite.angle_deg[0] == pytest.approx(PAPER_SETUP.initial_angle_opposite_deg, abs=0.05)
+    # The interfaces did not roll about x on the way: the prescribed turn, to round-off.
+    assert abs(opposite.angle_deg[0] - opposite.prescribed_angle_deg) < FOLD_ANGLE_TOLERANCE_DEG
+    assert opposite.summary()["prescribed_initial_angle_deg"] == 95.5
+    assert "the fold ended at" not in opposite.describe()
     assert opposite.energy["kinetic"][0] == 0.0
     # Released from rest, not jolted (the consistent start itself is tested on the single tape in
     # test_release.py): the kinetic energy of the first step is a small part of what the fold
@@ -146,6 +151,17 @@ def test_trial_gives_the_simulations_peaks(opposite: DeploymentSimulation) -> No
     # the fold's hold (a downward pull on the plate, Fz < 0).
     assert trial.force_plates[0].force[0, 2] < 0.0
     assert measured.force_z is not None and measured.force_z[0] < 0.0
+
+
+def test_a_fold_that_ended_off_its_prescribed_angle_says_so(
+    opposite: DeploymentSimulation,
+) -> None:
+    # Where the buckling rolls the interfaces about x on the way, the turns compose and the
+    # release angle is off the prescribed one (equal sense, t = 0.173 mm, E = 180 GPa, 5 mm
+    # meshes: -91.96 deg for -91.2; a 15 s run, so the description is tested on a copy).
+    off = replace(opposite, angle_deg=opposite.angle_deg + 0.76)
+    assert "the fold ended at +96.26 deg, not the prescribed +95.50 deg" in off.describe()
+    assert off.summary()["initial_angle_deg"] == pytest.approx(96.26)
 
 
 def test_summary_is_plain_json(opposite: DeploymentSimulation) -> None:
