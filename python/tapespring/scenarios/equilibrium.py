@@ -217,9 +217,9 @@ def _not_found(force_N: np.ndarray) -> str:
     first that exceeds that largest again: beyond it a push too long for the set-up crushes it
     with forces of kN). Held back (negative) there and rising through zero: the solver did not
     locate the zero (it jumped across). Positive all along, falling and rising again: the folded
-    set-up does not stay down under the weight alone (stiff tapes: on 3 and 5 mm meshes from
-    t = 0.168 mm with E from 172 GPa, and t = 0.2 mm from 124 GPa, within Table 4's bounds).
-    Otherwise (no buckle, or the force still falling or held back at the end) the push was too
+    set-up does not stay down under the weight alone (the stiff corner of Table 4's bounds:
+    t = 0.168 mm from E = 172 to 196 GPa by mesh, t = 0.2 mm from 124 GPa;
+    ``benchmarks/robustness_table4.py``). Otherwise (no buckle, or the force still falling or held back at the end) the push was too
     short."""
     f = np.asarray(force_N, dtype=float)
     push_further = "no folded equilibrium on the push path (push further)"
