@@ -421,10 +421,10 @@ def test_the_push_jumps_past_a_buckle_its_first_relaxation_crawled_by() -> None:
     from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
 
     # A thick, soft tape from the identification's search (t = 0.148 mm, E = 121 GPa; 3 mm
-    # meshes): the relaxation 3.5e-5 past the buckle's limit point used up its pseudo-time steps
-    # by the saddle; the path then went down the unstable branch, a later jump landed back on the
-    # unbuckled one, and the path closed a loop (a ConvergenceError: no equilibrium). The jump now
-    # tries once more, further past the limit.
+    # meshes): the relaxation 3.8e-5 in load factor past the buckle's limit point used up its
+    # pseudo-time steps by the saddle; the path then went down the unstable branch, a later jump
+    # landed back on the unbuckled one, and the path closed a loop (a ConvergenceError: no
+    # equilibrium). The jump now tries once more, further past the limit.
     tape = replace(
         PAPER_SETUP.tape, thickness=1.4814733903744187e-4, youngs_modulus=121.05700954576924e9
     )
@@ -433,8 +433,8 @@ def test_the_push_jumps_past_a_buckle_its_first_relaxation_crawled_by() -> None:
     assert result.found and result.results.event[-1] == "monitor_zero"
     pushed = result.results.in_step(1)
     jumps = pushed[result.results.jump[pushed]]
-    # One jump, at the buckle (the pushing force's largest value before it), onto the buckled
-    # branch: the driver then holds the weight back (a negative force).
+    # One jump, onto the buckled branch: the driver then holds the weight back (a negative
+    # force).
     assert len(jumps) == 1
     force = result.force_N[1:]
     assert force[np.flatnonzero(pushed == jumps[0])[0]] < 0.0
@@ -462,6 +462,9 @@ def test_a_path_without_the_equilibrium_says_why() -> None:
     why = _not_found(np.array([0.0, 2.0, 0.5, 0.3, 1.0, 5.0, -126.0, 40.0]))
     assert "from 2 N to 0.3 N" in why
     assert "push further" in _not_found(np.array([0.0, 2.0, np.nan, np.nan]))
+    # A NaN force past the buckle is left out; a wiggle while the force still falls is no rise.
+    assert "from 2 N to 0.4 N" in _not_found(np.array([0.0, 2.0, np.nan, 0.5, 0.4, 3.0]))
+    assert "push further" in _not_found(np.array([0.0, 2.0, 0.5, 0.4, 0.41]))
 
 
 def test_a_push_too_short_to_buckle_finds_no_folded_equilibrium() -> None:

@@ -9,11 +9,11 @@ configuration ``"appendix"``), in opposite or equal sense, in four analysis step
    initial angle (+95.5 or -91.2 deg), free to translate and to turn about x and z, on an
    arc-length path that passes the buckling of the tapes (jumping at the snap). The turns about
    y and x compose: where the buckling rolls the interfaces about x on the way (equal sense,
-   stiff tapes: by up to 23 deg at t = 0.173 mm, E = 180 GPa on 5 mm meshes, none on the paper's
-   tape), the angle at the release differs from the prescribed one (there by 0.76 deg), which
-   the summary (``initial_angle_deg`` beside ``prescribed_initial_angle_deg``) and the
-   description report. The paper drives marker 2 to its measured folded
-   position (which it does not give) at under 2 mm/s and holds it 5 s so that the motion dies
+   stiff tapes, docs/studies.md; not on the paper's tape), the angle at the release differs from
+   the prescribed one, which the summary (``initial_angle_deg`` beside
+   ``prescribed_initial_angle_deg``) and the description report. The paper drives marker 2 to
+   its measured folded position (which it does not give) at under 2 mm/s and holds it 5 s so
+   that the motion dies
    out: the equilibrium of a static step is the state both lead to, so neither the rate nor the
    hold is simulated (``settle`` adds a dynamic hold if wanted).
 3. ``settle`` (dynamic, optional, ``settle > 0``): the fold held for that time.
@@ -203,9 +203,9 @@ class DeploymentSettings:
 
 
 #: Difference [deg] between the bending angle at the release and the prescribed initial angle
-#: beyond which the description says so: the fold's turn about y alone leaves round-off (1e-4
-#: deg on the paper's tape); the interfaces' roll about x on the way composes with it (0.76 deg
-#: at t = 0.173 mm, E = 180 GPa, equal sense, 5 mm meshes).
+#: beyond which the description says so: the fold's turn about y alone leaves round-off (below
+#: 1e-4 deg on the paper's tape); a roll of the interfaces on the way composes with it (the
+#: module's notes, step 2).
 FOLD_ANGLE_TOLERANCE_DEG = 0.01
 
 
@@ -463,8 +463,9 @@ class DeploymentSimulation:
             if abs(self.angle_deg[0] - self.prescribed_angle_deg) > FOLD_ANGLE_TOLERANCE_DEG:
                 lines.append(
                     f"  the fold ended at {self.angle_deg[0]:+.2f} deg, not the prescribed "
-                    f"{self.prescribed_angle_deg:+.2f} deg: the small interfaces also turned about "
-                    "x on the way, and the turns compose (see tapespring.scenarios.deployment)"
+                    f"{self.prescribed_angle_deg:+.2f} deg: the prescribed turn about y composes "
+                    "with any turn of the small interfaces about x on the way (see "
+                    "tapespring.scenarios.deployment)"
                 )
         p = s["peaks"]
         for kind in ("max", "min"):
@@ -536,8 +537,9 @@ def deploy(
     built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
     model = built.model
     # The free end is turned to the initial angle about y at both small interfaces, free to
-    # translate: the tapes fold where they choose, and the bending angle (the free end's
-    # rotation) starts at the paper's value unless the interfaces roll on the way (see above).
+    # translate and to turn about x and z: the tapes fold where they choose, and the bending
+    # angle (the free end's rotation) starts at the paper's value unless the interfaces roll on
+    # the way (the module's notes, step 2).
     angle = math.radians(settings.spec.initial_angle_deg(settings.sense))
     for interface in built.interfaces:
         drive(model, interface, "ry", angle, "fold")

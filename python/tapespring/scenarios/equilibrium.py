@@ -217,13 +217,12 @@ def _not_found(force_N: np.ndarray) -> str:
     first that exceeds that largest again: beyond it a push too long for the set-up crushes it
     with forces of kN). Held back (negative) there and rising through zero: the solver did not
     locate the zero (it jumped across). Positive all along, falling and rising again: the folded
-    set-up does not stay down under the weight alone (the stiff corner of Table 4's bounds:
-    t = 0.168 mm from E = 172 to 196 GPa by mesh, t = 0.2 mm from 124 GPa;
-    ``benchmarks/robustness_table4.py``). Otherwise (no buckle, or the force still falling or held back at the end) the push was too
-    short."""
+    set-up does not stay down under the weight alone (the stiff corner of Table 4's bounds,
+    docs/studies.md). Otherwise (no buckle, or the force still falling or held back at the end)
+    the push was too short. NaN forces are left out."""
     f = np.asarray(force_N, dtype=float)
     push_further = "no folded equilibrium on the push path (push further)"
-    peak = np.maximum.accumulate(f[1:]) if f.size >= 3 else np.zeros(0)
+    peak = np.fmax.accumulate(f[1:]) if f.size >= 3 else np.zeros(0)
     fell = np.flatnonzero((peak > 0.0) & (f[1:] < 0.5 * peak))
     if not fell.size:
         return push_further
@@ -231,8 +230,6 @@ def _not_found(force_N: np.ndarray) -> str:
     above = np.flatnonzero(f[start:] > top)
     end = start + int(above[0]) if above.size else f.size
     past = f[start:end]
-    if np.isnan(past).all():
-        return push_further
     low = int(np.nanargmin(past))
     if past[low] < 0.0 and (
         end < f.size or np.any((past[low:-1] < 0.0) & (past[low + 1 :] >= 0.0))
@@ -242,7 +239,9 @@ def _not_found(force_N: np.ndarray) -> str:
             "without a state in between bringing it to zero (it jumped across: see the "
             "solver's warning)"
         )
-    if past[low] >= 0.0 and (end < f.size or low < past.size - 1):
+    # Rose again: back above the buckle's force, or by a tenth of the fall (not a wiggle).
+    rose = end < f.size or np.nanmax(past[low:]) - past[low] > 0.1 * (top - past[low])
+    if past[low] >= 0.0 and rose:
         return (
             "no folded equilibrium on the push path: past the buckle the pushing force fell "
             f"from {top:.3g} N to {past[low]:.3g} N and rose again without changing sign, so "

@@ -147,8 +147,9 @@ impl Driver<'_> {
 
     /// [`Self::on_plane`] from an equilibrium `from.0` on the plane at fraction `from.1` of the
     /// same chord: the predictor moves it along the chord by the difference, so that Newton starts
-    /// beside the path, not on the chord, which a strongly curved path leaves far behind.
-    pub(super) fn on_plane_from(
+    /// beside the path, not on the chord, which a strongly curved path leaves far behind. (The
+    /// plane reached is the one at `s` to first order in the rotations since `from.0`.)
+    fn on_plane_from(
         &mut self,
         (from, origin): (&State, f64),
         chord: &(Vec<f64>, f64),

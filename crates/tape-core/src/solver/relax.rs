@@ -86,8 +86,8 @@ impl Driver<'_> {
             match self.relax(state, saved.t + travel * offset, None) {
                 Ok(()) => {}
                 // Just past a limit point the flow crawls by the saddle it leaves (the set-up's
-                // push, 3.5e-5 past its buckle, used up its pseudo-time steps); further past it
-                // it leaves faster.
+                // push, 3.8e-5 in load factor past its buckle, used up its pseudo-time steps);
+                // further past it it leaves faster.
                 Err(Error::NotConverged { .. }) if failures < MAX_JUMP_FAILURES => {
                     log::debug!(
                         "jump from t = {}: no relaxation at offset {offset:.3e}, trying further",
