@@ -443,6 +443,11 @@ def pull(settings: PullSettings = PullSettings(), *, progress: bool = False) -> 
             locate_limit_points=True,
             monitor_node=node,
             monitor_dof="uz",
+            # The force rises smoothly to its maximum, no plateau of wiggles to ignore; at the
+            # stiff corner of Table 4's bounds that maximum is broad, the state after it falls
+            # by 0.1 to 0.17 % of it, below the solver's default 1 %, and the sampled maximum
+            # was 1.3 to 1.6 % low and 9 to 10 % early in displacement.
+            monitor_prominence=1e-4,
         ),
     ]
     # The clamp's six reactions make the force plate of the pull as a trial (to_trial).
