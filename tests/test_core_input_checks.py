@@ -208,3 +208,13 @@ def test_absurd_loads_gravity_and_prescribed_motions_are_refused_by_name():
     step = Step.static("s", control="displacement", node=5, dof="uz", delta=1e300)
     with pytest.raises(ValueError, match=r"delta 1e300 is beyond 1e50"):
         run(model, [step])
+
+
+def test_a_load_factor_out_of_scale_is_named_when_its_increments_fail():
+    # lambda_end = 1e300 in 2 increments: each tried load factor, 5e299 halved 10 times, makes
+    # the residual non-finite. The message said "cut back 10 times" at load factor 0 and blamed
+    # a limit point, not the value.
+    model = plate()
+    model.add_load(5, "uz", 1.0)
+    with pytest.raises(ConvergenceError, match=r"the last to load factor 4\.883e296"):
+        run(model, [Step.static("s", increments=2, lambda_end=1e300)])

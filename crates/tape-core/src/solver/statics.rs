@@ -1840,7 +1840,16 @@ impl<'a, 'b> Walk<'a, 'b> {
 fn give_up(p: &PathState, why: GiveUp, last: &Rejection, state: &State, params: &StaticParams, force: f64) -> Error {
     let (iterations, residual) = last.newton();
     let how = match why {
-        GiveUp::Cutbacks => format!("increment cut back {} times", params.max_cutbacks),
+        // Under load control the load factor tried names a value out of scale (lambda_end = 1e300
+        // failed as "cut back 10 times; the residual became non-finite" at load factor 0).
+        GiveUp::Cutbacks => match params.control {
+            Control::Load { .. } => format!(
+                "increment cut back {} times, the last to load factor {:.3e}",
+                params.max_cutbacks,
+                state.t + p.control.size
+            ),
+            _ => format!("increment cut back {} times", params.max_cutbacks),
+        },
         GiveUp::RoundOff => format!("increment cut back to {:.3e}, below round-off", p.control.size.abs()),
     };
     let tol = params.newton.tol_force * force;
