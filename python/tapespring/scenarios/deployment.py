@@ -13,9 +13,8 @@ configuration ``"appendix"``), in opposite or equal sense, in four analysis step
    the prescribed one, which the summary (``initial_angle_deg`` beside
    ``prescribed_initial_angle_deg``) and the description report. The paper drives marker 2 to
    its measured folded position (which it does not give) at under 2 mm/s and holds it 5 s so
-   that the motion dies
-   out: the equilibrium of a static step is the state both lead to, so neither the rate nor the
-   hold is simulated (``settle`` adds a dynamic hold if wanted).
+   that the motion dies out: the equilibrium of a static step is the state both lead to, so
+   neither the rate nor the hold is simulated (``settle`` adds a dynamic hold if wanted).
 3. ``settle`` (dynamic, optional, ``settle > 0``): the fold held for that time.
 4. ``release`` (dynamic): marker 2 is released with accelerations consistent with the state
    (no jolt) and the set-up deploys for ``duration`` seconds (generalised-alpha, ``rho_inf``,
