@@ -458,6 +458,30 @@ def test_the_push_jumps_past_a_buckle_its_first_relaxation_stopped_short_of() ->
     assert result.results.stats["factorisations"] < 600
 
 
+def test_the_push_finds_the_folded_equilibrium_past_a_limit_point_a_long_step_skipped(
+    caplog,
+) -> None:
+    from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+
+    # At the thin, stiff corner of Table 4's box (t = 0.12 mm, E = 220 GPa; 5 mm meshes) a step of
+    # 4.4 mm of push stepped over a limit point 0.4 mm short of zero (the holding force's maximum,
+    # -0.039 N) and the snap after it; the force changed sign on the unstable branch beyond, no
+    # state on the step's chord was at zero, and the push ended without the folded equilibrium.
+    # Such a step is now retried shorter: the path meets the limit point, jumps, and reaches the
+    # zero 8 mm further on, a stable equilibrium.
+    tape = replace(PAPER_SETUP.tape, thickness=1.2e-4, youngs_modulus=220e9)
+    spec = replace(PAPER_SETUP, tape=tape, mesh_tape=5e-3, mesh_plates=5e-3)
+    with caplog.at_level("WARNING", logger="tapespring.core"):
+        result = equilibrium(EquilibriumSettings(spec=spec))
+    assert result.found and result.results.event[-1] == "monitor_zero"
+    assert abs(result.force_N[-1]) < 1e-5
+    assert result.unstable_modes == 0
+    # The weight hangs 112.5 mm below its deployed height, as far as the paper's tape on these
+    # meshes takes it (109.9 mm; its bending stiffness E t^3 is 5 % larger).
+    assert 0.105 < result.marker3_m[2] < 0.12
+    assert not [r for r in caplog.records if "changed sign" in r.getMessage()]
+
+
 def test_a_path_without_the_equilibrium_says_why() -> None:
     from tapespring.scenarios.equilibrium import _not_found
 

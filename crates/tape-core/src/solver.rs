@@ -165,8 +165,9 @@ pub struct StaticParams {
     /// the characteristic length) and recorded as the path's last state ([`Event::MonitorZero`]);
     /// the step then ends there, and the next one starts from it. A change of sign counts where
     /// the reaction on both sides exceeds that resolution (round-off at the path's start is no
-    /// zero); one across a jump is not located, nor one across which the reaction jumps (logged;
-    /// the path goes on).
+    /// zero). A step across which no state on its chord is at zero is retried shorter while half
+    /// the cut-backs remain; one across a jump is not located, nor one across which the reaction
+    /// jumps (logged; the path goes on).
     #[serde(default)]
     pub stop_at_monitor_zero: ZeroStop,
 }

@@ -237,19 +237,19 @@ pub(super) fn after_step(s: &mut Driver, history: &[Point], path: &mut StaticPat
 
 /// After a converged state whose monitored reaction changed sign (see [`ZeroWatch`]): the zero
 /// where the path is to stop, located between the two states of `history` across which the sign
-/// changed, if `stop_at_monitor_zero` asks for a zero of that kind. `None` if it does not, if
-/// those two states are not both in the history (the sign changed across a jump), or if no zero
-/// is found between them (the reaction jumps across zero there, or Newton fails: logged, and the
-/// path goes on). The
-/// driver's pieces are those of the zero on return if one is found (the path ends there: they are
-/// not restored, which would factorise the last state's tangent again), unchanged otherwise.
+/// changed, if `stop_at_monitor_zero` asks for a zero of that kind. [`ZeroSearch::Absent`] if it
+/// does not, or if those two states are not both in the history (the sign changed across a
+/// jump); [`ZeroSearch::Missed`] if no zero is found between them (the reaction jumps across zero
+/// there, or Newton fails). The driver's pieces are those of the zero on return if one is found
+/// (the path ends there: they are not restored, which would factorise the last state's tangent
+/// again), unchanged otherwise.
 ///
 /// # Errors
 /// A failure of the linear algebra when the driver's factorisation is restored.
-pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point]) -> Result<Option<Found>> {
+pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point]) -> Result<ZeroSearch> {
     let stop = s.params.stop_at_monitor_zero;
     let (Some(c), Some(m)) = (history.last(), s.params.monitor) else {
-        return Ok(None);
+        return Ok(ZeroSearch::Absent);
     };
     // Back to the first state of the sign the reaction has now.
     let mut j = history.len() - 1;
@@ -257,38 +257,71 @@ pub(super) fn zero_to_stop_at(s: &mut Driver, history: &[Point]) -> Result<Optio
         j -= 1;
     }
     if j == 0 {
-        return Ok(None);
+        return Ok(ZeroSearch::Absent);
     }
     let (a, b) = (&history[j - 1], &history[j]);
     // The motion of the monitored DOF from `a` to `b`: beyond a resisting zero the reaction, the
     // force the constraint exerts, pushes along it. A DOF that does not move has none.
     let du = dof_motion(&a.state, &b.state, m.node, m.dof.index());
     if stop == ZeroStop::Never || (stop == ZeroStop::Resisting && b.monitor * du <= 0.0) {
-        return Ok(None);
+        return Ok(ZeroSearch::Absent);
     }
     let saved = s.save();
     let monitor = s.monitor_index();
-    match search_zero(s, a, b, monitor) {
-        Some(mut f) => {
-            f.step.arc = a.arc + f.s * (b.arc - a.arc);
-            f.step.event = Some(Event::MonitorZero);
-            if s.params.switch_branches {
-                discount_neutral(s, &mut f)?;
-            }
-            Ok(Some(f))
+    if let Some(mut f) = search_zero(s, a, b, monitor) {
+        f.step.arc = a.arc + f.s * (b.arc - a.arc);
+        f.step.event = Some(Event::MonitorZero);
+        if s.params.switch_branches {
+            discount_neutral(s, &mut f)?;
         }
-        None => {
+        return Ok(ZeroSearch::Found(Box::new(f)));
+    }
+    s.restore(saved)?;
+    Ok(ZeroSearch::Missed {
+        t: (a.state.t, b.state.t),
+        monitor: (a.monitor, b.monitor),
+    })
+}
+
+/// [`zero_to_stop_at`], the driver's pieces unchanged on return whatever it finds: for a
+/// search before the state beyond the zero is recorded, which needs that state's.
+///
+/// # Errors
+/// A failure of the linear algebra when the driver's factorisation is restored.
+pub(super) fn zero_ahead(s: &mut Driver, history: &[Point]) -> Result<ZeroSearch> {
+    let saved = s.save();
+    let search = zero_to_stop_at(s, history)?;
+    if let ZeroSearch::Found(_) = search {
+        s.restore(saved)?;
+    }
+    Ok(search)
+}
+
+/// What [`zero_to_stop_at`] finds.
+pub(super) enum ZeroSearch {
+    /// No zero the path is to stop at between the two states.
+    Absent,
+    /// The zero, as a state of the path (its arc position and event set).
+    Found(Box<Found>),
+    /// The sign changed between the two states at load factors `t`, the reaction going from
+    /// `monitor.0` to `monitor.1`, but no state between them brings it within its resolution of
+    /// zero.
+    Missed { t: (f64, f64), monitor: (f64, f64) },
+}
+
+impl ZeroSearch {
+    /// Logs a missed zero: the path goes on past it.
+    pub fn warn_if_missed(&self) {
+        if let Self::Missed { t, monitor } = self {
             log::warn!(
                 "the monitored reaction changed sign between load factors {} and {} ({:.3e} to \
                  {:.3e}) but no state there brings it within its resolution of zero (it jumps \
                  across zero, or Newton failed): the path goes on",
-                a.state.t,
-                b.state.t,
-                a.monitor,
-                b.monitor
+                t.0,
+                t.1,
+                monitor.0,
+                monitor.1
             );
-            s.restore(saved)?;
-            Ok(None)
         }
     }
 }
