@@ -13,7 +13,11 @@ wall time per run, then one line per run that did not end as the scenario should
 - ``vibrate``: a free decay of ``--decay`` seconds (a damping fit, its period against the modal
   one);
 - ``fold-opposite``, ``fold-equal``: the deployment's fold and 0.02 s of motion (the angle at the
-  release against the prescribed one, `FOLD_ANGLE_TOLERANCE_DEG`).
+  release against the prescribed one, `FOLD_ANGLE_TOLERANCE_DEG`);
+- ``deploy-opposite``, ``deploy-equal``: the whole deployment, ``--motion`` seconds after the
+  release (every run printed: the angle at the end and its range, beside the free end's mass
+  and the largest the pair deploys by eqs. (1)-(3), which a run that does not deploy should
+  exceed).
 
 What it found on 2026-11-29 (5 mm meshes, 2 workers, about 4 min) is in docs/studies.md ("Where
 in Table 4's box the tests run as they should").
@@ -35,7 +39,15 @@ from tapespring.analysis import ConvergenceError
 from tapespring.scenarios.setup import PAPER_SETUP, IdentificationBounds
 from tapespring.sweep import sweep
 
-SCENARIOS = ("equilibrium", "pull", "vibrate", "fold-opposite", "fold-equal")
+SCENARIOS = (
+    "equilibrium",
+    "pull",
+    "vibrate",
+    "fold-opposite",
+    "fold-equal",
+    "deploy-opposite",
+    "deploy-equal",
+)
 
 
 def _spec(task: dict[str, Any]) -> Any:
@@ -72,12 +84,24 @@ def run_one(task: dict[str, Any]) -> dict[str, Any]:
                 if v.fit is not None:
                     ratio = v.fit.period / v.modal_periods_s[0] - 1.0
                     why = f"period {v.fit.period:.4f} s, {100 * ratio:+.2f} % from the modal"
-            else:
+            elif kind.startswith("fold-"):
                 sense = kind.removeprefix("fold-")
                 d = deploy(DeploymentSettings(spec=spec, sense=sense, duration=0.02))
                 off = d.angle_deg[0] - d.prescribed_angle_deg
                 ok = abs(off) <= FOLD_ANGLE_TOLERANCE_DEG
                 why = f"release angle {d.angle_deg[0]:+.2f} deg, {off:+.2f} off the prescribed"
+            else:
+                from tapespring.scenarios.max_mass import MaxMassSettings, analytical_max_mass
+
+                sense = kind.removeprefix("deploy-")
+                d = deploy(DeploymentSettings(spec=spec, sense=sense, duration=task["motion"]))
+                m_max = float(analytical_max_mass(MaxMassSettings(), sense, task["t"], task["E"]))
+                a = d.angle_deg
+                why = (
+                    f"angle {a[-1]:+.1f} deg at {d.time_s[-1]:.1f} s (range {a.min():+.1f} to "
+                    f"{a.max():+.1f}); free end {1e3 * spec.free_end_mass:.0f} g, eqs. (1)-(3) "
+                    f"deploy up to {1e3 * m_max:.0f} g; {d.results.stats['steps']} steps"
+                )
     except ConvergenceError as exc:
         ok, why = False, f"ConvergenceError: {str(exc)[:160]}"
     return {**task, "ok": ok, "why": why, "wall_s": time.perf_counter() - start}
@@ -90,6 +114,7 @@ def main() -> None:
     parser.add_argument("--mesh", type=float, default=5e-3, help="tape mesh [m] (default 5 mm)")
     parser.add_argument("--plates", type=float, default=None, help="plates' mesh [m] (--mesh)")
     parser.add_argument("--decay", type=float, default=5.0, help="vibrate's decay [s] (5)")
+    parser.add_argument("--motion", type=float, default=2.0, help="deploy's motion [s] (2)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     bounds = IdentificationBounds()
@@ -104,6 +129,7 @@ def main() -> None:
                 "mesh": args.mesh,
                 "plates": args.plates or args.mesh,
                 "decay": args.decay,
+                "motion": args.motion,
             }
             for t in ts
             for e in es
@@ -117,7 +143,7 @@ def main() -> None:
             f"{kind}: {len(out) - len(bad)} of {len(out)} as they should, "
             f"{mean:.1f} s a run, {wall:.0f} s in all"
         )
-        for r in out if kind == "vibrate" else bad:
+        for r in out if kind == "vibrate" or kind.startswith("deploy-") else bad:
             print(f"  t = {r['t'] * 1e3:.3f} mm, E = {r['E'] / 1e9:.0f} GPa: {r['why']}")
 
 

@@ -1318,7 +1318,9 @@ impl<'a, 'b> Walk<'a, 'b> {
             }
         }
         let monitor = self.s.asm.f_int_c[i] - self.s.asm.f_ext_c[i];
-        if !self.p.zero.clone().crossed(monitor, self.s.zero_floor()) {
+        // A copy: the watch itself moves on when the state is recorded.
+        let mut watch = self.p.zero;
+        if !watch.crossed(monitor, self.s.zero_floor()) {
             return Ok(false);
         }
         // The plain count, as recorded (the factorisation is the one the record takes).
