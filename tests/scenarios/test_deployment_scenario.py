@@ -270,6 +270,7 @@ def test_compare_counts_both_series_peaks_from_the_same_prominence(
     assert wiggly["max_amplitude_deg"][0] == pytest.approx(plain["max_amplitude_deg"][0], abs=0.05)
     assert wiggly["max_amplitude_deg"][1] == pytest.approx(plain["max_amplitude_deg"][1])
     assert wiggly["min_amplitude_deg"] == pytest.approx(plain["min_amplitude_deg"])
+    assert wiggly["peak_prominence_deg"] == pytest.approx(np.degrees(measured.peaks.prominence))
 
 
 @pytest.mark.parametrize("metadata", [True, False])

@@ -349,7 +349,8 @@ class DeploymentSimulation:
             ``max_amplitude_deg``, ``min_amplitude_deg`` (simulation minus experiment) and
             ``max_separation_s``, ``min_separation_s`` (differences of the times between
             successive peaks, the first from the release), per peak (None where one series has
-            fewer peaks); ``initial_angle_deg`` of both; the trial's name; the peaks left aside.
+            fewer peaks); ``initial_angle_deg`` of both; the trial's name; the peaks left aside;
+            ``peak_prominence_deg``, the prominence both series' peaks count from.
 
         Raises
         ------
@@ -378,6 +379,7 @@ class DeploymentSimulation:
                 "experiment": float(np.degrees(measured.initial_angle)),
             },
             "left_aside": {"max": list(leave_aside_max), "min": list(leave_aside_min)},
+            "peak_prominence_deg": math.degrees(simulated.prominence),
             "max_amplitude_deg": listed(c.max_amplitude, 180.0 / np.pi),
             "min_amplitude_deg": listed(c.min_amplitude, 180.0 / np.pi),
             "max_separation_s": listed(c.max_separation, 1.0),
