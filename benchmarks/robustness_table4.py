@@ -14,16 +14,17 @@ wall time per run, then one line per run that did not end as the scenario should
   one);
 - ``fold-opposite``, ``fold-equal``: the deployment's fold and 0.02 s of motion (the angle at the
   release against the prescribed one, `FOLD_ANGLE_TOLERANCE_DEG`);
-- ``deploy-opposite``, ``deploy-equal``: the whole deployment, ``--motion`` seconds after the
-  release (every run printed: the angle at the end and its range, beside the free end's mass
-  and the largest the pair deploys by eqs. (1)-(3), which a run that does not deploy should
-  exceed).
+- ``deploy-opposite``, ``deploy-equal`` (not run unless named): the whole deployment,
+  ``--motion`` seconds after the release, as it should where it deploys (the angle comes within
+  20 deg of deployed) exactly where the free end's mass is below the largest the pair deploys by
+  eqs. (1)-(3) (every run printed: the angle at the end and its range, both masses).
 
-What it found on 2026-11-29 (5 mm meshes, 2 workers, about 4 min) is in docs/studies.md ("Where
-in Table 4's box the tests run as they should").
+What it found on 2026-11-29 (5 mm meshes, 2 workers, about 4 min without the deployments) is in
+docs/studies.md ("Where in Table 4's box the tests run as they should").
 
-    python benchmarks/robustness_table4.py                       # every scenario, 4 x 4, 5 mm
+    python benchmarks/robustness_table4.py              # all but the deployments, 4 x 4, 5 mm
     python benchmarks/robustness_table4.py --scenarios equilibrium --n 6 --mesh 3e-3
+    python benchmarks/robustness_table4.py --scenarios deploy-opposite deploy-equal --plates 1e-2
 """
 
 from __future__ import annotations
@@ -48,6 +49,13 @@ SCENARIOS = (
     "deploy-opposite",
     "deploy-equal",
 )
+
+#: The scenarios run by default: the whole deployments take minutes more.
+DEFAULT_SCENARIOS = SCENARIOS[:5]
+
+#: Within this of deployed [deg], a deployment has deployed (the set-up's equal-sense swings
+#: that lift the free end come within 4 deg; one that cannot stays below -45 deg).
+DEPLOYED_DEG = 20.0
 
 
 def _spec(task: dict[str, Any]) -> Any:
@@ -97,10 +105,13 @@ def run_one(task: dict[str, Any]) -> dict[str, Any]:
                 d = deploy(DeploymentSettings(spec=spec, sense=sense, duration=task["motion"]))
                 m_max = float(analytical_max_mass(MaxMassSettings(), sense, task["t"], task["E"]))
                 a = d.angle_deg
+                deployed = bool(np.any(np.abs(a) < DEPLOYED_DEG))
+                ok = deployed == (spec.free_end_mass < m_max)
                 why = (
-                    f"angle {a[-1]:+.1f} deg at {d.time_s[-1]:.1f} s (range {a.min():+.1f} to "
-                    f"{a.max():+.1f}); free end {1e3 * spec.free_end_mass:.0f} g, eqs. (1)-(3) "
-                    f"deploy up to {1e3 * m_max:.0f} g; {d.results.stats['steps']} steps"
+                    f"{'deployed' if deployed else 'not deployed'}: angle {a[-1]:+.1f} deg at "
+                    f"{d.time_s[-1]:.1f} s (range {a.min():+.1f} to {a.max():+.1f}); free end "
+                    f"{1e3 * spec.free_end_mass:.0f} g, eqs. (1)-(3) deploy up to "
+                    f"{1e3 * m_max:.0f} g; {d.summary()['steps']} steps of motion"
                 )
     except ConvergenceError as exc:
         ok, why = False, f"ConvergenceError: {str(exc)[:160]}"
@@ -109,7 +120,9 @@ def run_one(task: dict[str, Any]) -> dict[str, Any]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scenarios", nargs="+", choices=SCENARIOS, default=list(SCENARIOS))
+    parser.add_argument(
+        "--scenarios", nargs="+", choices=SCENARIOS, default=list(DEFAULT_SCENARIOS)
+    )
     parser.add_argument("--n", type=int, default=4, help="grid points per parameter (default 4)")
     parser.add_argument("--mesh", type=float, default=5e-3, help="tape mesh [m] (default 5 mm)")
     parser.add_argument("--plates", type=float, default=None, help="plates' mesh [m] (--mesh)")

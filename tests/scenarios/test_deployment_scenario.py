@@ -271,6 +271,34 @@ def test_compare_counts_both_series_peaks_from_the_same_prominence(
     assert wiggly["max_amplitude_deg"][1] == pytest.approx(plain["max_amplitude_deg"][1])
     assert wiggly["min_amplitude_deg"] == pytest.approx(plain["min_amplitude_deg"])
     assert wiggly["peak_prominence_deg"] == pytest.approx(np.degrees(measured.peaks.prominence))
+    # The peaks the leave-aside numbers count among are the ones compared, and the summary lists
+    # them: the dip is not one.
+    assert wiggly["simulation_peaks"]["maxima_deg"] == pytest.approx(
+        plain["simulation_peaks"]["maxima_deg"], abs=0.05
+    )
+    assert len(wiggly["simulation_peaks"]["maxima_deg"]) == len(opposite.peaks.maxima)
+    described = replace(opposite, comparison=wiggly).describe()
+    assert "simulated maxima compared (prominence 0.66 deg, the numbers --leave-aside-max" in (
+        described
+    )
+    assert "1: +50.2 deg at 0.5" in described and "2: +9.0 deg at 0.789 s" in described
+
+
+def test_compare_counts_a_recording_of_a_lower_threshold_from_the_simulations(
+    opposite: DeploymentSimulation,
+) -> None:
+    from tapespring.protocols.deployment import analyze_deployment
+    from tapespring.trials.samples import make_deployment_trial
+
+    # A recording analysed from half the simulation's threshold (its noise peaks counted): the
+    # comparison counts its peaks from the simulation's, as its own analysis would.
+    trial, _ = make_deployment_trial("opposite", duration=4.0)
+    low = analyze_deployment(trial, prominence=0.5 * opposite.peaks.prominence)
+    same = analyze_deployment(trial, prominence=opposite.peaks.prominence)
+    assert len(low.peaks.minima) >= len(same.peaks.minima)
+    c = opposite.compare(low, n=3)
+    assert c == opposite.compare(same, n=3)
+    assert c["peak_prominence_deg"] == pytest.approx(np.degrees(opposite.peaks.prominence))
 
 
 @pytest.mark.parametrize("metadata", [True, False])

@@ -165,9 +165,10 @@ pub struct StaticParams {
     /// the characteristic length) and recorded as the path's last state ([`Event::MonitorZero`]);
     /// the step then ends there, and the next one starts from it. A change of sign counts where
     /// the reaction on both sides exceeds that resolution (round-off at the path's start is no
-    /// zero). A step across which no state on its chord is at zero is retried shorter while half
-    /// the cut-backs remain; one across a jump is not located, nor one across which the reaction
-    /// jumps (logged; the path goes on).
+    /// zero). With `stability` on a path that does not switch branches, a step across the zero
+    /// that changes the stability count and has no state on its chord at zero is retried shorter
+    /// while half the cut-backs remain. Not located: a change of sign across a jump, and one
+    /// across a step whose chord has no state at zero once taken (logged; the path goes on).
     #[serde(default)]
     pub stop_at_monitor_zero: ZeroStop,
 }

@@ -115,7 +115,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
             default=[],
             metavar="K",
             help=f"with --experiment: the simulation's {word} left aside in the peak-by-peak "
-            "comparison, numbered from 1"
+            "comparison, numbered from 1 among those compared (counted from the recording's "
+            "prominence, and listed in the summary)"
             + (
                 " (the paper leaves aside the model's extra fourth minimum in equal sense: "
                 "--leave-aside-min 4)"

@@ -350,7 +350,10 @@ class DeploymentSimulation:
             ``max_separation_s``, ``min_separation_s`` (differences of the times between
             successive peaks, the first from the release), per peak (None where one series has
             fewer peaks); ``initial_angle_deg`` of both; the trial's name; the peaks left aside;
-            ``peak_prominence_deg``, the prominence both series' peaks count from.
+            ``peak_prominence_deg``, the prominence both series' peaks count from; and
+            ``simulation_peaks``, the simulation's peaks the numbers of those left aside count
+            among (``maxima_time_s``, ``maxima_deg``, ``minima_time_s``, ``minima_deg``: the
+            first `n` of each kind and as many more as are left aside).
 
         Raises
         ------
@@ -365,8 +368,8 @@ class DeploymentSimulation:
         if self.peaks is None:
             raise ValueError("the simulation has no peak to compare (run it longer)")
         k = self.settings.n_peaks if n is None else n
-        simulated, recorded = self._peaks_against(measured)
-        simulated = simulated.without(leave_aside_max, leave_aside_min)
+        numbered, recorded = self._peaks_against(measured)
+        simulated = numbered.without(leave_aside_max, leave_aside_min)
         c = compare_peaks(recorded.head(k), simulated.head(k), k)
 
         def listed(values: NDArray[np.float64], scale: float) -> list[float | None]:
@@ -380,6 +383,14 @@ class DeploymentSimulation:
             },
             "left_aside": {"max": list(leave_aside_max), "min": list(leave_aside_min)},
             "peak_prominence_deg": math.degrees(simulated.prominence),
+            "simulation_peaks": {
+                f"{kind}_{key}": [float(v) * scale for v in getattr(e, attr)[: k + len(aside)]]
+                for kind, e, aside in (
+                    ("maxima", numbered.maxima, leave_aside_max),
+                    ("minima", numbered.minima, leave_aside_min),
+                )
+                for key, attr, scale in (("time_s", "time", 1.0), ("deg", "value", 180.0 / np.pi))
+            },
             "max_amplitude_deg": listed(c.max_amplitude, 180.0 / np.pi),
             "min_amplitude_deg": listed(c.min_amplitude, 180.0 / np.pi),
             "max_separation_s": listed(c.max_separation, 1.0),
@@ -387,16 +398,16 @@ class DeploymentSimulation:
         }
 
     def _peaks_against(self, measured: Any) -> tuple[Peaks, Peaks]:
-        """This run's peaks and `measured`'s, both from the larger of their two prominence
-        thresholds (see :meth:`compare`); the series whose threshold that is keeps its own."""
+        """This run's peaks, all of them, and `measured`'s, both from the larger of their two
+        prominence thresholds (see :meth:`compare`); the recording keeps its own where that is
+        the larger."""
         from tapespring.signals.peaks import extract_peaks
 
         assert self.peaks is not None
         prominence = max(self.peaks.prominence, measured.peaks.prominence)
-        simulated, recorded = self.peaks, measured.peaks
-        if simulated.prominence < prominence:
-            tu, au = _uniform_angle(self.time_s, np.radians(self.angle_deg), self.settings)
-            simulated = extract_peaks(tu, au, None, prominence=prominence)
+        tu, au = _uniform_angle(self.time_s, np.radians(self.angle_deg), self.settings)
+        simulated = extract_peaks(tu, au, None, prominence=prominence)
+        recorded = measured.peaks
         if recorded.prominence < prominence:
             after = measured.time >= measured.release_time
             recorded = extract_peaks(
@@ -552,6 +563,16 @@ class DeploymentSimulation:
                 f"{c['initial_angle_deg']['experiment']:+.1f} deg measured; peak amplitudes "
                 + (f"differ by up to {max(amp):.1f} deg" if amp else "not comparable")
             )
+            sp = c["simulation_peaks"]
+            for kind in ("maxima", "minima"):
+                pairs = zip(sp[f"{kind}_time_s"], sp[f"{kind}_deg"], strict=True)
+                listed = ", ".join(
+                    f"{k}: {v:+.1f} deg at {t:.3f} s" for k, (t, v) in enumerate(pairs, 1)
+                )
+                lines.append(
+                    f"    simulated {kind} compared (prominence {c['peak_prominence_deg']:.2f} "
+                    f"deg, the numbers --leave-aside-{kind[:3]} takes): {listed or 'none'}"
+                )
         if s["error"]:
             lines.append(f"  stopped early: {s['error']}")
         return "\n".join(lines)

@@ -216,10 +216,10 @@ def _not_found(force_N: np.ndarray) -> str:
     buckle (from the first state whose force fell below half the largest before it, up to the
     first that exceeds that largest again: beyond it a push too long for the set-up crushes it
     with forces of kN). Held back (negative) there and rising through zero: the solver did not
-    locate the zero (it jumped across). Positive all along, falling and rising again: the folded
-    set-up does not stay down under the weight alone (the stiff corner of Table 4's bounds,
-    docs/studies.md). Otherwise (no buckle, or the force still falling or held back at the end)
-    the push was too short. NaN forces are left out."""
+    locate the zero (it jumped across, or a step went past a limit point). Positive all along,
+    falling and rising again: the folded set-up does not stay down under the weight alone (the
+    stiff corner of Table 4's bounds, docs/studies.md). Otherwise (no buckle, or the force still
+    falling or held back at the end) the push was too short. NaN forces are left out."""
     f = np.asarray(force_N, dtype=float)
     push_further = "no folded equilibrium on the push path (push further)"
     peak = np.fmax.accumulate(f[1:]) if f.size >= 3 else np.zeros(0)
@@ -236,8 +236,8 @@ def _not_found(force_N: np.ndarray) -> str:
     ):
         return (
             "no folded equilibrium on the push path: the pushing force rose through zero "
-            "without a state in between bringing it to zero (it jumped across: see the "
-            "solver's warning)"
+            "without a state in between bringing it to zero (it jumped across, or the push "
+            "stepped over a limit point there: see the solver's warning)"
         )
     # Rose again: back above the buckle's force, or by a tenth of the fall (not a wiggle).
     rose = end < f.size or np.nanmax(past[low:]) - past[low] > 0.1 * (top - past[low])

@@ -831,6 +831,7 @@ pub fn solve_static(
             Ok(true) => continue,
             Ok(false) => {}
             Err(e) => {
+                *state = saved;
                 w.path.error = Some(e);
                 break;
             }
@@ -1288,22 +1289,26 @@ impl<'a, 'b> Walk<'a, 'b> {
         coarse && self.retry_shorter(state, saved)
     }
 
-    /// A converged step across the zero of the monitored reaction the path is to stop at, from a
-    /// state of one stability count to one of another, where no state on the step's chord brings
-    /// the reaction to zero: the path between the two states is not the chord the search follows
-    /// (an instability lies between them). It is retried shorter while half the cut-backs remain.
-    /// Measured on the set-up's push at t = 0.12 mm, E = 220 GPa (5 mm meshes): a step of 4.4 mm
-    /// of push from a stable state went past a limit point 0.4 mm short of zero and the snap
-    /// after it, the reaction changed sign on the unstable branch beyond, and the path went on
-    /// without the folded equilibrium that shorter steps reach after the snap. A reaction that
-    /// jumps across zero with the stability unchanged (a load switched off within the step) is
-    /// left to the search after the step, as are steps that turn back at a limit point (the
-    /// jump's).
+    /// On a path that does not switch branches, a converged step across the zero of the monitored
+    /// reaction the path is to stop at, from a state of one stability count to one of another,
+    /// where no state on the step's chord brings the reaction to zero: the path between the two
+    /// states is not the chord the search follows (an instability lies between them). It is
+    /// retried shorter while half the cut-backs remain, then taken (the search after it then
+    /// warns). Measured on the set-up's push at t = 0.12 mm, E = 220 GPa (5 mm meshes): a step
+    /// of 4.4 mm of push from a stable state went past a limit point 0.4 mm short of zero and the
+    /// snap after it, the reaction changed sign on the unstable branch beyond, and the path went
+    /// on without the folded equilibrium that shorter steps reach after the snap. Left to the
+    /// search after the step: a reaction that jumps across zero with the stability unchanged (a
+    /// load switched off within the step), steps that turn back at a limit point (the jump's),
+    /// the path's first step (no count before it), and paths that switch branches (their counts
+    /// leave neutral modes out; their steps that refinement cannot draw are retried shorter by
+    /// `Walk::too_coarse`).
     fn zero_stepped_over(&mut self, state: &mut State, saved: &State, out: &Outcome) -> Result<bool> {
         let params = self.s.params;
-        let (true, true, Some(i), Some(before)) = (
+        let (true, true, false, Some(i), Some(before)) = (
             self.locate && params.stop_at_monitor_zero != ZeroStop::Never,
             params.stability,
+            self.switching(),
             self.monitor,
             self.p.last_negative,
         ) else {
@@ -1342,12 +1347,18 @@ impl<'a, 'b> Walk<'a, 'b> {
         let search = zero_ahead(&mut self.s, &self.p.history);
         self.p.history.pop();
         if let ZeroSearch::Missed { .. } = search? {
-            log::debug!(
-                "no zero on the chord of the step from t = {} (stability count {before} -> {after}): \
-                 retried shorter",
-                saved.t
-            );
-            return Ok(self.retry_shorter(state, saved));
+            // The step after a jump is a load increment of its own: halved with the arc.
+            let restart = self.p.restart;
+            self.p.restart = restart.map(|dl| 0.5 * dl);
+            if self.retry_shorter(state, saved) {
+                log::debug!(
+                    "no zero on the chord of the step from t = {} (stability count {before} -> \
+                     {after}): retried shorter",
+                    saved.t
+                );
+                return Ok(true);
+            }
+            self.p.restart = restart;
         }
         Ok(false)
     }

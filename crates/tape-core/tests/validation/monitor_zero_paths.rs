@@ -394,7 +394,8 @@ fn warnings_here() -> Vec<String> {
 /// load factor puts the force within it, though the force is continuous. `search_zero` narrows
 /// the bracket onto the drop until its 2 x 12 planes are spent (a trace of it: the bracket was
 /// still 2.5e-8 wide in t, above the 1e-12 at which it would also give up), `zero_to_stop_at`
-/// logs a warning, restores the driver's state and lets the path go on.
+/// restores the driver's state and reports the miss, which the path logs as a warning before
+/// going on (the stability count does not change across the drop: no shorter step is tried).
 ///
 /// Checked against the path without the stop (`Never`), which never searches: with `Any` and with
 /// `Resisting` (the force rises through zero along the motion: a resisting change of sign, which
