@@ -1347,9 +1347,6 @@ impl<'a, 'b> Walk<'a, 'b> {
         let search = zero_ahead(&mut self.s, &self.p.history);
         self.p.history.pop();
         if let ZeroSearch::Missed { .. } = search? {
-            // The step after a jump is a load increment of its own: halved with the arc.
-            let restart = self.p.restart;
-            self.p.restart = restart.map(|dl| 0.5 * dl);
             if self.retry_shorter(state, saved) {
                 log::debug!(
                     "no zero on the chord of the step from t = {} (stability count {before} -> \
@@ -1358,7 +1355,6 @@ impl<'a, 'b> Walk<'a, 'b> {
                 );
                 return Ok(true);
             }
-            self.p.restart = restart;
         }
         Ok(false)
     }
@@ -1368,6 +1364,12 @@ impl<'a, 'b> Walk<'a, 'b> {
     fn retry_shorter(&mut self, state: &mut State, saved: &State) -> bool {
         if self.p.control.reject().is_err() {
             return false;
+        }
+        // The step after a jump or a branch switch is a load increment of its own: halved with
+        // the arc, or the same step is taken again.
+        if let Some(dl) = self.p.restart.as_mut() {
+            *dl *= 0.5;
+            log::debug!("the restarting load increment from t = {} halved to {dl:e}", saved.t);
         }
         *state = saved.clone();
         self.s.invalidate();
