@@ -492,6 +492,11 @@ class PeakComparison:
 def compare_peaks(reference: Peaks, other: Peaks, n: int | None = None) -> PeakComparison:
     """Differences, peak by peak, between two series (e.g. experiment and simulation).
 
+    The k-th peak of one series is paired with the k-th of the other: count both from the same
+    prominence (`extract_peaks` again with the larger of the two ``Peaks.prominence``), or a
+    wiggle one threshold counts and the other does not pairs every later peak with the wrong
+    swing (`tapespring.scenarios.deployment.DeploymentSimulation.compare` does so).
+
     Parameters
     ----------
     reference, other : Peaks
