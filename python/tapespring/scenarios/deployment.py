@@ -375,6 +375,15 @@ class DeploymentSimulation:
         def listed(values: NDArray[np.float64], scale: float) -> list[float | None]:
             return [None if not np.isfinite(v) else float(v) * scale for v in values]
 
+        # The peaks the leave-aside numbers count among: the first k and those left aside.
+        numbered_peaks: dict[str, list[float | None]] = {}
+        for kind, e, aside in (
+            ("maxima", numbered.maxima, leave_aside_max),
+            ("minima", numbered.minima, leave_aside_min),
+        ):
+            count = k + len(aside)
+            numbered_peaks[f"{kind}_time_s"] = listed(e.time[:count], 1.0)
+            numbered_peaks[f"{kind}_deg"] = listed(e.value[:count], 180.0 / np.pi)
         return {
             "trial": measured.name,
             "initial_angle_deg": {
@@ -383,14 +392,7 @@ class DeploymentSimulation:
             },
             "left_aside": {"max": list(leave_aside_max), "min": list(leave_aside_min)},
             "peak_prominence_deg": math.degrees(simulated.prominence),
-            "simulation_peaks": {
-                f"{kind}_{key}": [float(v) * scale for v in getattr(e, attr)[: k + len(aside)]]
-                for kind, e, aside in (
-                    ("maxima", numbered.maxima, leave_aside_max),
-                    ("minima", numbered.minima, leave_aside_min),
-                )
-                for key, attr, scale in (("time_s", "time", 1.0), ("deg", "value", 180.0 / np.pi))
-            },
+            "simulation_peaks": numbered_peaks,
             "max_amplitude_deg": listed(c.max_amplitude, 180.0 / np.pi),
             "min_amplitude_deg": listed(c.min_amplitude, 180.0 / np.pi),
             "max_separation_s": listed(c.max_separation, 1.0),
