@@ -410,12 +410,24 @@ class Results:
         """Write to a NumPy ``.npz`` file; stats and settings are stored as JSON.
 
         Read it back with :meth:`load`. Returns the path written: `path`, with ``.npz`` appended
-        if it does not end so (as :func:`numpy.savez` does).
+        if it does not end so (as :func:`numpy.savez` does). The file also records the package
+        version that wrote it (``meta["package_version"]``).
+
+        Raises
+        ------
+        ValueError
+            If `path` names no file (``""``, ``"."``, ``".."``, a path ending in ``..``), before
+            anything is written.
         """
-        path = Path(path)
+        from tapespring import __version__
+
+        given, path = path, Path(path)
+        if path.name in ("", ".", ".."):
+            raise ValueError(f"cannot save results to {os.fspath(given)!r}: the path names no file")
         meta = {
             "format": _FORMAT,
             "version": _VERSION,
+            "package_version": __version__,
             "event": list(self.event),
             "marker_names": list(self.marker_names),
             "reaction_dofs": [list(rd) for rd in self.reaction_dofs],

@@ -385,8 +385,8 @@ class PullResult:
             "located": self.located,
             "paper_model_max_force_N": paper_f,
             "paper_model_displacement_m": paper_d,
-            "max_force_difference": self.max_force_N / paper_f - 1.0,
-            "displacement_difference": self.max_force_displacement_m / paper_d - 1.0,
+            "max_force_difference_relative": self.max_force_N / paper_f - 1.0,
+            "displacement_difference_relative": self.max_force_displacement_m / paper_d - 1.0,
             "displacement_m": self.displacement_m.tolist(),
             "force_N": self.force_N.tolist(),
             "ndof": last_ndof(r),
@@ -410,7 +410,8 @@ class PullResult:
                 f"{self.max_force_displacement_m * 1e3:.2f} mm of marker 2 ({how})",
                 f"  paper's model: {s['paper_model_max_force_N']:.1f} N at "
                 f"{s['paper_model_displacement_m'] * 1e3:.1f} mm (ours relative to it: "
-                f"{s['max_force_difference']:+.1%}, {s['displacement_difference']:+.1%})",
+                f"{s['max_force_difference_relative']:+.1%}, "
+                f"{s['displacement_difference_relative']:+.1%})",
             ]
             + ([f"  stopped early: {s['error']}"] if s["error"] else [])
             + ([] if self.comparison is None else ["", self.comparison.table()])
