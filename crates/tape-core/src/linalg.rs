@@ -119,8 +119,12 @@ impl Pattern {
 
 /// Backward error at which GMRES stops (a few hundred ulps).
 const REFINE_TOL: f64 = 1e-13;
-/// GMRES iterations before falling back to LU (restarts of 30).
-const REFINE_MAX: usize = 30;
+/// Cycles of GMRES(30) before falling back to LU. Where the symmetric part preconditions `K`
+/// well, GMRES converges within a few sweeps of the first cycle; where it does not, two more
+/// cycles rarely rescued it: the set-up's fold (10578 DOFs) needs the same 8 LU fallbacks after
+/// one cycle or three, with the same states to the bit, and a failed cycle of 30 sweeps costs
+/// about 40 ms there against 90 ms for the LU (docs/performance.md).
+const GMRES_CYCLES: usize = 1;
 
 /// Entries of the symmetric part formed per parallel task in [`LinearSolver::factorize`].
 const SYM_CHUNK: usize = 1 << 14;
@@ -702,7 +706,7 @@ impl LinearSolver {
         let tol = REFINE_TOL * (b_norm + self.k_norm * x_norm);
         let mut r = vec![0.0; n];
         let mut w = vec![0.0; n];
-        for _restart in 0..REFINE_MAX / 10 {
+        for _cycle in 0..GMRES_CYCLES {
             self.mul(x, &mut w);
             for i in 0..n {
                 r[i] = b[i] - w[i];
