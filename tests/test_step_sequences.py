@@ -89,10 +89,21 @@ def test_a_prescribed_ramp_at_rho_inf_one_stays_bounded(rho_inf):
     outputs = Outputs(reactions=[(CORNER, "uz")])
     step = Step.dynamic("move", duration=0.01, rho_inf=rho_inf)
     r = run(model, [step], outputs=outputs)
-    # Measured: 4238 steps and at most 54 N (the corner driven at 1.25 m/s through the plate's
-    # stiff modes, undamped); before, 100 000 steps ending on the step limit, and 3e8 N.
+    # Measured: 4238 steps and at most 54 N from the plate (the corner driven at 1.25 m/s
+    # through its stiff modes, undamped); before, 100 000 steps ending on the step limit, and
+    # 3e8 N. The recorded reaction adds the inertia of the corner's lumped mass (rho t A / 4 of
+    # its one element) at the ramp's mean acceleration over each step (docs/dynamics.md,
+    # "Prescribed motions"): the change of its velocity, the slope read just inside the step,
+    # over the step; at the ramp's end that is the impulse of the velocity jump, -822 N over a
+    # step of 2e-6 s.
     assert len(r.t) < 20_000
-    assert np.abs(r.reaction(CORNER, "uz")).max() < 200.0
+    mass = 7850.0 * 1e-3 * (0.2 / 3) * (0.02 / 2) / 4
+    h = np.diff(r.t)
+    inside = r.t[1:] - 1e-6 * h
+    velocity = np.where((inside > 0.002) & (inside <= 0.006), 5e-3 / 0.004, 0.0)
+    inertia = mass * np.diff(np.r_[0.0, velocity]) / h
+    assert np.abs(inertia).max() > 500.0  # the ramp's end in a short step
+    assert np.abs(r.reaction(CORNER, "uz")[1:] - inertia).max() < 200.0
     # The supports' work, the velocity jumps at the ramp's ends included, is the energy stored.
     assert abs(r.numerical_dissipation[-1]) < 1e-4 * r.work_prescribed[-1]
 
