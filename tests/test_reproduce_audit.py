@@ -845,17 +845,14 @@ def test_a_scenario_run_rebuilt_from_its_saved_results_gives_the_same_bits(vibra
     assert _same_results(r, again, wall=False) == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="Results.save of a scenario's results keeps the model and steps, not the "
-    "scenario's settings: the vibration's fitting window, initial displacement (and the spec, "
-    "the sense, n_peaks of a deployment) are lost, so the scenario's figures (damping ratio, "
-    "peaks) cannot be recomputed from the saved file; no scenario result has a save of its own",
-)
 def test_a_scenario_results_file_keeps_the_scenario_settings(vibration_run, tmp_path):
+    """The scenario's own figures (the damping fit's window, the initial displacement) depend on
+    settings that are not the model's or the steps': the file keeps them too."""
     loaded = Results.load(vibration_run.results.save(tmp_path / "v.npz"))
-    text = json.dumps(loaded.settings)
-    assert "window" in text and "initial_displacement" in text
+    scenario = loaded.settings["scenario"]
+    assert scenario["class"] == "tapespring.scenarios.vibration.VibrationSettings"
+    settings = jsonable_tree(dataclasses.asdict(vibration_run.settings))
+    assert scenario["settings"] == json.loads(json.dumps(settings))
 
 
 def test_a_saved_results_file_records_the_package_version(plate_results, tmp_path):
@@ -984,3 +981,14 @@ def test_files_of_other_formats_are_refused_by_name(tmp_path, cli):
     for path in sorted(tmp_path.iterdir()):
         with pytest.raises(ValueError, match=re.escape(str(path))):
             Results.load(path)
+
+
+def test_the_release_results_keep_its_setup(tmp_path):
+    """The single tape's release records its `ReleaseSetup` as the set-up's scenarios record
+    their settings (`record_scenario`)."""
+    setup = ReleaseSetup(tape=BendingSetup(mesh_size=4.5e-3), duration=0.005)
+    loaded = Results.load(release(setup).results.save(tmp_path / "r.npz"))
+    scenario = loaded.settings["scenario"]
+    assert scenario["class"] == "tapespring.scenarios.release.ReleaseSetup"
+    assert scenario["settings"]["duration"] == 0.005
+    assert scenario["settings"]["tape"]["mesh_size"] == 4.5e-3

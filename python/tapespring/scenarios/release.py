@@ -35,6 +35,7 @@ from tapespring.scenarios.setup import (
     check_rho_inf,
     check_tolerance,
     last_ndof,
+    record_scenario,
     step_counts,
 )
 
@@ -400,6 +401,7 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         setup=setup,
         wall_s=time.perf_counter() - start,
     )
+    record_scenario(results, setup)
     if results.error is not None:
         err = ConvergenceError(
             f"{results.error} (the release recorded so far is kept in the 'result' attribute)"

@@ -1681,10 +1681,27 @@ def dynamic_options(
     return options
 
 
+def record_scenario(results: Any, settings: Any) -> None:
+    """Record a scenario's `settings` (its settings dataclass) in its analysis `results`, as
+    ``results.settings["scenario"] = {"class": "module.Name", "settings": {...}}``: a saved
+    ``Results`` file then says which scenario produced it, with the settings that its own
+    figures (peaks, damping fit, ...) depend on beside the model and the steps."""
+    from dataclasses import asdict
+
+    from tapespring.report import jsonable_tree
+
+    results.settings["scenario"] = {
+        "class": f"{type(settings).__module__}.{type(settings).__qualname__}",
+        "settings": jsonable_tree(asdict(settings)),
+    }
+
+
 def raise_if_stopped(results: Any, result: Any, what: str) -> None:
-    """Raise ConvergenceError carrying `result` (what was recorded) if the run stopped early."""
+    """Record the scenario's settings (``result.settings``) in `results` (:func:`record_scenario`),
+    then raise ConvergenceError carrying `result` (what was recorded) if the run stopped early."""
     from tapespring.analysis import ConvergenceError
 
+    record_scenario(results, result.settings)
     if results.error is not None:
         err = ConvergenceError(f"{results.error} (the {what} so far is in the 'result' attribute)")
         err.result = result
