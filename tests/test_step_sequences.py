@@ -24,6 +24,10 @@ from tapespring.analysis import ramp
 # A free-end corner of the plate of `_plate`, and an interior node next to the clamp.
 CORNER, INNER = 11, 5
 
+#: Where a dynamic step reads a prescribed velocity, as a fraction of the step before its end
+#: (tape-core's `solver::dynamics::PRESCRIBED_SLOPE_INSET`).
+PRESCRIBED_SLOPE_INSET = 1e-6
+
 
 def test_a_max_step_below_the_time_resolution_is_refused_not_a_panic():
     model = plate()
@@ -99,7 +103,7 @@ def test_a_prescribed_ramp_at_rho_inf_one_stays_bounded(rho_inf):
     assert len(r.t) < 20_000
     mass = 7850.0 * 1e-3 * (0.2 / 3) * (0.02 / 2) / 4
     h = np.diff(r.t)
-    inside = r.t[1:] - 1e-6 * h
+    inside = r.t[1:] - PRESCRIBED_SLOPE_INSET * h
     velocity = np.where((inside > 0.002) & (inside <= 0.006), 5e-3 / 0.004, 0.0)
     inertia = mass * np.diff(np.r_[0.0, velocity]) / h
     assert np.abs(inertia).max() > 500.0  # the ramp's end in a short step

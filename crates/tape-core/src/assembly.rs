@@ -1128,6 +1128,13 @@ impl System {
     /// unknowns).
     #[must_use]
     pub fn probe(&self, asm: &Assembled) -> Vec<f64> {
+        self.probe_with(asm, &[])
+    }
+
+    /// [`Self::probe`], with `extra[c]` added to the reaction of constrained DOF `c` (an empty
+    /// `extra`: nothing; a dynamic step's inertia of the prescribed motions).
+    #[must_use]
+    pub fn probe_with(&self, asm: &Assembled, extra: &[f64]) -> Vec<f64> {
         self.probes
             .iter()
             .map(|&(node, dof)| {
@@ -1136,7 +1143,7 @@ impl System {
                 }
                 match self.dofs.slots[node][dof.index()] {
                     Slot::Free(eq) => asm.f_int[eq] - asm.f_ext[eq],
-                    Slot::Constrained(c) => asm.f_int_c[c] - asm.f_ext_c[c],
+                    Slot::Constrained(c) => asm.f_int_c[c] - asm.f_ext_c[c] + extra.get(c).unwrap_or(&0.0),
                 }
             })
             .collect()
