@@ -119,12 +119,14 @@ impl Pattern {
 
 /// Backward error at which GMRES stops (a few hundred ulps).
 const REFINE_TOL: f64 = 1e-13;
-/// Cycles of GMRES(30) before falling back to LU. Where the symmetric part preconditions `K`
-/// well, GMRES converges within a few sweeps of the first cycle; where it does not, two more
-/// cycles rarely rescued it: the set-up's fold (10578 DOFs) needs the same 8 LU fallbacks after
-/// one cycle or three, with the same states to the bit, and a failed cycle of 30 sweeps costs
-/// about 40 ms there against 90 ms for the LU (docs/performance.md).
+/// Cycles of GMRES([`GMRES_RESTART`]) before falling back to LU. Where the symmetric part
+/// preconditions `K` well, GMRES converges within a few sweeps of the first cycle; where it does
+/// not, two more cycles rarely rescued it: the set-up's fold (10578 DOFs) needs the same 8 LU
+/// fallbacks after one cycle or three, with the same states to the bit, and a failed cycle of 30
+/// sweeps costs about 40 ms there against 90 ms for the LU (docs/performance.md).
 const GMRES_CYCLES: usize = 1;
+/// Sweeps of one GMRES cycle (the Krylov space's size before a restart).
+const GMRES_RESTART: usize = 30;
 
 /// Entries of the symmetric part formed per parallel task in [`LinearSolver::factorize`].
 const SYM_CHUNK: usize = 1 << 14;
@@ -699,7 +701,7 @@ impl LinearSolver {
     /// Flexible GMRES(m) on `K x = b`, right-preconditioned by the LDL^T of the symmetric part,
     /// starting from `x` (= S^{-1} b). Returns whether `|b - K x| <= REFINE_TOL |b|` was reached.
     fn gmres(&mut self, b: &[f64], b_norm: f64, x: &mut [f64]) -> bool {
-        const M: usize = 30;
+        const M: usize = GMRES_RESTART;
         let n = b.len();
         // Backward-error criterion, as a direct solver would achieve: |b - K x| <= tol (|b| + |K| |x|).
         let x_norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
