@@ -861,7 +861,16 @@ def test_a_saved_results_file_records_the_package_version(plate_results, tmp_pat
         meta = json.loads(str(f["meta"]))
     import tapespring
 
-    assert tapespring.__version__ in json.dumps(meta)
+    assert meta["package_version"] == tapespring.__version__
+    # Loaded, the results keep the version that computed them, and save it again as it is.
+    loaded = Results.load(path)
+    assert (
+        plate_results.package_version is None and loaded.package_version == tapespring.__version__
+    )
+    older = dataclasses.replace(loaded, package_version="0.0.1")
+    with np.load(older.save(tmp_path / "older.npz")) as f:
+        assert json.loads(str(f["meta"]))["package_version"] == "0.0.1"
+    assert Results.load(tmp_path / "older.npz").package_version == "0.0.1"
 
 
 # ---------------------------------------------------------------------------------------------

@@ -137,6 +137,9 @@ class Results:
         Steps that ran to their end.
     settings : dict
         The model (JSON form), the steps with every option, and the outputs asked for.
+    package_version : str or None
+        The version of tapespring that computed them, for results loaded from a file that
+        records it (None: computed by this one, or a file of before 2026-11-29).
     """
 
     t: NDArray[np.float64]
@@ -171,6 +174,7 @@ class Results:
     cancelled: bool = False
     steps_completed: int = 0
     settings: dict[str, Any] = field(default_factory=dict)
+    package_version: str | None = None
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Results:
@@ -185,6 +189,7 @@ class Results:
             m if isinstance(m, Modes) else Modes.from_dict(m, step_settings(int(m["step"])))
             for m in d.get("modes", [])
         )
+        version = d.get("package_version")  # a saved file's (save records it)
         return cls(
             **arrays,
             modes=modes,
@@ -197,6 +202,7 @@ class Results:
             cancelled=bool(d["cancelled"]),
             steps_completed=int(d["steps_completed"]),
             settings=dict(d["settings"]),
+            package_version=version if isinstance(version, str) else None,
         )
 
     @property
@@ -411,7 +417,8 @@ class Results:
 
         Read it back with :meth:`load`. Returns the path written: `path`, with ``.npz`` appended
         if it does not end so (as :func:`numpy.savez` does). The file also records the package
-        version that wrote it (``meta["package_version"]``).
+        version that computed the results (``meta["package_version"]``: `package_version` for
+        results loaded from a file, this package's otherwise).
 
         Raises
         ------
@@ -427,7 +434,7 @@ class Results:
         meta = {
             "format": _FORMAT,
             "version": _VERSION,
-            "package_version": __version__,
+            "package_version": self.package_version or __version__,
             "event": list(self.event),
             "marker_names": list(self.marker_names),
             "reaction_dofs": [list(rd) for rd in self.reaction_dofs],
