@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from _cli import refused
+from tapespring import Results
 from tapespring.protocols import analyze_deployment
 from tapespring.scenarios.deployment import (
     DEFAULT_ENERGY_TOLERANCE,
@@ -21,6 +22,7 @@ from tapespring.scenarios.deployment import (
     DeploymentSettings,
     DeploymentSimulation,
     deploy,
+    load_deployment,
 )
 from tapespring.scenarios.setup import PAPER_MODEL, PAPER_SETUP
 from tapespring.trials import TrialWarning
@@ -486,3 +488,47 @@ def test_the_default_energy_tolerance_converges_the_first_maximum(
     error = abs(first_max_deg(opposite) - reference)
     assert error < 0.01 * reference
     assert abs(first_max_deg(off) - reference) > 2.0 * error
+
+
+def test_a_saved_deployment_loads_as_the_same_simulation(
+    opposite: DeploymentSimulation, tmp_path
+) -> None:
+    """Analysed again from its file (the settings it ran with recorded in it), a deployment has
+    the same histories, peaks, phases and summary figures, to the bit."""
+    path = opposite.save(tmp_path / "run")
+    assert path == tmp_path / "run.npz"
+    loaded = load_deployment(path)
+    assert loaded.settings == opposite.settings
+    for name in ("time_s", "angle_deg", "clamp_force_N", "tip_m"):
+        assert np.array_equal(getattr(loaded, name), getattr(opposite, name)), name
+    ours, theirs = opposite.summary(), loaded.summary()
+    for key in ("peaks", "phases", "clamp_force_at_crossings", "settings"):
+        assert json.dumps(theirs[key], default=str) == json.dumps(ours[key], default=str), key
+    assert loaded.wall_s == opposite.results.stats["wall_s"]
+
+
+def test_loading_other_results_as_a_deployment_is_refused(tmp_path) -> None:
+    from _plate import bent_strip
+
+    plain = bent_strip(0)[2].save(tmp_path / "plain.npz")
+    with pytest.raises(ValueError, match=r"plain\.npz holds no scenario's settings"):
+        load_deployment(plain)
+    recorded = Results.load(plain)
+    recorded.settings["scenario"] = {
+        "class": "tapespring.scenarios.pull.PullSettings",
+        "settings": {},
+    }
+    other = recorded.save(tmp_path / "other.npz")
+    with pytest.raises(
+        ValueError, match=r"other\.npz holds a tapespring.scenarios.pull.PullSettings"
+    ):
+        load_deployment(other)
+    recorded.settings["scenario"] = {
+        "class": "tapespring.scenarios.deployment.DeploymentSettings",
+        "settings": {"duration": -1.0},
+    }
+    bad = recorded.save(tmp_path / "bad.npz")
+    with pytest.raises(
+        ValueError, match=r"bad\.npz: the recorded settings do not rebuild: .*duration"
+    ):
+        load_deployment(bad)

@@ -312,12 +312,26 @@ def _vtu_file(text: str) -> str:
 
 
 #: The options naming a file a command writes, as `refuse_shared_paths` reads them.
-_OUTPUT_OPTIONS = ("animate", "csv", "plot", "snapshots", "vtu")
+@_path_type
+def _npz_file(text: str) -> str:
+    """An argparse type: the NumPy ``.npz`` file of a saved run the command will write (as
+    `_output_file`), ``.npz`` added to a name without that suffix, as
+    :meth:`tapespring.Results.save` adds it (so that the command names the file it wrote)."""
+    _output_file(text)
+    if text.lower().endswith(".npz"):
+        return text
+    named = f"{text}.npz"
+    _output_file(named)
+    return named
+
+
+_OUTPUT_OPTIONS = ("animate", "csv", "plot", "save", "snapshots", "vtu")
 
 
 def refuse_shared_paths(args: argparse.Namespace, option: str = "--experiment") -> None:
     """Refuse (as `refuse`) outputs that would overwrite each other or the recording the command
-    reads: ``--animate``, ``--csv``, ``--plot``, ``--snapshots`` and ``--vtu`` (its ``.pvd`` file
+    reads: ``--animate``, ``--csv``, ``--plot``, ``--save``, ``--snapshots`` and ``--vtu`` (its
+    ``.pvd`` file
     and the folder of its VTU files) naming one file, or naming the ``--experiment`` recording or
     a CSV recording's force side file (``<stem>.forces.csv``). Each writer replaced the file
     silently: ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's

@@ -11,6 +11,7 @@ from .bend import (
     _gif_file,
     _image_file,
     _input_file,
+    _npz_file,
     _vtu_file,
     refuse,
     refuse_shared_paths,
@@ -147,6 +148,16 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"run, as for --snapshots), at most {MAX_FRAMES} frames, at {ANIMATION_FPS:g} frames "
         "per second (.gif added to a name without a suffix)",
     )
+    p.add_argument(
+        "--save",
+        type=_npz_file,
+        metavar="FILE.npz",
+        help="write the whole run (every record, the clamp's reactions, the nodal fields that "
+        "--vtu, --snapshots or --animate keep, and the settings it ran with) to this NumPy "
+        "file (.npz added if missing), also when it stops early: "
+        "tapespring.scenarios.deployment.load_deployment(FILE) analyses it again in Python "
+        "without running it",
+    )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(
         p,
@@ -247,6 +258,10 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def fields(result: DeploymentSimulation) -> None:
+        if args.save:
+            saved = result.save(args.save)
+            if not args.json:
+                print(wrote(saved))
         write_vtu(args, result.results, result.setup.model)
         drawn = [f"--{name}" for name in ("snapshots", "animate") if getattr(args, name)]
         if not drawn:

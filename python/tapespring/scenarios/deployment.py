@@ -42,6 +42,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -68,10 +69,11 @@ from tapespring.scenarios.setup import (
     check_tolerance,
     drive,
     dynamic_options,
+    finish_scenario,
     gravity_step,
     last_ndof,
-    raise_if_stopped,
     sample_rows,
+    scenario_settings,
     step_counts,
 )
 
@@ -81,6 +83,7 @@ __all__ = [
     "DeploymentSettings",
     "DeploymentSimulation",
     "deploy",
+    "load_deployment",
 ]
 
 #: The deployment's default energy tolerance (the dynamic step's ``energy_tolerance``: each step's
@@ -266,6 +269,12 @@ class DeploymentSimulation:
     results: Any
     wall_s: float
     comparison: dict[str, Any] | None = None
+
+    def save(self, path: str | Path) -> Path:
+        """Write the run to a NumPy ``.npz`` file (:meth:`tapespring.Results.save` of `results`,
+        which holds these settings too); :func:`load_deployment` reads it back. Returns the path
+        written (``.npz`` appended if `path` does not end so)."""
+        return Path(self.results.save(path))
 
     def sample_rows(self) -> NDArray[np.int64]:
         """Rows of the histories at the sample instants ``k / sample_rate`` from the release.
@@ -593,9 +602,6 @@ def deploy(
         If a step stops early (its ``result`` is the `DeploymentSimulation` recorded so far).
     """
     from tapespring.analysis import Outputs, Step, run
-    from tapespring.signals.angle import bending_angle
-    from tapespring.signals.peaks import extract_peaks
-    from tapespring.signals.phases import detect_phases
 
     settings.validate()
     start = time.perf_counter()
@@ -623,6 +629,23 @@ def deploy(
         field_interval=settings.field_interval,
     )
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
+    out = _simulation(results, settings, built, start)
+    finish_scenario(results, out, "deployment")
+    return out
+
+
+def _simulation(
+    results: Any,
+    settings: DeploymentSettings,
+    built: SetupModel,
+    start: float,
+    wall_s: float | None = None,
+) -> DeploymentSimulation:
+    """The deployment in `results` (run from `settings` on `built`): histories from the release,
+    peaks, phases and energies; `wall_s` the run's wall time (None: since `start`)."""
+    from tapespring.signals.angle import bending_angle
+    from tapespring.signals.peaks import extract_peaks
+    from tapespring.signals.phases import detect_phases
 
     names = results.marker_names
     m1, m2, m3 = (names.index(n) for n in ("marker1", "marker2", "marker3"))
@@ -655,7 +678,7 @@ def deploy(
         "viscous": np.nan_to_num(results.viscous_dissipation[idx]),
         "numerical": np.nan_to_num(results.numerical_dissipation[idx]),
     }
-    out = DeploymentSimulation(
+    return DeploymentSimulation(
         time_s=t,
         angle_deg=np.degrees(angle),
         clamp_force_N=force,
@@ -666,10 +689,30 @@ def deploy(
         settings=settings,
         setup=built,
         results=results,
-        wall_s=time.perf_counter() - start,
+        wall_s=time.perf_counter() - start if wall_s is None else wall_s,
     )
-    raise_if_stopped(results, out, "deployment")
-    return out
+
+
+def load_deployment(path: str | Path) -> DeploymentSimulation:
+    """A deployment saved by :meth:`DeploymentSimulation.save`, analysed again without running it.
+
+    The settings it ran with are those recorded in the file (``results.settings["scenario"]``);
+    the set-up's model is built again from them (its markers, clamp and sense), so the histories,
+    peaks, phases and comparisons are those of the run. ``wall_s`` is the saved run's solver time.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        As :meth:`tapespring.Results.load`; ValueError also if the file holds no deployment's
+        settings (another scenario's results, or the generic analysis's).
+    """
+    from tapespring.results import Results
+
+    results = Results.load(path)
+    settings = scenario_settings(results, DeploymentSettings, path)
+    built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
+    wall = results.stats.get("wall_s")
+    return _simulation(results, settings, built, 0.0, math.nan if wall is None else float(wall))
 
 
 def _crossing_items(x: dict[str, Any]) -> list[str]:

@@ -50,9 +50,9 @@ from tapespring.scenarios.setup import (
     check_displacement,
     check_spec,
     drive,
+    finish_scenario,
     gravity_step,
     last_ndof,
-    raise_if_stopped,
 )
 
 if TYPE_CHECKING:
@@ -476,5 +476,5 @@ def equilibrium(
         wall_s=time.perf_counter() - start,
         setup=built,
     )
-    raise_if_stopped(results, out, "push")
+    finish_scenario(results, out, "push")
     return out

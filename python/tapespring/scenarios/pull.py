@@ -38,9 +38,9 @@ from tapespring.scenarios.setup import (
     check_displacement,
     check_spec,
     drive,
+    finish_scenario,
     gravity_step,
     last_ndof,
-    raise_if_stopped,
 )
 
 __all__ = [
@@ -477,5 +477,5 @@ def pull(settings: PullSettings = PullSettings(), *, progress: bool = False) -> 
         wall_s=time.perf_counter() - start,
         setup=built,
     )
-    raise_if_stopped(results, out, "pull")
+    finish_scenario(results, out, "pull")
     return out

@@ -76,6 +76,9 @@ __all__ = [
     "check_thin",
     "check_tolerance",
     "check_youngs_modulus",
+    "record_scenario",
+    "scenario_settings",
+    "settings_from_dict",
     "shown",
 ]
 
@@ -1696,9 +1699,85 @@ def record_scenario(results: Any, settings: Any) -> None:
     }
 
 
-def raise_if_stopped(results: Any, result: Any, what: str) -> None:
-    """Record the scenario's settings (``result.settings``) in `results` (:func:`record_scenario`),
-    then raise ConvergenceError carrying `result` (what was recorded) if the run stopped early."""
+def settings_from_dict(cls: type[Any], data: object, *, where: str = "settings") -> Any:
+    """Rebuild the settings dataclass `cls` from its ``dataclasses.asdict`` form as JSON keeps it
+    (tuples as lists), nested dataclasses included; fields missing from `data` take their
+    defaults. The inverse of what :func:`record_scenario` records.
+
+    Raises
+    ------
+    ValueError
+        If `data` is not a mapping of `cls`'s fields (an unknown field, a nested value of the
+        wrong shape), naming the field by its path from `where`.
+    """
+    import dataclasses
+    import typing
+
+    if not isinstance(data, dict):
+        raise ValueError(f"{where} must be an object of {cls.__name__}'s fields (got {data!r})")
+    names = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - names)
+    if unknown:
+        raise ValueError(f"{where}: {cls.__name__} has no field {', '.join(unknown)}")
+    hints = typing.get_type_hints(cls)
+    return cls(**{k: _field_value(hints[k], v, f"{where}.{k}") for k, v in data.items()})
+
+
+def _field_value(kind: Any, value: object, where: str) -> object:
+    """`value` read back as a field of type `kind` (see :func:`settings_from_dict`)."""
+    import dataclasses
+    import types
+    import typing
+
+    origin = typing.get_origin(kind)
+    if origin in (typing.Union, types.UnionType):
+        arms = [a for a in typing.get_args(kind) if a is not type(None)]
+        return None if value is None else _field_value(arms[0], value, where)
+    if dataclasses.is_dataclass(kind) and isinstance(kind, type):
+        return settings_from_dict(kind, value, where=where)
+    if origin is tuple:
+        if not isinstance(value, list | tuple):
+            raise ValueError(f"{where} must be a list (got {value!r})")
+        args = typing.get_args(kind)
+        each = args[:1] * len(value) if len(args) == 2 and args[1] is Ellipsis else args
+        if len(each) != len(value):
+            raise ValueError(f"{where} must have {len(each)} items (got {value!r})")
+        items = zip(each, value, strict=True)
+        return tuple(_field_value(a, v, f"{where}[{i}]") for i, (a, v) in enumerate(items))
+    return value
+
+
+def scenario_settings(results: Any, cls: type[Any], source: object) -> Any:
+    """The settings of scenario `cls` that :func:`record_scenario` recorded in `results` (read
+    from `source`, named in the errors), rebuilt and validated.
+
+    Raises
+    ------
+    ValueError
+        If `results` holds no scenario's settings, another scenario's, or settings that do not
+        rebuild or validate.
+    """
+    recorded = results.settings.get("scenario")
+    expected = f"{cls.__module__}.{cls.__qualname__}"
+    if not isinstance(recorded, dict) or "settings" not in recorded:
+        raise ValueError(
+            f"{source} holds no scenario's settings (results of the generic analysis, or saved "
+            f"before they were recorded): not a {cls.__name__} run"
+        )
+    if recorded.get("class") != expected:
+        raise ValueError(f"{source} holds a {recorded.get('class')} run, not a {expected} one")
+    try:
+        settings = settings_from_dict(cls, recorded["settings"])
+        settings.validate()
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{source}: the recorded settings do not rebuild: {exc}") from None
+    return settings
+
+
+def finish_scenario(results: Any, result: Any, what: str) -> None:
+    """End a set-up scenario's run: record its settings (``result.settings``) in its analysis
+    `results` (:func:`record_scenario`), then raise ConvergenceError carrying `result` (what was
+    recorded) if the run stopped early (`what` names the run in the message)."""
     from tapespring.analysis import ConvergenceError
 
     record_scenario(results, result.settings)

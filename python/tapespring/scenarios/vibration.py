@@ -50,9 +50,9 @@ from tapespring.scenarios.setup import (
     check_tolerance,
     drive,
     dynamic_options,
+    finish_scenario,
     gravity_step,
     last_ndof,
-    raise_if_stopped,
     sample_rows,
     shown,
     step_counts,
@@ -615,5 +615,5 @@ def vibrate(
         results=results,
         wall_s=time.perf_counter() - start,
     )
-    raise_if_stopped(results, out, "decay")
+    finish_scenario(results, out, "decay")
     return out

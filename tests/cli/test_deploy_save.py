@@ -1,0 +1,42 @@
+"""``tapespring deploy --save FILE.npz``: the whole run with the settings it ran with, which
+``load_deployment`` analyses again without running it, and the names it refuses before the run."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from _cli import refused
+from tapespring.cli import main
+from tapespring.scenarios.deployment import load_deployment
+
+#: The cheapest deployment: 7.5 mm tapes, 10 mm plates, 10 ms of motion (about 1.5 s, most of it
+#: the fold).
+_SHORT_DEPLOY = ["deploy", "--mesh-tape", "7.5e-3", "--mesh-plates", "1e-2", "--duration", "0.01"]
+
+
+def test_the_saved_run_loads_as_the_printed_deployment(tmp_path, capsys):
+    # A name without the suffix is written, and named, with .npz (as Results.save writes it).
+    assert main([*_SHORT_DEPLOY, "--save", str(tmp_path / "run"), "--no-progress"]) == 0
+    path = tmp_path / "run.npz"
+    assert f"  wrote {path}\n" in capsys.readouterr().out
+    # --json prints the object alone; the histories it prints are the loaded run's.
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--json", "--no-progress"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    loaded = load_deployment(path)
+    assert loaded.settings.duration == 0.01 and loaded.settings.spec.mesh_tape == 7.5e-3
+    assert np.array_equal(loaded.angle_deg, printed["angle_deg"])
+    assert np.array_equal(loaded.clamp_force_N, printed["clamp_force_N"])
+    assert json.loads(json.dumps(loaded.summary()["settings"])) == printed["settings"]
+
+
+def test_a_save_path_shared_with_another_output_is_refused(tmp_path, capsys):
+    shared = str(tmp_path / "out.npz")
+    line = refused([*_SHORT_DEPLOY, "--csv", shared, "--save", shared], capsys)
+    assert "--save" in line and "--csv" in line
+    assert not (tmp_path / "out.npz").exists()
+
+
+def test_a_save_path_in_a_missing_folder_is_refused(tmp_path, capsys):
+    line = refused([*_SHORT_DEPLOY, "--save", str(tmp_path / "nowhere" / "run.npz")], capsys)
+    assert "no folder" in line
