@@ -40,3 +40,54 @@ def test_a_save_path_shared_with_another_output_is_refused(tmp_path, capsys):
 def test_a_save_path_in_a_missing_folder_is_refused(tmp_path, capsys):
     line = refused([*_SHORT_DEPLOY, "--save", str(tmp_path / "nowhere" / "run.npz")], capsys)
     assert "no folder" in line
+
+
+def test_load_prints_the_saved_runs_summary_without_running(tmp_path, capsys, monkeypatch):
+    path = tmp_path / "run.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--json", "--no-progress"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    import tapespring.scenarios.deployment as deployment
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("--load ran a deployment")
+
+    monkeypatch.setattr(deployment, "deploy", no_run)
+    csv = tmp_path / "again.csv"
+    assert main(["deploy", "--load", str(path), "--json", "--csv", str(csv)]) == 0
+    again = json.loads(capsys.readouterr().out)
+    for key in ("angle_deg", "clamp_force_N", "peaks", "phases", "settings", "ndof"):
+        assert again[key] == printed[key], key
+    assert csv.read_text().splitlines()[0].startswith("# tapespring deploy: ")
+
+
+def test_load_refuses_the_options_that_set_a_run(tmp_path, capsys):
+    path = tmp_path / "run.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--no-progress"]) == 0
+    capsys.readouterr()
+    line = refused(["deploy", "--load", str(path), "--duration", "2", "--sense", "equal"], capsys)
+    assert "--sense, --duration would set another run" in line
+    line = refused(["deploy", "--load", str(path), "--csv", str(path)], capsys)
+    assert "would overwrite the saved run" in line
+
+
+def test_load_reports_a_file_that_holds_no_deployment(tmp_path, capsys):
+    from _plate import bent_strip
+
+    plain = bent_strip(0)[2].save(tmp_path / "plain.npz")
+    line = refused(["deploy", "--load", str(plain)], capsys, by_parser=False, code=1)
+    assert "plain.npz holds no scenario's settings" in line
+    line = refused(
+        ["deploy", "--load", str(tmp_path / "missing.npz")], capsys, by_parser=False, code=1
+    )
+    assert "missing.npz" in line
+
+
+def test_load_without_fields_refuses_the_pictures(tmp_path, capsys):
+    path = tmp_path / "run.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--no-progress"]) == 0
+    capsys.readouterr()
+    gif = str(tmp_path / "motion.gif")
+    line = refused(
+        ["deploy", "--load", str(path), "--animate", gif], capsys, by_parser=False, code=1
+    )
+    assert "kept no nodal fields for --animate" in line

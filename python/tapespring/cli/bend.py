@@ -329,11 +329,11 @@ _OUTPUT_OPTIONS = ("animate", "csv", "plot", "save", "snapshots", "vtu")
 
 
 def refuse_shared_paths(args: argparse.Namespace, option: str = "--experiment") -> None:
-    """Refuse (as `refuse`) outputs that would overwrite each other or the recording the command
+    """Refuse (as `refuse`) outputs that would overwrite each other or the files the command
     reads: ``--animate``, ``--csv``, ``--plot``, ``--save``, ``--snapshots`` and ``--vtu`` (its
-    ``.pvd`` file
-    and the folder of its VTU files) naming one file, or naming the ``--experiment`` recording or
-    a CSV recording's force side file (``<stem>.forces.csv``). Each writer replaced the file
+    ``.pvd`` file and the folder of its VTU files) naming one file, or naming the
+    ``--experiment`` recording, a CSV recording's force side file (``<stem>.forces.csv``) or the
+    saved run that ``--load`` reads. Each writer replaced the file
     silently: ``--experiment rec.csv --csv rec.csv`` replaced the recording with the simulation's
     table. Paths are compared once resolved (``./rec.csv``, a symbolic link). `option` names the
     recording's option in the messages (``--period-experiment`` of ``identify``)."""
@@ -352,6 +352,9 @@ def refuse_shared_paths(args: argparse.Namespace, option: str = "--experiment") 
                 read[side.resolve()] = (
                     f"the force side file {str(side)!r} of the {option} recording"
                 )
+    saved = getattr(args, "load", None)
+    if saved:
+        read[Path(saved).resolve()] = f"the saved run {saved} that --load reads"
     written: dict[Path, str] = {}
     for name in _OUTPUT_OPTIONS:
         text = getattr(args, name, None)

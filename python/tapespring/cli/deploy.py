@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .bend import (
+    CommandError,
     _count,
     _field,
     _gif_file,
@@ -13,12 +15,14 @@ from .bend import (
     _input_file,
     _npz_file,
     _vtu_file,
+    os_error_message,
     refuse,
     refuse_shared_paths,
     warn,
     wrote,
 )
 from .scenario_options import (
+    UNREADABLE_INPUT,
     add_energy_tolerance_option,
     add_output_options,
     add_rho_inf_option,
@@ -34,7 +38,7 @@ from .scenario_options import (
 )
 
 if TYPE_CHECKING:
-    from tapespring.scenarios.deployment import DeploymentSimulation
+    from tapespring.scenarios.deployment import DeploymentSettings, DeploymentSimulation
 
 __all__ = ["register", "run"]
 
@@ -158,6 +162,15 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "tapespring.scenarios.deployment.load_deployment(FILE) analyses it again in Python "
         "without running it",
     )
+    p.add_argument(
+        "--load",
+        type=_input_file,
+        metavar="FILE.npz",
+        help="analyse a run saved with --save instead of running one: its summary, --plot, "
+        "--csv, --json and --experiment comparison, and --vtu, --snapshots or --animate if it "
+        "kept nodal fields; the settings are the saved run's (the options that set a run are "
+        "refused with it)",
+    )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(
         p,
@@ -194,19 +207,11 @@ def _field_interval(args: argparse.Namespace, rate: float) -> int:
     return max(1, min(VTU_INTERVAL, int(args.duration * rate / 10.0)))
 
 
-def run(args: argparse.Namespace) -> int:
-    """Handler of ``tapespring deploy``; returns the exit code (0; 1 stopped early, no
-    comparison, or an experiment file that cannot be read; 2 bad input or a recording the
-    analysis refuses)."""
-    import numpy as np
+def _settings(args: argparse.Namespace) -> DeploymentSettings:
+    """The run's settings from the command's options, validated (main prints a ValueError as
+    bad input, exit 2, before a recording is read)."""
+    from tapespring.scenarios.deployment import DeploymentSettings
 
-    from tapespring.scenarios.deployment import DeploymentSettings, deploy
-
-    refuse_shared_paths(args)
-    if not args.experiment:
-        for kind in ("min", "max"):
-            if getattr(args, f"leave_aside_{kind}"):
-                refuse(args, f"--leave-aside-{kind} applies to the comparison with --experiment")
     spec = spec_from_args(args, support=args.support)
     rate = args.sample_rate
     if rate is None:
@@ -225,7 +230,82 @@ def run(args: argparse.Namespace) -> int:
         energy_tolerance=args.energy_tolerance,
         field_interval=_field_interval(args, rate),
     )
-    settings.validate()  # before a recording is read (main prints a ValueError, exit 2)
+    settings.validate()
+    return settings
+
+
+#: The options that set a run, which ``--load`` refuses (the saved run's settings apply).
+RUN_OPTIONS = (
+    "sense",
+    "support",
+    "sample_rate",
+    "duration",
+    "rho_inf",
+    "tolerance",
+    "energy_tolerance",
+    "mesh_tape",
+    "mesh_plates",
+    "thickness",
+    "youngs_modulus",
+    "eta",
+    "spec",
+)
+
+
+def _loaded(args: argparse.Namespace) -> DeploymentSimulation:
+    """The run saved in ``--load``'s file, after refusing the options that would set another
+    one (bad input, exit 2) and the pictures its file cannot draw; a file that is missing or
+    holds no saved deployment is reported as an unreadable input (`CommandError`, exit 1)."""
+    from tapespring.scenarios.deployment import load_deployment
+
+    given = [
+        f"--{name.replace('_', '-')}"
+        for name in RUN_OPTIONS
+        if getattr(args, name) != args.parser.get_default(name)
+    ]
+    if given:
+        refuse(
+            args,
+            f"--load analyses the saved run with its own settings: {', '.join(given)} "
+            "would set another run",
+        )
+    try:
+        if Path(args.load).is_dir():
+            raise IsADirectoryError(f"{args.load}: a folder, not a file")
+        loaded = load_deployment(args.load)
+    except (OSError, ValueError) as exc:
+        message = os_error_message(exc) if isinstance(exc, OSError) else str(exc)
+        if args.load not in message:
+            message = f"{args.load}: {message}"
+        raise CommandError(message, UNREADABLE_INPUT) from None
+    drawn = [f"--{name}" for name in ("vtu", "snapshots", "animate") if getattr(args, name)]
+    if drawn and loaded.results.field_records.size == 0:
+        raise CommandError(
+            f"{args.load}: the saved run kept no nodal fields for {' and '.join(drawn)} (save "
+            "it with one of --vtu, --snapshots or --animate)",
+            UNREADABLE_INPUT,
+        )
+    return loaded
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``tapespring deploy``; returns the exit code (0; 1 stopped early, no
+    comparison, or an experiment file that cannot be read; 2 bad input or a recording the
+    analysis refuses)."""
+    import numpy as np
+
+    from tapespring.scenarios.deployment import deploy
+
+    refuse_shared_paths(args)
+    if not args.experiment:
+        for kind in ("min", "max"):
+            if getattr(args, f"leave_aside_{kind}"):
+                refuse(args, f"--leave-aside-{kind} applies to the comparison with --experiment")
+    loaded = _loaded(args) if args.load else None
+    if loaded is not None:
+        settings = loaded.settings
+    else:
+        settings = _settings(args)
     measured = None
     if args.experiment:
         from tapespring.protocols.deployment import analyze_deployment
@@ -236,7 +316,7 @@ def run(args: argparse.Namespace) -> int:
         settings.check_recording(measured)
 
     def simulate() -> DeploymentSimulation:
-        result = deploy(settings, progress=shows_progress(args))
+        result = loaded if loaded is not None else deploy(settings, progress=shows_progress(args))
         if measured is not None:
 
             def compare() -> object:
