@@ -30,6 +30,33 @@ ROTATIONS = {
 }
 
 
+def _steel(nodes, quads, sets, thickness, **section) -> Model:
+    """A steel shell model (E_STEEL, nu = 0.3, RHO_STEEL) of the mesh, `section` added."""
+    return Model(
+        nodes,
+        quads,
+        node_sets=sets,
+        thickness=thickness,
+        youngs_modulus=E_STEEL,
+        poisson=0.3,
+        density=RHO_STEEL,
+        **section,
+    )
+
+
+def _aluminium(nodes, quads, sets, thickness) -> Model:
+    """An aluminium shell model (E = 70 GPa, nu = 0.3, 2700 kg/m^3) of the mesh."""
+    return Model(
+        nodes,
+        quads,
+        node_sets=sets,
+        thickness=thickness,
+        youngs_modulus=7e10,
+        poisson=0.3,
+        density=2700.0,
+    )
+
+
 def _rot(rotvec) -> np.ndarray:
     return Rotation.from_rotvec(rotvec).as_matrix()
 
@@ -106,15 +133,7 @@ def _loaded_panel(q, c, scale):
     offset rigid body with a full inertia tensor, under a tip force, a tip moment and gravity,
     everything placed by the rigid transform ``x -> q x + c``."""
     nodes, quads, sets = shell.cylindrical_panel_mesh(0.1, 0.12, -0.5, 0.5, 6, 6)
-    model = Model(
-        nodes @ q.T + c,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=7e10,
-        poisson=0.3,
-        density=2700.0,
-    )
+    model = _aluminium(nodes @ q.T + c, quads, sets, 1e-3)
     model.fix("x0")
     tip = model.add_node(q @ [0.12, 0.0, 0.1] + c)
     model.tie("x1", tip)
@@ -380,15 +399,7 @@ def test_dynamic_release_is_frame_invariant_on_fixed_steps():
 
 def _panel_for_reciprocity():
     nodes, quads, sets = shell.cylindrical_panel_mesh(0.1, 0.12, -0.5, 0.5, 6, 6)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=7e10,
-        poisson=0.3,
-        density=2700.0,
-    )
+    model = _aluminium(nodes, quads, sets, 1e-3)
     model.fix("x0")
     ref = model.add_node([0.13, 0.0, 0.1])
     model.tie("x1", ref)
@@ -464,15 +475,7 @@ def test_exported_stiffness_is_the_derivative_of_the_reactions_at_a_prestressed_
 
     def build():
         nodes, quads, sets = shell.cylindrical_panel_mesh(0.1, 0.06, -0.3, 0.3, 3, 3)
-        model = Model(
-            nodes,
-            quads,
-            node_sets=sets,
-            thickness=1e-3,
-            youngs_modulus=7e10,
-            poisson=0.3,
-            density=2700.0,
-        )
+        model = _aluminium(nodes, quads, sets, 1e-3)
         model.fix("x0")
         tip = model.nearest_node([0.06, 0.0, 0.1])
         model.add_load(tip, "uz", -load)
@@ -535,9 +538,7 @@ def test_effective_masses_over_all_modes_sum_to_the_free_mass():
     # completeness sums 1e-8 (eigenvectors to 1e-8).
     rho, t = RHO_STEEL, 1e-3
     nodes, quads, sets = shell.cylindrical_panel_mesh(0.1, 0.12, -0.5, 0.5, 3, 2)
-    model = Model(
-        nodes, quads, node_sets=sets, thickness=t, youngs_modulus=E_STEEL, poisson=0.3, density=rho
-    )
+    model = _steel(nodes, quads, sets, t)
     model.fix("x0")
     tip = model.add_node([0.15, 0.0, 0.1])
     model.tie("x1", tip)
@@ -636,9 +637,7 @@ def test_reactions_balance_loads_and_weight_at_large_rotation():
     # moment (Newton to 1e-8; measured 1e-10); the gravity potential -sum m g.x to 1e-10.
     rho, t = RHO_STEEL, 1e-3
     nodes, quads, sets = shell.flat_plate_mesh(0.2, 0.02, 12, 2)
-    model = Model(
-        nodes, quads, node_sets=sets, thickness=t, youngs_modulus=E_STEEL, poisson=0.3, density=rho
-    )
+    model = _steel(nodes, quads, sets, t)
     model.fix("x0")
     tip = model.add_node([0.2, 0.01, 0.0])
     model.tie("x1", tip)
@@ -832,16 +831,7 @@ def test_arc_length_and_displacement_control_reach_the_load_control_equilibrium(
 
 def _mode_one_strip(eta):
     nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-        eta=eta,
-    )
+    model = _steel(nodes, quads, sets, 1e-3, eta=eta)
     model.fix("x0")
     return model
 
@@ -915,15 +905,7 @@ def test_energy_identity_of_the_trapezoidal_rule_with_time_varying_loads(rho_inf
     # rho_inf = 0.7 the scheme dissipates: the remainder is positive at the end and larger
     # than that tolerance (measured 2e-4), so the bookkeeping is not trivially zero.
     nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-    )
+    model = _steel(nodes, quads, sets, 1e-3)
     model.fix("x0")
     tip = model.add_node([0.1, 0.01, 0.0])
     model.tie("x1", tip)
@@ -957,15 +939,7 @@ def test_pinned_rigid_body_reaction_is_its_inertia_less_its_weight():
     # integral at h = 2.5e-4 s, 1e-6 of the largest term (measured 2e-8; 4e-7 at rho_inf = 1);
     # the kinetic energy to round-off, 1e-12.
     pn, pq, ps = shell.flat_plate_mesh(0.01, 0.01, 1, 1)
-    model = Model(
-        pn + 5.0,
-        pq,
-        node_sets=ps,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-    )
+    model = _steel(pn + 5.0, pq, ps, 1e-3)
     model.fix("all")  # an element far away: a model needs one; the body is the system
     pin = model.add_node([0.0, 0.0, 0.0])
     offset, mass, inertia = np.array([0.3, 0.1, 0.0]), 2.0, np.diag([0.01, 0.02, 0.025])
@@ -993,15 +967,7 @@ def test_pinned_rigid_body_reaction_is_its_inertia_less_its_weight():
 
 def _free_panel(gravity, seed=0):
     nodes, quads, sets = shell.cylindrical_panel_mesh(0.05, 0.1, -0.8, 0.8, 6, 4)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=0.5e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-    )
+    model = _steel(nodes, quads, sets, 0.5e-3)
     tip = model.add_node([0.12, 0.0, 0.05])
     model.tie("x1", tip)
     offset, body = np.array([0.01, 0.02, -0.01]), 0.02
@@ -1128,9 +1094,7 @@ def test_impulse_momentum_of_a_clamped_vibrating_cantilever():
     # per period: tolerance 1e-5 of the largest term (measured 4e-8).
     rho, t = RHO_STEEL, 1e-3
     nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-    model = Model(
-        nodes, quads, node_sets=sets, thickness=t, youngs_modulus=E_STEEL, poisson=0.3, density=rho
-    )
+    model = _steel(nodes, quads, sets, t)
     model.fix("x0")
     tip = model.add_node([0.1, 0.01, 0.0])
     model.tie("x1", tip)
@@ -1173,16 +1137,7 @@ def _accelerated_support(mode, h, n, eta, pieces=1):
     nodes moved along a0 t^2/2 (a table of `pieces` pieces per time step)."""
     a0 = np.array([0.0, 3.0, 20.0])
     nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-        eta=eta,
-    )
+    model = _steel(nodes, quads, sets, 1e-3, eta=eta)
     clamp = sets["x0"]
     if mode == "gravity":
         model.fix("x0")
@@ -1282,16 +1237,7 @@ def test_prescribed_motion_is_insensitive_to_round_off_in_table_times():
     runs = []
     for times in (times_a, times_b):
         nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-        model = Model(
-            nodes,
-            quads,
-            node_sets=sets,
-            thickness=1e-3,
-            youngs_modulus=E_STEEL,
-            poisson=0.3,
-            density=RHO_STEEL,
-            eta=1e-4,
-        )
+        model = _steel(nodes, quads, sets, 1e-3, eta=1e-4)
         ref = model.add_node([0.0, 0.01, 0.0])
         model.tie("x0", ref)
         model.add_rigid_body(ref, 1.0)
@@ -1325,15 +1271,7 @@ def test_a_shaken_body_feels_its_inertia_in_the_reaction():
     # acceleration over a step of a five-hundredth of the period lags the peak by a phase of
     # 0.6 %, cos 0.006 = 1 - 2e-5) and (m + 2 x 1.063 m_strip) A w^2 (1 + 1 %) above.
     nodes, quads, sets = shell.flat_plate_mesh(0.1, 0.02, 8, 2)
-    model = Model(
-        nodes,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-    )
+    model = _steel(nodes, quads, sets, 1e-3)
     ref = model.add_node([0.0, 0.01, 0.0])
     model.tie("x0", ref)
     model.add_rigid_body(ref, 1.0)
@@ -1355,15 +1293,7 @@ def _pinned_body(centre, velocity=None):
     (from its node at the origin, or None: at the node), held in uz, rx, ry and rz, beside a
     fixed plate that gives the model a mesh."""
     nodes, quads, sets = shell.flat_plate_mesh(0.01, 0.01, 1, 1)
-    model = Model(
-        nodes + 5.0,
-        quads,
-        node_sets=sets,
-        thickness=1e-3,
-        youngs_modulus=E_STEEL,
-        poisson=0.3,
-        density=RHO_STEEL,
-    )
+    model = _steel(nodes + 5.0, quads, sets, 1e-3)
     model.fix("all")
     pin = model.add_node([0.0, 0.0, 0.0])
     model.add_rigid_body(pin, 2.0, centre_of_mass=centre, inertia=np.diag([0.01, 0.02, 0.025]))

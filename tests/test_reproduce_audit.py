@@ -37,6 +37,7 @@ from tapespring.results import _ARRAYS
 from tapespring.scenarios.bending import BendingSetup, bend, summarize
 from tapespring.scenarios.deployment import DeploymentSettings, deploy
 from tapespring.scenarios.equilibrium import EquilibriumSettings, equilibrium
+from tapespring.scenarios.max_mass import CSV_COLUMNS as MAX_MASS_COLUMNS
 from tapespring.scenarios.max_mass import MaxMassSettings, max_mass
 from tapespring.scenarios.pull import PullSettings, pull
 from tapespring.scenarios.release import ReleaseSetup, release
@@ -162,18 +163,7 @@ CSV_COLUMNS: dict[str, list[str]] = {
         "numerical_J",
     ],
     "bend": ["theta_deg", "moment_Nm", "stable", "branch", "jump", "event"],
-    "max-mass": [
-        "sense",
-        "thickness_m",
-        "youngs_modulus_Pa",
-        "residual_moment_Nm",
-        "residual_moment_analytical_Nm",
-        "m_max_kg",
-        "m_max_analytical_kg",
-        "ratio_fe_to_analytical",
-        "stable",
-        "run_wall_s",
-    ],
+    "max-mass": list(MAX_MASS_COLUMNS),
 }
 
 # Unit suffixes of names, and the dimensionless names (counts, flags, ratios, labels).
