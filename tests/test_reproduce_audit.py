@@ -991,3 +991,31 @@ def test_the_release_results_keep_its_setup(tmp_path):
     assert scenario["class"] == "tapespring.scenarios.release.ReleaseSetup"
     assert scenario["settings"]["duration"] == 0.005
     assert scenario["settings"]["tape"]["mesh_size"] == 4.5e-3
+
+
+def test_a_saved_vibration_loads_as_the_same_decay_and_refits_in_another_window(tmp_path):
+    """The free decay analysed again from its file: the same histories, fit and modal periods to
+    the bit; with another window, the fit that window gives on the same histories."""
+    from tapespring.scenarios.vibration import load_vibration
+    from tapespring.signals.damping import fit_damping
+
+    spec = replace(PAPER_SETUP, mesh_tape=5e-3, mesh_plates=10e-3)
+    # 0.35 s: three periods, six swings from 8 mm, enough for a fit in either window.
+    decay = vibrate(VibrationSettings(spec=spec, duration=0.35, window=(5e-4, 9e-3)))
+    assert decay.fit is not None
+    path = decay.save(tmp_path / "decay")
+    loaded = load_vibration(path)
+    assert loaded.settings == decay.settings
+    for name in ("time_s", "displacement_m", "modal_periods_s"):
+        assert np.array_equal(getattr(loaded, name), getattr(decay, name)), name
+    assert json.dumps(loaded.summary(), default=str) == json.dumps(
+        {**decay.summary(), "wall_s": loaded.wall_s}, default=str
+    )
+    window = (5e-4, 7.6e-3)  # the first swing (8 mm) left out
+    refit = load_vibration(path, window=window)
+    assert refit.settings.window == window
+    expected = fit_damping(decay.time_s, decay.displacement_m, window, t_start=0.0)
+    assert refit.fit.damping_ratio == expected.damping_ratio
+    assert refit.fit.damping_ratio != decay.fit.damping_ratio
+    with pytest.raises(ValueError, match="window"):
+        load_vibration(path, window=(9e-3, 1e-3))

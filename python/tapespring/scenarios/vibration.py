@@ -26,8 +26,10 @@ damping ratio of both, their differences, and the paper's model beside them
 from __future__ import annotations
 
 import copy
+import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,6 +56,7 @@ from tapespring.scenarios.setup import (
     gravity_step,
     last_ndof,
     sample_rows,
+    scenario_settings,
     shown,
     step_counts,
 )
@@ -65,6 +68,7 @@ __all__ = [
     "check_initial_displacement",
     "check_modes",
     "check_time_step",
+    "load_vibration",
     "loaded_periods",
     "vibrate",
 ]
@@ -251,6 +255,12 @@ class VibrationSimulation:
     results: Any
     wall_s: float
     comparison: VibrationComparison | None = None
+
+    def save(self, path: str | Path) -> Path:
+        """Write the run to a NumPy ``.npz`` file (:meth:`tapespring.Results.save` of `results`,
+        which holds these settings too); :func:`load_vibration` reads it back, with another
+        fitting window if asked. Returns the path written (``.npz`` appended if missing)."""
+        return Path(self.results.save(path))
 
     def sample_rows(self) -> NDArray[np.int64]:
         """Rows of the histories at the sample instants from the release: ``k / sample_rate``, or
@@ -566,7 +576,6 @@ def vibrate(
         If a step stops early (its ``result`` is the `VibrationSimulation` so far).
     """
     from tapespring.analysis import Outputs, Step, run
-    from tapespring.signals.damping import fit_damping
 
     settings.validate()
     start = time.perf_counter()
@@ -592,6 +601,17 @@ def vibrate(
     assert len(steps) - 1 == DECAY_STEP
     outputs = Outputs(reactions=((built.clamp, "uz"),), field_interval=settings.field_interval)
     results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
+    out = _simulation(results, settings, time.perf_counter() - start)
+    finish_scenario(results, out, "decay")
+    return out
+
+
+def _simulation(results: Any, settings: VibrationSettings, wall_s: float) -> VibrationSimulation:
+    """The free decay in `results` (run from `settings`): marker 3's displacement about the
+    loaded equilibrium from the release, its damping fit in ``settings.window``, the modal
+    periods; `wall_s` the run's wall time."""
+    from tapespring.signals.damping import fit_damping
+
     marker = results.marker_names.index("marker3")
     loaded = results.in_step(0)
     free = results.in_step(DECAY_STEP)
@@ -605,7 +625,7 @@ def vibrate(
         fit = fit_damping(t, z, settings.window, t_start=0.0)
     except ValueError as exc:
         fit_error = str(exc)
-    out = VibrationSimulation(
+    return VibrationSimulation(
         time_s=t,
         displacement_m=z,
         fit=fit,
@@ -613,7 +633,30 @@ def vibrate(
         modal_periods_s=np.asarray(periods),
         settings=settings,
         results=results,
-        wall_s=time.perf_counter() - start,
+        wall_s=wall_s,
     )
-    finish_scenario(results, out, "decay")
-    return out
+
+
+def load_vibration(
+    path: str | Path, *, window: tuple[float, float] | None = None
+) -> VibrationSimulation:
+    """A free decay saved by :meth:`VibrationSimulation.save`, analysed again without running it:
+    the settings it ran with are those recorded in the file; `window` [m] (low, high) fits the
+    damping in another band of peak amplitudes than the run's (the run's settings then carry it,
+    so that a comparison with a recording uses it too). ``wall_s`` is the saved run's solver time.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        As :meth:`tapespring.Results.load`; ValueError also if the file holds no vibration test's
+        settings, or for a bad `window`.
+    """
+    from tapespring.results import Results
+
+    results = Results.load(path)
+    settings = scenario_settings(results, VibrationSettings, path)
+    if window is not None:
+        settings = replace(settings, window=tuple(window))
+        settings.validate()
+    wall = results.stats.get("wall_s")
+    return _simulation(results, settings, math.nan if wall is None else float(wall))
