@@ -3,34 +3,31 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .bend import (
-    CommandError,
     _count,
     _field,
     _gif_file,
     _image_file,
     _input_file,
-    _npz_file,
     _vtu_file,
-    os_error_message,
     refuse,
     refuse_shared_paths,
     warn,
     wrote,
 )
 from .scenario_options import (
-    UNREADABLE_INPUT,
     add_energy_tolerance_option,
     add_output_options,
     add_rho_inf_option,
     add_sample_rate_option,
+    add_save_load_options,
     add_spec_options,
     add_tolerance_option,
     analyze_experiment,
     finish,
+    load_saved,
     shows_progress,
     spec_from_args,
     with_comparison,
@@ -152,24 +149,8 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"run, as for --snapshots), at most {MAX_FRAMES} frames, at {ANIMATION_FPS:g} frames "
         "per second (.gif added to a name without a suffix)",
     )
-    p.add_argument(
-        "--save",
-        type=_npz_file,
-        metavar="FILE.npz",
-        help="write the whole run (every record, the clamp's reactions, the nodal fields that "
-        "--vtu, --snapshots or --animate keep, and the settings it ran with) to this NumPy "
-        "file (.npz added if missing), also when it stops early: "
-        "tapespring.scenarios.deployment.load_deployment(FILE) analyses it again in Python "
-        "without running it",
-    )
-    p.add_argument(
-        "--load",
-        type=_input_file,
-        metavar="FILE.npz",
-        help="analyse a run saved with --save instead of running one: its summary, --plot, "
-        "--csv, --json and --experiment comparison, and --vtu, --snapshots or --animate if it "
-        "kept nodal fields; the settings are the saved run's (the options that set a run are "
-        "refused with it)",
+    add_save_load_options(
+        p, test="the deployment", python="tapespring.scenarios.deployment.load_deployment"
     )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(
@@ -253,39 +234,10 @@ RUN_OPTIONS = (
 
 
 def _loaded(args: argparse.Namespace) -> DeploymentSimulation:
-    """The run saved in ``--load``'s file, after refusing the options that would set another
-    one (bad input, exit 2) and the pictures its file cannot draw; a file that is missing or
-    holds no saved deployment is reported as an unreadable input (`CommandError`, exit 1)."""
+    """The deployment saved in ``--load``'s file (`load_saved`)."""
     from tapespring.scenarios.deployment import load_deployment
 
-    given = [
-        f"--{name.replace('_', '-')}"
-        for name in RUN_OPTIONS
-        if getattr(args, name) != args.parser.get_default(name)
-    ]
-    if given:
-        refuse(
-            args,
-            f"--load analyses the saved run with its own settings: {', '.join(given)} "
-            "would set another run",
-        )
-    try:
-        if Path(args.load).is_dir():
-            raise IsADirectoryError(f"{args.load}: a folder, not a file")
-        loaded = load_deployment(args.load)
-    except (OSError, ValueError) as exc:
-        message = os_error_message(exc) if isinstance(exc, OSError) else str(exc)
-        if args.load not in message:
-            message = f"{args.load}: {message}"
-        raise CommandError(message, UNREADABLE_INPUT) from None
-    drawn = [f"--{name}" for name in ("vtu", "snapshots", "animate") if getattr(args, name)]
-    if drawn and loaded.results.field_records.size == 0:
-        raise CommandError(
-            f"{args.load}: the saved run kept no nodal fields for {' and '.join(drawn)} (save "
-            "it with one of --vtu, --snapshots or --animate)",
-            UNREADABLE_INPUT,
-        )
-    return loaded
+    return load_saved(args, RUN_OPTIONS, load_deployment)
 
 
 def run(args: argparse.Namespace) -> int:

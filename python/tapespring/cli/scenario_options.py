@@ -19,9 +19,11 @@ from .bend import (
     _field,
     _image_file,
     _input_file,
+    _npz_file,
     _output_file,
     _vtu_file,
     os_error_message,
+    refuse,
     wrote,
 )
 
@@ -36,12 +38,14 @@ __all__ = [
     "add_progress_options",
     "add_rho_inf_option",
     "add_sample_rate_option",
+    "add_save_load_options",
     "add_spec_options",
     "add_thickness_option",
     "add_tolerance_option",
     "add_youngs_modulus_option",
     "analyze_experiment",
     "finish",
+    "load_saved",
     "shows_progress",
     "spec_assignment",
     "spec_from_args",
@@ -597,6 +601,66 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any], *, test: str) -
     if str(path) not in message and str(Path(path)) not in message:
         message = f"{path}: {message}"
     raise CommandError(message, code)
+
+
+def add_save_load_options(p: argparse.ArgumentParser, *, test: str, python: str) -> None:
+    """Add ``--save FILE.npz`` (the whole run with its settings) and ``--load FILE.npz`` (a
+    saved run analysed again instead of running one, `load_saved`); `test` names the run ("a
+    deployment"), `python` the function that loads it in Python."""
+    p.add_argument(
+        "--save",
+        type=_npz_file,
+        metavar="FILE.npz",
+        help=f"write the whole run of {test} (every record, the reactions, the nodal fields "
+        "that the pictures keep, and the settings it ran with) to this NumPy file (.npz added "
+        f"if missing), also when it stops early: --load, or {python}(FILE) in Python, "
+        "analyses it again without running it",
+    )
+    p.add_argument(
+        "--load",
+        type=_input_file,
+        metavar="FILE.npz",
+        help="analyse a run saved with --save instead of running one: its summary, --plot, "
+        "--csv, --json, --experiment comparison and pictures (if it kept nodal fields); the "
+        "settings are the saved run's (the options that set a run are refused with it)",
+    )
+
+
+def load_saved(args: argparse.Namespace, run_options: Sequence[str], load: Callable[[str], R]) -> R:
+    """The run saved in ``--load``'s file, read by `load`, after refusing (as `refuse`, exit 2)
+    the `run_options` (parser destinations) given with values other than their defaults, which
+    would set another run; a file that is missing or holds no saved run of this kind, or whose
+    run kept no nodal fields for ``--vtu``, ``--snapshots`` or ``--animate``, is reported as an
+    unreadable input (`CommandError`, exit 1)."""
+    given = [
+        f"--{name.replace('_', '-')}"
+        for name in run_options
+        if getattr(args, name) != args.parser.get_default(name)
+    ]
+    if given:
+        refuse(
+            args,
+            f"--load analyses the saved run with its own settings: {', '.join(given)} would "
+            "set another run",
+        )
+    try:
+        if Path(args.load).is_dir():
+            raise IsADirectoryError(f"{args.load}: a folder, not a file")
+        loaded = load(args.load)
+    except (OSError, ValueError) as exc:
+        message = os_error_message(exc) if isinstance(exc, OSError) else str(exc)
+        if args.load not in message:
+            message = f"{args.load}: {message}"
+        raise CommandError(message, UNREADABLE_INPUT) from None
+    drawn = [f"--{name}" for name in ("vtu", "snapshots", "animate") if getattr(args, name, None)]
+    saved: Any = loaded  # a scenario's result: its analysis results are `results`
+    if drawn and saved.results.field_records.size == 0:
+        raise CommandError(
+            f"{args.load}: the saved run kept no nodal fields for {' and '.join(drawn)} (save "
+            "it with one of them)",
+            UNREADABLE_INPUT,
+        )
+    return loaded
 
 
 def with_comparison(

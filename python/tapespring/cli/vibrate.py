@@ -8,16 +8,18 @@ import functools
 import warnings
 from typing import TYPE_CHECKING, Any
 
-from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths
+from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths, wrote
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
     add_rho_inf_option,
     add_sample_rate_option,
+    add_save_load_options,
     add_spec_options,
     add_tolerance_option,
     analyze_experiment,
     finish,
+    load_saved,
     shows_progress,
     spec_from_args,
     with_comparison,
@@ -57,11 +59,12 @@ def _check(args: argparse.Namespace) -> None:
     """Refuse a bad --window-mm and the options that the others given make ineffective."""
     from tapespring.signals.damping import check_window
 
-    low, high = args.window_mm
-    try:
-        check_window((low * 1e-3, high * 1e-3))
-    except ValueError as e:
-        refuse(args, f"--window-mm {low:g} {high:g}: {e}")
+    if args.window_mm is not None:
+        low, high = args.window_mm
+        try:
+            check_window((low * 1e-3, high * 1e-3))
+        except ValueError as e:
+            refuse(args, f"--window-mm {low:g} {high:g}: {e}")
     if args.rho_inf_study:
         repeated = sorted({r for r in args.rho_inf_study if args.rho_inf_study.count(r) > 1})
         if repeated:
@@ -79,6 +82,24 @@ def _check(args: argparse.Namespace) -> None:
                 flag = "--" + option.replace("_", "-")
                 refuse(args, f"{flag} applies to adaptive steps, not to a fixed --time-step")
 
+
+#: The options that set a run, which ``--load`` refuses (the saved run's settings apply; the
+#: fitting window, ``--window-mm``, is the analysis's and may be given).
+RUN_OPTIONS = (
+    "duration",
+    "initial_displacement",
+    "rho_inf",
+    "tolerance",
+    "sample_rate",
+    "time_step",
+    "rho_inf_study",
+    "mesh_tape",
+    "mesh_plates",
+    "thickness",
+    "youngs_modulus",
+    "eta",
+    "spec",
+)
 
 #: Rate of the ParaView series that ``--vtu`` writes [Hz].
 VTU_RATE = 50.0
@@ -127,11 +148,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--window-mm",
         type=float,
         nargs=2,
-        default=[w * 1e3 for w in d.window],
         metavar=("LOW", "HIGH"),
         help="range of the peaks' swing about the equilibrium fitted [mm] (default "
         + " ".join(f"{w * 1e3:g}" for w in d.window)
-        + " mm; paper: 0.4 4 mm)",
+        + " mm, or with --load the saved run's; paper: 0.4 4 mm)",
     )
     add_tolerance_option(p, d.tolerance, unset=True, caveat="; not with a fixed --time-step")
     add_sample_rate_option(
@@ -165,6 +185,9 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         vtu=f"about {VTU_RATE:g} Hz: every {round(d.sample_rate / VTU_RATE)}th record at the "
         f"default {d.sample_rate:g} Hz samples",
     )
+    add_save_load_options(
+        p, test="the free decay", python="tapespring.scenarios.vibration.load_vibration"
+    )
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3)
     add_output_options(
         p,
@@ -183,11 +206,15 @@ def run(args: argparse.Namespace) -> int:
     """Handler of ``tapespring vibrate``; returns the exit code (0; 1 stopped early, no
     comparison, or an experiment file that cannot be read; 2 bad input or a recording the
     analysis refuses)."""
-    from tapespring.scenarios.vibration import vibrate
+    from tapespring.scenarios.vibration import VibrationSettings, load_vibration, vibrate
 
     refuse_shared_paths(args)
     _check(args)
-    window = (args.window_mm[0] * 1e-3, args.window_mm[1] * 1e-3)
+    given = None if args.window_mm is None else (args.window_mm[0] * 1e-3, args.window_mm[1] * 1e-3)
+    loaded = None
+    if args.load:
+        loaded = load_saved(args, RUN_OPTIONS, lambda path: load_vibration(path, window=given))
+    window = given or (loaded.settings.window if loaded is not None else VibrationSettings.window)
     if args.rho_inf_study:
         return _run_study(args, window)
     measured = None
@@ -202,12 +229,15 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def simulate() -> VibrationSimulation:
-        settings = _settings(args, window, "rho_inf", "tolerance", "sample_rate")
-        if args.vtu:
-            # About VTU_RATE whatever the records' rate.
-            interval = max(1, round(settings.record_rate / VTU_RATE))
-            settings = dataclasses.replace(settings, field_interval=interval)
-        result = vibrate(settings, progress=shows_progress(args))
+        if loaded is not None:
+            result = loaded
+        else:
+            settings = _settings(args, window, "rho_inf", "tolerance", "sample_rate")
+            if args.vtu:
+                # About VTU_RATE whatever the records' rate.
+                interval = max(1, round(settings.record_rate / VTU_RATE))
+                settings = dataclasses.replace(settings, field_interval=interval)
+            result = vibrate(settings, progress=shows_progress(args))
         if result.fit is None:
             # The test's figures are the fitted damping ratio and period: without them the run
             # has not done what it was asked (it exited 0 with "no damping fit" in its summary).
@@ -233,6 +263,10 @@ def run(args: argparse.Namespace) -> int:
         }
 
     def extra(result: VibrationSimulation) -> None:
+        if args.save:
+            saved = result.save(args.save)
+            if not args.json:
+                print(wrote(saved))
         write_vtu(args, result.results, None)
 
     return finish(args, simulate, columns, plot, extra=extra, problems=problems)

@@ -1,5 +1,6 @@
-"""``tapespring deploy --save FILE.npz``: the whole run with the settings it ran with, which
-``load_deployment`` analyses again without running it, and the names it refuses before the run."""
+"""``tapespring deploy|vibrate --save FILE.npz``: the whole run with the settings it ran with,
+and ``--load FILE.npz`` (``load_deployment``, ``load_vibration`` in Python), which analyses it
+again without running it; the names and options they refuse."""
 
 from __future__ import annotations
 
@@ -91,3 +92,45 @@ def test_load_without_fields_refuses_the_pictures(tmp_path, capsys):
         ["deploy", "--load", str(path), "--animate", gif], capsys, by_parser=False, code=1
     )
     assert "kept no nodal fields for --animate" in line
+
+
+#: A short free decay on coarse meshes: three periods from 8 mm, enough swings for a fit.
+_SHORT_VIBRATE = [
+    "vibrate",
+    "--mesh-tape",
+    "5e-3",
+    "--mesh-plates",
+    "1e-2",
+    "--duration",
+    "0.35",
+    "--window-mm",
+    "0.5",
+    "9",
+]
+
+
+def test_vibrate_load_refits_the_saved_decay_in_another_window(tmp_path, capsys, monkeypatch):
+    path = tmp_path / "decay.npz"
+    assert main([*_SHORT_VIBRATE, "--save", str(path), "--json", "--no-progress"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    import tapespring.scenarios.vibration as vibration
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("--load ran a vibration test")
+
+    monkeypatch.setattr(vibration, "vibrate", no_run)
+    # Without --window-mm, the saved run's window: the same fit.
+    assert main(["vibrate", "--load", str(path), "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["damping_ratio"] == printed["damping_ratio"]
+    assert again["settings"] == printed["settings"]
+    # Another window fits other swings (the first, 8 mm one, left out).
+    assert main(["vibrate", "--load", str(path), "--window-mm", "0.5", "7.6", "--json"]) == 0
+    refit = json.loads(capsys.readouterr().out)
+    assert refit["settings"]["window"] == [0.5e-3, 7.6e-3]
+    assert refit["damping_ratio"] != printed["damping_ratio"]
+    assert refit["time_s"] == printed["time_s"]
+    line = refused(["vibrate", "--load", str(path), "--rho-inf-study", "0.7"], capsys)
+    assert "--rho-inf-study would set another run" in line
+    line = refused(["vibrate", "--load", str(path), "--window-mm", "4", "1"], capsys)
+    assert "--window-mm 4 1" in line
