@@ -134,3 +134,62 @@ def test_vibrate_load_refits_the_saved_decay_in_another_window(tmp_path, capsys,
     assert "--rho-inf-study would set another run" in line
     line = refused(["vibrate", "--load", str(path), "--window-mm", "4", "1"], capsys)
     assert "--window-mm 4 1" in line
+
+
+def _edited(path, tmp_path, name, **changes):
+    """The saved run of `path` with `changes` to its results (error=...) or, under "scenario",
+    to its recorded settings, saved as `name`."""
+    import dataclasses
+
+    from tapespring import Results
+
+    results = Results.load(path)
+    scenario = changes.pop("scenario", None)
+    if scenario:
+        results.settings["scenario"]["settings"].update(scenario)
+    return dataclasses.replace(results, **changes).save(tmp_path / name)
+
+
+def test_load_of_a_run_that_stopped_early_writes_it_and_exits_1(tmp_path, capsys):
+    path = tmp_path / "run.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--no-progress"]) == 0
+    capsys.readouterr()
+    stopped = _edited(path, tmp_path, "stopped.npz", error="the release did not converge")
+    csv = tmp_path / "stopped.csv"
+    assert main(["deploy", "--load", str(stopped), "--csv", str(csv)]) == 1
+    out = capsys.readouterr()
+    assert "the saved run stopped early: the release did not converge" in out.err
+    assert csv.is_file()
+
+
+def test_load_refuses_records_that_are_not_those_of_their_settings(tmp_path, capsys):
+    path = tmp_path / "run.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(path), "--no-progress"]) == 0
+    capsys.readouterr()
+    for name, edit in (("settle", {"settle": 0.005}), ("sense", {"sense": "equal"})):
+        edited = _edited(path, tmp_path, f"{name}.npz", scenario=edit)
+        line = refused(["deploy", "--load", str(edited)], capsys, by_parser=False, code=1)
+        assert "its records are not those of the run its recorded settings describe" in line
+
+
+def test_save_names_the_file_numpy_writes(tmp_path, capsys):
+    assert main([*_SHORT_DEPLOY, "--save", str(tmp_path / "RUN.NPZ"), "--no-progress"]) == 0
+    written = tmp_path / "RUN.NPZ.npz"
+    assert f"  wrote {written}\n" in capsys.readouterr().out and written.is_file()
+    # --load of that file and --save of the name numpy turns into it: one file, refused.
+    line = refused(["deploy", "--load", str(written), "--save", str(tmp_path / "RUN.NPZ")], capsys)
+    assert "would overwrite the saved run" in line
+
+
+def test_vibrate_resaved_after_a_refit_keeps_its_window(tmp_path, capsys):
+    from tapespring.scenarios.vibration import load_vibration
+
+    path = tmp_path / "decay.npz"
+    assert main([*_SHORT_VIBRATE, "--save", str(path), "--no-progress"]) == 0
+    again = tmp_path / "refit.npz"
+    argv = ["vibrate", "--load", str(path), "--window-mm", "0.5", "7.6", "--save", str(again)]
+    assert main(argv) == 0
+    assert load_vibration(again).settings.window == (0.5e-3, 7.6e-3)
+    capsys.readouterr()
+    line = refused([*_SHORT_VIBRATE, "--rho-inf-study", "0.7", "--save", str(again)], capsys)
+    assert "--rho-inf-study takes no --save" in line

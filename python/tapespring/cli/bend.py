@@ -311,20 +311,20 @@ def _vtu_file(text: str) -> str:
     return str(path)
 
 
-#: The options naming a file a command writes, as `refuse_shared_paths` reads them.
 @_path_type
 def _npz_file(text: str) -> str:
     """An argparse type: the NumPy ``.npz`` file of a saved run the command will write (as
     `_output_file`), ``.npz`` added to a name without that suffix, as
     :meth:`tapespring.Results.save` adds it (so that the command names the file it wrote)."""
     _output_file(text)
-    if text.lower().endswith(".npz"):
+    if text.endswith(".npz"):  # as numpy.savez: "RUN.NPZ" is written "RUN.NPZ.npz"
         return text
     named = f"{text}.npz"
     _output_file(named)
     return named
 
 
+#: The options naming a file a command writes, as `refuse_shared_paths` reads them.
 _OUTPUT_OPTIONS = ("animate", "csv", "plot", "save", "snapshots", "vtu")
 
 

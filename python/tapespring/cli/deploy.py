@@ -28,9 +28,11 @@ from .scenario_options import (
     analyze_experiment,
     finish,
     load_saved,
+    saved_run,
     shows_progress,
     spec_from_args,
     with_comparison,
+    write_saved,
     write_vtu,
 )
 
@@ -150,7 +152,10 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "per second (.gif added to a name without a suffix)",
     )
     add_save_load_options(
-        p, test="the deployment", python="tapespring.scenarios.deployment.load_deployment"
+        p,
+        test="the deployment",
+        python="tapespring.scenarios.deployment.load_deployment",
+        pictures="--vtu, --snapshots and --animate",
     )
     add_spec_options(p, mesh_tape=DEFAULT_MESH_TAPE, mesh_plates=DEFAULT_MESH_PLATES)
     add_output_options(
@@ -268,7 +273,10 @@ def run(args: argparse.Namespace) -> int:
         settings.check_recording(measured)
 
     def simulate() -> DeploymentSimulation:
-        result = loaded if loaded is not None else deploy(settings, progress=shows_progress(args))
+        if loaded is not None:
+            result = saved_run(loaded)
+        else:
+            result = deploy(settings, progress=shows_progress(args))
         if measured is not None:
 
             def compare() -> object:
@@ -290,10 +298,7 @@ def run(args: argparse.Namespace) -> int:
     problems: list[str] = []
 
     def fields(result: DeploymentSimulation) -> None:
-        if args.save:
-            saved = result.save(args.save)
-            if not args.json:
-                print(wrote(saved))
+        write_saved(args, result)
         write_vtu(args, result.results, result.setup.model)
         drawn = [f"--{name}" for name in ("snapshots", "animate") if getattr(args, name)]
         if not drawn:

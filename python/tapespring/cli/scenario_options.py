@@ -46,11 +46,13 @@ __all__ = [
     "analyze_experiment",
     "finish",
     "load_saved",
+    "saved_run",
     "shows_progress",
     "spec_assignment",
     "spec_from_args",
     "with_comparison",
     "with_spec_assignments",
+    "write_saved",
     "write_vtu",
 ]
 
@@ -603,16 +605,19 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any], *, test: str) -
     raise CommandError(message, code)
 
 
-def add_save_load_options(p: argparse.ArgumentParser, *, test: str, python: str) -> None:
+def add_save_load_options(
+    p: argparse.ArgumentParser, *, test: str, python: str, pictures: str, analysis: str = ""
+) -> None:
     """Add ``--save FILE.npz`` (the whole run with its settings) and ``--load FILE.npz`` (a
-    saved run analysed again instead of running one, `load_saved`); `test` names the run ("a
-    deployment"), `python` the function that loads it in Python."""
+    saved run analysed again instead of running one, `load_saved`); `test` names the run ("the
+    deployment"), `python` the function that loads it in Python, `pictures` the options that
+    draw nodal fields ("--vtu"), `analysis` what else may be given with ``--load``."""
     p.add_argument(
         "--save",
         type=_npz_file,
         metavar="FILE.npz",
         help=f"write the whole run of {test} (every record, the reactions, the nodal fields "
-        "that the pictures keep, and the settings it ran with) to this NumPy file (.npz added "
+        f"that {pictures} keep, and the settings it ran with) to this NumPy file (.npz added "
         f"if missing), also when it stops early: --load, or {python}(FILE) in Python, "
         "analyses it again without running it",
     )
@@ -621,9 +626,33 @@ def add_save_load_options(p: argparse.ArgumentParser, *, test: str, python: str)
         type=_input_file,
         metavar="FILE.npz",
         help="analyse a run saved with --save instead of running one: its summary, --plot, "
-        "--csv, --json, --experiment comparison and pictures (if it kept nodal fields); the "
-        "settings are the saved run's (the options that set a run are refused with it)",
+        f"--csv, --json, --experiment comparison and {pictures} (if it kept nodal fields)"
+        f"{analysis}; the settings are the saved run's, and the options that set a run are "
+        "refused with it (exit 1 if it had stopped early, as the run did)",
     )
+
+
+def saved_run(result: R) -> R:
+    """A run loaded by `load_saved`, for a command's `finish`: ConvergenceError carrying it if
+    the saved run had stopped early, so that the command writes what it has and exits with 1,
+    as after the run itself."""
+    from tapespring.analysis import ConvergenceError
+
+    loaded: Any = result  # a scenario's result: its analysis results are `results`
+    error = loaded.results.error
+    if error is None:
+        return result
+    err = ConvergenceError(f"the saved run stopped early: {error}")
+    err.result = result
+    raise err
+
+
+def write_saved(args: argparse.Namespace, result: Any) -> None:
+    """``--save``: write the run (its ``save``) and say so unless ``--json``."""
+    if args.save:
+        path = result.save(args.save)
+        if not args.json:
+            print(wrote(path))
 
 
 def load_saved(args: argparse.Namespace, run_options: Sequence[str], load: Callable[[str], R]) -> R:

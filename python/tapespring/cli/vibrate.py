@@ -8,7 +8,7 @@ import functools
 import warnings
 from typing import TYPE_CHECKING, Any
 
-from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths, wrote
+from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths
 from .scenario_options import (
     add_comparison_options,
     add_output_options,
@@ -20,9 +20,11 @@ from .scenario_options import (
     analyze_experiment,
     finish,
     load_saved,
+    saved_run,
     shows_progress,
     spec_from_args,
     with_comparison,
+    write_saved,
     write_vtu,
 )
 
@@ -73,7 +75,7 @@ def _check(args: argparse.Namespace) -> None:
             refuse(args, f"--rho-inf-study gives {twice} more than once: give each radius once")
         if args.rho_inf is not None:
             refuse(args, "--rho-inf is not used with --rho-inf-study, which gives the radii")
-        for option in ("experiment", "vtu"):
+        for option in ("experiment", "vtu", "save"):
             if getattr(args, option):
                 refuse(args, f"--rho-inf-study takes no --{option}")
     if args.time_step > 0.0:
@@ -186,7 +188,11 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"default {d.sample_rate:g} Hz samples",
     )
     add_save_load_options(
-        p, test="the free decay", python="tapespring.scenarios.vibration.load_vibration"
+        p,
+        test="the free decay",
+        python="tapespring.scenarios.vibration.load_vibration",
+        pictures="--vtu",
+        analysis="; --window-mm fits it in another window",
     )
     add_spec_options(p, mesh_tape=5e-3, mesh_plates=5e-3)
     add_output_options(
@@ -230,7 +236,7 @@ def run(args: argparse.Namespace) -> int:
 
     def simulate() -> VibrationSimulation:
         if loaded is not None:
-            result = loaded
+            result = saved_run(loaded)
         else:
             settings = _settings(args, window, "rho_inf", "tolerance", "sample_rate")
             if args.vtu:
@@ -263,10 +269,7 @@ def run(args: argparse.Namespace) -> int:
         }
 
     def extra(result: VibrationSimulation) -> None:
-        if args.save:
-            saved = result.save(args.save)
-            if not args.json:
-                print(wrote(saved))
+        write_saved(args, result)
         write_vtu(args, result.results, None)
 
     return finish(args, simulate, columns, plot, extra=extra, problems=problems)

@@ -62,6 +62,7 @@ from tapespring.scenarios.setup import (
     check_energy_tolerance,
     check_min_samples,
     check_number,
+    check_recorded,
     check_rho_inf,
     check_sampling,
     check_sense,
@@ -73,6 +74,8 @@ from tapespring.scenarios.setup import (
     gravity_step,
     last_ndof,
     sample_rows,
+    save_run,
+    saved_wall_s,
     scenario_settings,
     step_counts,
 )
@@ -272,9 +275,9 @@ class DeploymentSimulation:
 
     def save(self, path: str | Path) -> Path:
         """Write the run to a NumPy ``.npz`` file (:meth:`tapespring.Results.save` of `results`,
-        which holds these settings too); :func:`load_deployment` reads it back. Returns the path
-        written (``.npz`` appended if `path` does not end so)."""
-        return Path(self.results.save(path))
+        with these settings); :func:`load_deployment` reads it back. Returns the path written
+        (``.npz`` appended if `path` does not end so)."""
+        return save_run(self, path)
 
     def sample_rows(self) -> NDArray[np.int64]:
         """Rows of the histories at the sample instants ``k / sample_rate`` from the release.
@@ -601,10 +604,21 @@ def deploy(
     tapespring.analysis.ConvergenceError
         If a step stops early (its ``result`` is the `DeploymentSimulation` recorded so far).
     """
-    from tapespring.analysis import Outputs, Step, run
+    from tapespring.analysis import run
 
     settings.validate()
     start = time.perf_counter()
+    built, steps, outputs = _plan(settings)
+    results = run(built.model, steps, outputs=outputs, progress=progress, raise_on_error=False)
+    out = _simulation(results, settings, built, start)
+    finish_scenario(results, out, "deployment")
+    return out
+
+
+def _plan(settings: DeploymentSettings) -> tuple[SetupModel, list[Any], Any]:
+    """The set-up, the analysis steps and the outputs of a deployment run from `settings`."""
+    from tapespring.analysis import Outputs, Step
+
     built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
     model = built.model
     # The free end is turned to the initial angle about y at both small interfaces, free to
@@ -628,10 +642,7 @@ def deploy(
         reactions=tuple((built.clamp, d) for d in ("ux", "uy", "uz", "rx", "ry", "rz")),
         field_interval=settings.field_interval,
     )
-    results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
-    out = _simulation(results, settings, built, start)
-    finish_scenario(results, out, "deployment")
-    return out
+    return built, steps, outputs
 
 
 def _simulation(
@@ -697,22 +708,25 @@ def load_deployment(path: str | Path) -> DeploymentSimulation:
     """A deployment saved by :meth:`DeploymentSimulation.save`, analysed again without running it.
 
     The settings it ran with are those recorded in the file (``results.settings["scenario"]``);
-    the set-up's model is built again from them (its markers, clamp and sense), so the histories,
-    peaks, phases and comparisons are those of the run. ``wall_s`` is the saved run's solver time.
+    the set-up's model is built again from them (its markers, clamp and sense) and must be the
+    recorded one, so the histories, peaks, phases and comparisons are those of the run. A run
+    that stopped early loads as recorded (``results.error`` says why). ``wall_s`` is the saved
+    run's solver time.
 
     Raises
     ------
     FileNotFoundError, ValueError
         As :meth:`tapespring.Results.load`; ValueError also if the file holds no deployment's
-        settings (another scenario's results, or the generic analysis's).
+        settings (another scenario's results, or the generic analysis's), or records that are not
+        those of its settings.
     """
     from tapespring.results import Results
 
     results = Results.load(path)
     settings = scenario_settings(results, DeploymentSettings, path)
-    built = build_setup(settings.spec, configuration="appendix", sense=settings.sense)
-    wall = results.stats.get("wall_s")
-    return _simulation(results, settings, built, 0.0, math.nan if wall is None else float(wall))
+    built, steps, _ = _plan(settings)
+    check_recorded(results, built.model, steps, path)
+    return _simulation(results, settings, built, 0.0, saved_wall_s(results))
 
 
 def _crossing_items(x: dict[str, Any]) -> list[str]:

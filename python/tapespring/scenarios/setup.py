@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -76,7 +78,10 @@ __all__ = [
     "check_thin",
     "check_tolerance",
     "check_youngs_modulus",
+    "check_recorded",
     "record_scenario",
+    "save_run",
+    "saved_wall_s",
     "scenario_settings",
     "settings_from_dict",
     "shown",
@@ -1772,6 +1777,53 @@ def scenario_settings(results: Any, cls: type[Any], source: object) -> Any:
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{source}: the recorded settings do not rebuild: {exc}") from None
     return settings
+
+
+def save_run(result: Any, path: str | os.PathLike[str]) -> Any:
+    """Write a scenario's `result` (its ``results`` and ``settings``) to a NumPy ``.npz`` file:
+    the settings recorded again first (:func:`record_scenario`), so that a result loaded with
+    another analysis setting (``load_vibration``'s window) is saved with the one it shows.
+    Returns the path written (:meth:`tapespring.Results.save`)."""
+    from pathlib import Path
+
+    record_scenario(result.results, result.settings)
+    return Path(result.results.save(path))
+
+
+def check_recorded(results: Any, model: Any, steps: Sequence[Any], source: object) -> None:
+    """Refuse (ValueError naming `source`) `results` whose recorded model or steps are not the
+    `model` and `steps` that their recorded scenario settings build: a file whose settings were
+    edited, or records of another run under them, would otherwise be analysed as that run (the
+    wrong clamp, sense or release step: a traceback or wrong figures)."""
+    import json
+
+    def plain(value: object) -> object:
+        return json.loads(json.dumps(value, default=str))
+
+    recorded = results.settings.get("steps")
+    same = json.loads(model.to_json()) == results.settings.get("model")
+    if same and isinstance(recorded, list) and len(recorded) == len(steps):
+        for step, saved in zip(steps, recorded, strict=True):
+            wanted = {"name": step.name, "kind": step.kind, **step.options}
+            if not isinstance(saved, dict) or any(
+                plain(v) != plain(saved.get(k)) for k, v in wanted.items()
+            ):
+                same = False
+                break
+    else:
+        same = False
+    if not same:
+        raise ValueError(
+            f"{source}: its records are not those of the run its recorded settings describe "
+            "(settings edited, or another run's records)"
+        )
+
+
+def saved_wall_s(results: Any) -> float:
+    """The solver's wall time recorded in loaded `results` [s] (NaN if missing or not a number)."""
+    wall = results.stats.get("wall_s")
+    ok = isinstance(wall, numbers.Real) and not isinstance(wall, bool)
+    return float(wall) if ok else math.nan
 
 
 def finish_scenario(results: Any, result: Any, what: str) -> None:

@@ -26,7 +26,6 @@ damping ratio of both, their differences, and the paper's model beside them
 from __future__ import annotations
 
 import copy
-import math
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -46,6 +45,7 @@ from tapespring.scenarios.setup import (
     check_displacement,
     check_min_samples,
     check_number,
+    check_recorded,
     check_rho_inf,
     check_sampling,
     check_spec,
@@ -56,6 +56,8 @@ from tapespring.scenarios.setup import (
     gravity_step,
     last_ndof,
     sample_rows,
+    save_run,
+    saved_wall_s,
     scenario_settings,
     shown,
     step_counts,
@@ -260,7 +262,7 @@ class VibrationSimulation:
         """Write the run to a NumPy ``.npz`` file (:meth:`tapespring.Results.save` of `results`,
         which holds these settings too); :func:`load_vibration` reads it back, with another
         fitting window if asked. Returns the path written (``.npz`` appended if missing)."""
-        return Path(self.results.save(path))
+        return save_run(self, path)
 
     def sample_rows(self) -> NDArray[np.int64]:
         """Rows of the histories at the sample instants from the release: ``k / sample_rate``, or
@@ -575,10 +577,21 @@ def vibrate(
     tapespring.analysis.ConvergenceError
         If a step stops early (its ``result`` is the `VibrationSimulation` so far).
     """
-    from tapespring.analysis import Outputs, Step, run
+    from tapespring.analysis import run
 
     settings.validate()
     start = time.perf_counter()
+    built, steps, outputs = _plan(settings)
+    results = run(built.model, steps, outputs=outputs, progress=progress, raise_on_error=False)
+    out = _simulation(results, settings, time.perf_counter() - start)
+    finish_scenario(results, out, "decay")
+    return out
+
+
+def _plan(settings: VibrationSettings) -> tuple[Any, list[Any], Any]:
+    """The set-up, the analysis steps and the outputs of a vibration test from `settings`."""
+    from tapespring.analysis import Outputs, Step
+
     built = build_setup(settings.spec, configuration="weight", sense="opposite")
     model, tip = built.model, built.tip_node
     push = settings.initial_displacement * _push_per_marker_displacement(built)
@@ -600,10 +613,7 @@ def vibrate(
     ]
     assert len(steps) - 1 == DECAY_STEP
     outputs = Outputs(reactions=((built.clamp, "uz"),), field_interval=settings.field_interval)
-    results = run(model, steps, outputs=outputs, progress=progress, raise_on_error=False)
-    out = _simulation(results, settings, time.perf_counter() - start)
-    finish_scenario(results, out, "decay")
-    return out
+    return built, steps, outputs
 
 
 def _simulation(results: Any, settings: VibrationSettings, wall_s: float) -> VibrationSimulation:
@@ -655,8 +665,10 @@ def load_vibration(
 
     results = Results.load(path)
     settings = scenario_settings(results, VibrationSettings, path)
+    built, steps, _ = _plan(settings)
+    check_recorded(results, built.model, steps, path)
     if window is not None:
-        settings = replace(settings, window=tuple(window))
+        pair = tuple(window) if isinstance(window, tuple | list) else window
+        settings = replace(settings, window=pair)
         settings.validate()
-    wall = results.stats.get("wall_s")
-    return _simulation(results, settings, math.nan if wall is None else float(wall))
+    return _simulation(results, settings, saved_wall_s(results))
