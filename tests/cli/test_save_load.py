@@ -4,9 +4,11 @@ again without running it; the names and options they refuse."""
 
 from __future__ import annotations
 
+import argparse
 import json
 
 import numpy as np
+import pytest
 from _cli import refused
 from tapespring.cli import main
 from tapespring.scenarios.deployment import load_deployment
@@ -193,3 +195,21 @@ def test_vibrate_resaved_after_a_refit_keeps_its_window(tmp_path, capsys):
     capsys.readouterr()
     line = refused([*_SHORT_VIBRATE, "--rho-inf-study", "0.7", "--save", str(again)], capsys)
     assert "--rho-inf-study takes no --save" in line
+
+
+@pytest.mark.parametrize("command", ["deploy", "vibrate"])
+def test_every_option_either_sets_the_run_or_is_allowed_with_load(command):
+    """A new option that sets a run must join the command's RUN_OPTIONS, or --load would take
+    it silently; the others are outputs, comparisons, pictures or the analysis's own."""
+    import importlib
+
+    from tapespring.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    dests = {a.dest for a in sub.choices[command]._actions} - {"help", "verbose_1"}
+    run_options = set(importlib.import_module(f"tapespring.cli.{command}").RUN_OPTIONS)
+    allowed = {"csv", "plot", "json", "progress", "no_progress", "save", "load", "experiment"}
+    allowed |= {"vtu", "snapshots", "animate", "leave_aside_min", "leave_aside_max"}
+    allowed |= {"window_mm"}  # vibrate's fit, which --load refits
+    assert run_options <= dests
+    assert dests - run_options - allowed == set()

@@ -18,6 +18,7 @@ from .bend import (
     wrote,
 )
 from .scenario_options import (
+    SPEC_OPTIONS,
     add_energy_tolerance_option,
     add_output_options,
     add_rho_inf_option,
@@ -229,12 +230,7 @@ RUN_OPTIONS = (
     "rho_inf",
     "tolerance",
     "energy_tolerance",
-    "mesh_tape",
-    "mesh_plates",
-    "thickness",
-    "youngs_modulus",
-    "eta",
-    "spec",
+    *SPEC_OPTIONS,
 )
 
 

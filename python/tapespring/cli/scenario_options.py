@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
 __all__ = [
+    "SPEC_OPTIONS",
     "add_comparison_options",
     "add_eta_option",
     "add_json_and_progress_options",
@@ -62,6 +63,11 @@ R = TypeVar("R")
 
 #: A scenario's result that `with_comparison` copies with its comparison (a frozen dataclass).
 D = TypeVar("D", bound="DataclassInstance")
+
+
+#: The parser destinations of `add_spec_options` (all of them: the mesh sizes, the material,
+#: ``--eta`` and ``--spec``), which set a run (``--load`` refuses them, `load_saved`).
+SPEC_OPTIONS = ("mesh_tape", "mesh_plates", "thickness", "youngs_modulus", "eta", "spec")
 
 
 def add_spec_options(

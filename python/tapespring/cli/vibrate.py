@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from .bend import _checked, _field, print_warnings, refuse, refuse_shared_paths
 from .scenario_options import (
+    SPEC_OPTIONS,
     add_comparison_options,
     add_output_options,
     add_rho_inf_option,
@@ -95,12 +96,7 @@ RUN_OPTIONS = (
     "sample_rate",
     "time_step",
     "rho_inf_study",
-    "mesh_tape",
-    "mesh_plates",
-    "thickness",
-    "youngs_modulus",
-    "eta",
-    "spec",
+    *SPEC_OPTIONS,
 )
 
 #: Rate of the ParaView series that ``--vtu`` writes [Hz].
