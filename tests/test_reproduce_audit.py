@@ -23,7 +23,6 @@ import json
 import os
 import pickle
 import re
-import typing
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -41,7 +40,7 @@ from tapespring.scenarios.max_mass import CSV_COLUMNS as MAX_MASS_COLUMNS
 from tapespring.scenarios.max_mass import MaxMassSettings, max_mass
 from tapespring.scenarios.pull import PullSettings, pull
 from tapespring.scenarios.release import ReleaseSetup, release
-from tapespring.scenarios.setup import PAPER_SETUP
+from tapespring.scenarios.setup import PAPER_SETUP, settings_from_dict
 from tapespring.scenarios.vibration import VibrationSettings, vibrate
 
 # ---------------------------------------------------------------------------------------------
@@ -283,28 +282,11 @@ def _at(tree: Any, path: str) -> Any:
     return tree
 
 
-def _rebuild(cls: type, d: dict[str, Any]) -> Any:
-    """The dataclass `cls` from its `asdict` form as JSON gave it back (nested dataclasses
-    rebuilt, lists made tuples); a field the dict lacks keeps its default."""
-    hints = typing.get_type_hints(cls)
-    values = {}
-    for f in dataclasses.fields(cls):
-        if f.name not in d:
-            continue
-        v = d[f.name]
-        if dataclasses.is_dataclass(hints[f.name]) and isinstance(v, dict):
-            v = _rebuild(hints[f.name], v)
-        elif isinstance(v, list):
-            v = tuple(v)
-        values[f.name] = v
-    return cls(**values)
-
-
 def _rerun(name: str, cli) -> Any:
     """The scenario run again from Python, on the settings rebuilt from the CSV header."""
     if name not in _RERUNS:
         cls, fn = SCENARIOS[name]
-        settings = _rebuild(cls, _header_settings(name, cli(name).csv))
+        settings = settings_from_dict(cls, _header_settings(name, cli(name).csv))
         _RERUNS[name] = fn(settings)
     return _RERUNS[name]
 
@@ -507,7 +489,7 @@ def test_the_settings_rebuild_the_settings_object_exactly(name, cli):
     that might differ): the rebuilt object's `asdict` is the header."""
     cls, _ = SCENARIOS[name]
     header = _header_settings(name, cli(name).csv)
-    rebuilt = _rebuild(cls, header)
+    rebuilt = settings_from_dict(cls, header)
     redone = json.loads(json.dumps(jsonable_tree(dataclasses.asdict(rebuilt))))
     if name == "release":
         # The release leaves out the tape's fields it overrides (theta_max_deg, jump, unload).

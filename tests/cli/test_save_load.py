@@ -18,6 +18,17 @@ from tapespring.scenarios.deployment import load_deployment
 _SHORT_DEPLOY = ["deploy", "--mesh-tape", "7.5e-3", "--mesh-plates", "1e-2", "--duration", "0.01"]
 
 
+def _forbid_running(monkeypatch, module: str, function: str) -> None:
+    """Make ``tapespring.scenarios.<module>.<function>``, the scenario's run, fail if called:
+    the CLI imports it at call time, so a ``--load`` that ran it fails the test."""
+    import importlib
+
+    def no_run(*args, **kwargs):
+        raise AssertionError(f"--load ran {function}")
+
+    monkeypatch.setattr(importlib.import_module(f"tapespring.scenarios.{module}"), function, no_run)
+
+
 def test_the_saved_run_loads_as_the_printed_deployment(tmp_path, capsys):
     # A name without the suffix is written, and named, with .npz (as Results.save writes it).
     assert main([*_SHORT_DEPLOY, "--save", str(tmp_path / "run"), "--no-progress"]) == 0
@@ -49,12 +60,7 @@ def test_load_prints_the_saved_runs_summary_without_running(tmp_path, capsys, mo
     path = tmp_path / "run.npz"
     assert main([*_SHORT_DEPLOY, "--save", str(path), "--json", "--no-progress"]) == 0
     printed = json.loads(capsys.readouterr().out)
-    import tapespring.scenarios.deployment as deployment
-
-    def no_run(*args, **kwargs):
-        raise AssertionError("--load ran a deployment")
-
-    monkeypatch.setattr(deployment, "deploy", no_run)
+    _forbid_running(monkeypatch, "deployment", "deploy")
     csv = tmp_path / "again.csv"
     assert main(["deploy", "--load", str(path), "--json", "--csv", str(csv)]) == 0
     again = json.loads(capsys.readouterr().out)
@@ -115,12 +121,7 @@ def test_vibrate_load_refits_the_saved_decay_in_another_window(tmp_path, capsys,
     path = tmp_path / "decay.npz"
     assert main([*_SHORT_VIBRATE, "--save", str(path), "--json", "--no-progress"]) == 0
     printed = json.loads(capsys.readouterr().out)
-    import tapespring.scenarios.vibration as vibration
-
-    def no_run(*args, **kwargs):
-        raise AssertionError("--load ran a vibration test")
-
-    monkeypatch.setattr(vibration, "vibrate", no_run)
+    _forbid_running(monkeypatch, "vibration", "vibrate")
     # Without --window-mm, the saved run's window: the same fit.
     assert main(["vibrate", "--load", str(path), "--json"]) == 0
     again = json.loads(capsys.readouterr().out)

@@ -610,7 +610,7 @@ def deploy(
     start = time.perf_counter()
     built, steps, outputs = _plan(settings)
     results = run(built.model, steps, outputs=outputs, progress=progress, raise_on_error=False)
-    out = _simulation(results, settings, built, start)
+    out = _simulation(results, settings, built, time.perf_counter() - start)
     finish_scenario(results, out, "deployment")
     return out
 
@@ -646,14 +646,10 @@ def _plan(settings: DeploymentSettings) -> tuple[SetupModel, list[Any], Any]:
 
 
 def _simulation(
-    results: Any,
-    settings: DeploymentSettings,
-    built: SetupModel,
-    start: float,
-    wall_s: float | None = None,
+    results: Any, settings: DeploymentSettings, built: SetupModel, wall_s: float
 ) -> DeploymentSimulation:
     """The deployment in `results` (run from `settings` on `built`): histories from the release,
-    peaks, phases and energies; `wall_s` the run's wall time (None: since `start`)."""
+    peaks, phases and energies; `wall_s` the run's wall time [s]."""
     from tapespring.signals.angle import bending_angle
     from tapespring.signals.peaks import extract_peaks
     from tapespring.signals.phases import detect_phases
@@ -700,7 +696,7 @@ def _simulation(
         settings=settings,
         setup=built,
         results=results,
-        wall_s=time.perf_counter() - start if wall_s is None else wall_s,
+        wall_s=wall_s,
     )
 
 
@@ -726,7 +722,7 @@ def load_deployment(path: str | Path) -> DeploymentSimulation:
     settings = scenario_settings(results, DeploymentSettings, path)
     built, steps, _ = _plan(settings)
     check_recorded(results, built.model, steps, path)
-    return _simulation(results, settings, built, 0.0, saved_wall_s(results))
+    return _simulation(results, settings, built, saved_wall_s(results))
 
 
 def _crossing_items(x: dict[str, Any]) -> list[str]:
