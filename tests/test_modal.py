@@ -161,6 +161,50 @@ def test_every_mode_of_a_small_model_matches_a_dense_solve():
         run(model, [Step.modal("too many", modes=n_free + 1)])
 
 
+def test_kelvin_voigt_damping_ratios_without_prestress_are_eta_omega_over_2():
+    """Unstressed, with one viscosity everywhere, the damping matrix is eta K exactly, so each
+    mode's phi^T C phi / (2 omega) is eta omega / 2: to 1e-8 (the eigenpairs' tolerance). The
+    rigid modes of a free plate dissipate nothing: round-off of the viscous force over their
+    round-off omega (1e-3 rad/s), up to 6e-12 measured against 0.08 for the first elastic mode,
+    so below 1e-9; NaN where round-off made omega^2 negative. Without viscosity every ratio
+    is 0."""
+    eta = 1e-4
+    model, _ = strip(eta=eta)
+    modes = run(model, [Step.modal("m", modes=6)]).modes[0]
+    expected = eta * np.sqrt(modes.eigenvalues) / 2.0
+    np.testing.assert_allclose(modes.damping_ratios, expected, rtol=1e-8)
+    nodes, quads, sets = flat_plate_mesh(L, B, 16, 2)
+    free = Model(nodes, quads, thickness=T, youngs_modulus=E, poisson=0.3, density=RHO, eta=eta)
+    rigid = run(free, [Step.modal("m", modes=6)]).modes[0]
+    ratios = rigid.damping_ratios
+    assert np.all(np.isnan(ratios[rigid.eigenvalues <= 0.0]))
+    assert np.all(np.abs(ratios[rigid.eigenvalues > 0.0]) < 1e-9)
+    undamped = run(strip()[0], [Step.modal("m", modes=3)]).modes[0]
+    np.testing.assert_array_equal(undamped.damping_ratios, 0.0)
+
+
+def test_kelvin_voigt_damping_ratios_leave_the_prestress_undamped():
+    """Stretched by 900 N, the strip's bending modes owe most of their stiffness to the tension
+    (geometric stiffness, which Kelvin-Voigt does not damp): phi^T C phi is eta phi^T K0 phi
+    with K0 the unstressed tangent, exported here from the reference state; the strains of the
+    stretched state (1e-4) change K0 by that much, hence 1e-3. The ratio is then well below
+    eta omega / 2 (a fifth measured for the first mode)."""
+    eta = 1e-4
+    model, sets = strip(eta=eta)
+    for n in sets["x1"]:
+        model.add_load(int(n), "ux", 300.0)
+    k0 = system_matrices(model).stiffness
+    results = run(model, [Step.static("pull", increments=2), Step.modal("m", modes=4)])
+    modes = results.modes[0]
+    free = system_matrices(model).free_dofs
+    for k in range(4):
+        phi = modes.mode_shapes[k][free[:, 0], free[:, 1]]
+        omega = math.sqrt(modes.eigenvalues[k])
+        expected = eta * (phi @ (0.5 * (k0 + k0.T) @ phi)) / (2.0 * omega)
+        assert modes.damping_ratios[k] == pytest.approx(expected, rel=1e-3)
+    assert modes.damping_ratios[0] < 0.5 * eta * math.sqrt(modes.eigenvalues[0]) / 2.0
+
+
 def test_results_with_modes_round_trip(tmp_path):
     model, _ = strip(poisson=0.0)
     results = run(model, [Step.modal("m", modes=4, matrices=True)])
@@ -168,7 +212,8 @@ def test_results_with_modes_round_trip(tmp_path):
     back = Results.load(path)
     assert len(back.modes) == 1
     a, b = results.modes[0], back.modes[0]
-    for key in ("eigenvalues", "frequencies_hz", "periods_s", "mode_shapes", "effective_masses"):
+    keys = ("eigenvalues", "frequencies_hz", "periods_s", "mode_shapes", "effective_masses")
+    for key in (*keys, "damping_ratios"):
         np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
     assert (a.step, a.name, a.record, a.t, a.shift) == (b.step, b.name, b.record, b.t, b.shift)
     assert b.settings["modes"] == 4

@@ -48,8 +48,12 @@ def test_table_comment_is_one_line_read_past_by_numpy(tmp_path: Path) -> None:
     import numpy as np
 
     path = write_table(tmp_path / "t.csv", ["a", "b"], [[0.1, 1e-300]], comment='run: {"x": 1}')
-    assert path.read_text() == '# run: {"x": 1}\na,b\n0.1,1e-300\n'
-    assert np.loadtxt(path, delimiter=",", skiprows=2).tolist() == [0.1, 1e-300]
+    built = f"# package: tapespring {tapespring.build_version()}\n"
+    assert path.read_text() == '# run: {"x": 1}\n' + built + "a,b\n0.1,1e-300\n"
+    assert np.loadtxt(path, delimiter=",", skiprows=3).tolist() == [0.1, 1e-300]
+    # Without a comment, the header and the rows alone (the trials report's tables).
+    bare = write_table(tmp_path / "b.csv", ["a"], [[1]])
+    assert bare.read_text() == "a\n1\n"
     for bad in ("two\nlines", "carriage\rreturn"):
         with pytest.raises(ValueError, match="one line"):
             write_table(tmp_path / "u.csv", ["a"], [[1]], comment=bad)

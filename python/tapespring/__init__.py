@@ -63,6 +63,7 @@ __all__ = [
     "TapeError",
     "__version__",
     "analysis",
+    "build_version",
     "cli",
     "identify",
     "modes",
@@ -77,6 +78,21 @@ __all__ = [
     "sweep",
     "trials",
 ]
+
+
+def build_version() -> str:
+    """The version of the code that computes: `__version__` with the commit the native module
+    was built from as a PEP 440 local label (``0.1.0+g15fc537d2a``; ``.dirty`` if its tracked
+    files differed from that commit at build time, ``.debug`` if unoptimised). The bare
+    `__version__` when the native module is missing or was built without git.
+
+    Saved results (:meth:`Results.save`) and the commands' CSV and JSON outputs record it.
+    """
+    try:
+        from tapespring._core import BUILD_VERSION
+    except ImportError:
+        return __version__
+    return str(BUILD_VERSION)
 
 
 _FROM = {

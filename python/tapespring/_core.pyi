@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "BUILD_VERSION",
     "DOFS",
     "MAX_YOUNGS_MODULUS",
     "ConvergenceError",
@@ -27,6 +28,10 @@ __all__ = [
     "tape_spring_mesh",
 ]
 __version__: str
+#: The version with the source it was built from (PEP 440 local label): ``0.1.0+g<commit>``,
+#: ``.dirty`` if tracked files differed from that commit at build time, ``.debug`` if
+#: unoptimised; the bare version when built without a git repository.
+BUILD_VERSION: str
 #: Names of the six nodal degrees of freedom, in solver order: ux, uy, uz, rx, ry, rz.
 DOFS: list[str]
 #: Largest Young's modulus a section accepts [Pa] (1e13).

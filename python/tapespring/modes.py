@@ -178,6 +178,14 @@ class Modes:
         axes through the step's ``reference_point`` [kg m^2] (free DOFs only).
     residuals : ndarray, shape (n_modes,)
         Relative residual of each eigenpair (below the step's ``tolerance``).
+    damping_ratios : ndarray, shape (n_modes,)
+        Kelvin-Voigt damping ratio of each mode [-], ``phi^T C phi / (2 omega)`` with ``C`` the
+        damping matrix of the viscous stresses at the state (``eta K_material`` of the sections
+        with a viscosity): what a small free decay in that mode shows. It is ``eta omega / 2``
+        only where all the mode's stiffness is viscous material stiffness; the prestress of a
+        loaded state and undamped sections lower the share (the set-up's weight under gravity
+        decays 3 % faster than ``eta omega / 2``). 0 without viscosity; NaN where
+        ``omega^2 <= 0``, and for modes saved by a version before 2026-11-29.
     below_shift : int
         Number of eigenvalues below the shift (Sturm count).
     equilibrium_residual : float
@@ -199,6 +207,7 @@ class Modes:
     mode_shapes: NDArray[np.float64]
     effective_masses: NDArray[np.float64]
     residuals: NDArray[np.float64]
+    damping_ratios: NDArray[np.float64]
     below_shift: int = 0
     equilibrium_residual: float = 0.0
     matrices: SystemMatrices | None = None
@@ -222,6 +231,7 @@ class Modes:
             mode_shapes=shapes.reshape(n, -1, 6) if n else shapes.reshape(0, 0, 6),
             effective_masses=np.asarray(d["effective_masses"], dtype=float).reshape(n, 6),
             residuals=np.asarray(d["residuals"], dtype=float),
+            damping_ratios=np.asarray(d["damping_ratios"], dtype=float),
             below_shift=int(d["below_shift"]),
             equilibrium_residual=float(d["equilibrium_residual"]),
             matrices=None if matrices is None else SystemMatrices.from_dict(matrices),

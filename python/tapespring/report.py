@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -36,9 +36,11 @@ __all__ = [
     "format_summary",
     "jsonable",
     "save_figure",
+    "stamped",
     "summary_dict",
     "summary_json",
     "summary_row",
+    "version_comment",
     "write_report",
     "write_table",
 ]
@@ -172,6 +174,22 @@ def format_summary(analysis: TrialsAnalysis[Any]) -> str:
     return "\n".join(lines)
 
 
+def version_comment() -> str:
+    """The line (after ``# ``) by which every CSV file the package writes names the code that
+    wrote it: ``package: tapespring 0.1.0+g15fc537d2a`` (:func:`tapespring.build_version`)."""
+    from tapespring import build_version
+
+    return f"package: tapespring {build_version()}"
+
+
+def stamped(tree: Mapping[str, Any]) -> dict[str, Any]:
+    """`tree` (a command's JSON object) with ``package_version``, the code that computed it
+    (:func:`tapespring.build_version`), as its last key."""
+    from tapespring import build_version
+
+    return {**tree, "package_version": build_version()}
+
+
 def write_table(
     path: Path,
     header: Sequence[str],
@@ -185,14 +203,16 @@ def write_table(
     text) is quoted. The csv module quotes only the characters of its line terminator, so with
     ``\n`` alone a ``\r`` went out bare and readers split the row there. A `comment` (one line,
     such as the settings that produced the table as JSON) goes first, after ``# ``, as the
-    bending and maximum-mass files write theirs (``np.loadtxt`` and pandas' ``comment="#"``
-    skip it). Floats are written in full (``repr``).
+    bending and maximum-mass files write theirs, then :func:`version_comment`'s line: the
+    code that computed what the settings describe (pandas' ``comment="#"`` skips both;
+    ``np.loadtxt`` needs ``skiprows`` to pass the header too). Without a comment the file is
+    the header and the rows alone. Floats are written in full (``repr``).
     """
     if comment is not None and ("\n" in comment or "\r" in comment):
         raise ValueError("a table's comment must be one line")
     with path.open("w", newline="", encoding="utf-8") as fh:
         if comment is not None:
-            fh.write(f"# {comment}\n")
+            fh.write(f"# {comment}\n# {version_comment()}\n")
         for row in [header, *rows]:
             line = io.StringIO()
             # "\r\n" makes the writer quote both characters; the row then ends in "\n".

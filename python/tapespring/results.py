@@ -31,8 +31,9 @@ if TYPE_CHECKING:
 __all__ = ["Results"]
 
 _FORMAT = "tapespring.Results"
-# 3: modal steps' results (``modes``); 4: per-record costs (``factorisations``, ``wall_s``).
-_VERSION = 4
+# 3: modal steps' results (``modes``); 4: per-record costs (``factorisations``, ``wall_s``);
+# 5: the modes' Kelvin-Voigt damping ratios.
+_VERSION = 5
 # Arrays of each modal step, saved as ``modes<i>_<name>``.
 _MODE_ARRAYS = (
     "eigenvalues",
@@ -41,6 +42,7 @@ _MODE_ARRAYS = (
     "mode_shapes",
     "effective_masses",
     "residuals",
+    "damping_ratios",
 )
 _MODE_SCALARS = ("step", "name", "record", "t", "shift", "below_shift", "equilibrium_residual")
 
@@ -418,7 +420,8 @@ class Results:
         Read it back with :meth:`load`. Returns the path written: `path`, with ``.npz`` appended
         if it does not end so (as :func:`numpy.savez` does). The file also records the package
         version that computed the results (``meta["package_version"]``: `package_version` for
-        results loaded from a file, this package's otherwise).
+        results loaded from a file, this package's :func:`tapespring.build_version` otherwise,
+        which names the commit it was built from).
 
         Raises
         ------
@@ -426,7 +429,7 @@ class Results:
             If `path` names no file (``""``, ``"."``, ``".."``, a path ending in ``..``), before
             anything is written.
         """
-        from tapespring import __version__
+        from tapespring import build_version
 
         given, path = path, Path(path)
         if path.name in ("", ".", ".."):
@@ -434,7 +437,7 @@ class Results:
         meta = {
             "format": _FORMAT,
             "version": _VERSION,
-            "package_version": self.package_version or __version__,
+            "package_version": self.package_version or build_version(),
             "event": list(self.event),
             "marker_names": list(self.marker_names),
             "reaction_dofs": [list(rd) for rd in self.reaction_dofs],
@@ -765,8 +768,14 @@ def _load_modes(f: Any, i: int, entry: Mapping[str, Any]) -> Modes:
 
     Raises ValueError naming the array whose shape or type is inconsistent.
     """
-    arrays = {k: f[f"modes{i}_{k}"] for k in _MODE_ARRAYS}
+    # Files before format 5 have no damping ratios: NaN, "not recorded".
+    arrays = {
+        k: f[f"modes{i}_{k}"]
+        for k in _MODE_ARRAYS
+        if k != "damping_ratios" or f"modes{i}_{k}" in f
+    }
     m = len(np.atleast_1d(arrays["eigenvalues"]))
+    arrays.setdefault("damping_ratios", np.full(m, np.nan))
     shape = arrays["mode_shapes"].shape
     n_nodes = shape[1] if len(shape) == 3 and m else None
     expected: dict[str, tuple[int | None, ...]] = {

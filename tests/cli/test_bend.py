@@ -61,7 +61,8 @@ def test_csv_plot_and_text_summary(tmp_path, capsys):
     assert code == 0
     lines = csv_path.read_text().splitlines()
     assert lines[0].startswith("# tapespring bend: {")
-    assert lines[2] == "theta_deg,moment_Nm,stable,branch,jump,event"
+    assert lines[2].startswith("# package: tapespring ")
+    assert lines[3] == "theta_deg,moment_Nm,stable,branch,jump,event"
     assert len(lines) > 10
     assert png_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "M_max" in out

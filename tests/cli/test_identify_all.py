@@ -48,6 +48,7 @@ SUMMARY_KEYS = {
     "static",
     "damping",
     "settings",
+    "package_version",
 }
 
 
@@ -77,6 +78,7 @@ def test_all_identifies_t_and_e_then_eta_with_them(
     assert f"warning: {note}" in captured.err
     with table.open() as fh:
         assert fh.readline().startswith("# tapespring identify all: ")
+        assert fh.readline().startswith("# package: tapespring ")
         rows = list(csv.DictReader(fh))
     kinds = [row["identification"] for row in rows]
     assert kinds == ["static"] * 3 + ["damping"] * len(data["damping"]["runs"])
@@ -195,7 +197,7 @@ def test_nothing_identified_exits_1_and_writes_what_was_done(
     assert "warning: no run found a stable folded equilibrium" in captured.err
     assert "eta not run" in captured.out and f"  wrote {figure}" in captured.out
     with table.open() as fh:
-        fh.readline()
+        fh.readline(), fh.readline()  # the settings, the package's version
         assert {row["identification"] for row in csv.DictReader(fh)} == {"static"}
     assert figure.stat().st_size > 10_000
 

@@ -39,6 +39,7 @@ def test_static_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.Capture
     assert data["objective"] == best
     with table.open() as fh:
         assert fh.readline().startswith("# tapespring identify static: ")
+        assert fh.readline().startswith("# package: tapespring ")
         rows = list(csv.DictReader(fh))
     assert len(rows) == 3
     assert [float(r["objective"]) for r in rows] == [e["objective"] for e in data["evaluations"]]
@@ -128,6 +129,7 @@ def test_damping_runs_and_writes_every_run(tmp_path: Path, capsys: pytest.Captur
     assert data["eta_s"] == pytest.approx(1.75e-4, rel=0.05)
     with table.open() as fh:
         assert fh.readline().startswith("# tapespring identify damping: ")
+        assert fh.readline().startswith("# package: tapespring ")
         rows = list(csv.DictReader(fh))
     assert [float(r["eta_s"]) for r in rows] == [r["eta_s"] for r in data["runs"]]
     assert (tmp_path / "eta.png").stat().st_size > 10_000

@@ -53,7 +53,8 @@ def test_csv_and_plot_of_a_short_release(tmp_path, capsys, runs):
     assert code == 0
     (result,) = runs
     with open(csv_path, newline="") as fh:
-        comment = fh.readline()
+        comment, built = fh.readline(), fh.readline()
+        assert built.startswith("# package: tapespring ")
         header, *rows = list(csv.reader(fh))
     # First the settings that produced the file, as the summary gives them.
     prefix = "# tapespring release: "

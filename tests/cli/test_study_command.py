@@ -25,12 +25,14 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 def _table(path: Path, command: str) -> list[dict[str, str]]:
-    """The rows of a study's CSV file, after its ``# tapespring <command>: {...}`` line."""
+    """The rows of a study's CSV file, after its ``# tapespring <command>: {...}`` line and the
+    package's version."""
     with path.open(encoding="utf-8") as fh:
         first = fh.readline()
         assert first.startswith(f"# tapespring {command}: {{"), first
         settings = json.loads(first.split(": ", 1)[1])
         assert settings["settings"]["mesh_size"] == 4e-3
+        assert fh.readline().startswith("# package: tapespring ")
         return list(csv.DictReader(fh))
 
 

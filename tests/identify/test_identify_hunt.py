@@ -699,6 +699,7 @@ def test_cli_nothing_identified_exits_1_with_strict_json_csv_and_plot(
     assert "Traceback" not in err
     with table.open() as fh:
         assert fh.readline().startswith("# tapespring identify static: ")
+        assert fh.readline().startswith("# package: tapespring ")
         rows = list(csv.DictReader(fh))
     assert len(rows) == 6 and all(r["marker3_dz_m"] == "" for r in rows)
     assert figure.stat().st_size > 5_000

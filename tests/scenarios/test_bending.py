@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tapespring
 from tapespring.scenarios.bending import (
     BendingResult,
     BendingSetup,
@@ -499,9 +500,10 @@ def test_csv_has_setup_header_and_round_trips_with_numpy(opposite, tmp_path):
     assert lines[1].startswith("# settings: ")
     settings = json.loads(lines[1][len("# settings: ") :])
     assert settings["mesh_size"] == pytest.approx(2e-3)
-    assert lines[2] == "theta_deg,moment_Nm,stable,branch,jump,event"
-    assert len(lines) == 3 + opposite.theta_deg.size
-    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=3, ndmin=2, usecols=range(5))
+    assert lines[2] == f"# package: tapespring {tapespring.build_version()}"
+    assert lines[3] == "theta_deg,moment_Nm,stable,branch,jump,event"
+    assert len(lines) == 4 + opposite.theta_deg.size
+    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=4, ndmin=2, usecols=range(5))
     assert data.shape == (opposite.theta_deg.size, 5)
     # Written with 6 decimals (deg) and 10 significant digits (N m).
     np.testing.assert_allclose(data[:, 0], opposite.theta_deg, rtol=0, atol=5e-7)

@@ -360,8 +360,8 @@ def test_deploy_command_with_an_experiment(tmp_path, capsys) -> None:
     assert main([*args, f"--experiment={path}", *extra]) == 0
     out = json.loads(capsys.readouterr().out)
     # The CSV has a row per sample, as a recording at 800 Hz, where the JSON has every step.
-    table = np.loadtxt(csv, delimiter=",", skiprows=2)  # the settings line, the header
-    comment, header = csv.read_text().splitlines()[:2]
+    table = np.loadtxt(csv, delimiter=",", skiprows=3)  # the settings, the version, the header
+    comment, _, header = csv.read_text().splitlines()[:3]
     assert header == "time_s,angle_deg,clamp_force_N"
     # The settings that produced the file, as the JSON's.
     assert comment.startswith("# tapespring deploy: {")

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tapespring
 from _cli import refused
 from tapespring.cli import main
 from tapespring.scenarios.bending import analytical_residual_moment
@@ -361,9 +362,10 @@ def test_csv_round_trips_with_numpy(opposite, tmp_path):
     prefix = "# tapespring max-mass: "
     assert lines[0].startswith(prefix)
     assert json.loads(lines[0][len(prefix) :])["thicknesses"] == [T_MIN, T_MAX]
-    assert lines[1] == ",".join(CSV_COLUMNS)
-    assert len(lines) == 2 + 4
-    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=2, usecols=range(1, 10))
+    assert lines[1] == f"# package: tapespring {tapespring.build_version()}"
+    assert lines[2] == ",".join(CSV_COLUMNS)
+    assert len(lines) == 3 + 4
+    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=3, usecols=range(1, 10))
     np.testing.assert_allclose(data[:, 4], opposite.m_max[0].ravel(), rtol=1e-9)
     np.testing.assert_allclose(data[:, 6], opposite.ratio[0].ravel(), rtol=1e-9)
 
@@ -466,7 +468,7 @@ def test_cli_writes_json_csv_and_plot(opposite, tmp_path, capsys):
     # The same settings as the fixture: the same deterministic runs.
     np.testing.assert_allclose(data["m_max_kg"]["opposite"], opposite.m_max[0], rtol=1e-12)
     assert data["wall_s"] > 0.0
-    assert csv_path.read_text().splitlines()[1] == ",".join(CSV_COLUMNS)
+    assert csv_path.read_text().splitlines()[2] == ",".join(CSV_COLUMNS)
     assert png_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

@@ -229,12 +229,14 @@ def test_vibration_decays_at_the_kelvin_voigt_rate_and_the_modal_period() -> Non
     assert sim.fit.peak_time.size >= 8
     # Transient against modal period: the 1 %; measured 0.3 %.
     assert sim.fit.period == pytest.approx(sim.modal_periods_s[0], rel=0.01)
-    # Damping ratio against eta omega / 2 of the linearised Kelvin-Voigt system, within 3 %: the
-    # undamped rod and weight store some of the strain energy, and the 8 mm start is slightly
-    # nonlinear. Generalised-alpha's own dissipation is negligible here (rho_inf = 0.7, 2.5 ms
-    # steps at the default 400 Hz, omega h = 0.146: 8.5e-6 of damping ratio against the 5 % of
-    # ten times the paper's eta, `_core.generalized_alpha_decay`).
-    assert sim.fit.damping_ratio == pytest.approx(sim.kelvin_voigt_damping_ratio, rel=0.03)
+    # Damping ratio against the first mode's phi^T C phi / (2 omega) of the linearised
+    # Kelvin-Voigt system about the loaded equilibrium: measured -0.8 % (the 8 mm start is
+    # slightly nonlinear, its period 0.3 % long), so within 1.5 %. (Against eta omega / 2, which
+    # the scenario reported before 2026-11-29, +1.9 %: the prestress is not damped.)
+    # Generalised-alpha's own dissipation is negligible here (rho_inf = 0.7, 2.5 ms steps at the
+    # default 400 Hz, omega h = 0.146: 8.5e-6 of damping ratio against the 5 % of ten times the
+    # paper's eta, `_core.generalized_alpha_decay`).
+    assert sim.fit.damping_ratio == pytest.approx(sim.kelvin_voigt_damping_ratio, rel=0.015)
     # Damping ratio proportional to eta: the paper's eta gives a tenth (the next test).
     # The rows `--csv` writes are those of a recording: every 400 Hz sample from the release,
     # none of the steps the error control puts between them.
@@ -290,7 +292,8 @@ def test_vibrate_command_records_at_the_sample_rate_it_is_given(tmp_path, capsys
     assert "error: no damping fit" in captured.err
     assert json.loads(captured.out)["settings"]["sample_rate"] == 800.0
     # One CSV row per 800 Hz sample from the release (not the default 400 Hz).
-    t = np.loadtxt(csv_path, delimiter=",", skiprows=2, usecols=0)  # the settings, the header
+    # The settings, the package's version, the header.
+    t = np.loadtxt(csv_path, delimiter=",", skiprows=3, usecols=0)
     assert csv_path.read_text().startswith('# tapespring vibrate: {"spec": {')
     np.testing.assert_allclose(t, np.arange(81) / 800.0, rtol=0, atol=1e-12)
     # --vtu keeps about 50 Hz at any rate: every 16th record at 800 Hz (8th at 400), and each
@@ -316,7 +319,7 @@ def test_pull_command_writes_json_csv_and_plot(tmp_path, capsys) -> None:
     out = json.loads(capsys.readouterr().out)
     assert out["max_force_N"] > 0 and math.isfinite(out["max_force_displacement_m"])
     assert out["settings"]["spec"]["tape_spacing"] == PAPER_SETUP.tape_spacing
-    comment, header = csv_path.read_text().splitlines()[:2]
+    comment, _, header = csv_path.read_text().splitlines()[:3]
     assert header.startswith("displacement_m,force_N")
     assert json.loads(comment.removeprefix("# tapespring pull: ")) == out["settings"]
     assert png.stat().st_size > 10_000

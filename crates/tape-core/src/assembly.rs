@@ -437,6 +437,12 @@ impl System {
         Ok(renumber)
     }
 
+    /// Whether a section has a Kelvin-Voigt viscosity (`eta > 0`).
+    #[must_use]
+    pub fn has_viscosity(&self) -> bool {
+        self.eta.iter().any(|&e| e > 0.0)
+    }
+
     /// Number of free equations.
     #[must_use]
     pub fn n_free(&self) -> usize {

@@ -693,6 +693,7 @@ fn modes_to_dict<'py>(py: Python<'py>, m: &tape_core::solver::Modes, n_nodes: us
     d.set_item("mode_shapes", shapes.into_pyarray(py))?;
     d.set_item("effective_masses", rows_to_numpy(py, &m.effective_masses))?;
     d.set_item("residuals", vec_to_numpy(py, m.residuals.clone()))?;
+    d.set_item("damping_ratios", vec_to_numpy(py, m.damping_ratios.clone()))?;
     d.set_item("below_shift", m.below_shift)?;
     d.set_item("equilibrium_residual", m.equilibrium_residual)?;
     let matrices = match &m.matrices {

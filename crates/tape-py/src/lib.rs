@@ -10,6 +10,19 @@ mod logging;
 mod mesh;
 mod model;
 
+/// The package version with the source it was built from as a PEP 440 local label, e.g.
+/// `0.1.0+g15fc537d2a` (`.dirty`: tracked files differed from that commit at build time;
+/// `.debug`: an unoptimised build); the bare version when the build had no git repository.
+fn build_version() -> String {
+    let local = env!("TAPESPRING_BUILD_LOCAL");
+    let version = env!("CARGO_PKG_VERSION");
+    if local.is_empty() {
+        version.to_string()
+    } else {
+        format!("{version}+{local}")
+    }
+}
+
 /// Native core of tapespring: the model, the analysis runner and the mesh generators.
 #[pyo3::pymodule]
 mod _core {
@@ -35,6 +48,7 @@ mod _core {
         convergence.setattr("result", py.None())?;
         m.add("ConvergenceError", convergence)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+        m.add("BUILD_VERSION", super::build_version())?;
         m.add("DOFS", tape_core::Dof::NAMES.to_vec())?;
         m.add("MAX_YOUNGS_MODULUS", tape_core::MAX_YOUNGS_MODULUS)?;
         super::logging::install(py);

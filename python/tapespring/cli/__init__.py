@@ -45,7 +45,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-__all__ = ["build_parser", "main", "package_version"]
+__all__ = ["build_parser", "main"]
 
 #: The command line's exit codes, in ``tapespring --help`` (and docs/errors.md).
 EXIT_CODES = (
@@ -62,21 +62,10 @@ _VERBOSE_HELP = (
 )
 
 
-def package_version() -> str:
-    """The installed package's version (its metadata), else ``tapespring.__version__``."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("tapespring")
-    except PackageNotFoundError:
-        import tapespring
-
-        return str(getattr(tapespring, "__version__", "unknown"))
-
-
 class _VersionAction(argparse.Action):
-    """``--version``: print ``tapespring VERSION`` on stdout and exit 0; the version is looked
-    up only then, so that building the parser reads no package metadata."""
+    """``--version``: print ``tapespring VERSION`` (:func:`tapespring.build_version`: the
+    commit the native module was built from too) on stdout and exit 0; the version is looked
+    up only then, so that building the parser loads no native module."""
 
     def __init__(self, option_strings: Sequence[str], dest: str, help: str | None = None) -> None:
         super().__init__(
@@ -90,7 +79,9 @@ class _VersionAction(argparse.Action):
         values: object,
         option_string: str | None = None,
     ) -> None:
-        print(f"{parser.prog} {package_version()}")
+        from tapespring import build_version
+
+        print(f"{parser.prog} {build_version()}")
         parser.exit()
 
 

@@ -582,7 +582,9 @@ def run(args: argparse.Namespace) -> int:
             # What produced it, as the CSV's comment lines hold it.
             "settings": {"setup": asdict(result.setup), "solver": result.settings},
         }
-        json.dump(out, sys.stdout, default=str)
+        from tapespring.report import stamped
+
+        json.dump(stamped(out), sys.stdout, default=str)
         sys.stdout.write("\n")
     else:
         sense = "opposite" if setup.theta_max_deg > 0 else "equal"

@@ -256,7 +256,9 @@ def run(args: argparse.Namespace) -> int:
 
         save_figure(plot_max_mass_figure(result), args.plot)
     if args.json:
-        json.dump(result.to_json(), sys.stdout)
+        from tapespring.report import stamped
+
+        json.dump(stamped(result.to_json()), sys.stdout)
         sys.stdout.write("\n")
     else:
         lines = [result.summary()]

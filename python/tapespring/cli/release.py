@@ -197,7 +197,9 @@ def run(args: argparse.Namespace) -> int:
 
         save_figure(plot_release(result), args.plot)
     if args.json:
-        json.dump(summary, sys.stdout)
+        from tapespring.report import stamped
+
+        json.dump(stamped(summary), sys.stdout)
         sys.stdout.write("\n")
     else:
         print(result.describe())

@@ -459,7 +459,7 @@ def finish(
     after the outputs.
     """
     from tapespring.analysis import ConvergenceError
-    from tapespring.report import jsonable_tree, write_table
+    from tapespring.report import jsonable_tree, stamped, write_table
 
     failure = None
     result: Any  # R, or the partial result a ConvergenceError carries
@@ -492,7 +492,7 @@ def finish(
         matplotlib.use("Agg")  # files only: no display needed
         plot(result, args.plot)
     if args.json:
-        print(json.dumps(jsonable_tree(summary), default=str))
+        print(json.dumps(jsonable_tree(stamped(summary)), default=str))
     else:
         print(result.describe())
         for name in ("csv", "plot"):

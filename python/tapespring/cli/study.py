@@ -393,11 +393,12 @@ def _names_checked(args: argparse.Namespace, settings: Any, option: str, names: 
 def _write_csv(result: Any, path: str, comment: dict[str, Any]) -> None:
     """`result`'s table (its ``write_csv``), after a ``#`` line: the command and `comment` as
     JSON, as the other commands' tables begin."""
-    from tapespring.report import jsonable_tree
+    from tapespring.report import jsonable_tree, version_comment
 
     result.write_csv(path)
     body = Path(path).read_bytes()
     line = f"# {comment.pop('command')}: {json.dumps(jsonable_tree(comment), default=str)}\n"
+    line += f"# {version_comment()}\n"
     Path(path).write_bytes(line.encode("utf-8") + body)
 
 
@@ -417,7 +418,9 @@ def _outputs(
 
         save_figure(plot(result), args.plot)
     if args.json:
-        print(json.dumps(summary, default=str))
+        from tapespring.report import stamped
+
+        print(json.dumps(stamped(summary), default=str))
     else:
         print(result.describe())
         for name in ("csv", "plot"):
@@ -498,7 +501,9 @@ def run_ensemble(args: argparse.Namespace) -> int:
 
         return plot_ensemble(r)
 
-    comment = ["scenario", "parameters", "sampling", "seed", "settings"]
+    # With the distributions' exact arguments, enough to draw the runs' values again: a Latin
+    # hypercube's draws depend on the number of runs too.
+    comment = ["scenario", "parameters", "sampling", "seed", "runs_planned", "settings"]
     _outputs(args, result, result.summary(), comment, plot)
     return _exit_code(result)
 

@@ -379,7 +379,9 @@ def run_analyze(args: argparse.Namespace) -> int:
     notes = [str(w.message) for w in caught]
     if args.json:
         data = summary_dict(analysis) | {"report": str(args.out), "warnings": notes}
-        print(json.dumps(data, allow_nan=False))
+        from tapespring.report import stamped
+
+        print(json.dumps(stamped(data), allow_nan=False))
     else:
         print(format_summary(analysis))
         print(wrote(args.out))

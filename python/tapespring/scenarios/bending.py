@@ -621,13 +621,17 @@ def summarize(result: BendingResult) -> BendingSummary:
 def write_csv(result: BendingResult, path: str | Path) -> None:
     """Write the curve as CSV: ``theta_deg, moment_Nm, stable, branch, jump, event``.
 
-    The first lines are ``#`` comments holding the set-up and every solver setting as JSON, so
-    the file carries what produced it.
+    The first lines are ``#`` comments holding the set-up and every solver setting as JSON,
+    then the package's version (:func:`tapespring.report.version_comment`), so the file
+    carries what produced it.
     """
+    from tapespring.report import version_comment
+
     path = Path(path)
     with path.open("w", newline="") as fh:
         fh.write("# tapespring bend: " + json.dumps(asdict(result.setup)) + "\n")
         fh.write("# settings: " + json.dumps(result.settings, default=str) + "\n")
+        fh.write(f"# {version_comment()}\n")
         writer = csv.writer(fh)
         writer.writerow(["theta_deg", "moment_Nm", "stable", "branch", "jump", "event"])
         rows = zip(

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tapespring.report import jsonable, jsonable_tree
+from tapespring.report import jsonable, jsonable_tree, version_comment
 from tapespring.scenarios.bending import BendingSetup, analytical_residual_moment
 from tapespring.scenarios.setup import (
     MAX_GRAVITY,
@@ -797,14 +797,15 @@ CSV_COLUMNS = (
 def write_csv(result: MaxMassResult, path: str | Path) -> None:
     """Write one row per (sense, t, E) point; columns `CSV_COLUMNS` (NaN where a run failed).
 
-    The first line is a ``#`` comment holding the settings as JSON, so the file carries what
-    produced it.
+    The first lines are ``#`` comments holding the settings as JSON, then the package's
+    version (:func:`tapespring.report.version_comment`), so the file carries what produced it.
     """
     path = Path(path)
     m, ma, r = result.m_max, result.m_max_analytical, result.ratio
     with path.open("w", newline="") as fh:
         settings = json.dumps(jsonable_tree(asdict(result.settings)))
         fh.write(f"# tapespring max-mass: {settings}\n")
+        fh.write(f"# {version_comment()}\n")
         writer = csv.writer(fh)
         writer.writerow(CSV_COLUMNS)
         for i, s in enumerate(result.senses):

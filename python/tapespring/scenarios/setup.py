@@ -346,9 +346,13 @@ class SetupSpec:
       the fourth large peak is there with eta = 1.73e-4 s and gone with 2.1e-4 s, as in the
       paper's model, where the earlier split (6 g of the appendix in the rod) keeps it at
       2.1e-4 s. That figure is therefore a check of the split, not a prediction.
-    * the additional weight (Figs. 21, 25): a rigid steel block (30 x 20 x 20 mm) fixed under
-      the rod's middle and reaching beyond it along x, marker 3 at its tip.
-    * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp; marker 1 on top
+    * the additional weight (Figs. 21, 25): a rigid block of 170 g, 30 mm along x from the rod's
+      far end, hanging below it, marker 3 at its tip. Its mass and length are pinned (below);
+      its 20 x 20 mm section is a guess that sets only the block's own inertia (the paper gives
+      neither; 170 g in 30 x 20 x 20 mm is 14 200 kg/m^3, denser than steel: a block with a
+      heavy insert), which is 0.5 % of the free end's pitch inertia about the clamp.
+    * markers: marker 0 on the support 30 mm behind and 30 mm above the clamp in the laboratory
+      (the support is not turned with the block in equal sense); marker 1 on top
       of the first small interface; marker 2 on the rod's middle; marker 3 at the tip of the
       appendix or the weight; markers 1-3 16 mm above the tapes' mid-line plane (an active
       marker of about 10 mm on a 12 mm interface).
@@ -427,7 +431,9 @@ class SetupSpec:
     weight_mass, weight_length, weight_width, weight_height : float
         The additional weight [kg, m].
     support_marker : tuple of float
-        Position of marker 0 on the support [m].
+        Position of marker 0 on the support, from the set-up's origin (the tapes' clamped
+        sections, on their mid-line arc), in the laboratory's axes (z up, the same for both
+        senses) [m].
     marker_height : float
         Height of markers 1-3 above the plane of the tapes' mid-lines, on the laboratory's upper
         side [m].
@@ -730,7 +736,7 @@ _SPEC_THICKNESSES = ("rod_thickness", "appendix_thickness", "support_thickness")
 MIN_ELEMENTS_ACROSS = 4
 
 #: Most elements a tape may have, in the set-up or alone (bending, release): 6 million DOFs,
-#: whose factorisation needs more memory than a workstation has (the paper's 2 mm mesh has 475
+#: whose factorisation needs more memory than a workstation has (the paper's 2 mm mesh has 500
 #: per tape). Checked by :func:`check_element_count`.
 MAX_ELEMENTS = 1e6
 
@@ -1515,7 +1521,10 @@ def build_setup(
 
     model.set_gravity([0.0, 0.0, down * spec.gravity], function=ramp(0.0, 1.0), id="gravity")
     if support is None:
-        offset = np.asarray(spec.support_marker) - [0.0, 0.0, zc]
+        # support_marker is in the laboratory's axes; the set-up's frame is the laboratory's
+        # turned half a turn about x in equal sense (y and z reversed), the support not.
+        x, y, z = spec.support_marker
+        offset = [x, -down * y, -down * z - zc]
         model.add_marker("marker0", clamp, offset=offset)
     else:
         # On the middle of the bracket's corner, which moves with the support.

@@ -10,9 +10,12 @@ of marker 3's vertical position about the loaded equilibrium goes through the da
 measured decays (:func:`tapespring.signals.damping.fit_damping`, peaks within ``window``).
 
 For the Kelvin-Voigt material ``sigma = C (eps + eta d(eps)/dt)`` the damping matrix of the
-linearised system is ``eta K_material``, so a mode of pulsation ``omega`` has the damping ratio
-``eta omega / 2`` (the rod and the weight, undamped, store a small part of the strain energy).
-The summary reports that value beside the fitted one.
+linearised system is ``eta K_material`` of the tapes, so a mode ``phi`` of pulsation ``omega``
+has the damping ratio ``phi^T C phi / (2 omega)`` (:attr:`tapespring.modes.Modes.damping_ratios`);
+the summary reports the first mode's beside the fitted one. It is not ``eta omega / 2``: about
+the loaded equilibrium the prestress (geometric) stiffness stores energy that is not damped,
+and so do the rod and the weight (3 % above ``eta omega / 2`` on the paper's meshes; without
+gravity, 0.1 % below).
 
 Comparison with a recorded free decay (Tables 7-8, Fig. 23): :meth:`VibrationSimulation.to_trial`
 samples the decay like a recording (markers at the sample rate, the pushed state held before the
@@ -337,8 +340,13 @@ class VibrationSimulation:
 
     @property
     def kelvin_voigt_damping_ratio(self) -> float:
-        """``eta omega_1 / 2`` with the first modal pulsation [-]."""
-        return self.settings.spec.eta * np.pi / float(self.modal_periods_s[0])
+        """The first mode's Kelvin-Voigt damping ratio about the loaded equilibrium [-]
+        (:attr:`tapespring.modes.Modes.damping_ratios`; module doc); NaN without a modal step
+        or from a file saved before 2026-11-29, which did not record it."""
+        modes = self.results.modes
+        if not modes or modes[0].damping_ratios.size == 0:
+            return float("nan")
+        return float(modes[0].damping_ratios[0])
 
     @property
     def rejected_steps(self) -> int:
@@ -398,7 +406,7 @@ class VibrationSimulation:
             f"steps ({s['newton_iterations']} iterations in all steps, the modal solver's "
             f"included), wall time {self.wall_s:.1f} s",
             f"  modal period about the loaded equilibrium {s['modal_period_s']:.4f} s; "
-            f"Kelvin-Voigt eta omega/2 = {s['kelvin_voigt_damping_ratio']:.3%}",
+            f"Kelvin-Voigt damping ratio of that mode {s['kelvin_voigt_damping_ratio']:.3%}",
         ]
         if s["fixed_step_cutbacks"] is not None:
             cut = s["fixed_step_cutbacks"]

@@ -178,8 +178,15 @@ fn cantilever_strip_first_frequency_is_euler_bernoulli() -> Result<()> {
 /// A strip simply supported at both ends (uz = 0 on the end edges, ux at x = 0, uy at one node),
 /// loaded axially at x = L by `p` \[N\] (> 0 tension), then a modal step at the loaded state.
 fn prestressed_first_frequency(p: f64, l: f64) -> Result<f64> {
+    Ok(prestressed_first_mode(p, l, 0.0)?.0)
+}
+
+/// [`prestressed_first_frequency`] with the Kelvin-Voigt viscosity `eta` \[s\]: the first mode's
+/// frequency \[Hz\] and damping ratio \[-\].
+fn prestressed_first_mode(p: f64, l: f64, eta: f64) -> Result<(f64, f64)> {
     let mut section = common::section(T, E, 0.0);
     section.density = RHO;
+    section.eta = eta;
     let mut model = Model::try_new(flat_plate(l, B, 16, 2)?, section)?;
     let (x0, x1) = (model.mesh.node_set("x0")?.to_vec(), model.mesh.node_set("x1")?.to_vec());
     model.fix(&x0, &[Dof::Ux, Dof::Uz])?;
@@ -211,7 +218,34 @@ fn prestressed_first_frequency(p: f64, l: f64) -> Result<f64> {
     let modes = &hist.modes[0];
     assert_eq!(modes.record, hist.len() - 1);
     assert!(modes.equilibrium_residual < 1e-6 * p.abs().max(1.0));
-    Ok(modes.frequencies_hz[0])
+    Ok((modes.frequencies_hz[0], modes.damping_ratios[0]))
+}
+
+/// Kelvin-Voigt damps the material stiffness only: the simply supported strip's first mode keeps
+/// its shape `sin(pi x / L)` under the axial force, so `phi^T C phi = eta omega(0)^2` and the
+/// damping ratio is `eta omega(0)^2 / (2 omega(P))`, i.e. `eta omega(P) / 2 / (1 + P / P_cr)`:
+/// a third below `eta omega(P) / 2` at `P_cr / 2` (tension), twice it at `-P_cr / 2`. Unstressed it is `eta
+/// omega / 2` to the eigenpair's tolerance (1e-8). Under `P` the discrete relation holds as the
+/// continuous one does: on the uniform mesh the first mode is the same vector for the material
+/// and the geometric stiffness, and the membrane strain `P / (E A)` = 1e-5 changes the material
+/// stiffness at second order only (measured 6e-10), hence 1e-6.
+#[test]
+fn kelvin_voigt_damping_ratios_leave_the_prestress_undamped() -> Result<()> {
+    let (l, eta) = (0.4, 1e-4);
+    let p_cr = PI * PI * E * (B * T.powi(3) / 12.0) / (l * l);
+    let (f0, z0) = prestressed_first_mode(0.0, l, eta)?;
+    let omega0 = 2.0 * PI * f0;
+    assert!((z0 / (eta * omega0 / 2.0) - 1.0).abs() < 1e-8, "unstressed: {z0:e}");
+    for p in [0.5 * p_cr, -0.5 * p_cr] {
+        let (f, z) = prestressed_first_mode(p, l, eta)?;
+        let expected = eta * omega0 * omega0 / (2.0 * 2.0 * PI * f);
+        eprintln!(
+            "P = {p:+.3} N: damping ratio {z:.5e} vs eta omega0^2 / (2 omega) {expected:.5e} ({:+.1e})",
+            z / expected - 1.0
+        );
+        assert!((z / expected - 1.0).abs() < 1e-6, "P = {p}: {z:e} vs {expected:e}");
+    }
+    Ok(())
 }
 
 /// Pre-stress: `f(P)^2 / f(0)^2 = 1 + P / P_cr` at P = +-P_cr / 2 within 0.5 % (the FE buckling
