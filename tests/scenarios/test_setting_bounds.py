@@ -208,6 +208,7 @@ def _simulation(time_step: float, cutbacks: int) -> VibrationSimulation:
         step_stats=({}, {}, {}, {"steps": 20, "cutbacks": cutbacks}),
         stats={"iterations": 40},
         ndof=np.array([100]),
+        modes=(),
         completed=True,
         error=None,
     )

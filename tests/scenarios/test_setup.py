@@ -85,8 +85,10 @@ def test_builder_puts_every_mass_in_the_model(configuration: str) -> None:
 def test_markers_sit_where_the_spec_puts_them(configuration: str, sense: str) -> None:
     # Sec. 3 / Fig. 10 of the paper: marker 0 on the support, marker 1 on a small interface,
     # marker 2 in the middle of the rod, marker 3 at the tip of the appendix (or of the additional
-    # weight); 1-3 on the laboratory's upper side, -z in the upturned equal-sense block. Read at
-    # the reference state (record 0 of a run), in the set-up's frame.
+    # weight); 1-3 on the laboratory's upper side, -z in the upturned equal-sense block; marker 0
+    # at support_marker in the laboratory, the support not being turned (in the set-up's frame
+    # y and z reversed in equal sense). Read at the reference state (record 0 of a run), in the
+    # set-up's frame.
     from tapespring.analysis import Step, run
 
     s = COARSE
@@ -96,7 +98,7 @@ def test_markers_sit_where_the_spec_puts_them(configuration: str, sense: str) ->
     up = -built.down * s.marker_height
     tip = s.setup_length if configuration == "appendix" else s.appendix_x + s.weight_length
     expected = {
-        "marker0": s.support_marker,
+        "marker0": np.array(s.support_marker) * [1.0, -built.down, -built.down],
         "marker1": (s.tape.length + s.interface_length / 2.0, -s.tape_spacing / 2.0, up),
         "marker2": (s.rod_x + s.rod_width / 2.0, 0.0, up),
         "marker3": (tip, 0.0, up),

@@ -8,10 +8,10 @@ adaptive run takes, hardly at all; with a fixed step of a twentieth of the perio
 
 `numerical_damping_study` runs the vibration test (:func:`tapespring.scenarios.vibration.vibrate`)
 once per ``rho_inf`` and sets the fitted damping ratios and periods beside what the scheme does to
-a linear oscillator with the structure's first modal period and its Kelvin-Voigt damping ratio
-``eta omega / 2``, computed with the same fixed step (the amplification matrix of the scheme,
-:func:`tapespring._core.generalized_alpha_decay`): the simulation's departures from ``rho_inf = 1``
-are then predictions, not fits.
+a linear oscillator with the structure's first modal period and that mode's Kelvin-Voigt damping
+ratio (:attr:`tapespring.modes.Modes.damping_ratios`), computed with the same fixed step (the
+amplification matrix of the scheme, :func:`tapespring._core.generalized_alpha_decay`): the
+simulation's departures from ``rho_inf = 1`` are then predictions, not fits.
 """
 
 from __future__ import annotations
@@ -188,9 +188,10 @@ def numerical_damping_study(
     period = np.array([nan if r.fit is None else r.fit.period for r in runs])
     reference = runs[int(np.argmax(rho))]
     predicted = np.full((rho.size, 2), nan)
-    if settings.time_step > 0.0:
-        modal = float(reference.modal_periods_s[0])
-        xi = reference.kelvin_voigt_damping_ratio
+    modal = float(reference.modal_periods_s[0])
+    xi = reference.kelvin_voigt_damping_ratio
+    # NaN without a modal step's damping ratio: no prediction.
+    if settings.time_step > 0.0 and np.isfinite(xi) and np.isfinite(modal):
         for k, r in enumerate(rho):
             predicted[k] = oscillator_decay(float(r), modal, xi, settings.time_step)
     return NumericalDampingStudy(
