@@ -396,8 +396,8 @@ class SetupSpec:
       ("larger and thicker" than the small ones, Sec. 3.2). Each ties its tape's x = 0 section
       and the flange's nodes under its footprint (bolted, it holds the flange there). In
       equal sense the block of tapes is turned upside down on the same support, so in the
-      set-up's frame the support stands on the +z side (the blocks then hang under the
-      flange).
+      set-up's frame the support stands on the +z side (in the laboratory the blocks still sit
+      on the flange, the set-up's +z being down).
     * marker 0 with the flexible support: on the middle of the bracket's corner (the top of the
       fixation support, Sec. 4.1), moving with it; ``support_marker`` places it on the rigid
       support only.
