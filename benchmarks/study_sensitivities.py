@@ -10,9 +10,9 @@ differences at ``--rel-step``) about the spec's values, on the paper's meshes:
 - ``vibrate``: Table 8's damping ratio and period, and the modal period (8 s of decay);
 - ``deploy``: the opposite-sense deployment's first extrema (1.2 s of motion).
 
-It prints each study's table of elasticities (``*``: the two one-sided changes disagree, the
-figure is not smooth there) and writes each study's JSON with ``--json-dir`` (times in
-docs/studies.md).
+It prints each study's table of elasticities (``*``: the figure is not smooth there, a kink or a
+jump that half steps confirmed: see ``SensitivityStudy.nonsmooth``) and writes each study's JSON
+with ``--json-dir`` (times in docs/studies.md).
 
     python benchmarks/study_sensitivities.py --tests equilibrium pull --workers 2
 """

@@ -18,7 +18,8 @@ import subprocess
 import sys
 import textwrap
 import time
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import pytest
@@ -172,6 +173,35 @@ def test_a_dead_worker_is_reported_with_the_tasks_left():
     with pytest.raises(WorkerDied, match=r"worker process died .* not reported") as info:
         collect(die_on, [0, 1, 2], 2)
     assert 1 in info.value.unfinished and isinstance(info.value, RuntimeError)
+
+
+class _DeadAt(Executor):
+    """Runs each task ``(x, delay)`` at once, but fails the future of the one whose x is `dead`
+    as a pool does whose worker died: every future is done by the time the study first looks."""
+
+    def __init__(self, dead: int) -> None:
+        self.dead = dead
+
+    def submit(self, fn, /, *args, **kwargs):
+        future: Future = Future()
+        if args[0][0] == self.dead:
+            future.set_exception(BrokenProcessPool("a worker died"))
+        else:
+            future.set_result(fn(*args, **kwargs))
+        return future
+
+
+@pytest.mark.parametrize("dead", [0, 1, 3])
+def test_a_dead_worker_leaves_the_runs_that_ended_elsewhere_to_on_done(dead):
+    # The runs after the dead one had ended with their results (in another worker) when the
+    # death was seen: they are handed over, in index order, and only the dead one is
+    # unfinished (until 2026-11-29 every future after it was, their results lost).
+    got: list[int] = []
+    with pytest.raises(WorkerDied, match=rf"tasks \[{dead}\] of 4 not reported") as info:
+        run_tasks(square_after, [(x, 0.0) for x in range(4)], on_done=lambda i, r: got.append(i),
+                  executor=_DeadAt(dead))  # fmt: skip
+    assert info.value.unfinished == [dead]
+    assert got == [x for x in range(4) if x != dead]
 
 
 def test_a_study_run_from_a_script_read_on_standard_input_gets_its_workers():

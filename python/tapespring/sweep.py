@@ -107,7 +107,8 @@ class WorkerDied(RuntimeError):
     Attributes
     ----------
     unfinished : list of int
-        Indices of the tasks whose results were not reported.
+        Indices of the tasks that gave no result (those that did were reported first, in
+        whichever worker they ran).
     """
 
     def __init__(self, message: str, unfinished: list[int]) -> None:
@@ -247,7 +248,9 @@ def run_tasks(
     WorkerDied
         A RuntimeError: a local worker process died (killed, out of memory, or it could not
         start: a script that starts a study without ``if __name__ == "__main__":`` is imported
-        again by each worker); its ``unfinished`` lists the tasks not reported.
+        again by each worker); its ``unfinished`` lists the tasks that gave no result. The runs
+        that had ended with theirs, in any worker, are first handed to `on_done` (its answers
+        then ignored).
     """
     tasks = list(tasks)
     done_with = on_done or (lambda i, r: None)
@@ -367,9 +370,12 @@ def _run_on(
                 try:
                     result = future.result()
                 except BrokenProcessPool as exc:
-                    # Every task not reported fails with it: which one the dead worker ran is
-                    # not known.
-                    unfinished = sorted([i, *pending.values()])
+                    # The runs that ended before the death (in any worker, reported or not yet
+                    # seen here) keep their results; every other one fails with it, since which
+                    # one the dead worker ran is not known.
+                    pending[future] = i
+                    _hand_over_results(pending, on_done)
+                    unfinished = sorted(pending.values())
                     raise WorkerDied(
                         "a worker process died (killed, out of memory, or it could not start: "
                         f"{_GUARD}) with tasks {unfinished} of {len(tasks)} not reported",
@@ -412,6 +418,21 @@ def _hand_over_ended(
     for future in sorted((f for f in pending if f.done()), key=pending.__getitem__):
         if not future.cancelled() and future.exception() is None:
             on_done(pending.pop(future), future.result())
+
+
+def _hand_over_results(
+    pending: dict[Future[R], int], on_done: Callable[[int, R], bool | None]
+) -> None:
+    """After a worker's death, hands `on_done` every run of `pending` that ended with its result,
+    in index order, and takes them out of `pending`, so that only the runs without one are
+    reported unfinished. The study ends with the death: `on_done`'s answers no longer count, and
+    a Ctrl-C in it does not keep the runs after it from being handed over."""
+    for future in sorted((f for f in pending if f.done()), key=pending.__getitem__):
+        if future.cancelled() or future.exception() is not None:
+            continue
+        index = pending.pop(future)
+        with contextlib.suppress(KeyboardInterrupt):
+            on_done(index, future.result())
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:

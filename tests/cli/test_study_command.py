@@ -63,7 +63,11 @@ def test_sensitivity_gives_the_bending_curves_exact_elasticities(
     # The analytical residual moment goes as t^3 (D): 3 to the central difference's error.
     analytical = figures["m_star_analytical_Nm"]["parameters"]["thickness"]["elasticity"]
     assert analytical == pytest.approx(3.0, abs=1e-3)
-    assert len(data["runs"]) == 5 and all(r["error"] is None for r in data["runs"])
+    # The located snap jumps within the thickness's steps: its two sides disagree, and the
+    # thickness is run at half its steps too (two more runs), where the jump stays.
+    assert data["halved"] == ["thickness"]
+    assert figures["theta_snap_deg"]["parameters"]["thickness"]["smooth"] is False
+    assert len(data["runs"]) == 7 and all(r["error"] is None for r in data["runs"])
     rows = _table(table, "study sensitivity")
     assert len(rows) == 2 * len(figures)
     row = next(r for r in rows if (r["figure"], r["parameter"]) == ("m_max_Nm", "youngs_modulus"))
@@ -99,6 +103,14 @@ def test_ensemble_writes_its_draws_figures_and_statistics(
     assert stats["mean"] == pytest.approx(sum(r["figures"]["m_max_Nm"] for r in runs) / 4)
     rows = _table(table, "study ensemble")
     assert [int(r["run"]) for r in rows] == [1, 2, 3, 4]
+    # The '#' line records the draws exactly: the distribution's arguments as they were, the
+    # seed, the sampling and the number of runs (a Latin hypercube's draws depend on it).
+    with table.open(encoding="utf-8") as fh:
+        recorded = json.loads(fh.readline().split(": ", 1)[1])
+    assert recorded["runs_planned"] == 4 and recorded["seed"] == 3
+    assert recorded["parameters"]["youngs_modulus"].startswith(
+        "uniform(140000000000.0, 40000000000.0), "
+    )
     assert [float(r["youngs_modulus"]) for r in rows] == moduli
     assert [float(r["m_max_Nm"]) for r in rows] == [r["figures"]["m_max_Nm"] for r in runs]
     assert all(r["error"] == "" for r in rows)

@@ -190,10 +190,12 @@ def _register_sensitivity(
             "Run SCENARIO at its nominal settings and, for each setting of --parameter, once "
             "with the setting stepped up and once stepped down (2 P + 1 runs for P settings), "
             "and report each figure's derivative and elasticity (df/f)/(dp/p) by central "
-            "differences: the percentage change of the figure per percent of the setting. A "
-            f"figure whose two one-sided changes disagree by more than {NONSMOOTH:g} of the "
-            "larger is flagged (*): a kink or jump within the steps, where the difference is no "
-            "derivative, or on a tiny elasticity the figure's own noise; ? where a run failed. "
+            "differences: the percentage change of the figure per percent of the setting. "
+            f"Where a figure's two one-sided changes disagree by more than {NONSMOOTH:g} of the "
+            "larger, the setting is run again at half its steps (two more runs), and the figure "
+            "is flagged (*) if its five values are not those of a smooth curve: a kink or jump "
+            "within the steps, where the difference is no derivative, or on a tiny elasticity "
+            "the figure's own noise; ? where a run failed. "
             "For a setting at 0 the table gives the derivatives (d/dp)."
         ),
         epilog=(

@@ -280,9 +280,10 @@ def plot_ensemble(result: Ensemble) -> Figure:
 def plot_sensitivity(result: SensitivityStudy, *, ax: Axes | None = None) -> Axes:
     """A sensitivity study's elasticities (:func:`tapespring.study.sensitivity`) as a tornado
     chart: one group of horizontal bars per figure, one bar per setting (coloured by setting,
-    its value at its end), the figures with the largest elasticity at the top. A bar whose two
-    one-sided changes disagree (:attr:`SensitivityStudy.nonsmooth`: a kink or jump within the
-    steps, or on a tiny elasticity the figure's own noise) is hatched, as the legend says; an
+    its value at its end), the figures with the largest elasticity at the top. A bar of a figure
+    that is not smooth in the setting (:attr:`SensitivityStudy.nonsmooth`: a kink or jump within
+    the steps, confirmed at half steps where the setting was run so, or on a tiny elasticity the
+    figure's own noise) is hatched, as the legend says; an
     elasticity that could not be computed (a failed run, a figure that is 0) is marked n/a.
 
     Parameters

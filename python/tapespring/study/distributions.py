@@ -4,6 +4,7 @@ form the command line gives them (``normal:0.138e-3:2%``)."""
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -58,16 +59,16 @@ def check_distribution(name: str, distribution: object) -> None:
 
 def describe_distribution(distribution: Any) -> str:
     """``norm(0.000138, 2e-06), mean 0.000138, std 2e-06``: SciPy's name and arguments, and the
-    mean and standard deviation, for tables and JSON."""
+    mean and standard deviation, for tables and JSON.
+
+    The arguments are written exactly (each float as its shortest text that reads back as the
+    same number), so that ``getattr(scipy.stats, name)(*args, **kwds)`` rebuilds the
+    distribution bit for bit, and with an ensemble's recorded seed, sampling and number of runs
+    draws its values again; the moments after them are rounded, for a person."""
     dist = getattr(distribution, "dist", None)
     name = getattr(dist, "name", type(distribution).__name__)
-    args = [
-        f"{a:.6g}" if isinstance(a, float) else repr(a) for a in getattr(distribution, "args", ())
-    ]
-    kwds = [
-        f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v!r}"
-        for k, v in getattr(distribution, "kwds", {}).items()
-    ]
+    args = [_exact(a) for a in getattr(distribution, "args", ())]
+    kwds = [f"{k}={_exact(v)}" for k, v in getattr(distribution, "kwds", {}).items()]
     text = f"{name}({', '.join(args + kwds)})"
     try:
         # A heavy tail's moments overflow to inf (lognormal with a large sigma): shown as such.
@@ -78,6 +79,16 @@ def describe_distribution(distribution: Any) -> str:
     # SciPy's arguments are its own (a uniform's are its low end and width): the moments say it
     # plainly.
     return f"{text}, mean {mean:.6g}, std {std:.3g}"
+
+
+def _exact(value: Any) -> str:
+    """`value` as text that reads back as the same number: NumPy's scalars as Python's (their
+    own repr is ``np.float64(...)`` since NumPy 2)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return repr(value)
+    if isinstance(value, numbers.Integral):
+        return repr(int(value))
+    return repr(float(value))
 
 
 def _number(text: str, what: str, form: str) -> float:

@@ -35,7 +35,7 @@ from tapespring import _checks
 from .distributions import check_distribution, describe_distribution
 from .figures import History
 from .paths import is_integer_setting, number_at, resolve
-from .runs import StudyRun, reporter, run_all, runner_for, warn_failed
+from .runs import StudyRun, StudyWarning, reporter, run_all, runner_for, warn_failed
 
 __all__ = ["MAX_RUNS", "QUANTILES", "SAMPLINGS", "SAVE_FORMAT", "Ensemble", "ensemble"]
 
@@ -84,7 +84,8 @@ class Ensemble:
     parameters : tuple of str
         The varied settings' names, as given.
     distributions : tuple of str
-        Their distributions (SciPy's names and arguments).
+        Their distributions: SciPy's names and arguments, exact (enough to rebuild them), then
+        their mean and standard deviation, rounded (:func:`describe_distribution`).
     samples : ndarray, shape (runs, parameters)
         Every draw, in the order of the runs (those not run after a stop included).
     runs : tuple of StudyRun
@@ -171,13 +172,24 @@ class Ensemble:
             pass
         raise KeyError(f"{parameter!r} was not varied; varied: {', '.join(self.parameters)}")
 
+    def infinite(self) -> dict[str, int]:
+        """The figures some runs gave as infinite (a time never reached, a ratio over zero), and
+        in how many runs: such values are left out of :meth:`statistics` and
+        :meth:`correlations`, as a failed run's are, and :func:`ensemble` warns of them."""
+        counts = {name: int(np.isinf(self.values(name)).sum()) for name in self.figure_names}
+        return {name: n for name, n in counts.items() if n}
+
     def statistics(self) -> dict[str, dict[str, float]]:
-        """Each figure's statistics over the runs that gave it: ``count``, ``mean``, ``std``
-        (sample), ``cv`` (std / |mean|), ``min``, ``p05``, ``median``, ``p95``, ``max``, in the
-        figure's unit (NaN where no run gave it; std and cv NaN from fewer than two)."""
+        """Each figure's statistics over the runs that gave it a finite value: ``count``,
+        ``mean``, ``std`` (sample), ``cv`` (std / |mean|), ``min``, ``p05``, ``median``,
+        ``p95``, ``max``, in the figure's unit (NaN where no run gave it; std and cv NaN from
+        fewer than two). Failed runs, figures a run did not produce (NaN) and infinite values
+        (:meth:`infinite`) are left out."""
         out: dict[str, dict[str, float]] = {}
         for name in self.figure_names:
             x = self.values(name)
+            # An infinite value would make the mean and the spread inf or NaN whatever the other
+            # runs gave: it is left out as a failed run is, and counted by `infinite`.
             x = x[np.isfinite(x)]
             n = int(x.size)
             if n == 0:
@@ -203,9 +215,10 @@ class Ensemble:
 
     def correlations(self) -> dict[str, dict[str, float]]:
         """Spearman's rank correlation of each figure (rows) with each varied setting, over the
-        runs that gave the figure: +1 or -1 where the figure rises or falls steadily with the
-        setting, near 0 where the setting does not drive its scatter. NaN from fewer than three
-        runs, or where the figure or the setting does not vary."""
+        runs that gave the figure a finite value (as :meth:`statistics`): +1 or -1 where the
+        figure rises or falls steadily with the setting, near 0 where the setting does not drive
+        its scatter. NaN from fewer than three runs, or where the figure or the setting does not
+        vary."""
         from scipy.stats import spearmanr
 
         out: dict[str, dict[str, float]] = {}
@@ -343,6 +356,8 @@ class Ensemble:
             lines.append(f"  run {run.index + 1} failed: {run.error}")
         if len(self.failed) > 3:
             lines.append(f"  ... and {len(self.failed) - 3} more failed runs")
+        for name, n in self.infinite().items():
+            lines.append(f"  {name} is infinite in {n} runs: left out of its statistics")
         if self.figure_names:
             lines += ["", self.table()]
         return "\n".join(lines)
@@ -549,7 +564,8 @@ def ensemble(
         A run's result to its figures (name: number); the scenario's defaults
         (:mod:`tapespring.study.figures`) if None.
     history : callable, bool or None
-        A run's result to the history kept for the band (abscissa, ordinate); None or True: the
+        A run's result to the history kept for the band (abscissa, ordinate: 1-D arrays of one
+        length, or the run fails with a ``history: ...`` message); None or True: the
         ready-made scenario's (none for a scenario of your own); False: none.
     workers : int or None
         Runs side by side in that many processes (None: one per core; 1: one after the other
@@ -583,7 +599,9 @@ def ensemble(
     -----
     StudyWarning
         If some runs failed (their settings refused, the solver stopped, a worker process died
-        before reporting them); they are kept in ``runs`` with their message.
+        before reporting them); they are kept in ``runs`` with their message. Also for each
+        figure that some runs gave as infinite (:meth:`Ensemble.infinite`), naming it and how
+        many runs: those values are left out of the statistics as the failed runs are.
     """
     from tapespring.sweep import check_workers
 
@@ -646,6 +664,14 @@ def ensemble(
         history_labels=runner.history_labels,
     )
     warn_failed(result.failed, len(ended), "; they are left out of the statistics")
+    for name, n in result.infinite().items():
+        first = next(r.index for r in ended if math.isinf(r.figures.get(name, 0.0)) and r.ok)
+        warnings.warn(
+            f"figure {name!r} is infinite in {n} of {len(ended)} runs (run {first + 1} the "
+            "first): those values are left out of its statistics and correlations",
+            StudyWarning,
+            stacklevel=2,
+        )
     if progress is True:
         print(
             f"ensemble of {runner.name}: {len(ended)} runs in {result.wall_s:.1f} s",

@@ -30,9 +30,10 @@ __all__ = [
 
 
 class StudyWarning(UserWarning):
-    """A study's runs did not all give their figures (settings out of range, a solver stop). A
-    `UserWarning`, so that the command line prints it as a ``warning: ...`` line; the study's
-    result keeps every run, the failed ones with their message."""
+    """A study's runs did not all give their figures (settings out of range, a solver stop), or
+    an ensemble's runs gave a figure as infinite. A `UserWarning`, so that the command line
+    prints it as a ``warning: ...`` line; the study's result keeps every run, the failed ones
+    with their message."""
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,8 @@ class StudyRun:
     figures : dict of str to float
         The scenario's figures (NaN: not produced); empty if it failed before running.
     history : (ndarray, ndarray) or None
-        Its history (abscissa, ordinate), None if not recorded.
+        Its history (abscissa, ordinate: 1-D, of one length), None if not recorded; a history
+        of another shape fails the run (``history: ...``).
     error : str or None
         Why it gave no figures: settings out of range (refused before running) or the solver
         stopped (the figures so far are kept but not used by the study's statistics).
@@ -219,6 +221,16 @@ def _run(task: _Task) -> StudyRun:
                 history = (np.asarray(x, dtype=float), np.asarray(y, dtype=float))
             except Exception as exc:
                 error = error or _failure(exc, "history: ")
+            else:
+                # Caught here, naming the run: a curve of unequal parts would fail only the
+                # ensemble's band, later and without saying whose it is.
+                shapes = (history[0].shape, history[1].shape)
+                if not (len(shapes[0]) == 1 and shapes[0] == shapes[1]):
+                    history = None
+                    error = error or (
+                        "history: its abscissa and ordinate must be 1-D arrays of the same "
+                        f"length (got shapes {shapes[0]} and {shapes[1]})"
+                    )
     return StudyRun(
         index=task.index,
         values=task.values,
@@ -246,8 +258,9 @@ def run_all(
     refused run ends when its turn comes, before the next run starts. In worker processes or on
     an executor the runs are reported in the order they end, a refused run as soon as every run
     before it has been reported but not before the first run that ran (what the workers cannot
-    receive is refused before any run is reported). After a worker's death, the runs it left
-    unreported fail with that message and are reported with the rest, in index order. The runs
+    receive is refused before any run is reported). After a worker's death, the runs that had
+    ended in any worker are reported first; those without a result fail with that message and
+    are reported with the rest, in index order. The runs
     that had ended when `report` stopped the study (False or Ctrl-C) are kept, `report` not told
     of them; so is a run that ended where `report`, told of a refused run before it, stops the
     study first.

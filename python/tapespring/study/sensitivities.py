@@ -7,9 +7,14 @@ force proportional to Young's modulus, 3 for a bending moment of a plate against
 A tape spring's figures are not all smooth in its settings: a peak's time jumps where a fold
 appears one swing later, a phase may not be detected. Each pair of one-sided differences is
 compared, and a figure whose two sides disagree is flagged as not smooth there: its central
-difference is then no derivative. A flag on a tiny elasticity (0.001) is usually the figure's own
-noise rather than a kink: a located extremum's position moves by the solver's tolerance (the
-pull's displacement at its maximum force, on the flat top of the curve, by about 1e-7 m).
+difference is then no derivative. Three runs cannot tell a kink from curvature (a parabola near
+its vertex has sides as unequal as a V near its tip), so where the sides disagree the setting is
+run at half its steps too, two more runs, and the figure is flagged only if its five values are
+not those of a smooth curve: a smooth figure's disagreement halves with the step, a kink's or a
+jump's does not (:attr:`SensitivityStudy.nonsmooth`). A flag on a tiny elasticity (0.001) is
+usually the figure's own noise rather than a kink: a located extremum's position moves by the
+solver's tolerance (the pull's displacement at its maximum force, on the flat top of the curve,
+by about 1e-7 m).
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ import numbers
 import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -60,9 +65,14 @@ def check_rel_step(value: object) -> float:
     return step
 
 
-#: A figure is flagged as not smooth in a setting when its two one-sided changes differ by more
-#: than this share of the larger: `|df+ + df-| > NONSMOOTH max(|df+|, |df-|)` (0 for a straight
-#: line, h f'' / f' for a smooth curve: 0.02 for a figure going as p^3 at a 1 % step).
+#: A figure's two one-sided changes disagree when they differ by more than this share of the
+#: larger: `|df+ + df-| > NONSMOOTH max(|df+|, |df-|)` (0 for a straight line, h f'' / f' for a
+#: smooth curve: 0.02 for a figure going as p^3 at a 1 % step, but any share near an extremum,
+#: where f' goes to 0). Checked again at half the steps, the figure is flagged when its five
+#: values' second differences spread by more than this share of their largest first difference:
+#: 0 for a parabola, whatever its vertex, about h^2 |f''' / f'| / 2 for a smooth curve (1e-4
+#: for p^3 at a 1 % step); for a kink at the nominal value the same share as the one-sided
+#: changes' own.
 NONSMOOTH = 0.25
 
 #: A change below this share of the figure is taken as no change, and never flagged: the solver
@@ -89,7 +99,9 @@ class SensitivityStudy:
         The step of each (absolute, SI units).
     runs : tuple of StudyRun
         The runs that ended: the nominal one first (index 0), then for each setting its step up
-        (index ``2 j + 1``) and down (``2 j + 2``).
+        (index ``2 j + 1``) and down (``2 j + 2``), then for each setting of `halved` (the
+        ``k``-th) its half step up (index ``2 P + 2 k + 1``, ``P`` settings) and down
+        (``2 P + 2 k + 2``).
     settings : object
         The nominal settings.
     workers : int
@@ -98,6 +110,9 @@ class SensitivityStudy:
         True if stopped before every run ended.
     wall_s : float
         Wall time [s].
+    halved : tuple of str
+        The settings also run at half their steps, since a figure's two sides disagreed at the
+        full steps (:attr:`nonsmooth`), in the order of their runs.
     """
 
     scenario: str
@@ -109,6 +124,7 @@ class SensitivityStudy:
     workers: int
     cancelled: bool
     wall_s: float
+    halved: tuple[str, ...] = ()
 
     @property
     def figure_names(self) -> tuple[str, ...]:
@@ -145,6 +161,21 @@ class SensitivityStudy:
         return np.array(up).T.reshape(shape), np.array(down).T.reshape(shape)
 
     @property
+    def half_changes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The figures' changes from the nominal run at each setting's half step up and down,
+        each of shape (figures, parameters): NaN for a setting not in :attr:`halved`, or where
+        a run failed."""
+        shape = (len(self.figure_names), len(self.parameters))
+        up, down = np.full(shape, math.nan), np.full(shape, math.nan)
+        first = 2 * len(self.parameters) + 1
+        base = self.base
+        for k, name in enumerate(self.halved):
+            j = self.parameters.index(name)
+            up[:, j] = self._figures(first + 2 * k) - base
+            down[:, j] = self._figures(first + 2 * k + 1) - base
+        return up, down
+
+    @property
     def derivatives(self) -> NDArray[np.float64]:
         """d figure / d setting, shape (figures, parameters), in the figure's unit per the
         setting's: central differences (which need no nominal run), one-sided where one side
@@ -170,13 +201,26 @@ class SensitivityStudy:
 
     @property
     def nonsmooth(self) -> NDArray[np.bool_]:
-        """True where a figure's two one-sided changes disagree (:data:`NONSMOOTH`): a jump or
-        kink within the steps, where the derivative means little. Shape (figures, parameters)."""
+        """True where a figure is not smooth in a setting: a jump or kink within the steps,
+        where the derivative means little. Shape (figures, parameters).
+
+        Where the setting was also run at half its steps (:attr:`halved`), the figure's five
+        values decide: flagged if their second differences spread by more than
+        :data:`NONSMOOTH` of their largest first difference (a smooth curve's second
+        differences are all about ``f'' (h / 2)^2``; a kink or a jump puts its break into one
+        or two of them). Elsewhere (the half steps not run, or one of them failed) a figure is
+        flagged where its two one-sided changes disagree by more than :data:`NONSMOOTH` of the
+        larger, which a curved figure near its extremum does too. A change below
+        :data:`NO_CHANGE` of the figure is never flagged."""
         up, down = self.changes
         larger = np.maximum(np.abs(up), np.abs(down))
         floor = NO_CHANGE * np.abs(self.base)[:, None]
+        half_up, half_down = self.half_changes
+        values = np.stack([down, half_down, np.zeros_like(up), half_up, up], axis=-1)
+        known = np.isfinite(values).all(axis=-1)
+        five = _not_smooth(np.where(known[..., None], values, 0.0))
         with np.errstate(invalid="ignore"):
-            return (np.abs(up + down) > NONSMOOTH * larger) & (larger > floor)
+            return np.where(known, five, _sides_disagree(up, down)) & (larger > floor)
 
     @property
     def assessed(self) -> NDArray[np.bool_]:
@@ -192,7 +236,8 @@ class SensitivityStudy:
 
     def summary(self) -> dict[str, Any]:
         """The study as JSON-ready values: per figure its nominal value, and per setting its
-        derivative, elasticity and smoothness; the runs; the settings."""
+        derivative, elasticity and smoothness; the runs, and which settings were run at half
+        steps too (``halved``); the settings."""
         from tapespring.report import jsonable_tree
 
         d, e, rough, known = self.derivatives, self.elasticities, self.nonsmooth, self.assessed
@@ -226,6 +271,7 @@ class SensitivityStudy:
                      "error": r.error, "wall_s": r.wall_s}
                     for r in self.runs
                 ],
+                "halved": list(self.halved),
                 "cancelled": self.cancelled,
                 "workers": self.workers,
                 "wall_s": self.wall_s,
@@ -264,20 +310,23 @@ class SensitivityStudy:
             f"{p} = {self.nominal[j]:.6g} +/- {self.steps[j]:.3g}"
             for j, p in enumerate(self.parameters)
         )
+        planned = 2 * (len(self.parameters) + len(self.halved)) + 1
         lines = [
-            f"sensitivity of {self.scenario}: {len(self.runs)} of {2 * len(self.parameters) + 1} "
+            f"sensitivity of {self.scenario}: {len(self.runs)} of {planned} "
             f"runs ended ({len(self.failed)} failed){', stopped early' if self.cancelled else ''}"
             f" {_where(self.workers)}, wall time {self.wall_s:.1f} s",
             f"  about {steps}",
         ]
+        if self.halved:
+            lines.append(f"  at half steps too (two sides disagreed): {', '.join(self.halved)}")
         for run in self.failed[:3]:
             lines.append(f"  run {run.index + 1} failed: {run.error}")
         if self.figure_names:
             lines += [
                 "",
-                "elasticities (d f / f) / (d p / p); *: the two sides differ (a kink or jump "
-                "within the steps, or, on a tiny elasticity, the figure's own noise); ?: not "
-                "known (a run failed)",
+                "elasticities (d f / f) / (d p / p); *: not smooth, the two sides differ and "
+                "at half steps too where run (a kink or jump within the steps, or, on a tiny "
+                "elasticity, the figure's own noise); ?: not known (a run failed)",
                 self.table(),
             ]
         return "\n".join(lines)
@@ -305,6 +354,27 @@ class SensitivityStudy:
     def write_json(self, path: str | Path) -> None:
         """:meth:`summary` as a JSON file (NaN written as null)."""
         Path(path).write_text(json.dumps(self.summary(), indent=1), encoding="utf-8")
+
+
+def _sides_disagree(up: NDArray[np.float64], down: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Where the changes at a step up and down differ by more than :data:`NONSMOOTH` of the
+    larger (False where either is NaN)."""
+    larger = np.maximum(np.abs(up), np.abs(down))
+    with np.errstate(invalid="ignore"):
+        return np.abs(up + down) > NONSMOOTH * larger
+
+
+def _not_smooth(values: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Where a figure's values at the steps -h, -h/2, 0, h/2, h (the last axis) are not a
+    smooth curve's: their three second differences spread by more than :data:`NONSMOOTH` of
+    their largest first difference. For a parabola they are equal; for a kink of slopes a and b
+    at 0 they are 0, (b - a) h / 2 and 0, the first differences up to max(|a|, |b|) h / 2, so
+    that the test is then the one-sided changes' own; a kink or a jump elsewhere within the
+    steps puts its break into one or two of them."""
+    second = values[..., :-2] - 2.0 * values[..., 1:-1] + values[..., 2:]
+    spread = second.max(axis=-1) - second.min(axis=-1)
+    first = np.abs(np.diff(values, axis=-1)).max(axis=-1)
+    return spread > NONSMOOTH * first
 
 
 def _steps(
@@ -365,9 +435,11 @@ def sensitivity(
     workers: int | None = 1,
     executor: Any = None,
     progress: bool | Callable[[StudyRun], bool | None] | None = None,
+    confirm_kinks: bool = True,
 ) -> SensitivityStudy:
     """The derivatives of a scenario's figures with respect to some of its settings, by central
-    differences about `settings` (``2 P + 1`` runs for ``P`` settings).
+    differences about `settings` (``2 P + 1`` runs for ``P`` settings), and where a figure's two
+    sides disagree, two more runs at half that setting's steps (``4 P + 1`` at most).
 
     Parameters
     ----------
@@ -384,7 +456,17 @@ def sensitivity(
     figures : callable, optional
         A run's result to its figures; the scenario's defaults if None.
     workers, executor, progress
-        As :func:`tapespring.study.ensemble`.
+        As :func:`tapespring.study.ensemble`. The half steps' runs, if any, start once the
+        others have ended, and are reported as ``run 2 P + 2 of ...`` on.
+    confirm_kinks : bool
+        True: for each setting in which some figure's one-sided changes disagree by more than
+        :data:`NONSMOOTH` of the larger (a kink, a jump, or only curvature near the figure's
+        extremum: three runs cannot tell), run the setting at half its steps too, two more
+        runs, and flag only the figures whose five values are not a smooth curve's
+        (:attr:`SensitivityStudy.nonsmooth`, :attr:`SensitivityStudy.halved`). A study whose
+        figures all agree costs nothing more; after a stop (`progress` returning False, Ctrl-C)
+        no half steps are run. False: ``2 P + 1`` runs always, every disagreement flagged. The
+        derivatives are the full steps' central differences either way.
 
     Returns
     -------
@@ -394,7 +476,8 @@ def sensitivity(
     ------
     TypeError, ValueError
         For bad arguments (an unknown or non-numeric setting, a setting at 0 without its step,
-        a step out of range, a function local workers cannot receive), before any run.
+        a step out of range, a function local workers cannot receive, a `confirm_kinks` that
+        is not a bool), before any run.
 
     Warns
     -----
@@ -407,6 +490,8 @@ def sensitivity(
     rel = check_rel_step(rel_step)
     check_workers(workers)
     check_progress(progress)
+    if not isinstance(confirm_kinks, bool):
+        raise TypeError(f"confirm_kinks must be True or False (got {confirm_kinks!r})")
     runner, settings = runner_for(scenario, settings, figures, False)
     names, nominal, steps = _steps(settings, parameters, rel)
     values: list[dict[str, float]] = [{}]
@@ -415,9 +500,19 @@ def sensitivity(
         values.append({name: float(nominal[j] - steps[j])})
 
     report = reporter(f"sensitivity of {runner.name}", len(values), progress)
+    asked_to_stop = False
+
+    # A stop asked on the last run is no stop of those runs (all ended), but still no more runs.
+    def report_first(run: StudyRun) -> bool:
+        nonlocal asked_to_stop
+        asked_to_stop = True
+        go_on = report(run)
+        asked_to_stop = not go_on
+        return go_on
+
     t0 = time.perf_counter()
     ended, stopped, processes = run_all(
-        runner, settings, values, workers=workers, executor=executor, report=report
+        runner, settings, values, workers=workers, executor=executor, report=report_first
     )
     result = SensitivityStudy(
         scenario=runner.name,
@@ -430,8 +525,50 @@ def sensitivity(
         cancelled=stopped,
         wall_s=time.perf_counter() - t0,
     )
-    warn_failed(result.failed, len(ended))
+    halved = _to_halve(result) if confirm_kinks and not (stopped or asked_to_stop) else ()
+    if halved:
+        half_values: list[dict[str, float]] = []
+        for name in halved:
+            j = names.index(name)
+            half_values.append({name: float(nominal[j] + steps[j] / 2.0)})
+            half_values.append({name: float(nominal[j] - steps[j] / 2.0)})
+        offset = len(values)
+        report_half = reporter(f"sensitivity of {runner.name}", offset + len(half_values), progress)
+
+        # The half steps' runs continue the numbering of the others, in the reports too.
+        def report_shifted(run: StudyRun) -> bool:
+            return report_half(replace(run, index=run.index + offset))
+
+        more, stopped, half_processes = run_all(
+            runner, settings, half_values, workers=workers, executor=executor,
+            report=report_shifted,
+        )  # fmt: skip
+        result = replace(
+            result,
+            runs=(*ended, *(replace(run, index=run.index + offset) for run in more)),
+            workers=max(processes, half_processes),
+            cancelled=stopped,
+            wall_s=time.perf_counter() - t0,
+            halved=halved,
+        )
+    warn_failed(result.failed, len(result.runs))
     if progress is True:
-        print(f"sensitivity of {runner.name}: {len(ended)} runs in {result.wall_s:.1f} s",
+        print(f"sensitivity of {runner.name}: {len(result.runs)} runs in {result.wall_s:.1f} s",
               file=sys.stderr)  # fmt: skip
     return result
+
+
+def _to_halve(study: SensitivityStudy) -> tuple[str, ...]:
+    """The settings in which some figure's one-sided changes disagree, which half steps can
+    check: not an integer setting whose step is odd, nor one whose half step does not move it in
+    floating point."""
+    suspect = study.nonsmooth.any(axis=0)  # no half steps yet: the sides' test
+    out = []
+    for j, name in enumerate(study.parameters):
+        nominal, half = study.nominal[j], study.steps[j] / 2.0
+        if not suspect[j] or nominal + half == nominal or nominal - half == nominal:
+            continue
+        if is_integer_setting(study.settings, name) and not float(half).is_integer():
+            continue
+        out.append(name)
+    return tuple(out)
