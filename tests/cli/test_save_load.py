@@ -77,6 +77,22 @@ def test_load_refuses_the_options_that_set_a_run(tmp_path, capsys):
     assert "--sense, --duration would set another run" in line
     line = refused(["deploy", "--load", str(path), "--csv", str(path)], capsys)
     assert "would overwrite the saved run" in line
+    # Given at its default value too (the saved run's duration is 0.01 s, the default 10 s):
+    # the command cannot know the saved run was made with it. An appended option as well.
+    default = str(build_parser_default("deploy", "duration"))
+    line = refused(["-v", "deploy", "--load", str(path), "--duration", default], capsys)
+    assert "--duration would set another run" in line
+    line = refused(["deploy", "--load", str(path), "--spec", "hold=5"], capsys)
+    assert "--spec would set another run" in line
+
+
+def build_parser_default(command: str, dest: str) -> object:
+    """The default of `command`'s option `dest`."""
+    from tapespring.cli import build_parser
+
+    parser = build_parser()
+    args = parser.parse_args([command, "--no-progress"])
+    return args.parser.get_default(dest)
 
 
 def test_load_reports_a_file_that_holds_no_deployment(tmp_path, capsys):

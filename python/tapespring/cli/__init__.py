@@ -180,6 +180,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``tapespring`` command; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    # What was typed, for the options whose presence matters, not only their value
+    # (`scenario_options.given_options`).
+    args.argv = list(sys.argv[1:] if argv is None else argv)
     verbosity = _verbosity(args)
     core = logging.getLogger("tapespring.core")
     handler = None

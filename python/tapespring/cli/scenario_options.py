@@ -661,17 +661,33 @@ def write_saved(args: argparse.Namespace, result: Any) -> None:
             print(wrote(path))
 
 
+def given_options(args: argparse.Namespace, names: Sequence[str]) -> list[str]:
+    """The parser destinations among `names` that the command line gave, at any value (a value
+    equal to the default is given too). The command's arguments (after the command's name in
+    ``args.argv``, which `main` records) are parsed again by its parser into a namespace whose
+    `names` hold markers of their own: argparse sets a default only where the namespace has no
+    value, so a marker left in place is an option not given. Without ``args.argv`` (a namespace
+    not made by `main`), the options whose values differ from their defaults."""
+    argv = getattr(args, "argv", None)
+    if argv is None:
+        return [n for n in names if getattr(args, n) != args.parser.get_default(n)]
+    # The main parser's own options (-v, --version) all begin with "-": the command is the
+    # first word that does not.
+    start = next(i for i, word in enumerate(argv) if not word.startswith("-")) + 1
+    # Lists, so that an "append" option (--spec) copies its marker into a new list.
+    markers: dict[str, list[Any]] = {name: [] for name in names}
+    again = argparse.Namespace(**markers)
+    args.parser.parse_known_args(argv[start:], again)
+    return [n for n in names if getattr(again, n) is not markers[n]]
+
+
 def load_saved(args: argparse.Namespace, run_options: Sequence[str], load: Callable[[str], R]) -> R:
     """The run saved in ``--load``'s file, read by `load`, after refusing (as `refuse`, exit 2)
-    the `run_options` (parser destinations) given with values other than their defaults, which
-    would set another run; a file that is missing or holds no saved run of this kind, or whose
-    run kept no nodal fields for ``--vtu``, ``--snapshots`` or ``--animate``, is reported as an
-    unreadable input (`CommandError`, exit 1)."""
-    given = [
-        f"--{name.replace('_', '-')}"
-        for name in run_options
-        if getattr(args, name) != args.parser.get_default(name)
-    ]
+    the `run_options` (parser destinations) given (`given_options`: at any value, its default
+    too), which would set another run; a file that is missing or holds no saved run of this
+    kind, or whose run kept no nodal fields for ``--vtu``, ``--snapshots`` or ``--animate``, is
+    reported as an unreadable input (`CommandError`, exit 1)."""
+    given = [f"--{name.replace('_', '-')}" for name in given_options(args, run_options)]
     if given:
         refuse(
             args,
