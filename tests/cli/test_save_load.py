@@ -1,6 +1,6 @@
-"""``tapespring deploy|vibrate --save FILE.npz``: the whole run with the settings it ran with,
-and ``--load FILE.npz`` (``load_deployment``, ``load_vibration`` in Python), which analyses it
-again without running it; the names and options they refuse."""
+"""``tapespring deploy|vibrate|release --save FILE.npz``: the whole run with the settings it ran
+with, and ``--load FILE.npz`` (``load_deployment``, ``load_vibration``, ``load_release`` in
+Python), which analyses it again without running it; the names and options they refuse."""
 
 from __future__ import annotations
 
@@ -214,7 +214,36 @@ def test_vibrate_resaved_after_a_refit_keeps_its_window(tmp_path, capsys):
     assert "--rho-inf-study takes no --save" in line
 
 
-@pytest.mark.parametrize("command", ["deploy", "vibrate"])
+#: A short release: 4 mm tapes, 3 ms of free motion (about 1 s).
+_SHORT_RELEASE = ["release", "--mesh-size", "0.004", "--duration", "0.003"]
+
+
+def test_release_save_and_load(tmp_path, capsys, monkeypatch):
+    """The release saved and loaded prints the same JSON (wall time aside), without running;
+    its run options are refused with --load, and a file of another scenario is not a release."""
+    from tapespring.scenarios.release import load_release
+
+    path = tmp_path / "release.npz"
+    assert main([*_SHORT_RELEASE, "--save", str(path), "--json", "--no-progress"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    _forbid_running(monkeypatch, "release", "release")
+    csv = tmp_path / "again.csv"
+    assert main(["release", "--load", str(path), "--json", "--csv", str(csv)]) == 0
+    again = json.loads(capsys.readouterr().out)
+    printed.pop("wall_s"), again.pop("wall_s")
+    assert again == printed
+    assert csv.read_text().startswith("# tapespring release: ")
+    assert load_release(path).theta_deg.tolist() == printed["theta_deg"]
+    line = refused(["release", "--load", str(path), "--fold-deg", "60"], capsys)
+    assert "--fold-deg would set another run" in line
+    deployment = tmp_path / "deploy.npz"
+    assert main([*_SHORT_DEPLOY, "--save", str(deployment), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert main(["release", "--load", str(deployment)]) == 1
+    assert "not a tapespring.scenarios.release.ReleaseSetup one" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["deploy", "vibrate", "release"])
 def test_every_option_either_sets_the_run_or_is_allowed_with_load(command):
     """A new option that sets a run must join the command's RUN_OPTIONS, or --load would take
     it silently; the others are outputs, comparisons, pictures or the analysis's own."""

@@ -28,9 +28,13 @@ from .scenario_options import (
     add_eta_option,
     add_json_and_progress_options,
     add_rho_inf_option,
+    add_save_load_options,
     add_tolerance_option,
+    load_saved,
+    saved_run,
     settings_comment,
     shows_progress,
+    write_saved,
 )
 
 __all__ = ["register", "run"]
@@ -124,9 +128,37 @@ def register(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "line of the settings as JSON",
     )
     p.add_argument("--plot", type=_image_file, help="write the angle and energy histories as a PNG")
+    add_save_load_options(
+        p,
+        test="the release",
+        python="tapespring.scenarios.release.load_release",
+        pictures=None,
+    )
     add_json_and_progress_options(p)
     p.set_defaults(func=run, parser=p)
     return p
+
+
+#: The options that set a run, which ``--load`` refuses (the saved run's set-up applies).
+RUN_OPTIONS = (
+    "fold_deg",
+    "tip_mass",
+    "tip_inertia",
+    "duration",
+    "eta",
+    "rho_inf",
+    "gravity",
+    "planar",
+    "tolerance",
+    "energy_tolerance",
+    "length",
+    "radius",
+    "alpha",
+    "thickness",
+    "youngs_modulus",
+    "poisson",
+    "mesh_size",
+)
 
 
 def _write_csv(result: Any, path: str, comment: str) -> None:
@@ -158,25 +190,28 @@ def run(args: argparse.Namespace) -> int:
     """
     from tapespring.analysis import ConvergenceError
     from tapespring.scenarios.bending import BendingSetup
-    from tapespring.scenarios.release import ReleaseSetup, release
+    from tapespring.scenarios.release import ReleaseSetup, load_release, release
 
     refuse_shared_paths(args)
+    failure = None
     try:
-        setup = ReleaseSetup(
-            tape=BendingSetup(**tape_fields(args)),
-            fold_deg=args.fold_deg,
-            tip_mass=args.tip_mass,
-            tip_inertia=args.tip_inertia,
-            duration=args.duration,
-            eta=args.eta,
-            rho_inf=args.rho_inf,
-            gravity=args.gravity,
-            planar=args.planar,
-            tolerance=args.tolerance,
-            energy_tolerance=args.energy_tolerance,
-        )
-        result = release(setup, progress=shows_progress(args))
-        failure = None
+        if args.load:
+            result = saved_run(load_saved(args, RUN_OPTIONS, load_release))
+        else:
+            setup = ReleaseSetup(
+                tape=BendingSetup(**tape_fields(args)),
+                fold_deg=args.fold_deg,
+                tip_mass=args.tip_mass,
+                tip_inertia=args.tip_inertia,
+                duration=args.duration,
+                eta=args.eta,
+                rho_inf=args.rho_inf,
+                gravity=args.gravity,
+                planar=args.planar,
+                tolerance=args.tolerance,
+                energy_tolerance=args.energy_tolerance,
+            )
+            result = release(setup, progress=shows_progress(args))
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -185,6 +220,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"error: {exc}", file=sys.stderr)
             return 1
         result, failure = exc.result, str(exc)
+    write_saved(args, result)
     summary = result.summary()
     if args.csv:
         _write_csv(result, args.csv, settings_comment(args, summary["settings"]))

@@ -612,29 +612,39 @@ def analyze_experiment(path: str, analyze: Callable[[Any], Any], *, test: str) -
 
 
 def add_save_load_options(
-    p: argparse.ArgumentParser, *, test: str, python: str, pictures: str, analysis: str = ""
+    p: argparse.ArgumentParser,
+    *,
+    test: str,
+    python: str,
+    pictures: str | None,
+    analysis: str = "",
 ) -> None:
     """Add ``--save FILE.npz`` (the whole run with its settings) and ``--load FILE.npz`` (a
     saved run analysed again instead of running one, `load_saved`); `test` names the run ("the
     deployment"), `python` the function that loads it in Python, `pictures` the options that
-    draw nodal fields ("--vtu"), `analysis` what else may be given with ``--load``."""
+    draw nodal fields ("--vtu"; None: a command without them nor ``--experiment``), `analysis`
+    what else may be given with ``--load``."""
+    fields = "" if pictures is None else f"the nodal fields that {pictures} keep, "
+    outputs = (
+        "--csv and --json"
+        if pictures is None
+        else (f"--csv, --json, --experiment comparison and {pictures} (if it kept nodal fields)")
+    )
     p.add_argument(
         "--save",
         type=_npz_file,
         metavar="FILE.npz",
-        help=f"write the whole run of {test} (every record, the reactions, the nodal fields "
-        f"that {pictures} keep, and the settings it ran with) to this NumPy file (.npz added "
-        f"if missing), also when it stops early: --load, or {python}(FILE) in Python, "
-        "analyses it again without running it",
+        help=f"write the whole run of {test} (every record, the reactions, {fields}and the "
+        "settings it ran with) to this NumPy file (.npz added if missing), also when it stops "
+        f"early: --load, or {python}(FILE) in Python, analyses it again without running it",
     )
     p.add_argument(
         "--load",
         type=_input_file,
         metavar="FILE.npz",
         help="analyse a run saved with --save instead of running one: its summary, --plot, "
-        f"--csv, --json, --experiment comparison and {pictures} (if it kept nodal fields)"
-        f"{analysis}; the settings are the saved run's, and the options that set a run are "
-        "refused with it (exit 1 if it had stopped early, as the run did)",
+        f"{outputs}{analysis}; the settings are the saved run's, and the options that set a run "
+        "are refused with it (exit 1 if it had stopped early, as the run did)",
     )
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -32,10 +33,13 @@ from tapespring.scenarios.setup import (
     check_energy_tolerance,
     check_eta,
     check_number,
+    check_recorded,
     check_rho_inf,
     check_tolerance,
     last_ndof,
     record_scenario,
+    saved_wall_s,
+    scenario_settings,
     step_counts,
 )
 
@@ -47,6 +51,7 @@ __all__ = [
     "check_gravity",
     "check_tip_inertia",
     "check_tip_mass",
+    "load_release",
     "release",
     "release_model",
     "release_steps",
@@ -292,6 +297,13 @@ class ReleaseResult:
     setup: ReleaseSetup
     wall_s: float
 
+    def save(self, path: str | Path) -> Path:
+        """Write the run to a NumPy ``.npz`` file (:meth:`tapespring.Results.save` of `results`,
+        which records the set-up too); :func:`load_release` reads it back. Returns the path
+        written (``.npz`` appended if missing)."""
+        record_scenario(self.results, self.setup)
+        return Path(self.results.save(path))
+
     def describe(self) -> str:
         """A few lines for a person: set-up, outcome, energy balance and cost."""
         s = self.summary()
@@ -379,6 +391,20 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
     results = run(
         model, release_steps(setup, tip), outputs=outputs, progress=progress, raise_on_error=False
     )
+    out = _result(results, setup, clamped, time.perf_counter() - start)
+    record_scenario(results, setup)
+    if results.error is not None:
+        err = ConvergenceError(
+            f"{results.error} (the release recorded so far is kept in the 'result' attribute)"
+        )
+        err.result = out
+        raise err
+    return out
+
+
+def _result(results: Any, setup: ReleaseSetup, clamped: int, wall_s: float) -> ReleaseResult:
+    """The free motion in `results` (run from `setup`; `clamped` the clamped end's reference
+    node): the histories from the release; `wall_s` the run's wall time."""
     free = results.in_step(FREE_STEP)
     t0 = results.t[free[0] - 1] if free.size else 0.0
     idx = np.concatenate([[free[0] - 1], free]) if free.size else free
@@ -392,23 +418,34 @@ def release(setup: ReleaseSetup = ReleaseSetup(), *, progress: bool = False) -> 
         "viscous": np.nan_to_num(results.viscous_dissipation[idx]),
         "numerical": np.nan_to_num(results.numerical_dissipation[idx]),
     }
-    out = ReleaseResult(
+    return ReleaseResult(
         time_s=results.t[idx] - t0,
         theta_deg=np.degrees(rot),
         moment_Nm=results.reaction(clamped, "ry")[idx],
         energy=energy,
         results=results,
         setup=setup,
-        wall_s=time.perf_counter() - start,
+        wall_s=wall_s,
     )
-    record_scenario(results, setup)
-    if results.error is not None:
-        err = ConvergenceError(
-            f"{results.error} (the release recorded so far is kept in the 'result' attribute)"
-        )
-        err.result = out
-        raise err
-    return out
+
+
+def load_release(path: str | Path) -> ReleaseResult:
+    """A release saved by :meth:`ReleaseResult.save`, analysed again without running it, with
+    the set-up recorded in the file. ``wall_s`` is the saved run's solver time.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        As :meth:`tapespring.Results.load`; ValueError also if the file holds no release's
+        set-up, or records that are not those of the run its set-up describes.
+    """
+    from tapespring.results import Results
+
+    results = Results.load(path)
+    setup = scenario_settings(results, ReleaseSetup, path)
+    model, clamped, tip = release_model(setup)
+    check_recorded(results, model, release_steps(setup, tip), path)
+    return _result(results, setup, clamped, saved_wall_s(results))
 
 
 #: The bending set-up's fields the release sets itself or does not read: the fold goes to
