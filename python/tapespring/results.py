@@ -770,9 +770,7 @@ def _load_modes(f: Any, i: int, entry: Mapping[str, Any]) -> Modes:
     """
     # Files before format 5 have no damping ratios: NaN, "not recorded".
     arrays = {
-        k: f[f"modes{i}_{k}"]
-        for k in _MODE_ARRAYS
-        if k != "damping_ratios" or f"modes{i}_{k}" in f
+        k: f[f"modes{i}_{k}"] for k in _MODE_ARRAYS if k != "damping_ratios" or f"modes{i}_{k}" in f
     }
     m = len(np.atleast_1d(arrays["eigenvalues"]))
     arrays.setdefault("damping_ratios", np.full(m, np.nan))

@@ -282,3 +282,26 @@ def test_equilibrium_figure_draws_on_given_axes():
         assert isinstance(ax.get_legend(), Legend)
     finally:
         plt.close(fig)
+
+
+def test_a_recording_is_drawn_with_its_detected_release_at_the_runs():
+    # The recording's clock starts wherever the capture began, the run's at the exact release;
+    # each release is detected as the first sample 2 deg off the fold (the trial analysis'
+    # rule), so the figure puts the recording's detected release where the run's is
+    # (DeploymentSimulation.detected_release_s), not at the run's exact release: the curves
+    # were 15 to 26 ms apart on the paper's deployments. A stand-in recording: the run's own
+    # angle delayed by 0.5 s of capture before it, at the same samples.
+    sim = _deployment("opposite")
+    delay = 0.5
+    release = sim.detected_release_s
+    assert 0.0 < release < 0.05
+    recording = SimpleNamespace(
+        time=sim.time_s + delay,
+        angle=np.radians(sim.angle_deg),
+        release_time=release + delay,
+        force_time=None,
+    )
+    fig = plot_deployment(sim, recording)
+    experiment = next(ln for ln in fig.axes[0].get_lines() if ln.get_label() == "experiment")
+    np.testing.assert_allclose(experiment.get_xdata(), sim.time_s, rtol=0, atol=1e-12)
+    plt.close(fig)

@@ -51,6 +51,30 @@ def test_deployment_tip_circle_and_lateral_excursion():
     )
 
 
+def test_the_first_tip_point_is_the_held_fold_and_the_excursion_the_shared_function():
+    from tapespring.protocols.deployment import lateral_excursion
+
+    trial, truth = make_deployment_trial("opposite", seed=5)
+    result = analyze_deployment(trial)
+    # Fig. 16's first point: the tip held in the fold (the sample tip at 235 mm turned by the
+    # initial angle about marker 1), about its equilibrium. The median of the ~250 samples before
+    # the detected release scatters by 0.05 mm * 1.25 / sqrt(250) = 4 um, and the 15-20 of them
+    # already moving shift it a little: 13 um at most over seeds 0-7 in both senses (measured);
+    # bound 20 um, 0.4 of the marker precision. Until 2026-11-29 it was the sample before the
+    # release, up to 2 deg (8 mm) into the motion.
+    eq = truth.equilibrium_angle
+    folded = truth.tip_radius * np.array(
+        [
+            np.cos(truth.initial_angle + eq) - np.cos(eq),
+            -np.sin(truth.initial_angle + eq) + np.sin(eq),
+        ]
+    )
+    np.testing.assert_allclose(result.tip_points[0], folded, rtol=0, atol=2e-5)
+    # The simulation's summary reuses the analysis's own lateral excursion.
+    tip_y = trial.marker("M3")[:, 1]
+    assert lateral_excursion(trial.time, tip_y) == result.lateral_max
+
+
 def test_deployment_with_marker_gap_fails_then_succeeds_after_filling():
     trial, _ = make_deployment_trial("opposite", seed=1)
     markers = {k: np.array(v) for k, v in trial.markers.items()}

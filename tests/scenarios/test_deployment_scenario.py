@@ -218,6 +218,22 @@ def test_sample_rows_are_the_recorded_samples_only(opposite: DeploymentSimulatio
     assert opposite.time_s.size > rows.size
 
 
+def test_peaks_count_from_the_release_a_recording_would_detect(
+    opposite: DeploymentSimulation,
+) -> None:
+    # As analyze_deployment on a recording: the release is the first sample 2 deg off the held
+    # fold (the run's first sample), and the first separations count from it, not from the
+    # exact release at 0 (until 2026-11-29 they did: 15 ms, 12 samples, earlier on this run).
+    rows = opposite.sample_rows()
+    t, angle = opposite.time_s[rows], opposite.angle_deg[rows]
+    first = t[np.flatnonzero(np.abs(angle - angle[0]) > 2.0)[0]]
+    assert first > 0.0
+    assert opposite.detected_release_s == pytest.approx(first, abs=1e-12)
+    assert opposite.peaks.t_ref == opposite.detected_release_s
+    for ext in (opposite.peaks.maxima, opposite.peaks.minima):
+        assert ext.separation[0] == pytest.approx(ext.time[0] - first, abs=1e-12)
+
+
 def test_compare_with_a_measured_deployment(opposite: DeploymentSimulation) -> None:
     from tapespring.protocols.deployment import analyze_deployment
     from tapespring.trials.samples import make_deployment_trial

@@ -33,7 +33,8 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     sim : tapespring.scenarios.deployment.DeploymentSimulation
         The simulated deployment.
     trial_result : tapespring.protocols.deployment.DeploymentResult, optional
-        A measured deployment, aligned at its release.
+        A measured deployment, its detected release at the run's
+        (:attr:`DeploymentSimulation.detected_release_s`: both 2 deg off the fold).
 
     Returns
     -------
@@ -44,8 +45,11 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     from ._legend import place_legends
 
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6.0))
+    # The recording on the run's clock: its release, detected 2 deg off the fold, lined up with
+    # the run's release detected by the same rule (the run's clock starts at the exact release:
+    # the curves were 15 to 26 ms apart).
+    t0 = 0.0 if trial_result is None else trial_result.release_time - sim.detected_release_s
     if trial_result is not None:
-        t0 = trial_result.release_time
         top.plot(
             trial_result.time - t0,
             np.degrees(trial_result.angle),
@@ -68,7 +72,7 @@ def plot_deployment(sim: Any, trial_result: Any | None = None) -> Figure:
     top.set_title(f"deployment, {sim.settings.sense} sense")
     if trial_result is not None and getattr(trial_result, "force_time", None) is not None:
         bottom.plot(
-            trial_result.force_time - trial_result.release_time,
+            trial_result.force_time - t0,
             trial_result.force_z,
             color="tab:blue",
             lw=0.6,

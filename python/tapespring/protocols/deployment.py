@@ -40,14 +40,23 @@ from .registry import Protocol, TrialsAnalysis, check_n_peaks
 
 __all__ = [
     "PROTOCOL",
+    "RELEASE_THRESHOLD",
     "SENSE_SIGN",
     "DeploymentGroup",
     "DeploymentResult",
     "analyze_deployment",
     "analyze_deployment_group",
+    "lateral_excursion",
+    "peaks_after_release",
 ]
 
 KIND = "deployment"
+
+#: Departure from the held fold that marks the release [rad] (2 deg): the release is the first
+#: sample this far from the initial angle, and the first peak separations count from it. A
+#: simulated deployment is released by the same rule (`DeploymentSimulation.compare`), so that
+#: both count from the same point of the motion.
+RELEASE_THRESHOLD = float(np.deg2rad(2.0))
 
 
 @dataclass(frozen=True)
@@ -63,7 +72,8 @@ class DeploymentResult:
     angle : ndarray, shape (n,)
         Bending angle relative to the deployed equilibrium [rad].
     release_time : float
-        Instant the angle leaves its initial value [s].
+        Instant the angle leaves its initial value [s]: the first sample more than
+        `release_threshold` from it.
     initial_angle : float
         Bending angle held before the release [rad].
     peaks : Peaks
@@ -74,7 +84,8 @@ class DeploymentResult:
     tip_xz : ndarray, shape (n, 2)
         Tip trajectory in the x-z plane, origin at its equilibrium position [m].
     tip_points : ndarray, shape (k, 2)
-        Tip positions at the initial folded state and at the phase I peaks [m].
+        Tip positions at the initial folded state (the median over the samples held before the
+        release, as the initial angle) and at the phase I peaks [m] (Fig. 16).
     tip_circle : CircleFit or None
         Circle fitted to ``tip_points`` (None with fewer than 3 points).
     lateral_max : float
@@ -85,6 +96,9 @@ class DeploymentResult:
     frame : str
         Axes the markers were analysed in: ``"lab"`` (as recorded), the signed
         axes given (``"x,-z,y"``), ``"given"`` (a matrix) or ``"fitted"``.
+    release_threshold : float
+        Departure from the initial angle that marked the release [rad] (a simulation compared
+        with this trial is released by the same rule).
     """
 
     name: str
@@ -104,6 +118,7 @@ class DeploymentResult:
     force_time: np.ndarray | None
     force_z: np.ndarray | None
     frame: str = "lab"
+    release_threshold: float = RELEASE_THRESHOLD
 
 
 #: Sign of the initial bending angle for each sense (paper Sec. 2), in the rig's frame.
@@ -212,6 +227,13 @@ def _check_at_rest(label: str, trial: Trial, angle: np.ndarray, tail: float) -> 
         )
 
 
+def _held(i0: int) -> slice:
+    """The samples held in the fold before the release at sample `i0`: the sample just before
+    it is within the threshold but may already move, so it is left out (the first sample stays,
+    for a record that starts at the release)."""
+    return slice(0, max(1, i0 - 1))
+
+
 def _angle_and_release(
     t: np.ndarray, m1: np.ndarray, m2: np.ndarray, tail: float, threshold: float
 ) -> tuple[np.ndarray, int, float]:
@@ -219,8 +241,66 @@ def _angle_and_release(
     raw = bending_angle(m1, m2)
     angle = raw - equilibrium_value(t, raw, tail=tail)
     i0 = release_index(angle, threshold)
-    initial = float(np.median(angle[: max(1, i0 - 1)]))
+    initial = float(np.median(angle[_held(i0)]))
     return angle, i0, initial
+
+
+def peaks_after_release(
+    time: np.ndarray, angle: np.ndarray, release: int, *, prominence: float | None = None
+) -> Peaks:
+    """Every peak of the bending angle from the release on, the first separations counted from
+    the release (paper Sec. 4.1, Fig. 15).
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Sampling instants [s], uniform.
+    angle : ndarray, shape (n,)
+        Bending angle [rad].
+    release : int
+        Index of the release sample (`tapespring.signals.levels.release_index` with
+        `RELEASE_THRESHOLD`).
+    prominence : float, optional
+        Peak prominence threshold [rad] (default: see `extract_peaks`).
+
+    Returns
+    -------
+    Peaks
+        All maxima and minima of ``angle[release:]``, ``t_ref = time[release]``.
+    """
+    return extract_peaks(
+        time[release:], angle[release:], None, prominence=prominence, t_ref=float(time[release])
+    )
+
+
+def lateral_excursion(
+    time: np.ndarray, lateral: np.ndarray, *, tail: float = 1.0, span: int = 25
+) -> float:
+    """Largest lateral excursion of the tip about its deployed equilibrium (paper Sec. 4.1).
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Sampling instants [s].
+    lateral : ndarray, shape (n,)
+        Lateral (y) coordinate of the tip [m].
+    tail : float
+        Final part of the record whose median is the equilibrium [s]
+        (`tapespring.signals.levels.equilibrium_value`).
+    span : int
+        Moving-average span applied before taking the maximum [samples], over the samples whose
+        window is complete (`analyze_deployment`'s ``lateral_span``); 1: none.
+
+    Returns
+    -------
+    float
+        ``max |lateral - equilibrium|`` [m].
+    """
+    reference = equilibrium_value(time, lateral, tail=tail)
+    smoothed = smooth(lateral, span) if span > 1 else lateral
+    return max_lateral_displacement(
+        smoothed[complete_windows(smoothed.size, span)], reference=reference
+    )
 
 
 def analyze_deployment(
@@ -229,7 +309,7 @@ def analyze_deployment(
     markers: Sequence[str] = DEFAULT_MARKERS,
     n_peaks: int = 10,
     prominence: float | None = None,
-    release_threshold: float = np.deg2rad(2.0),
+    release_threshold: float = RELEASE_THRESHOLD,
     tail: float = 1.0,
     lateral_span: int = 25,
     lateral_span_time: float | None = None,
@@ -249,7 +329,8 @@ def analyze_deployment(
     prominence : float, optional
         Peak prominence threshold [rad] (default: see `extract_peaks`).
     release_threshold : float
-        Departure from the initial angle that marks the release [rad].
+        Departure from the initial angle that marks the release [rad] (`RELEASE_THRESHOLD`,
+        2 deg).
     tail : float
         Final part of the record defining the equilibrium [s].
     lateral_span : int
@@ -268,7 +349,8 @@ def analyze_deployment(
         and z, e.g. ``"x,-z,y"`` for a capture with z up and the bending axis
         along -z (`tapespring.signals.frame.parse_frame`), or a 3x3 rotation.
         ``"fit"``: fit the plane of motion to the markers
-        (`tapespring.signals.frame.fit_motion_frame`); the sign of the bending
+        (`tapespring.signals.frame.fit_motion_frame` on markers 1 and 2, whose vector
+        the bending angle is, not on the tip, which sways); the sign of the bending
         axis is then chosen so that the initial angle agrees with the trial's
         sense (or from the laboratory y axis, with a warning, if the sense is
         unknown). A rig turned about the vertical shifts every angle unless the
@@ -306,7 +388,9 @@ def analyze_deployment(
     rotation, frame_name = _rig_frame(frame)
     if frame_name == "fitted":
         try:
-            rotation = fit_motion_frame(m1, m2, m3, deployed=t >= t[-1] - tail)
+            # Markers 1 and 2 only: the tip's lateral sway follows the fold (Sec. 4.1), so
+            # marker 3 tilted the fitted axis with it (0.74 deg for a 4.3 mm sway).
+            rotation = fit_motion_frame(m1, m2, deployed=t >= t[-1] - tail)
         except ValueError as exc:
             raise TrialError(label, str(exc)) from None
     if rotation is not None:
@@ -347,8 +431,7 @@ def analyze_deployment(
         )
     _check_at_rest(label, trial, angle, tail)
     t_rel = float(t[i0])
-    tt, yy = t[i0:], angle[i0:]
-    all_peaks = extract_peaks(tt, yy, None, prominence=prominence, t_ref=t_rel)
+    all_peaks = peaks_after_release(t, angle, i0, prominence=prominence)
     if len(all_peaks.maxima) == 0 and len(all_peaks.minima) == 0:
         raise TrialError(trial.metadata.label, "no peak found in the bending angle")
     peaks = all_peaks.head(n_peaks)
@@ -361,8 +444,11 @@ def analyze_deployment(
     tip_xz = (m3 - tip_eq)[:, [0, 2]]
     end = phases.phase_ii_index if phases.phase_ii_index is not None else phases.phase_iii_index
     pt = phases.peak_time[:end] if end is not None else phases.peak_time[:5]
-    pt = np.concatenate(([t[max(0, i0 - 1)]], pt))
-    tip_points = np.column_stack([np.interp(pt, t, tip_xz[:, k]) for k in range(2)])
+    # Fig. 16's first point is the folded state itself: the tip held there, as the initial
+    # angle is (the sample before the release may already be 2 deg, 7 mm, into the motion).
+    folded = np.median(tip_xz[_held(i0)], axis=0)
+    at_peaks = np.column_stack([np.interp(pt, t, tip_xz[:, k]) for k in range(2)])
+    tip_points = np.vstack((folded, at_peaks))
     try:
         circle = fit_circle(tip_points) if tip_points.shape[0] >= 3 else None
     except ValueError as exc:
@@ -370,10 +456,7 @@ def analyze_deployment(
             label, f"no circle through the tip's positions at the peaks: {exc}"
         ) from None
     span = span_samples(lateral_span_time, trial.rate) if lateral_span_time else lateral_span
-    lateral = smooth(m3[:, 1], span) if span > 1 else m3[:, 1]
-    lateral_max = max_lateral_displacement(
-        lateral[complete_windows(lateral.size, span)], reference=tip_eq[1]
-    )
+    lateral_max = lateral_excursion(t, m3[:, 1], tail=tail, span=span)
 
     force_time = force_z = None
     if trial.force_plates:
@@ -398,6 +481,7 @@ def analyze_deployment(
         force_time=force_time,
         force_z=force_z,
         frame=frame_name,
+        release_threshold=float(release_threshold),
     )
 
 

@@ -226,6 +226,24 @@ def _uniform_angle(
     return tu, np.interp(tu, t, angle)
 
 
+def _detected_release(angle: NDArray[np.float64], threshold: float | None = None) -> int:
+    """Index of the release sample of the uniformly sampled `angle` [rad] by the trial
+    analysis's rule: the first sample more than `threshold` [rad] (default
+    :data:`~tapespring.protocols.deployment.RELEASE_THRESHOLD`, 2 deg) from the held fold.
+
+    A recording's held angle is the median of its first samples (held, noisy); a simulation's
+    record starts at the release, so its first sample is the held fold exactly, and the median of
+    its first ten would be 0.2 deg into the motion already. 0 if the angle never leaves the fold
+    by that much (the first peak is then counted from the exact release).
+    """
+    from tapespring.protocols.deployment import RELEASE_THRESHOLD
+    from tapespring.signals.levels import release_index
+
+    if threshold is None:
+        threshold = RELEASE_THRESHOLD
+    return release_index(angle, threshold, n_initial=1) if angle.size else 0
+
+
 def _release_step(settings: DeploymentSettings) -> int:
     """Index of the release among the analysis steps: gravity, fold, settle (if any), release."""
     return 3 if settings.settle > 0.0 else 2
@@ -248,7 +266,9 @@ class DeploymentSimulation:
     tip_m : ndarray
         Position of the appendix tip (marker 3) [m], shape (n, 3).
     peaks : tapespring.signals.peaks.Peaks or None
-        The first ``n_peaks`` maxima and minima of the angle (None if none).
+        The first ``n_peaks`` maxima and minima of the angle (None if none), analysed as a
+        recording's (`tapespring.protocols.deployment.peaks_after_release`): the first time
+        separations are counted from :attr:`detected_release_s`, not from the exact release.
     phases : tapespring.signals.phases.Phases or None
     energy : dict of ndarray
         kinetic, strain, gravity, viscous and numerical energy [J] from the release.
@@ -360,9 +380,11 @@ class DeploymentSimulation:
         dict
             ``max_amplitude_deg``, ``min_amplitude_deg`` (simulation minus experiment) and
             ``max_separation_s``, ``min_separation_s`` (differences of the times between
-            successive peaks, the first from the release), per peak (None where one series has
-            fewer peaks); ``initial_angle_deg`` of both; the trial's name; the peaks left aside;
-            ``peak_prominence_deg``, the prominence both series' peaks count from; and
+            successive peaks, the first from the release as the trial analysis detects it in
+            both series: the first sample ``measured.release_threshold`` off the fold, 2 deg by
+            default, :attr:`detected_release_s` in the simulation), per peak (None where one
+            series has fewer peaks); ``initial_angle_deg`` of both; the trial's name; the peaks
+            left aside; ``peak_prominence_deg``, the prominence both series' peaks count from; and
             ``simulation_peaks``, the simulation's peaks the numbers of those left aside count
             among (``maxima_time_s``, ``maxima_deg``, ``minima_time_s``, ``minima_deg``: the
             first `n` of each kind and as many more as are left aside).
@@ -414,24 +436,39 @@ class DeploymentSimulation:
     def _peaks_against(self, measured: Any) -> tuple[Peaks, Peaks]:
         """This run's peaks, all of them, and `measured`'s, both from the larger of their two
         prominence thresholds (see :meth:`compare`); the recording keeps its own where that is
-        the larger."""
-        from tapespring.signals.peaks import extract_peaks
+        the larger. Both count their first separations from the release the trial analysis
+        detects, by the recording's threshold: the first sample 2 deg off the fold, which the
+        recording's count starts from, comes 10 to 20 samples (at 800 Hz) after the exact
+        release the simulation's time starts at."""
+        from tapespring.protocols.deployment import RELEASE_THRESHOLD, peaks_after_release
 
         assert self.peaks is not None
         prominence = max(self.peaks.prominence, measured.peaks.prominence)
         tu, au = _uniform_angle(self.time_s, np.radians(self.angle_deg), self.settings)
-        simulated = extract_peaks(tu, au, None, prominence=prominence)
+        threshold = getattr(measured, "release_threshold", RELEASE_THRESHOLD)
+        simulated = peaks_after_release(
+            tu, au, _detected_release(au, threshold), prominence=prominence
+        )
         recorded = measured.peaks
         if recorded.prominence < prominence:
-            after = measured.time >= measured.release_time
-            recorded = extract_peaks(
-                measured.time[after],
-                measured.angle[after],
-                None,
-                prominence=prominence,
-                t_ref=measured.release_time,
+            release = int(np.searchsorted(measured.time, measured.release_time))
+            recorded = peaks_after_release(
+                measured.time, measured.angle, release, prominence=prominence
             )
         return simulated, recorded
+
+    @property
+    def detected_release_s(self) -> float:
+        """The release as the trial analysis detects it [s], from the exact release (0): the first
+        sample at ``sample_rate`` more than
+        :data:`~tapespring.protocols.deployment.RELEASE_THRESHOLD` (2 deg) off the fold, as a
+        recording's ``release_time`` is on its clock (15 ms, 12 samples, in opposite sense on 5 mm
+        tapes). To draw a recording over the run, shift its time by ``release_time -
+        detected_release_s``."""
+        if self.time_s.size == 0:
+            return 0.0
+        tu, au = _uniform_angle(self.time_s, np.radians(self.angle_deg), self.settings)
+        return float(tu[_detected_release(au)])
 
     def clamp_force_at_crossings(self) -> Any:
         """The clamp force's peak at each zero crossing of the bending angle in phases I and II
@@ -476,9 +513,7 @@ class DeploymentSimulation:
                 "phase_ii_start_s": self.phases.phase_ii_start,
                 "phase_iii_start_s": self.phases.phase_iii_start,
             }
-        lateral = (
-            float(np.max(np.abs(self.tip_m[:, 1] - self.tip_m[0, 1]))) if self.tip_m.size else 0.0
-        )
+        lateral = self._lateral_excursion()
         k = int(np.argmax(np.abs(self.clamp_force_N))) if self.clamp_force_N.size else None
         return {
             "sense": self.settings.sense,
@@ -510,6 +545,20 @@ class DeploymentSimulation:
             "comparison": self.comparison,
             "settings": asdict(self.settings),
         }
+
+    def _lateral_excursion(self) -> float:
+        """Largest lateral excursion of the appendix tip about its deployed equilibrium [m], as
+        the trial analysis measures it (`tapespring.protocols.deployment.lateral_excursion`: the
+        equilibrium is the median of the last second of the samples) but unsmoothed: smoothing
+        cuts marker noise, which a simulation has none of, and its window would average the
+        first samples away, where a run (which starts at the release, not held) has its largest
+        excursion. 0 without samples."""
+        from tapespring.protocols.deployment import lateral_excursion
+
+        if self.tip_m.size == 0:
+            return 0.0
+        rows = self.sample_rows()
+        return lateral_excursion(self.time_s[rows], self.tip_m[rows, 1], span=1)
 
     def describe(self) -> str:
         """A few lines for a person."""
@@ -650,8 +699,8 @@ def _simulation(
 ) -> DeploymentSimulation:
     """The deployment in `results` (run from `settings` on `built`): histories from the release,
     peaks, phases and energies; `wall_s` the run's wall time [s]."""
+    from tapespring.protocols.deployment import peaks_after_release
     from tapespring.signals.angle import bending_angle
-    from tapespring.signals.peaks import extract_peaks
     from tapespring.signals.phases import detect_phases
 
     names = results.marker_names
@@ -674,8 +723,10 @@ def _simulation(
     if t.size > 8:
         tu, au = _uniform_angle(t, angle, settings)
         try:
-            peaks = extract_peaks(tu, au, settings.n_peaks)
-            phases = detect_phases(extract_peaks(tu, au, None))
+            # As a recording's (analyze_deployment): every peak after the detected release.
+            every = peaks_after_release(tu, au, _detected_release(au))
+            peaks = every.head(settings.n_peaks)
+            phases = detect_phases(every)
         except ValueError:
             peaks = phases = None
     energy = {

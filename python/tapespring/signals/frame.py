@@ -8,11 +8,33 @@ shifts, or its sign flips. Two remedies:
 
 - give the frame: ``parse_frame("x,-z,y")`` says that the rig's x, y and z axes
   are the laboratory's x, -z and y (a signed permutation, right-handed);
-- fit it (`fit_motion_frame`): the rod turns in a plane, so the direction of
-  least spread of the marker 1 -> 2 (and 1 -> 3) vectors is the bending axis y
-  (`motion_plane`); x is the deployed rod direction projected on the plane. A fit cannot tell the
-  sign of y (which way is "positive" bending); the caller chooses it (from the
+- fit it (`fit_motion_frame`): the free end moves in a plane, so the direction of
+  least spread of the trajectories of markers 1 and 2 (each about its mean) is the bending axis
+  y (`motion_plane`); x is the deployed rod direction projected on the plane. A fit cannot tell
+  the sign of y (which way is "positive" bending); the caller chooses it (from the
   sense of bending, for a deployment).
+
+Which markers define that plane: only markers of the free end's rigid body, markers 1 and 2,
+whose vector the bending angle is. The appendix tip (marker 3) also sways sideways as the tapes
+fold (4.3 mm, Sec. 4.1), in step with the bending angle: with its vector from marker 1 in the
+fit (until 2026-11-29), the fitted axis tilted by 0.74 deg, absorbed the sway (0.51 mm of
+lateral excursion instead of 4.3 mm) and leaked the marker 1 -> 2 vector's sideways component
+into the angle (0.12 deg).
+
+Why their trajectories and not their vector alone. The vector defines the plane in exact
+arithmetic (it turns by the bending angle, 100 deg or more, and a turning vector's centred
+samples lie in the plane normal to the axis whatever its component along it), but poorly under
+the markers' noise when it lies mostly across the rig, as on the simulated set-up (marker 1 on a
+small interface, 12.5 mm from marker 2 along x and 20 mm to the side): on 7 s deployments with
+the paper's marker noise its plane tilts by up to 0.4-0.6 deg, which the 20 mm leak into
+bending angles 1.1-1.3 deg off; and when the capture's 0.3 mm transverse noise is not along the
+rig's y (a rig turned in the capture, the case a fit is for), its covariance biases the plane by
+1.3-4.7 deg (3-12 deg of angle). Every point of a free end moving in a plane stays in a plane
+normal to the axis, wherever the folds travel, so the markers' own trajectories hold the same
+plane over arcs as long as their distance from the fold: on the same records within 0.05 deg
+(0.12 deg of angle), and 0.09 deg (0.22 deg) with the noise turned. Unlike the vector, they
+would also tilt with a sideways translation of markers 1 and 2 in step with the fold (the paper
+gives the tip's lateral motion only).
 
 The same plane checks a frame given or assumed: `MotionPlane.tilt` is the angle between the
 plane's normal and the frame's y axis (0 in the rig's frame, 90 degrees when a wrong frame puts
@@ -170,14 +192,22 @@ def motion_plane(origin: np.ndarray, *moving: np.ndarray) -> MotionPlane:
 def fit_motion_frame(
     origin: np.ndarray, *moving: np.ndarray, deployed: np.ndarray | None = None
 ) -> np.ndarray:
-    """The rig's frame fitted to markers that turn about one axis through ``origin``.
+    """The rig's frame fitted to markers of one body that moves in a plane (turning about the
+    bending axis, which may travel in that plane).
+
+    The plane is that of the markers' trajectories, each about its mean (the `motion_plane` of
+    the positions, `origin` included): in a planar motion every marker stays in a plane normal
+    to the axis, whether it is on the axis or not (module notes).
 
     Parameters
     ----------
     origin : ndarray, shape (n, 3)
-        Marker on the axis (marker 1) [m].
+        Marker 1 [m], on the body (on the axis or not), from which the first moving marker
+        gives the rod's direction.
     *moving : ndarray, shape (n, 3)
-        Markers that turn about it (markers 2 and 3) [m]; at least one.
+        Other markers of the same rigid body [m] (marker 2); at least one. A marker that also
+        moves sideways with the motion (the appendix tip, marker 3) tilts the plane (module
+        notes).
     deployed : ndarray of bool, shape (n,), optional
         Samples in the deployed state, whose mean marker 1 -> first moving marker
         direction is the rig's x axis; default the last tenth of the record.
@@ -198,7 +228,11 @@ def fit_motion_frame(
     """
     if not moving:
         raise ValueError("fit_motion_frame needs at least one moving marker")
-    plane = motion_plane(origin, *moving)
+    p0 = _positions(origin, "origin")
+    points = [_positions(m, f"moving[{k}]", p0.shape[0]) for k, m in enumerate(moving)]
+    # Each marker's trajectory about its own mean (motion_plane centres each cloud): the vector
+    # between two markers holds the plane too, over a far shorter arm (module notes).
+    plane = motion_plane(np.zeros_like(p0), p0, *points)
     spread = plane.spread
     if not spread[1] > MIN_SPREAD_RATIO * spread[0]:
         ratio = spread[1] / spread[0] if spread[0] > 0 else 0.0
@@ -207,7 +241,7 @@ def fit_motion_frame(
             f"(spread ratio {ratio:.2g}, needs > {MIN_SPREAD_RATIO})"
         )
     y = plane.normal
-    rod = _positions(moving[0], "moving[0]") - _positions(origin, "origin")
+    rod = points[0] - p0
     n = rod.shape[0]
     if deployed is None:
         mask = np.zeros(n, bool)

@@ -217,7 +217,7 @@ class SensitivityStudy:
         floor = NO_CHANGE * np.abs(self.base)[:, None]
         half_up, half_down = self.half_changes
         values = np.stack([down, half_down, np.zeros_like(up), half_up, up], axis=-1)
-        known = np.isfinite(values).all(axis=-1)
+        known = np.asarray(np.isfinite(values).all(axis=-1), dtype=bool)
         five = _not_smooth(np.where(known[..., None], values, 0.0))
         with np.errstate(invalid="ignore"):
             return np.where(known, five, _sides_disagree(up, down)) & (larger > floor)
@@ -562,7 +562,7 @@ def _to_halve(study: SensitivityStudy) -> tuple[str, ...]:
     """The settings in which some figure's one-sided changes disagree, which half steps can
     check: not an integer setting whose step is odd, nor one whose half step does not move it in
     floating point."""
-    suspect = study.nonsmooth.any(axis=0)  # no half steps yet: the sides' test
+    suspect = np.asarray(study.nonsmooth.any(axis=0), dtype=bool)  # no half steps: the sides' test
     out = []
     for j, name in enumerate(study.parameters):
         nominal, half = study.nominal[j], study.steps[j] / 2.0
