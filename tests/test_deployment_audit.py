@@ -33,6 +33,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 from tapespring.protocols import analyze_deployment
+from tapespring.protocols.deployment import DeploymentResult
 from tapespring.scenarios.deployment import (
     DeploymentSettings,
     DeploymentSimulation,
@@ -403,6 +404,17 @@ def test_lateral_excursion_and_its_share_of_the_setup_length(sense, lateral, per
 # the fold (4.3 mm, Sec. 4.1) tilted the fitted bending axis by 0.74 deg.
 
 
+def _swaying_capture(sense: str) -> tuple[DeploymentResult, DeploymentResult]:
+    """The phased deployment with the tip swaying 4.3 mm sideways with the fold, in the capture's
+    frame, analysed with its true frame and with frame='fit' (noise free)."""
+    knot_t, knot_v, *_ = _phased_knots(sense)
+    t = np.arange(round(7.0 * RATE)) / RATE
+    rig = _rig_markers(_halfcos(t, knot_t, knot_v), lateral=4.3e-3)
+    lab, frame = _to_capture(rig, sense, CAPTURE)
+    known = analyze_deployment(_trial(t, lab, sense), frame=frame)
+    return known, analyze_deployment(_trial(t, lab, sense), frame="fit")
+
+
 @pytest.mark.parametrize("sense", ["opposite", "equal"])
 def test_a_fitted_frame_keeps_the_tips_lateral_excursion(sense):
     # Was a defect: the tilted axis absorbed the sway, lateral_max 0.51 mm instead of 4.3 mm
@@ -410,12 +422,7 @@ def test_a_fitted_frame_keeps_the_tips_lateral_excursion(sense):
     # The same capture analysed with its true frame and with frame='fit' (noise free): the
     # lateral excursion is a property of the motion, not of how the frame was found. Bound: 5 %
     # of the excursion (0.2 mm, below the 0.3 mm transverse marker precision).
-    knot_t, knot_v, *_ = _phased_knots(sense)
-    t = np.arange(round(7.0 * RATE)) / RATE
-    rig = _rig_markers(_halfcos(t, knot_t, knot_v), lateral=4.3e-3)
-    lab, frame = _to_capture(rig, sense, CAPTURE)
-    known = analyze_deployment(_trial(t, lab, sense), frame=frame)
-    fitted = analyze_deployment(_trial(t, lab, sense), frame="fit")
+    known, fitted = _swaying_capture(sense)
     assert known.lateral_max == pytest.approx(4.3e-3, rel=1e-9)
     assert fitted.lateral_max == pytest.approx(known.lateral_max, rel=0.05)
 
@@ -428,13 +435,7 @@ def test_a_fitted_frame_keeps_the_bending_angle():
     # tilts by e, and the marker 1 -> 2 vector's constant y component d_y (16 mm here) leaks
     # into the fitted x-z plane by d_y e: 0.016 * 0.013 / 0.05 = 4e-3 rad at most. Bound: the
     # marker precision's angle, 0.05 deg (the refinement alone is good to 0.002 deg).
-    sense = "opposite"
-    knot_t, knot_v, *_ = _phased_knots(sense)
-    t = np.arange(round(7.0 * RATE)) / RATE
-    rig = _rig_markers(_halfcos(t, knot_t, knot_v), lateral=4.3e-3)
-    lab, frame = _to_capture(rig, sense, CAPTURE)
-    known = analyze_deployment(_trial(t, lab, sense), frame=frame)
-    fitted = analyze_deployment(_trial(t, lab, sense), frame="fit")
+    known, fitted = _swaying_capture("opposite")
     assert np.max(np.abs(fitted.angle - known.angle)) < 0.05 * DEG
 
 
