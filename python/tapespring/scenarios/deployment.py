@@ -310,8 +310,13 @@ class DeploymentSimulation:
         """
         return sample_rows(self.time_s, self.settings.sample_rate)
 
-    def to_trial(self, *, rate_hz: float | None = None) -> Any:
-        """The release and the motion as a :class:`tapespring.trials.Trial`.
+    def to_trial(self, *, rate_hz: float | None = None, hold: float = 0.25) -> Any:
+        """The release and the motion as a :class:`tapespring.trials.Trial`, after `hold`
+        seconds [s] (>= 0) of the held fold: a recording starts before the hand lets go, and
+        the trial analysis takes the initial angle from the samples before the release, which
+        it finds 2 deg off that angle (:attr:`detected_release_s` after the hold; without a
+        hold the first samples already move, and the release came 2.5 ms later). The trial
+        starts at the release's simulation time.
 
         Markers M1 (marker 1, on a small interface), M2 (marker 2, middle of the rod) and M3
         (marker 3, appendix tip), as :data:`TRIAL_MARKERS` maps them (marker 0, on the support,
@@ -324,6 +329,7 @@ class DeploymentSimulation:
         """
         import dataclasses
 
+        from tapespring.scenarios.pull import rest_before
         from tapespring.trials.trial import Metadata
 
         rate = self.settings.sample_rate if rate_hz is None else rate_hz
@@ -338,15 +344,15 @@ class DeploymentSimulation:
             steps=steps,
             metadata=meta,
         )
-        if self.setup.down < 0:
-            return trial
-        # Equal sense: the block is turned about x, and the plate stays on the floor.
-        turn = np.array([1.0, -1.0, -1.0])
-        plates = tuple(
-            dataclasses.replace(p, force=p.force * turn, moment=p.moment * turn)
-            for p in trial.force_plates
-        )
-        return dataclasses.replace(trial, force_plates=plates)
+        if self.setup.down > 0:
+            # Equal sense: the block is turned about x, and the plate stays on the floor.
+            turn = np.array([1.0, -1.0, -1.0])
+            plates = tuple(
+                dataclasses.replace(p, force=p.force * turn, moment=p.moment * turn)
+                for p in trial.force_plates
+            )
+            trial = dataclasses.replace(trial, force_plates=plates)
+        return rest_before(trial, hold)
 
     def compare(
         self,
