@@ -19,12 +19,11 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from _vibrate_stand_in import Simulation
 from tapespring import Model, Step, run, shell
 from tapespring.identify import damping as damping_identification
 from tapespring.identify import static
@@ -295,19 +294,6 @@ def test_a_kelvin_voigt_strips_decay_fits_to_the_schemes_damping_of_eta_omega_ov
     assert 2 * fit.damping_ratio / omega == pytest.approx(eta, rel=0.01)
 
 
-@dataclass(frozen=True)
-class _Simulation:
-    """The fields of a VibrationSimulation that identify_damping reads."""
-
-    fit: Any
-    fit_error: str | None
-    modal_periods_s: np.ndarray
-    time_s: np.ndarray
-    displacement_m: np.ndarray
-    settings: VibrationSettings
-    wall_s: float
-
-
 def test_the_damping_identification_recovers_eta_through_the_real_fit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -319,7 +305,7 @@ def test_the_damping_identification_recovers_eta_through_the_real_fit(
     # target / (target - eps0) = 1.04 in eta: 2e-3 covers it.
     period, eps0, target = 0.1095, 2e-4, EPS
 
-    def vibrate(settings: VibrationSettings, *, progress: bool = False) -> _Simulation:
+    def vibrate(settings: VibrationSettings, *, progress: bool = False) -> Simulation:
         eps = eps0 + settings.spec.eta * math.pi / period
         omega0 = 2 * math.pi / period
         omega_d, a = omega0 * math.sqrt(1 - eps**2), eps * omega0
@@ -330,7 +316,7 @@ def test_the_damping_identification_recovers_eta_through_the_real_fit(
             fit, error = fit_damping(t, z, settings.window, t_start=0.0), None
         except ValueError as exc:
             fit, error = None, str(exc)
-        return _Simulation(fit, error, np.array([period]), t, z, settings, 0.0)
+        return Simulation(fit, error, np.array([period]), t, z, settings, 0.0)
 
     monkeypatch.setattr(damping_identification, "vibrate", vibrate)
     with warnings.catch_warnings():

@@ -374,7 +374,7 @@ def _run_on(
                     # seen here) keep their results; every other one fails with it, since which
                     # one the dead worker ran is not known.
                     pending[future] = i
-                    _hand_over_results(pending, on_done)
+                    _hand_over_ended(pending, on_done, interruptible=False)
                     unfinished = sorted(pending.values())
                     raise WorkerDied(
                         "a worker process died (killed, out of memory, or it could not start: "
@@ -410,29 +410,23 @@ def _run_on(
 
 
 def _hand_over_ended(
-    pending: dict[Future[R], int], on_done: Callable[[int, R], bool | None]
+    pending: dict[Future[R], int],
+    on_done: Callable[[int, R], bool | None],
+    *,
+    interruptible: bool = True,
 ) -> None:
-    """After a stop, hands `on_done` the runs that have ended all the same (with the run it was
-    asked on, or while it was asked), in index order, and takes them out of `pending`; its
-    answer no longer counts. A run that failed is left: the study stopped before reaching it."""
+    """After a stop or a worker's death, hands `on_done` the runs that have ended all the same
+    with their results (with the run it was asked on, or while it was asked; in any worker), in
+    index order, and takes them out of `pending`, so that after a death only the runs without
+    one are reported unfinished; its answer no longer counts. A run that failed is left: the
+    study stopped before reaching it. Not `interruptible` (after a death, which ends the study
+    anyway), a Ctrl-C in `on_done` does not keep the runs after it from being handed over."""
+    guard = contextlib.nullcontext() if interruptible else contextlib.suppress(KeyboardInterrupt)
     for future in sorted((f for f in pending if f.done()), key=pending.__getitem__):
         if not future.cancelled() and future.exception() is None:
-            on_done(pending.pop(future), future.result())
-
-
-def _hand_over_results(
-    pending: dict[Future[R], int], on_done: Callable[[int, R], bool | None]
-) -> None:
-    """After a worker's death, hands `on_done` every run of `pending` that ended with its result,
-    in index order, and takes them out of `pending`, so that only the runs without one are
-    reported unfinished. The study ends with the death: `on_done`'s answers no longer count, and
-    a Ctrl-C in it does not keep the runs after it from being handed over."""
-    for future in sorted((f for f in pending if f.done()), key=pending.__getitem__):
-        if future.cancelled() or future.exception() is not None:
-            continue
-        index = pending.pop(future)
-        with contextlib.suppress(KeyboardInterrupt):
-            on_done(index, future.result())
+            index = pending.pop(future)
+            with guard:
+                on_done(index, future.result())
 
 
 def _terminate(pool: ProcessPoolExecutor) -> None:

@@ -183,12 +183,9 @@ def _sinusoid_fit(
     # nearest of its kind, but over 2 samples either side at least, and a noise peak 3 samples
     # from the next has a sinusoid that turned past its troughs over those (its top was refined
     # to 1e11 times the noise).
-    u = min(omega * w, 0.5 * math.pi)
-    if u > 0:
-        s_col = np.sin(u * x) / u
-        c_col = (2.0 * np.sin(0.5 * u * x) / u) ** 2  # 2 (1 - cos u x) / u^2 without cancellation
-    else:
-        s_col, c_col = x, x * x
+    u = min(omega * w, 0.5 * math.pi)  # > 0: `_extrema`'s omega and w are
+    s_col = np.sin(u * x) / u
+    c_col = (2.0 * np.sin(0.5 * u * x) / u) ** 2  # 2 (1 - cos u x) / u^2 without cancellation
     basis = np.column_stack((np.ones_like(x), s_col, -c_col))
     (e, f, g), *_ = np.linalg.lstsq(basis, y, rcond=None)
     return float(e), float(f), float(g), w, u
@@ -200,7 +197,7 @@ def _sinusoid_top(e: float, f: float, g: float, u: float) -> tuple[float, float,
     ``e - P + R cos(u x - phi)`` with ``P = 2 g / u^2``, ``R = root / u^2``,
     ``root = sqrt(4 g^2 + f^2 u^2)``, written so that ``u -> 0`` gives the parabola's vertex."""
     root = math.sqrt(4.0 * g * g + (f * u) ** 2)
-    x = math.atan2(f * u, 2.0 * g) / u if u > 0 else f / (2.0 * g)
+    x = math.atan2(f * u, 2.0 * g) / u
     return x, e + f * f / (2.0 * g + root), root  # R - P = f^2 / (2 g + root), no cancellation
 
 
@@ -235,8 +232,8 @@ def _refine(
     reach: int,
     omega: float,
 ) -> tuple[float, float]:
-    """Vertex of a least-squares sinusoid of pulsation ``omega`` (`_fit_vertex`; a parabola
-    where ``omega`` is 0) through the top of the maximum at sample i.
+    """Vertex of a least-squares sinusoid of pulsation ``omega`` > 0 (`_fit_vertex`) through the
+    top of the maximum at sample i.
 
     The first window is the run of samples around i where a 5-sample moving
     average stays within ``depth`` of its top, below or above (the average keeps

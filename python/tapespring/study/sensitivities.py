@@ -220,7 +220,10 @@ class SensitivityStudy:
         known = np.asarray(np.isfinite(values).all(axis=-1), dtype=bool)
         five = _not_smooth(np.where(known[..., None], values, 0.0))
         with np.errstate(invalid="ignore"):
-            return np.where(known, five, _sides_disagree(up, down)) & (larger > floor)
+            # Elsewhere the sides' test: they differ by more than NONSMOOTH of the larger (False
+            # where either is NaN).
+            sides = np.abs(up + down) > NONSMOOTH * larger
+            return np.where(known, five, sides) & (larger > floor)
 
     @property
     def assessed(self) -> NDArray[np.bool_]:
@@ -354,14 +357,6 @@ class SensitivityStudy:
     def write_json(self, path: str | Path) -> None:
         """:meth:`summary` as a JSON file (NaN written as null)."""
         Path(path).write_text(json.dumps(self.summary(), indent=1), encoding="utf-8")
-
-
-def _sides_disagree(up: NDArray[np.float64], down: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """Where the changes at a step up and down differ by more than :data:`NONSMOOTH` of the
-    larger (False where either is NaN)."""
-    larger = np.maximum(np.abs(up), np.abs(down))
-    with np.errstate(invalid="ignore"):
-        return np.abs(up + down) > NONSMOOTH * larger
 
 
 def _not_smooth(values: NDArray[np.float64]) -> NDArray[np.bool_]:

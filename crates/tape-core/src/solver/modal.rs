@@ -237,11 +237,12 @@ fn viscous_damping_ratio(system: &mut System, state: &State, eigenvalue: f64, ph
     if !system.has_viscosity() {
         return Ok(0.0);
     }
+    let mut moving = state.clone();
+    moving.v = vec![Vector3::zeros(); state.x.len()];
+    moving.w = vec![Vector3::zeros(); state.x.len()];
     let mut forces = [Vec::new(), Vec::new()];
     for (f, sign) in forces.iter_mut().zip([1.0, -1.0]) {
-        let mut moving = state.clone();
-        moving.v = vec![Vector3::zeros(); state.x.len()];
-        moving.w = vec![Vector3::zeros(); state.x.len()];
+        // The same components each time: the second pass overwrites the first's.
         for (eq, &(node, dof)) in system.dofs.free_dofs.iter().enumerate() {
             let k = dof.index();
             let target = if k < 3 {
